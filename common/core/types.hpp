@@ -1,6 +1,6 @@
 #pragma once
 // Basic numeric types shared by every module.
-#include <Eigen/Core>
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
 namespace msfab {

@@ -1,0 +1,145 @@
+#include "cli/stage_app.hpp"
+
+#include <omp.h>
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+
+#include "cli/logging.hpp"
+#include "cli/progress.hpp"
+#include "core/errors.hpp"
+
+#ifndef MSFAB_VERSION
+#define MSFAB_VERSION "unknown"
+#endif
+#ifndef MSFAB_GIT_REVISION
+#define MSFAB_GIT_REVISION "unknown"
+#endif
+
+namespace msfab {
+namespace {
+
+// Prints "<stage>: error: <first line>" followed by any further lines as
+// they are (residual histories, lists of keys).
+void print_error(const std::string& stage, const std::string& message) {
+  std::cerr << stage << ": error: " << message << "\n";
+  std::cerr.flush();
+}
+
+// Checks the text before CLI11 converts it: CLI11 would wrap "-1" around
+// to 2^64-1 for an unsigned option, and its range messages are unreadable.
+CLI::Validator integer_validator(bool positive) {
+  return CLI::Validator(
+      [positive](std::string& text) -> std::string {
+        const bool digits =
+            !text.empty() && text.size() <= 20 && text.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && !(positive && text.find_first_not_of('0') == std::string::npos)) return {};
+        return std::string("expected a ") + (positive ? "positive" : "non-negative") + " integer, found '" + text + "'";
+      },
+      "");
+}
+
+}  // namespace
+
+const std::string& StageContext::require_out() const {
+  if (options.out.empty()) throw InputError("missing --out PATH (where to write the result)");
+  return options.out;
+}
+
+StageApp::StageApp(std::string name, std::string description) : name_(std::move(name)), cli_(description, name_) {
+  cli_.footer(
+      "Exit codes: 0 done; 1 internal error; 2 bad usage or bad input; 3 numerical failure.\n"
+      "Config keys can be overridden with --set key.path=value (value in YAML syntax).");
+}
+
+void StageApp::add_common_options() {
+  cli_.add_option("-c,--config", options_.config_path, "YAML config file (default: built-in defaults)")
+      ->type_name("FILE");
+  cli_.add_option("--set", options_.overrides,
+                  "override a config value, e.g. --set grid.size=[8,8,8] (value in YAML syntax; repeatable)")
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  cli_.add_option("-o,--out", options_.out, "output path")->type_name("PATH");
+  cli_.add_option("-j,--threads", options_.threads, "worker threads (default: OMP_NUM_THREADS or all cores)")
+      ->type_name("N")
+      ->check(integer_validator(true));
+  cli_.add_option("--seed", options_.seed, "global random seed (default: 0)")
+      ->type_name("N")
+      ->check(integer_validator(false));
+  cli_.add_option("--log-level", options_.log_level, "how much to log (default: info)")
+      ->type_name("LEVEL")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  cli_.add_flag("-q,--quiet", options_.quiet, "only warnings and errors; no progress display");
+  cli_.set_version_flag("--version", name_ + " " + MSFAB_VERSION + " (revision " + MSFAB_GIT_REVISION + ")");
+}
+
+void StageApp::set_default_config(std::string yaml_text) { default_config_ = std::move(yaml_text); }
+
+Config StageApp::load_config() const {
+  Config config = !options_.config_path.empty() ? Config::load_file(options_.config_path)
+                  : default_config_ ? Config::from_string(*default_config_, "<built-in defaults of " + name_ + ">")
+                                    : Config::from_string("{}", "<no config file>");
+  config.apply_overrides(options_.overrides);
+  return config;
+}
+
+int StageApp::run(int argc, const char* const* argv, const std::function<void(StageContext&)>& body) {
+  try {
+    cli_.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
+      cli_.exit(e);  // --help / --version print to stdout
+      return kExitOk;
+    }
+    print_error(name_, std::string(e.what()) + "\nRun with --help for more information.");
+    return kExitBadInput;
+  }
+
+  try {
+    LogLevel level = parse_log_level(options_.log_level);
+    if (options_.quiet && level < LogLevel::warn) level = LogLevel::warn;
+    init_logging(name_, level);
+    Progress::set_quiet(options_.quiet);
+    if (options_.threads > 0) omp_set_num_threads(options_.threads);
+
+    StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};
+    spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, MSFAB_VERSION, MSFAB_GIT_REVISION,
+                  omp_get_max_threads(), options_.seed);
+    spdlog::debug("command line: {}", ctx.command_line);
+    body(ctx);
+    return kExitOk;
+  } catch (const InputError& e) {
+    print_error(name_, e.what());
+    return kExitBadInput;
+  } catch (const NumericalError& e) {
+    print_error(name_, e.what());
+    return kExitNumerical;
+  } catch (const std::exception& e) {
+    print_error(name_, std::string("internal error: ") + e.what());
+    return kExitInternal;
+  } catch (...) {
+    print_error(name_, "internal error: unknown exception");
+    return kExitInternal;
+  }
+}
+
+std::string quoted_command_line(int argc, const char* const* argv) {
+  std::string out;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i] ? argv[i] : "";
+    const bool plain = !arg.empty() && arg.find_first_not_of(
+                                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                           "0123456789_-+=/.,:@%") == std::string::npos;
+    if (!out.empty()) out += ' ';
+    if (plain) {
+      out += arg;
+    } else {
+      out += '\'';
+      for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+      out += '\'';
+    }
+  }
+  return out;
+}
+
+}  // namespace msfab

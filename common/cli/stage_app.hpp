@@ -1,0 +1,80 @@
+#pragma once
+// Command-line conventions shared by every stage executable (DESIGN §6).
+//
+//   int main(int argc, char** argv) {
+//     msfab::StageApp app("msfab-simulate", "static and dynamic FEM on a scene");
+//     app.add_common_options();
+//     app.cli().add_flag("--resume", resume, "continue from the last checkpoint");
+//     return app.run(argc, argv, [&](msfab::StageContext& ctx) {
+//       double E = ctx.config.require_positive("E", "Young's modulus");
+//       ctx.config.check_no_unknown_keys();   // before any long work
+//       ...
+//     });
+//   }
+//
+// run() parses the command line, sets up logging and threads, loads the
+// config (+ --set overrides), calls the stage body and maps the outcome to
+// an exit code: 0 ok, 2 bad usage or input (CLI11 errors, InputError),
+// 3 NumericalError, 1 anything else. Errors go to stderr as
+// "<stage>: error: <message>".
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/config.hpp"
+
+namespace msfab {
+
+struct StageOptions {
+  std::string config_path;             // --config; empty = built-in defaults
+  std::vector<std::string> overrides;  // --set key=value, in order given
+  std::string out;                     // --out; empty when not given
+  int threads = 0;                     // --threads; 0 = OpenMP default
+  std::uint64_t seed = 0;              // --seed
+  std::string log_level = "info";      // --log-level
+  bool quiet = false;                  // --quiet
+};
+
+struct StageContext {
+  std::string stage_name;
+  Config config;  // loaded, overrides applied
+  StageOptions options;
+  std::string command_line;  // shell-quoted argv, for provenance
+
+  // The --out path; InputError when it was not given.
+  const std::string& require_out() const;
+};
+
+class StageApp {
+ public:
+  StageApp(std::string name, std::string description);
+
+  // The CLI11 app, for stage-specific options.
+  CLI::App& cli() { return cli_; }
+  const std::string& name() const { return name_; }
+
+  // --config, --set, --out, --threads, --seed, --log-level, --quiet,
+  // --version (--help is always there).
+  void add_common_options();
+  // YAML used when --config is not given; its display name in messages is
+  // "<built-in defaults of NAME>". Without it the config starts empty.
+  void set_default_config(std::string yaml_text);
+
+  int run(int argc, const char* const* argv, const std::function<void(StageContext&)>& body);
+
+ private:
+  Config load_config() const;
+
+  std::string name_;
+  CLI::App cli_;
+  StageOptions options_;
+  std::optional<std::string> default_config_;
+};
+
+// argv joined with shell quoting where needed, e.g. "msfab-map --set 'a=b c'".
+std::string quoted_command_line(int argc, const char* const* argv);
+
+}  // namespace msfab

@@ -1,0 +1,32 @@
+#pragma once
+// Energy, gradient and Hessian of one hexahedron whose quadrature points each
+// carry a material (a plain element uses the same material everywhere; a
+// DDFEM coarse element, Eq. 2.6-2.7, uses a different one per point).
+#include <vector>
+
+#include "fem/hex8.hpp"
+#include "material/material.hpp"
+
+namespace msfab {
+
+// Materials at the quadrature points of one element. A single entry applies
+// to every point.
+struct QuadratureMaterials {
+  std::vector<MaterialPtr> at_point;
+  const Material& operator[](int q) const {
+    return *at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)];
+  }
+};
+
+// Element energy for deformed node positions x (rows = nodes). Returns +inf
+// as soon as one quadrature point is inverted.
+double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
+                  const hex8::NodeMatrix& x);
+
+// Energy, gradient (24, node-major: 3*i + a) and Hessian (24x24) in one pass;
+// pass nullptr for what is not needed. Returns the energy (+inf if inverted,
+// in which case gradient and Hessian are not meaningful).
+double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
+                    const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian);
+
+}  // namespace msfab

@@ -1,0 +1,179 @@
+#include "io/artifact.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/errors.hpp"
+#include "io/sha256.hpp"
+
+namespace msfab {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Pushes a file's (or directory's) data to the disk, so that after a power
+// loss the renamed artifact is either complete or absent.
+void sync_to_disk(const std::string& path, bool directory) {
+  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
+  if (fd < 0) {
+    if (directory) return;  // some file systems do not allow opening directories
+    throw std::runtime_error(path + ": cannot open to sync (" + std::strerror(errno) + ")");
+  }
+  const int status = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (status != 0 && !directory) {
+    throw std::runtime_error(path + ": fsync failed (" + std::strerror(err) + ")");
+  }
+}
+
+std::string parent_directory(const std::string& path) {
+  const fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
+}
+
+std::string versions_text(int min_version, int max_version) {
+  if (min_version == max_version) return "version " + std::to_string(min_version);
+  return "version " + std::to_string(min_version) + " to " + std::to_string(max_version);
+}
+
+}  // namespace
+
+std::string producer_string(const std::string& executable) {
+  return executable + " " + MSFAB_VERSION + " (git " + MSFAB_GIT_REVISION + ")";
+}
+
+std::string utc_timestamp_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+std::string format_inputs(const std::vector<ArtifactInput>& inputs) {
+  std::string text;
+  for (const ArtifactInput& input : inputs) text += input.sha256 + "  " + input.path + "\n";
+  return text;
+}
+
+std::vector<ArtifactInput> parse_inputs(const std::string& text) {
+  std::vector<ArtifactInput> inputs;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty()) continue;
+    const std::size_t gap = line.find("  ");
+    if (gap == std::string::npos) {
+      inputs.push_back({line, ""});  // written by something else; keep the text
+    } else {
+      inputs.push_back({line.substr(gap + 2), line.substr(0, gap)});
+    }
+  }
+  return inputs;
+}
+
+// ---------------------------------------------------------------------------
+// ArtifactWriter
+
+ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
+                               const std::string& executable, const std::string& config_text,
+                               const std::vector<std::string>& input_paths, std::uint64_t seed)
+    : path_(std::move(path)), tmp_path_(path_ + ".tmp") {
+  std::vector<ArtifactInput> inputs;
+  for (const std::string& input : input_paths) inputs.push_back({input, sha256_file_hex(input)});
+
+  const std::string directory = parent_directory(path_);
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) {
+    throw InputError(path_ + ": output directory '" + directory + "' does not exist");
+  }
+  file_.emplace(H5File::create(tmp_path_));
+  try {
+    H5File& out = *file_;
+    out.write_attribute("/", "schema", schema);
+    out.write_attribute("/", "schema_version", std::int32_t(schema_version));
+    out.write_attribute("/", "producer", producer_string(executable));
+    out.write_attribute("/", "config", config_text);
+    out.write_attribute("/", "inputs", format_inputs(inputs));
+    out.write_attribute("/", "seed", std::uint64_t(seed));
+    out.write_attribute("/", "created", utc_timestamp_now());
+  } catch (...) {
+    discard();  // the destructor does not run for a half-built object
+    throw;
+  }
+}
+
+void ArtifactWriter::discard() noexcept {
+  file_.reset();  // closes quietly
+  std::error_code ignored;
+  fs::remove(tmp_path_, ignored);
+}
+
+ArtifactWriter::~ArtifactWriter() {
+  if (!committed_) discard();
+}
+
+H5File& ArtifactWriter::file() {
+  if (committed_) throw std::logic_error(path_ + ": artifact used after commit()");
+  return *file_;
+}
+
+void ArtifactWriter::commit() {
+  if (committed_) throw std::logic_error(path_ + ": commit() called twice");
+  file_->flush();
+  file_->close();
+  sync_to_disk(tmp_path_, false);
+  std::error_code ec;
+  fs::rename(tmp_path_, path_, ec);
+  if (ec) {
+    throw std::runtime_error("cannot rename " + tmp_path_ + " to " + path_ + " (" + ec.message() +
+                             ")");
+  }
+  committed_ = true;
+  sync_to_disk(parent_directory(path_), true);
+}
+
+// ---------------------------------------------------------------------------
+// ArtifactReader
+
+ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
+                               int supported_version)
+    : ArtifactReader(path, expected_schema, supported_version, supported_version) {}
+
+ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
+                               int min_version, int max_version)
+    : file_(H5File::open(path)) {
+  const std::string expected =
+      "expected schema '" + expected_schema + "' " + versions_text(min_version, max_version);
+  if (!file_.has_attribute("/", "schema") || !file_.has_attribute("/", "schema_version")) {
+    throw InputError(path + ": " + expected +
+                     ", found no schema/schema_version root attributes (not an msfab artifact)");
+  }
+  schema_ = file_.read_string_attribute("/", "schema");
+  schema_version_ = int(file_.read_attribute<std::int64_t>("/", "schema_version"));
+  if (schema_ != expected_schema || schema_version_ < min_version ||
+      schema_version_ > max_version) {
+    throw InputError(path + ": " + expected + ", found schema '" + schema_ + "' version " +
+                     std::to_string(schema_version_));
+  }
+}
+
+std::string ArtifactReader::producer() const { return file_.read_string_attribute("/", "producer"); }
+std::string ArtifactReader::config() const { return file_.read_string_attribute("/", "config"); }
+std::vector<ArtifactInput> ArtifactReader::inputs() const {
+  return parse_inputs(file_.read_string_attribute("/", "inputs"));
+}
+std::uint64_t ArtifactReader::seed() const { return file_.read_attribute<std::uint64_t>("/", "seed"); }
+std::string ArtifactReader::created() const { return file_.read_string_attribute("/", "created"); }
+
+}  // namespace msfab

@@ -1,0 +1,365 @@
+#include "scene/scene.hpp"
+
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "core/errors.hpp"
+#include "fem/voxel_shapes.hpp"
+#include "material/linear_anisotropic.hpp"
+#include "material/linear_isotropic.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Vec3 read_vec3(const Config& c, const std::string& key) {
+  const auto v = c.get<std::vector<double>>(key);
+  if (v.size() != 3) c.fail(key, "expected 3 numbers [x, y, z], found " + std::to_string(v.size()));
+  for (double x : v)
+    if (!std::isfinite(x)) c.fail(key, "values must be finite");
+  return Vec3(v[0], v[1], v[2]);
+}
+
+int read_axis(const Config& c, const std::string& key) {
+  const std::string a = c.one_of(key, {"x", "y", "z"});
+  return a == "x" ? 0 : a == "y" ? 1 : 2;
+}
+
+MaterialPtr make_material(const Config& c, PaletteEntry& p) {
+  p.model = c.one_of("model", {"neo-hookean", "linear", "linear-anisotropic"});
+  p.density = c.get_or<double>("density", 1000.0);
+  if (!(p.density > 0) || !std::isfinite(p.density)) c.fail("density", "density must be positive and finite");
+  if (p.model == "linear-anisotropic") {
+    const auto v = c.get<std::vector<double>>("C");
+    if (v.size() != 36) c.fail("C", "expected the 6x6 Voigt stiffness as 36 numbers (row by row)");
+    Mat6 C;
+    for (int i = 0; i < 36; ++i) C(i / 6, i % 6) = v[i];
+    try {
+      return std::make_shared<LinearAnisotropic>(C);
+    } catch (const InputError& e) {
+      c.fail("C", e.what());
+    }
+  }
+  p.E = c.require_positive("E", "Young's modulus");
+  p.nu = c.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
+  if (p.model == "neo-hookean") return std::make_shared<NeoHookean>(p.E, p.nu);
+  return std::make_shared<LinearIsotropic>(p.E, p.nu);
+}
+
+Region read_region(const Config& parent, const VoxelGrid& grid) {
+  const Config c = parent.child("region");
+  Region r;
+  const bool face = c.has("face"), box = c.has("box");
+  if (face == box) parent.fail("region", "give exactly one of 'face' (xmin..zmax) or 'box' {min, max}");
+  if (face) {
+    const std::string f = c.one_of("face", {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"});
+    r.kind = Region::Kind::Face;
+    r.axis = f[0] - 'x';
+    r.upper = f.substr(1) == "max";
+  } else {
+    const Config b = c.child("box");
+    r.kind = Region::Kind::Box;
+    r.lo = read_vec3(b, "min");
+    r.hi = read_vec3(b, "max");
+    if ((r.lo.array() > r.hi.array()).any()) b.fail("max", "box max must be >= min in every coordinate");
+  }
+  (void)grid;
+  return r;
+}
+
+void paint_layout(const Config& config, Scene& s) {
+  for (const Config& item : config.children("layout")) {
+    auto id_of = [&](const std::string& key) {
+      const int id = item.get<int>(key);
+      if (id < 0 || id >= static_cast<int>(s.material_by_id.size()) || (id > 0 && !s.material_by_id[id]))
+        item.fail(key, "material id " + std::to_string(id) + " is not in the palette (0 = void)");
+      return id;
+    };
+    if (item.has("fill")) {
+      std::fill(s.grid.ids.begin(), s.grid.ids.end(), id_of("fill"));
+    } else if (item.has("box")) {
+      const Config b = item.child("box");
+      paint_box(s.grid, read_vec3(b, "min"), read_vec3(b, "max"), id_of("id"));
+    } else if (item.has("layers")) {
+      const Config l = item.child("layers");
+      const auto t = l.get<std::vector<double>>("thickness");
+      std::vector<int> ids = l.get<std::vector<int>>("ids");
+      if (t.size() != ids.size() || t.empty()) l.fail("ids", "need one id per thickness");
+      for (size_t k = 0; k < ids.size(); ++k)
+        if (ids[k] < 0 || ids[k] >= static_cast<int>(s.material_by_id.size()) ||
+            (ids[k] > 0 && !s.material_by_id[ids[k]]))
+          l.fail("ids", "material id " + std::to_string(ids[k]) + " is not in the palette");
+      for (double x : t)
+        if (!(x > 0)) l.fail("thickness", "layer thicknesses must be positive");
+      paint_layers(s.grid, read_axis(l, "axis"), t, ids);
+    } else if (item.has("cylinder")) {
+      const Config c = item.child("cylinder");
+      const int axis = read_axis(c, "axis");
+      paint_cylinder(s.grid, axis, read_vec3(c, "center"), c.require_positive("radius"),
+                     c.get_or<double>("from", -1e300), c.get_or<double>("to", 1e300), id_of("id"));
+    } else if (item.has("helical_fibers")) {
+      const Config c = item.child("helical_fibers");
+      paint_helical_fibers(s.grid, read_axis(c, "axis"), read_vec3(c, "center"), c.require_positive("helix_radius"),
+                           c.require_positive("pitch"), c.require_positive("fiber_radius"),
+                           c.require_positive<int>("count"), id_of("id"));
+    } else {
+      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers");
+    }
+  }
+}
+
+}  // namespace
+
+std::string Region::describe() const {
+  std::ostringstream o;
+  if (kind == Kind::Face) {
+    o << "face " << char('x' + axis) << (upper ? "max" : "min");
+  } else {
+    o << "box [" << lo.transpose() << "] - [" << hi.transpose() << "]";
+  }
+  return o.str();
+}
+
+Scene read_scene(const Config& config) {
+  Scene s;
+  s.name = config.get_or<std::string>("name", "scene");
+  {
+    const Config g = config.child("grid");
+    const auto size = g.get<std::vector<int>>("size");
+    if (size.size() != 3) g.fail("size", "expected [nx, ny, nz]");
+    for (int n : size)
+      if (n <= 0) g.fail("size", "grid dimensions must be positive");
+    if (double(size[0]) * size[1] * size[2] > 2e9) g.fail("size", "grid has more than 2e9 voxels");
+    s.grid = VoxelGrid(size[0], size[1], size[2], g.require_positive("voxel_size", "voxel size"));
+    if (g.has("origin")) s.grid.origin = read_vec3(g, "origin");
+  }
+  for (const Config& m : config.children("materials")) {
+    PaletteEntry p;
+    p.id = m.get<int>("id");
+    if (p.id <= 0 || p.id > 65535) m.fail("id", "material ids are 1..65535 (0 is void)");
+    p.name = m.get_or<std::string>("name", "material" + std::to_string(p.id));
+    p.material = make_material(m, p);
+    if (p.id >= static_cast<int>(s.material_by_id.size())) s.material_by_id.resize(p.id + 1);
+    if (s.material_by_id[p.id]) m.fail("id", "material id " + std::to_string(p.id) + " is defined twice");
+    s.material_by_id[p.id] = p.material;
+    s.palette.push_back(p);
+  }
+  if (s.palette.empty()) config.fail("materials", "the palette is empty");
+  s.nonlinear = false;
+  for (const auto& p : s.palette) s.nonlinear |= p.model == "neo-hookean";
+
+  paint_layout(config, s);
+  if (s.grid.count_solid() == 0) config.fail("layout", "the layout leaves every voxel void (empty grid)");
+
+  if (config.has("boundary")) {
+    for (const Config& b : config.children("boundary")) {
+      BoundaryCondition bc;
+      bc.where = b.path();
+      bc.region = read_region(b, s.grid);
+      const bool has_disp = b.has("displacement"), has_rot = b.has("rotation");
+      if (has_disp) bc.displacement = read_vec3(b, "displacement");
+      if (has_rot) {
+        const Config r = b.child("rotation");
+        bc.has_rotation = true;
+        bc.rotation_axis = read_vec3(r, "axis");
+        if (bc.rotation_axis.norm() == 0) r.fail("axis", "rotation axis must be non-zero");
+        bc.rotation_axis.normalize();
+        bc.rotation_center = read_vec3(r, "center");
+        bc.rotation_angle = r.require_finite("angle_deg") * kPi / 180.0;
+      }
+      if (b.has("fix")) {
+        for (const std::string& comp : b.get<std::vector<std::string>>("fix")) {
+          if (comp != "x" && comp != "y" && comp != "z") b.fail("fix", "components are x, y, z; found '" + comp + "'");
+          bc.fix[comp[0] - 'x'] = true;
+        }
+      } else if (has_disp || has_rot) {
+        bc.fix[0] = bc.fix[1] = bc.fix[2] = true;
+      } else {
+        b.fail("", "a boundary condition needs 'fix', 'displacement' or 'rotation'");
+      }
+      s.boundary.push_back(bc);
+    }
+  }
+  if (config.has("loads")) {
+    for (const Config& l : config.children("loads")) {
+      Load load;
+      load.where = l.path();
+      load.region = read_region(l, s.grid);
+      const bool f = l.has("force"), t = l.has("traction");
+      if (f == t) l.fail("", "a load needs exactly one of 'force' (total, N) or 'traction' (Pa)");
+      load.is_traction = t;
+      load.value = read_vec3(l, t ? "traction" : "force");
+      if (t && load.region.kind != Region::Kind::Face) l.fail("traction", "a traction needs a face region");
+      s.loads.push_back(load);
+    }
+  }
+  if (config.has("gravity")) s.gravity = read_vec3(config, "gravity");
+
+  if (config.has("solver")) {
+    const Config c = config.child("solver");
+    NewtonOptions& o = s.newton;
+    o.relative_tolerance = c.get_or<double>("tolerance", o.relative_tolerance);
+    if (!(o.relative_tolerance > 0 && o.relative_tolerance < 1)) c.fail("tolerance", "must be in (0, 1)");
+    o.max_iterations = c.get_or<int>("max_iterations", o.max_iterations);
+    if (o.max_iterations < 1) c.fail("max_iterations", "must be at least 1");
+    o.load_steps = c.get_or<int>("load_steps", o.load_steps);
+    if (o.load_steps < 1) c.fail("load_steps", "must be at least 1");
+    o.max_step_halvings = c.get_or<int>("max_step_halvings", o.max_step_halvings);
+    o.linear_solver = c.get_or<std::string>("linear_solver", o.linear_solver);
+    o.linear.pcg_tolerance = c.get_or<double>("pcg_tolerance", o.linear.pcg_tolerance);
+    o.linear.pcg_max_iterations = c.get_or<int>("pcg_max_iterations", o.linear.pcg_max_iterations);
+    o.linear.pcg_preconditioner = c.get_or<std::string>("pcg_preconditioner", o.linear.pcg_preconditioner);
+    const auto names = linear_solver_names();
+    if (std::find(names.begin(), names.end(), o.linear_solver) == names.end()) c.one_of("linear_solver", names);
+  }
+  return s;
+}
+
+RegionNodes select_region(const Region& region, const VoxelGrid& grid, const VoxelMesh& vm) {
+  RegionNodes out;
+  const HexMesh& mesh = vm.mesh;
+  const double tol = 1e-9 * grid.voxel_size;
+  if (region.kind == Region::Kind::Box) {
+    for (int n = 0; n < mesh.num_nodes(); ++n) {
+      const Vec3 p = mesh.nodes.row(n).transpose();
+      if ((p.array() >= region.lo.array() - tol).all() && (p.array() <= region.hi.array() + tol).all())
+        out.nodes.push_back(n);
+    }
+    out.weight.assign(out.nodes.size(), out.nodes.empty() ? 0.0 : 1.0 / out.nodes.size());
+    return out;
+  }
+  // Face: every solid voxel touching the plane contributes a quarter of its
+  // face area to each of the face's four nodes.
+  const int a = region.axis, u = (a + 1) % 3, v = (a + 2) % 3;
+  const int dims[3] = {grid.nx, grid.ny, grid.nz};
+  const int layer = region.upper ? dims[a] - 1 : 0;
+  std::map<int, double> area;
+  const double quarter = 0.25 * grid.voxel_size * grid.voxel_size;
+  for (int iu = 0; iu < dims[u]; ++iu)
+    for (int iv = 0; iv < dims[v]; ++iv) {
+      int ijk[3];
+      ijk[a] = layer;
+      ijk[u] = iu;
+      ijk[v] = iv;
+      const int e = vm.voxel_element[grid.index(ijk[0], ijk[1], ijk[2])];
+      if (e < 0) continue;
+      for (int c = 0; c < 8; ++c) {
+        const int bits[3] = {c >> 2 & 1, c >> 1 & 1, c & 1};
+        if (bits[a] != (region.upper ? 1 : 0)) continue;
+        area[mesh.elements[e][c]] += quarter;
+      }
+    }
+  for (const auto& [n, w] : area) {
+    out.nodes.push_back(n);
+    out.weight.push_back(w);
+  }
+  return out;
+}
+
+namespace {
+
+// Each connected part of the mesh must have its six rigid motions fixed by
+// the Dirichlet DOFs, or the stiffness matrix is singular.
+void check_rigid_motion_fixed(const HexMesh& mesh, const DirichletConditions& d) {
+  const int n = mesh.num_nodes();
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& el : mesh.elements)
+    for (int i = 1; i < 8; ++i) parent[find(el[i])] = find(el[0]);
+  std::map<int, Eigen::Matrix<double, 6, 6>> gram;
+  std::map<int, int> part_nodes;
+  const Vec3 c = 0.5 * (mesh.bbox_min() + mesh.bbox_max());
+  const double L = std::max(1e-300, (mesh.bbox_max() - mesh.bbox_min()).norm());
+  for (int i = 0; i < n; ++i) {
+    const int root = find(i);
+    part_nodes[root]++;
+    auto& G = gram[root];
+    if (part_nodes[root] == 1) G.setZero();
+    const Vec3 p = (mesh.nodes.row(i).transpose() - c) / L;
+    for (int a = 0; a < 3; ++a) {
+      if (!d.fixed[3 * i + a]) continue;
+      // Row of the rigid-mode matrix for DOF (i, a): translations, then rotations e_k x p.
+      Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
+      r[a] = 1;
+      for (int k = 0; k < 3; ++k) r[3 + k] = Vec3::Unit(k).cross(p)[a];
+      G += r * r.transpose();
+    }
+  }
+  int part_index = 0;
+  for (const auto& [root, G] : gram) {
+    const double lmin = Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(G).eigenvalues().minCoeff();
+    if (!(lmin > 1e-10)) {
+      std::ostringstream msg;
+      msg << "the boundary conditions leave rigid motion free";
+      if (gram.size() > 1) msg << " for disconnected part " << part_index << " (" << part_nodes[root] << " nodes)";
+      msg << ": the stiffness matrix would be singular; fix enough nodes (e.g. a whole face) on every part";
+      throw InputError(msg.str());
+    }
+    ++part_index;
+  }
+}
+
+}  // namespace
+
+StaticConditions build_static_conditions(const Scene& scene, const VoxelMesh& vm) {
+  const HexMesh& mesh = vm.mesh;
+  StaticConditions sc;
+  sc.dirichlet = DirichletConditions::none(mesh.num_dofs());
+  sc.force = VecX::Zero(mesh.num_dofs());
+  for (const auto& bc : scene.boundary) {
+    const RegionNodes sel = select_region(bc.region, scene.grid, vm);
+    if (sel.nodes.empty())
+      throw InputError(bc.where + ": region (" + bc.region.describe() + ") selects no solid node; it lies in void");
+    const Mat3 R = Eigen::AngleAxisd(bc.rotation_angle, bc.rotation_axis).toRotationMatrix();
+    for (int node : sel.nodes) {
+      const Vec3 X = mesh.nodes.row(node).transpose();
+      Vec3 u = bc.displacement;
+      if (bc.has_rotation) u += R * (X - bc.rotation_center) + bc.rotation_center - X;
+      for (int a = 0; a < 3; ++a)
+        if (bc.fix[a]) {
+          sc.dirichlet.fixed[3 * node + a] = 1;
+          sc.dirichlet.displacement[3 * node + a] = u[a];
+        }
+    }
+  }
+  if (sc.dirichlet.count_fixed() == 0)
+    throw InputError("the scene has no boundary condition: without fixed nodes the stiffness matrix is singular "
+                     "(add a 'boundary' entry with 'fix' or 'displacement')");
+  check_rigid_motion_fixed(mesh, sc.dirichlet);
+
+  for (const auto& load : scene.loads) {
+    const RegionNodes sel = select_region(load.region, scene.grid, vm);
+    if (sel.nodes.empty())
+      throw InputError(load.where + ": load region (" + load.region.describe() +
+                       ") selects no solid node; a load on void has nothing to act on");
+    double total = 0;
+    for (double w : sel.weight) total += w;
+    for (size_t k = 0; k < sel.nodes.size(); ++k) {
+      const double share = load.is_traction ? sel.weight[k] : sel.weight[k] / total;
+      sc.force.segment<3>(3 * sel.nodes[k]) += share * load.value;
+    }
+  }
+  if (scene.gravity.norm() > 0) {
+    const double vol = std::pow(scene.grid.voxel_size, 3);
+    std::vector<double> density(scene.material_by_id.size(), 0.0);
+    for (const auto& p : scene.palette) density[p.id] = p.density;
+    for (int e = 0; e < mesh.num_elements(); ++e) {
+      const double m = density[mesh.element_tag[e]] * vol;
+      for (int node : mesh.elements[e]) sc.force.segment<3>(3 * node) += 0.125 * m * scene.gravity;
+    }
+  }
+  return sc;
+}
+
+}  // namespace msfab

@@ -1,0 +1,248 @@
+#include "solve/cholmod_solver.hpp"
+
+#include <cholmod.h>
+#include <dlfcn.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "core/errors.hpp"
+#include "solve/sparse_ops.hpp"
+
+namespace msfab {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to
+// read only the lower triangle of the full symmetric matrix.
+cholmod_sparse lower_triangle_view(const SpMat& A) {
+  cholmod_sparse view;
+  std::memset(&view, 0, sizeof(view));
+  view.nrow = static_cast<size_t>(A.rows());
+  view.ncol = static_cast<size_t>(A.cols());
+  view.nzmax = static_cast<size_t>(A.isCompressed() ? A.nonZeros()
+                                                    : A.outerIndexPtr()[A.cols()]);
+  view.p = const_cast<int*>(A.outerIndexPtr());
+  view.i = const_cast<int*>(A.innerIndexPtr());
+  view.nz = A.isCompressed() ? nullptr : const_cast<int*>(A.innerNonZeroPtr());
+  view.x = const_cast<double*>(A.valuePtr());
+  view.z = nullptr;
+  view.stype = -1;
+  view.itype = CHOLMOD_INT;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  view.sorted = 1;  // Eigen keeps inner indices sorted
+  view.packed = A.isCompressed() ? 1 : 0;
+  return view;
+}
+
+cholmod_dense vector_view(const VecX& v) {
+  cholmod_dense view;
+  std::memset(&view, 0, sizeof(view));
+  view.nrow = static_cast<size_t>(v.size());
+  view.ncol = 1;
+  view.nzmax = static_cast<size_t>(v.size());
+  view.d = static_cast<size_t>(v.size());
+  view.x = const_cast<double*>(v.data());
+  view.z = nullptr;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  return view;
+}
+
+// The supernodal kernels spend their time in the BLAS. OpenBLAS is found at
+// run time so that another BLAS (or none with this entry point) still works.
+void set_blas_threads(int threads) {
+  using SetThreads = void (*)(int);
+  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) {
+    reinterpret_cast<SetThreads>(symbol)(threads);
+  }
+}
+
+std::string status_text(int status) {
+  switch (status) {
+    case CHOLMOD_OK: return "ok";
+    case CHOLMOD_NOT_INSTALLED: return "method not installed";
+    case CHOLMOD_OUT_OF_MEMORY: return "out of memory";
+    case CHOLMOD_TOO_LARGE: return "integer overflow (problem too large for 32-bit indices)";
+    case CHOLMOD_INVALID: return "invalid input";
+    case CHOLMOD_GPU_PROBLEM: return "GPU problem";
+    case CHOLMOD_NOT_POSDEF: return "matrix not positive definite";
+    case CHOLMOD_DSMALL: return "tiny diagonal entry";
+    default: return "status " + std::to_string(status);
+  }
+}
+
+}  // namespace
+
+// Owns every CHOLMOD allocation; destroyed in reverse order of need.
+struct CholmodSolver::Cholmod {
+  cholmod_common common;
+  cholmod_factor* factor = nullptr;
+  // Solution and workspace reused by cholmod_solve2 across solves.
+  cholmod_dense* x = nullptr;
+  cholmod_dense* y = nullptr;
+  cholmod_dense* e = nullptr;
+  Eigen::Index n = -1;  // -1: not analyzed
+  std::uint64_t pattern = 0;
+  double factor_nonzeros = 0.0;
+  bool factor_ready = false;
+
+  Cholmod() {
+    cholmod_start(&common);
+    common.supernodal = CHOLMOD_SUPERNODAL;  // BLAS-3 kernels on dense supernodes
+    common.final_ll = 1;
+    // Failures are reported through our exceptions and return values.
+    common.print = 0;
+    // An indefinite Hessian is expected in Newton's method; stop at the first
+    // bad pivot instead of finishing a useless factorization.
+    common.quick_return_if_not_posdef = 1;
+  }
+  ~Cholmod() {
+    free_factor();
+    cholmod_finish(&common);
+  }
+  Cholmod(const Cholmod&) = delete;
+  Cholmod& operator=(const Cholmod&) = delete;
+
+  void free_factor() {
+    if (x) cholmod_free_dense(&x, &common);
+    if (y) cholmod_free_dense(&y, &common);
+    if (e) cholmod_free_dense(&e, &common);
+    if (factor) cholmod_free_factor(&factor, &common);
+    factor_ready = false;
+  }
+
+  void use_ordering(int ordering) {
+    common.nmethods = 1;
+    common.method[0].ordering = ordering;
+    common.postorder = 1;
+  }
+};
+
+CholmodSolver::CholmodSolver(const LinearSolverOptions& options)
+    : cholmod_(std::make_unique<Cholmod>()), options_(options) {
+  validate_linear_solver_options(options);
+  if (options.threads > 0) set_blas_threads(options.threads);
+}
+
+CholmodSolver::~CholmodSolver() = default;
+
+double CholmodSolver::factor_nonzeros() const { return cholmod_->factor_nonzeros; }
+
+void CholmodSolver::analyze(const SpMat& A) {
+  const auto start = std::chrono::steady_clock::now();
+  if (A.rows() != A.cols()) {
+    throw std::invalid_argument("CholmodSolver::analyze: matrix is " + std::to_string(A.rows()) +
+                                "x" + std::to_string(A.cols()) + ", not square");
+  }
+  Cholmod& c = *cholmod_;
+  c.free_factor();
+  factorized_ = nullptr;
+  c.n = -1;
+  stats_ = LinearSolveStats{};
+
+  if (A.rows() > 0) {
+    cholmod_sparse view = lower_triangle_view(A);
+    c.use_ordering(CHOLMOD_METIS);
+    c.factor = cholmod_analyze(&view, &c.common);
+    if (c.factor == nullptr || c.common.status < CHOLMOD_OK) {
+      if (c.factor) cholmod_free_factor(&c.factor, &c.common);
+      c.use_ordering(CHOLMOD_AMD);
+      c.factor = cholmod_analyze(&view, &c.common);
+    }
+    if (c.factor == nullptr || c.common.status < CHOLMOD_OK) {
+      const int status = c.common.status;
+      c.free_factor();
+      throw NumericalError("CHOLMOD symbolic analysis of a " + std::to_string(A.rows()) + "x" +
+                           std::to_string(A.cols()) + " matrix failed: " + status_text(status) +
+                           (status == CHOLMOD_TOO_LARGE || status == CHOLMOD_OUT_OF_MEMORY
+                                ? "; use the 'pcg' linear solver for systems this large"
+                                : ""));
+    }
+    ordering_ = c.factor->ordering == CHOLMOD_METIS ? "metis"
+                : c.factor->ordering == CHOLMOD_AMD ? "amd"
+                                                    : "other";
+    c.factor_nonzeros = c.common.lnz;
+  } else {
+    ordering_ = "none";
+    c.factor_nonzeros = 0.0;
+  }
+  c.n = A.rows();
+  c.pattern = pattern_fingerprint(A);
+  stats_.analyze_seconds = seconds_since(start);
+}
+
+bool CholmodSolver::factorize(const SpMat& A, double shift) {
+  const auto start = std::chrono::steady_clock::now();
+  Cholmod& c = *cholmod_;
+  if (c.n < 0) throw std::logic_error("CholmodSolver::factorize called before analyze");
+  if (A.rows() != c.n || A.cols() != c.n || pattern_fingerprint(A) != c.pattern) {
+    throw std::invalid_argument(
+        "CholmodSolver::factorize: the matrix pattern differs from the one given to analyze()");
+  }
+  c.factor_ready = false;
+  factorized_ = nullptr;
+  stats_.positive_definite = false;
+
+  if (c.n > 0) {
+    cholmod_sparse view = lower_triangle_view(A);
+    double beta[2] = {shift, 0.0};  // CHOLMOD factors A + beta[0] * I
+    const int ok = cholmod_factorize_p(&view, beta, nullptr, 0, c.factor, &c.common);
+    const int status = c.common.status;
+    if (status < CHOLMOD_OK || (!ok && status != CHOLMOD_NOT_POSDEF)) {
+      throw NumericalError("CHOLMOD numeric factorization failed: " + status_text(status));
+    }
+    if (status == CHOLMOD_NOT_POSDEF || c.factor->minor < c.factor->n) {
+      stats_.factorize_seconds = seconds_since(start);
+      return false;
+    }
+  }
+  c.factor_ready = true;
+  factorized_ = &A;
+  shift_ = shift;
+  stats_.positive_definite = true;
+  stats_.factorize_seconds = seconds_since(start);
+  return true;
+}
+
+VecX CholmodSolver::solve(const VecX& b) {
+  const auto start = std::chrono::steady_clock::now();
+  Cholmod& c = *cholmod_;
+  if (!c.factor_ready) {
+    throw NumericalError(
+        "CHOLMOD solve without a valid factorization (the last factorize() found the matrix "
+        "not positive definite, or none was done); factorize with a larger shift first");
+  }
+  if (b.size() != c.n) {
+    throw std::invalid_argument("CholmodSolver::solve: right-hand side has " +
+                                std::to_string(b.size()) + " entries, matrix has " +
+                                std::to_string(c.n) + " rows");
+  }
+  VecX x = VecX::Zero(c.n);
+  if (c.n > 0) {
+    cholmod_dense rhs = vector_view(b);
+    if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e,
+                        &c.common)) {
+      throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
+    }
+    x = Eigen::Map<const VecX>(static_cast<const double*>(c.x->x), c.n);
+  }
+  stats_.iterations = 0;
+  stats_.relative_residual = relative_residual(*factorized_, x, b, shift_, options_.threads);
+  stats_.solve_seconds = seconds_since(start);
+  if (!std::isfinite(stats_.relative_residual)) {
+    throw NumericalError("CHOLMOD solve produced a non-finite solution (relative residual " +
+                         std::to_string(stats_.relative_residual) + ")");
+  }
+  return x;
+}
+
+}  // namespace msfab

@@ -1,0 +1,70 @@
+#pragma once
+// Sparse symmetric linear solvers behind one interface, so the Newton solver
+// can switch between a direct factorization and an iterative method by name.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace msfab {
+
+struct LinearSolverOptions {
+  // PCG stops when ||b - (A + shift I) x|| <= pcg_tolerance * ||b||.
+  double pcg_tolerance = 1e-8;
+  int pcg_max_iterations = 10000;
+  // "jacobi" (diagonal) or "block-jacobi3" (3x3 diagonal blocks, one per
+  // mesh node with 3 displacement unknowns; needs n divisible by 3).
+  std::string pcg_preconditioner = "jacobi";
+  // OpenMP threads for the parallel kernels; 0 uses the OpenMP default.
+  // CHOLMOD also sets the (process-wide) OpenBLAS thread count to this when
+  // it is > 0; with 0 the BLAS follows OPENBLAS_NUM_THREADS.
+  int threads = 0;
+};
+
+struct LinearSolveStats {
+  int iterations = 0;               // CG iterations of the last solve (0 for direct)
+  double relative_residual = 0.0;   // ||b - (A + shift I) x|| / ||b|| of the last solve
+  double analyze_seconds = 0.0;     // last analyze()
+  double factorize_seconds = 0.0;   // last factorize()
+  double solve_seconds = 0.0;       // last solve()
+  bool positive_definite = false;   // last factorize() (PCG: also its last solve)
+};
+
+// Usage: analyze(A) once per sparsity pattern, factorize(A, shift) whenever
+// the values change, solve(b) for each right-hand side.
+//
+// A is symmetric and given with both triangles. The solver keeps a reference
+// to the matrix passed to factorize() (to compute residuals, and for PCG to
+// multiply by it), so that matrix must stay alive and unchanged until the
+// last solve() that follows.
+class LinearSolver {
+ public:
+  virtual ~LinearSolver();
+
+  // Pattern-dependent work (ordering, symbolic factorization).
+  virtual void analyze(const SpMat& A) = 0;
+  // Prepares solves with A + shift*I (the shift regularizes an indefinite
+  // Hessian). Returns false if that matrix is found not positive definite;
+  // solve() then throws until a later factorize() succeeds. A must have the
+  // pattern given to analyze().
+  virtual bool factorize(const SpMat& A, double shift = 0.0) = 0;
+  // Solves (A + shift I) x = b. Throws NumericalError on failure.
+  virtual VecX solve(const VecX& b) = 0;
+
+  virtual const LinearSolveStats& stats() const = 0;
+  virtual std::string name() const = 0;
+};
+
+// Throws InputError naming the first invalid field.
+void validate_linear_solver_options(const LinearSolverOptions& options);
+
+// The names make_linear_solver() accepts.
+std::vector<std::string> linear_solver_names();
+
+// name: "cholmod" | "pcg". Throws InputError for an unknown name or an
+// invalid option, naming the field and the valid choices.
+std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name,
+                                                 const LinearSolverOptions& options = {});
+
+}  // namespace msfab

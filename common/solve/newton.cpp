@@ -1,0 +1,241 @@
+#include "solve/newton.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Zeroes the rows and columns of fixed DOFs and puts `diag` on their
+// diagonal, so the system decouples into the free block and an identity-like
+// block whose solution is the prescribed gap.
+void constrain_matrix(SpMat& K, const std::vector<char>& fixed, double diag) {
+  for (int c = 0; c < K.outerSize(); ++c) {
+    for (SpMat::InnerIterator it(K, c); it; ++it) {
+      const int r = static_cast<int>(it.row());
+      if (fixed[c] || fixed[r]) it.valueRef() = (r == c) ? diag : 0.0;
+    }
+  }
+}
+
+double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
+  double sum = 0;
+  int count = 0;
+  for (int c = 0; c < K.outerSize(); ++c) {
+    if (fixed[c]) continue;
+    sum += std::abs(K.coeff(c, c));
+    ++count;
+  }
+  return count ? sum / count : 1.0;
+}
+
+}  // namespace
+
+int DirichletConditions::count_fixed() const {
+  int n = 0;
+  for (char f : fixed) n += f ? 1 : 0;
+  return n;
+}
+
+std::string format_history(const std::vector<NewtonIteration>& history, size_t max_lines) {
+  std::ostringstream out;
+  out << "  step  load    iter  residual     energy         alpha      shift\n";
+  const size_t first = history.size() > max_lines ? history.size() - max_lines : 0;
+  if (first > 0) out << "  ... (" << first << " earlier iterations)\n";
+  char line[160];
+  for (size_t i = first; i < history.size(); ++i) {
+    const auto& h = history[i];
+    std::snprintf(line, sizeof line, "  %4d  %.4f  %4d  %.4e  % .6e  %.3e  %.2e\n", h.load_step, h.load_factor,
+                  h.iteration, h.residual, h.energy, h.step_length, h.shift);
+    out << line;
+  }
+  return out.str();
+}
+
+NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
+                          const VecX& force, const NewtonOptions& options, const VecX& x0) {
+  const auto t_start = Clock::now();
+  const int n = assembler.mesh().num_dofs();
+  const VecX X = assembler.rest_positions();
+  const std::vector<char>& fixed = dirichlet.fixed;
+  if (static_cast<int>(fixed.size()) != n || dirichlet.displacement.size() != n || force.size() != n)
+    throw std::invalid_argument("solve_static: DOF vectors do not match the mesh");
+
+  NewtonResult result;
+  result.x = x0.size() == n ? x0 : X;
+  SpMat K = assembler.pattern();
+  auto solver = make_linear_solver(options.linear_solver, options.linear);
+  {
+    const auto t0 = Clock::now();
+    solver->analyze(K);
+    result.timings.solve += seconds_since(t0);
+  }
+  VecX g(n), gap(n), rhs(n), dx(n), Kgap(n);
+  auto free_norm = [&](const VecX& v) {
+    double s = 0;
+    for (int i = 0; i < n; ++i)
+      if (!fixed[i]) s += v[i] * v[i];
+    return std::sqrt(s);
+  };
+  auto fixed_norm = [&](const VecX& v) {
+    double s = 0;
+    for (int i = 0; i < n; ++i)
+      if (fixed[i]) s += v[i] * v[i];
+    return std::sqrt(s);
+  };
+  const double length_scale = (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm();
+
+  // Runs Newton at one load factor from result.x; returns true on convergence.
+  auto newton_at = [&](double s, int step, std::string& why) -> bool {
+    const VecX fs = s * force;
+    VecX target = X + s * dirichlet.displacement;
+    double stiffness_scale = 0;
+    for (int it = 0; it <= options.max_iterations; ++it) {
+      auto t0 = Clock::now();
+      const double E = assembler.evaluate(result.x, &g, &K);
+      if (!std::isfinite(E)) {
+        why = "the configuration is inverted (an element has det F <= 0)";
+        return false;
+      }
+      g -= fs;
+      const double potential = E - fs.dot(result.x - X);
+      gap.setZero();
+      for (int i = 0; i < n; ++i)
+        if (fixed[i]) gap[i] = target[i] - result.x[i];
+      const double gap_norm = gap.norm();
+      if (gap_norm > 0) Kgap = K * gap;
+      const double diag = mean_free_diagonal(K, fixed);
+      if (stiffness_scale == 0) stiffness_scale = diag;
+      // Force scale: applied loads and the reactions at prescribed DOFs.
+      const double scale = std::max({fs.norm(), fixed_norm(g), 1e-12 * stiffness_scale * length_scale});
+      const double residual = free_norm(g) / scale;
+      result.timings.assembly += seconds_since(t0);
+
+      NewtonIteration rec;
+      rec.load_step = step;
+      rec.load_factor = s;
+      rec.iteration = it;
+      rec.residual = residual;
+      rec.energy = potential;
+      const bool gap_closed = gap_norm <= 1e-12 * length_scale;
+      if (gap_closed && residual <= options.relative_tolerance) {
+        result.history.push_back(rec);
+        return true;
+      }
+      if (it == options.max_iterations) {
+        result.history.push_back(rec);
+        why = "no convergence in " + std::to_string(options.max_iterations) + " iterations";
+        return false;
+      }
+
+      // Newton step with inertia regularization: if the Hessian is not
+      // positive definite (or the step is not a descent direction) a growing
+      // multiple of the identity is added, as interior-point codes do.
+      t0 = Clock::now();
+      constrain_matrix(K, fixed, diag);
+      double shift = 0;
+      bool ok = false;
+      for (int attempt = 0; attempt < 12 && !ok; ++attempt) {
+        if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
+        if (!solver->factorize(K, shift)) continue;
+        for (int i = 0; i < n; ++i) rhs[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
+        dx = solver->solve(rhs);
+        if (!dx.allFinite()) continue;
+        double slope = 0;
+        for (int i = 0; i < n; ++i)
+          if (!fixed[i]) slope += g[i] * dx[i];
+        ok = gap_norm > 0 || slope < 0;
+      }
+      result.timings.solve += seconds_since(t0);
+      rec.shift = shift;
+      rec.linear_iterations = solver->stats().iterations;
+      if (!ok) {
+        result.history.push_back(rec);
+        why = "the Newton system could not be solved even with regularization";
+        return false;
+      }
+
+      // Backtracking line search on the total potential; an inverted state
+      // has +inf energy and is always rejected. While the prescribed gap is
+      // still open the potential may rise, so only feasibility is required.
+      t0 = Clock::now();
+      double slope = 0;
+      for (int i = 0; i < n; ++i)
+        if (!fixed[i]) slope += g[i] * dx[i];
+      double alpha = 1;
+      bool accepted = false;
+      VecX trial(n);
+      for (int ls = 0; ls < options.max_line_search; ++ls, alpha *= 0.5) {
+        trial = result.x + alpha * dx;
+        const double Et = assembler.energy(trial);
+        if (!std::isfinite(Et)) continue;
+        const double pt = Et - fs.dot(trial - X);
+        if (gap_norm > 0 || pt <= potential + options.armijo * alpha * slope ||
+            std::abs(pt - potential) <= 1e-14 * std::abs(potential)) {
+          accepted = true;
+          break;
+        }
+      }
+      result.timings.line_search += seconds_since(t0);
+      rec.step_length = accepted ? alpha : 0;
+      result.history.push_back(rec);
+      spdlog::debug("newton load {:.4f} iter {:2d} residual {:.3e} energy {:.6e} alpha {:.3g} shift {:.2e}", s, it,
+                    residual, potential, rec.step_length, shift);
+      if (!accepted) {
+        why = "line search failed to find a decrease";
+        return false;
+      }
+      result.x = trial;
+      ++result.iterations;
+    }
+    return false;
+  };
+
+  // Load stepping with adaptive halving of failing increments.
+  const int steps = std::max(1, options.load_steps);
+  double s_done = 0, ds = 1.0 / steps;
+  int halvings = 0, step = 0;
+  while (s_done < 1.0 - 1e-12) {
+    const double s = std::min(1.0, s_done + ds);
+    const VecX x_saved = result.x;
+    std::string why;
+    ++step;
+    if (newton_at(s, step, why)) {
+      spdlog::info("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
+      s_done = s;
+      halvings = 0;
+      continue;
+    }
+    if (halvings >= options.max_step_halvings) {
+      result.x = x_saved;
+      std::ostringstream msg;
+      msg << "Newton failed at load factor " << s << " after " << options.max_step_halvings
+          << " load-step halvings: " << why;
+      result.failure = msg.str();
+      result.converged = false;
+      result.load_steps = step;
+      result.timings.total = seconds_since(t_start);
+      return result;
+    }
+    spdlog::warn("load factor {:.4f} failed ({}); halving the load increment", s, why);
+    result.x = x_saved;
+    ds *= 0.5;
+    ++halvings;
+  }
+  result.converged = true;
+  result.load_steps = step;
+  result.timings.total = seconds_since(t_start);
+  return result;
+}
+
+}  // namespace msfab

@@ -1,0 +1,77 @@
+#pragma once
+// Nonlinear elastostatics by Newton's method with backtracking line search
+// (thesis Algorithm 1), with load stepping for large loads.
+//
+// Unknowns are node positions. Dirichlet DOFs are driven to their
+// prescribed values through the Newton step itself (the gap between the
+// current and the prescribed position is part of the step), so a large
+// prescribed displacement moves the interior along with the boundary
+// instead of inverting the elements next to it.
+#include <string>
+#include <vector>
+
+#include "fem/elastic_assembler.hpp"
+#include "solve/linear_solver.hpp"
+
+namespace msfab {
+
+struct DirichletConditions {
+  std::vector<char> fixed;  // per DOF: 1 if prescribed
+  VecX displacement;        // per DOF: displacement at full load (read where fixed)
+
+  static DirichletConditions none(int num_dofs) {
+    return {std::vector<char>(num_dofs, 0), VecX::Zero(num_dofs)};
+  }
+  int count_fixed() const;
+};
+
+struct NewtonOptions {
+  double relative_tolerance = 1e-6;  // on ||residual|| / force scale
+  int max_iterations = 50;           // per load step
+  int load_steps = 1;                // initial number of equal load increments
+  int max_step_halvings = 8;         // adaptive cuts of a failing increment
+  double armijo = 1e-4;
+  int max_line_search = 40;
+  std::string linear_solver = "cholmod";
+  LinearSolverOptions linear;
+};
+
+struct NewtonIteration {
+  int load_step = 0;
+  double load_factor = 0;
+  int iteration = 0;
+  double residual = 0;           // ||free residual|| / force scale
+  double energy = 0;             // total potential
+  double step_length = 0;        // accepted line-search step
+  double shift = 0;              // diagonal regularization used (0 if none)
+  int linear_iterations = 0;
+};
+
+struct NewtonTimings {
+  double assembly = 0;     // energy, gradient, Hessian (Alg. 1 lines 2-18)
+  double solve = 0;        // factorization and solve (line 19)
+  double line_search = 0;  // lines 20-21
+  double total = 0;
+};
+
+struct NewtonResult {
+  VecX x;                      // final positions
+  bool converged = false;
+  int iterations = 0;
+  int load_steps = 0;
+  std::vector<NewtonIteration> history;
+  NewtonTimings timings;
+  std::string failure;         // why it stopped, when not converged
+};
+
+// Solves for equilibrium under external nodal forces `force` (full load)
+// and `dirichlet`. Starts from x0 (rest positions if empty). Never throws
+// on non-convergence: the result says converged = false with the reason
+// and the residual history, and callers decide (stages exit with code 3).
+NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
+                          const VecX& force, const NewtonOptions& options, const VecX& x0 = VecX());
+
+// The residual history as readable text, for error messages.
+std::string format_history(const std::vector<NewtonIteration>& history, size_t max_lines = 30);
+
+}  // namespace msfab

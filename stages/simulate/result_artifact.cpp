@@ -1,0 +1,92 @@
+#include "result_artifact.hpp"
+
+#include "io/artifact.hpp"
+#include "io/mesh_io.hpp"
+#include "io/xdmf.hpp"
+
+namespace msfab {
+
+std::string write_result_artifact(const std::string& path, const SimulationRecord& r) {
+  const HexMesh& mesh = r.mesh->mesh;
+  const NewtonResult& nr = *r.newton;
+  ArtifactWriter writer(path, kResultSchema, kResultSchemaVersion, "msfab-simulate", r.config_text, {}, r.seed);
+  H5File& f = writer.file();
+  f.write_attribute("/", "command_line", r.command_line);
+  f.write_attribute("/", "scene", r.scene->name);
+
+  f.create_group("/grid");
+  f.write_attribute("/grid", "size", std::vector<int>{r.scene->grid.nx, r.scene->grid.ny, r.scene->grid.nz});
+  f.write_attribute("/grid", "voxel_size", r.scene->grid.voxel_size);
+  write_hex_mesh(f, "/mesh", mesh);
+
+  NodeArray u(mesh.num_nodes(), 3), force(mesh.num_nodes(), 3);
+  Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor> fixed(mesh.num_nodes(), 3);
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    for (int a = 0; a < 3; ++a) {
+      u(n, a) = nr.x[3 * n + a] - mesh.nodes(n, a);
+      force(n, a) = r.conditions->force[3 * n + a];
+      fixed(n, a) = r.conditions->dirichlet.fixed[3 * n + a];
+    }
+  H5WriteOptions big;
+  big.gzip_level = mesh.num_nodes() > 4096 ? 4 : 0;
+  f.write_matrix("/displacement", u, big);
+  f.write_attribute("/displacement", "units", "m");
+  f.write_matrix("/external_force", force, big);
+  f.write_attribute("/external_force", "units", "N");
+  f.write_matrix("/fixed", fixed, big);
+
+  std::vector<int> step, iteration;
+  std::vector<double> load, residual, energy, alpha, shift;
+  for (const auto& h : nr.history) {
+    step.push_back(h.load_step);
+    iteration.push_back(h.iteration);
+    load.push_back(h.load_factor);
+    residual.push_back(h.residual);
+    energy.push_back(h.energy);
+    alpha.push_back(h.step_length);
+    shift.push_back(h.shift);
+  }
+  f.write_vector("/newton/load_step", step);
+  f.write_vector("/newton/iteration", iteration);
+  f.write_vector("/newton/load_factor", load);
+  f.write_vector("/newton/residual", residual);
+  f.write_attribute("/newton/residual", "units", "relative to the force scale");
+  f.write_vector("/newton/energy", energy);
+  f.write_attribute("/newton/energy", "units", "J");
+  f.write_vector("/newton/step_length", alpha);
+  f.write_vector("/newton/shift", shift);
+  f.write_attribute("/newton", "converged", int(nr.converged));
+  f.write_attribute("/newton", "iterations", nr.iterations);
+  f.write_attribute("/newton", "load_steps", nr.load_steps);
+
+  f.create_group("/timings");
+  f.write_attribute("/timings", "units", "s");
+  f.write_attribute("/timings", "setup", r.setup_seconds);
+  f.write_attribute("/timings", "assembly", nr.timings.assembly);
+  f.write_attribute("/timings", "solve", nr.timings.solve);
+  f.write_attribute("/timings", "line_search", nr.timings.line_search);
+  f.write_attribute("/timings", "newton_total", nr.timings.total);
+
+  f.write_attribute("/", "dofs", mesh.num_dofs());
+  f.write_attribute("/", "free_dofs", mesh.num_dofs() - r.conditions->dirichlet.count_fixed());
+  f.write_attribute("/", "elements", mesh.num_elements());
+  writer.commit();
+
+  std::string xmf = path;
+  const auto dot = xmf.rfind(".h5");
+  xmf = (dot != std::string::npos && dot + 3 == xmf.size()) ? xmf.substr(0, dot) + ".xmf" : xmf + ".xmf";
+  const auto slash = path.rfind('/');
+  XdmfHexMesh xm;
+  xm.h5_file = slash == std::string::npos ? path : path.substr(slash + 1);
+  xm.nodes_dataset = "/mesh/nodes";
+  xm.connectivity_dataset = "/mesh/elements_vtk";
+  xm.n_nodes = mesh.num_nodes();
+  xm.n_elems = mesh.num_elements();
+  write_hex_mesh_xdmf(xmf, xm,
+                      {{"displacement", "/displacement", 3, H5Dtype::kFloat64},
+                       {"external_force", "/external_force", 3, H5Dtype::kFloat64}},
+                      {{"material_id", "/mesh/element_tag", 1, H5Dtype::kInt32}});
+  return xmf;
+}
+
+}  // namespace msfab

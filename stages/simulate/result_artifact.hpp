@@ -1,0 +1,29 @@
+#pragma once
+// The `msfab.result` artifact of msfab-simulate (docs/artifacts.md).
+#include <string>
+
+#include "fem/voxel_grid.hpp"
+#include "scene/scene.hpp"
+#include "solve/newton.hpp"
+
+namespace msfab {
+
+constexpr const char* kResultSchema = "msfab.result";
+constexpr int kResultSchemaVersion = 1;
+
+struct SimulationRecord {
+  const Scene* scene = nullptr;
+  const VoxelMesh* mesh = nullptr;
+  const StaticConditions* conditions = nullptr;
+  const NewtonResult* newton = nullptr;
+  double setup_seconds = 0;
+  std::string config_text;
+  std::string command_line;
+  std::uint64_t seed = 0;
+};
+
+// Writes the artifact atomically to `path` and its XDMF sidecar next to it;
+// returns the sidecar's path.
+std::string write_result_artifact(const std::string& path, const SimulationRecord& record);
+
+}  // namespace msfab

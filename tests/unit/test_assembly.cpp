@@ -1,0 +1,175 @@
+// Element and global energy / gradient / Hessian: finite differences,
+// invariances, patch test, determinism.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <Eigen/Geometry>
+#include <cstring>
+#include <random>
+
+#include "fem/elastic_assembler.hpp"
+#include "fem/voxel_grid.hpp"
+#include "material/linear_isotropic.hpp"
+#include "material/neo_hookean.hpp"
+
+using namespace msfab;
+
+namespace {
+
+std::vector<MaterialPtr> two_material_palette() {
+  return {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e7, 0.3)};
+}
+
+VoxelGrid small_mixed_grid() {
+  VoxelGrid g(3, 2, 2, 0.01, 1);
+  g.at(1, 0, 0) = 2;
+  g.at(2, 1, 1) = 2;
+  g.at(0, 1, 0) = 0;  // a void voxel
+  return g;
+}
+
+VecX perturbed(const VecX& X, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  VecX x = X;
+  for (int i = 0; i < x.size(); ++i) x[i] += u(rng);
+  return x;
+}
+
+}  // namespace
+
+TEST(Assembly, ElementGradientAndHessianMatchFiniteDifferences) {
+  hex8::NodeMatrix X;
+  for (int i = 0; i < 8; ++i) X.row(i) = 0.5 * (hex8::natural_node(i).transpose() + Eigen::RowVector3d::Ones());
+  X(7, 0) += 0.1;  // non-cubic
+  const auto geo = hex8::element_geometry(X, hex8::gauss_rule(2));
+  QuadratureMaterials mat{{std::make_shared<NeoHookean>(1e3, 0.4)}};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  hex8::NodeMatrix x = X;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a) x(i, a) += u(rng);
+  Vec24 g;
+  Mat24 K;
+  hex_evaluate(geo, mat, x, &g, &K);
+  const double h = 1e-6;
+  for (int k = 0; k < 24; ++k) {
+    hex8::NodeMatrix xp = x, xm = x;
+    xp(k / 3, k % 3) += h;
+    xm(k / 3, k % 3) -= h;
+    const double fd = (hex_energy(geo, mat, xp) - hex_energy(geo, mat, xm)) / (2 * h);
+    EXPECT_NEAR(g[k], fd, 1e-6 * (1 + std::abs(fd)));
+    Vec24 gp, gm;
+    hex_evaluate(geo, mat, xp, &gp, nullptr);
+    hex_evaluate(geo, mat, xm, &gm, nullptr);
+    const Vec24 col = (gp - gm) / (2 * h);
+    EXPECT_LT((K.col(k) - col).norm(), 1e-6 * (1 + col.norm())) << "column " << k;
+  }
+  EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm());
+}
+
+TEST(Assembly, GlobalGradientAndHessianMatchFiniteDifferences) {
+  const VoxelMesh vm = build_voxel_mesh(small_mixed_grid(), two_material_palette());
+  ElasticAssembler asmb(vm.mesh);
+  const VecX x = perturbed(asmb.rest_positions(), 4e-4, 7);
+  VecX g;
+  SpMat K = asmb.pattern();
+  asmb.evaluate(x, &g, &K);
+  const double h = 1e-8;
+  double max_rel_g = 0, max_rel_k = 0;
+  for (int k = 0; k < x.size(); ++k) {
+    VecX xp = x, xm = x;
+    xp[k] += h;
+    xm[k] -= h;
+    const double fd = (asmb.energy(xp) - asmb.energy(xm)) / (2 * h);
+    max_rel_g = std::max(max_rel_g, std::abs(g[k] - fd) / (1e-3 * g.cwiseAbs().maxCoeff() + std::abs(fd)));
+    VecX gp, gm;
+    asmb.evaluate(xp, &gp, nullptr);
+    asmb.evaluate(xm, &gm, nullptr);
+    const VecX col = (gp - gm) / (2 * h);
+    max_rel_k = std::max(max_rel_k, (VecX(K.col(k)) - col).norm() / col.norm());
+  }
+  EXPECT_LT(max_rel_g, 1e-5);
+  EXPECT_LT(max_rel_k, 1e-5);
+  const SpMat Kt = K.transpose();
+  EXPECT_LT((K - Kt).norm(), 1e-10 * K.norm());
+}
+
+TEST(Assembly, RigidMotionGivesZeroEnergyAndForce) {
+  const VoxelMesh vm = build_voxel_mesh(small_mixed_grid(), two_material_palette());
+  ElasticAssembler asmb(vm.mesh);
+  const VecX X = asmb.rest_positions();
+  const Mat3 R = Eigen::AngleAxisd(0.8, Vec3(1, 2, -0.5).normalized()).toRotationMatrix();
+  VecX x(X.size());
+  for (int i = 0; i < X.size() / 3; ++i) x.segment<3>(3 * i) = R * X.segment<3>(3 * i) + Vec3(0.1, -0.3, 2);
+  VecX g;
+  const double E = asmb.evaluate(x, &g, nullptr);
+  EXPECT_NEAR(E, 0.0, 1e-9);
+  EXPECT_LT(g.cwiseAbs().maxCoeff(), 1e-6);
+  asmb.evaluate(X, &g, nullptr);
+  EXPECT_NEAR(asmb.energy(X), 0.0, 1e-20);
+  EXPECT_LT(g.cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(Assembly, InternalForcesConserveMomentum) {
+  // Sum of forces and of torques about the origin vanish for any deformation.
+  const VoxelMesh vm = build_voxel_mesh(small_mixed_grid(), two_material_palette());
+  ElasticAssembler asmb(vm.mesh);
+  const VecX x = perturbed(asmb.rest_positions(), 2e-3, 11);
+  VecX g;
+  asmb.evaluate(x, &g, nullptr);
+  Vec3 force = Vec3::Zero(), torque = Vec3::Zero();
+  for (int i = 0; i < x.size() / 3; ++i) {
+    force += g.segment<3>(3 * i);
+    torque += x.segment<3>(3 * i).cross(Vec3(g.segment<3>(3 * i)));
+  }
+  const double scale = g.cwiseAbs().maxCoeff();
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(force.norm(), 1e-10 * scale);
+  EXPECT_LT(torque.norm(), 1e-10 * scale);
+}
+
+TEST(Assembly, InvertedElementGivesInfiniteEnergyNotNaN) {
+  const VoxelMesh vm = build_voxel_mesh(small_mixed_grid(), two_material_palette());
+  ElasticAssembler asmb(vm.mesh);
+  VecX x = asmb.rest_positions();
+  // Push one node through the opposite face of its element.
+  const int n = vm.mesh.elements[0][7];
+  x.segment<3>(3 * n) -= Vec3(0.02, 0.02, 0.02);
+  const double E = asmb.energy(x);
+  EXPECT_TRUE(std::isinf(E) && E > 0);
+}
+
+TEST(Assembly, ResultsAreIndependentOfThreadCount) {
+  VoxelGrid grid(6, 5, 4, 0.01, 1);
+  for (size_t i = 0; i < grid.size(); i += 3) grid.ids[i] = 2;
+  const VoxelMesh vm = build_voxel_mesh(grid, two_material_palette());
+  ElasticAssembler asmb(vm.mesh);
+  const VecX x = perturbed(asmb.rest_positions(), 5e-4, 5);
+  VecX g1, g2;
+  SpMat K1 = asmb.pattern(), K2 = asmb.pattern();
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const double E1 = asmb.evaluate(x, &g1, &K1);
+  omp_set_num_threads(3);
+  const double E2 = asmb.evaluate(x, &g2, &K2);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(E1, E2);
+  EXPECT_EQ((g1 - g2).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(std::memcmp(K1.valuePtr(), K2.valuePtr(), sizeof(double) * K1.nonZeros()), 0);
+}
+
+TEST(VoxelMesh, OnlySolidVoxelsBecomeElementsWithSharedNodes) {
+  VoxelGrid g(2, 1, 1, 1.0, 1);
+  auto vm = build_voxel_mesh(g, two_material_palette());
+  EXPECT_EQ(vm.mesh.num_elements(), 2);
+  EXPECT_EQ(vm.mesh.num_nodes(), 12);  // two cubes sharing a face
+  g.at(1, 0, 0) = 0;
+  vm = build_voxel_mesh(g, two_material_palette());
+  EXPECT_EQ(vm.mesh.num_elements(), 1);
+  EXPECT_EQ(vm.mesh.num_nodes(), 8);
+  g.at(0, 0, 0) = 0;
+  EXPECT_ANY_THROW(build_voxel_mesh(g, two_material_palette()));
+  g.at(0, 0, 0) = 5;  // not in the palette
+  EXPECT_ANY_THROW(build_voxel_mesh(g, two_material_palette()));
+}

@@ -1,0 +1,310 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "io/config.hpp"
+
+namespace msfab {
+namespace {
+
+// Runs `fn`, expects an InputError, and returns its message.
+template <class Fn>
+std::string input_error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return "";
+}
+
+::testing::AssertionResult AssertContains(const char* text_expr, const char* part_expr, const std::string& text,
+                                          const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << text_expr << " = \"" << text << "\"\n  does not contain " << part_expr
+                                       << " = \"" << part << "\"";
+}
+#define EXPECT_CONTAINS(text, part) EXPECT_PRED_FORMAT2(AssertContains, text, part)
+
+const char* kScene = R"(
+name: bar
+E: 2.5e9
+count: 12
+enabled: true
+grid:
+  size: [4, 8, 16]
+  spacing: 0.5
+boundary:
+  type: clamped
+  faces: [xmin, xmax]
+materials:
+  - {E: 1.0e6, nu: 0.3}
+  - E: 2.0e6
+    nu: 0.45
+)";
+
+TEST(Config, TypedReadsOfScalarsAndLists) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  EXPECT_EQ(c.get<std::string>("name"), "bar");
+  EXPECT_DOUBLE_EQ(c.get<double>("E"), 2.5e9);
+  EXPECT_EQ(c.get<int>("count"), 12);
+  EXPECT_DOUBLE_EQ(c.get<double>("count"), 12.0);  // an integer is a number too
+  EXPECT_TRUE(c.get<bool>("enabled"));
+  EXPECT_EQ(c.get<std::vector<int>>("grid.size"), (std::vector<int>{4, 8, 16}));
+  EXPECT_EQ(c.get<std::vector<double>>("grid.size"), (std::vector<double>{4.0, 8.0, 16.0}));
+  EXPECT_DOUBLE_EQ(c.get<double>("grid.spacing"), 0.5);
+}
+
+TEST(Config, DefaultsApplyOnlyWhenKeyIsAbsent) {
+  Config c = Config::from_string("tol: 1e-6\nempty:\n", "s.yaml");
+  EXPECT_DOUBLE_EQ(c.get_or("tol", 1.0), 1e-6);
+  EXPECT_DOUBLE_EQ(c.get_or("max_step", 0.25), 0.25);
+  EXPECT_EQ(c.get_or("empty", 7), 7);  // "key:" with no value counts as not given
+  EXPECT_EQ(c.get_or("solver", "cholmod"), "cholmod");
+  EXPECT_FALSE(c.has("max_step"));
+  EXPECT_FALSE(c.has("empty"));
+  EXPECT_TRUE(c.has("tol"));
+  // A default does not excuse a wrongly typed value.
+  Config bad = Config::from_string("tol: small\n", "s.yaml");
+  EXPECT_CONTAINS(input_error_of([&] { bad.get_or("tol", 1.0); }), ("s.yaml: tol: expected a number"));
+}
+
+TEST(Config, NestedChildrenCarryTheirKeyPath) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  Config boundary = c.child("boundary");
+  EXPECT_EQ(boundary.path(), "boundary");
+  EXPECT_EQ(boundary.get<std::string>("type"), "clamped");
+  EXPECT_EQ(boundary.get<std::vector<std::string>>("faces"), (std::vector<std::string>{"xmin", "xmax"}));
+  EXPECT_CONTAINS(input_error_of([&] { boundary.get<double>("type"); }),
+                  ("bar.yaml: boundary.type: expected a number, found 'clamped'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.child("name"); }), ("bar.yaml: name: expected a mapping"));
+  EXPECT_CONTAINS(input_error_of([&] { c.child("solver"); }), ("missing required section 'solver'"));
+}
+
+TEST(Config, ListsOfMapsGiveIndexedChildren) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  std::vector<Config> materials = c.children("materials");
+  ASSERT_EQ(materials.size(), 2u);
+  EXPECT_DOUBLE_EQ(materials[0].get<double>("E"), 1.0e6);
+  EXPECT_DOUBLE_EQ(materials[1].get<double>("nu"), 0.45);
+  EXPECT_EQ(materials[1].path(), "materials[1]");
+  EXPECT_CONTAINS(input_error_of([&] { materials[1].get<int>("nu"); }),
+                  ("bar.yaml: materials[1].nu: expected an integer, found '0.45'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.children("grid"); }), ("grid: expected a list of mappings"));
+}
+
+TEST(Config, OverridesReplaceValuesListsAndCreateNewPaths) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  c.apply_overrides(
+      {"E=7", "grid.size=[8,8,8]", "solver.newton.max_iterations=50", "materials[1].nu=0.25", "name=\"two words\""});
+  EXPECT_DOUBLE_EQ(c.get<double>("E"), 7.0);
+  EXPECT_EQ(c.get<std::vector<int>>("grid.size"), (std::vector<int>{8, 8, 8}));
+  EXPECT_DOUBLE_EQ(c.get<double>("grid.spacing"), 0.5);  // sibling untouched
+  EXPECT_EQ(c.child("solver").child("newton").get<int>("max_iterations"), 50);
+  EXPECT_DOUBLE_EQ(c.children("materials")[1].get<double>("nu"), 0.25);
+  EXPECT_DOUBLE_EQ(c.children("materials")[0].get<double>("nu"), 0.3);
+  EXPECT_EQ(c.get<std::string>("name"), "two words");
+  // The resolved text reflects the overrides and parses back to the same values.
+  Config again = Config::from_string(c.resolved_text(), "resolved");
+  EXPECT_EQ(again.get<std::vector<int>>("grid.size"), (std::vector<int>{8, 8, 8}));
+  EXPECT_EQ(again.get<int>("solver.newton.max_iterations"), 50);
+  EXPECT_EQ(again.get<std::string>("name"), "two words");
+  // Quoted strings stay strings on the way through.
+  Config quoted = Config::from_string("id: \"007\"\nn: 7\n", "q.yaml");
+  Config back = Config::from_string(quoted.resolved_text(), "resolved");
+  EXPECT_EQ(back.get<std::string>("id"), "007");
+  EXPECT_THROW(back.get<int>("id"), InputError);
+  EXPECT_EQ(back.get<int>("n"), 7);
+}
+
+TEST(Config, MalformedOverridesNameTheOverride) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("E"); }), ("--set 'E': expected key=value"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("=3"); }), ("--set '=3'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("grid..size=3"); }), ("--set 'grid..size=3'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("grid.size=[1,2"); }), ("cannot parse value"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("E.x=1"); }), ("not a mapping"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("materials[5].nu=0.1"); }), ("out of range"));
+  EXPECT_CONTAINS(input_error_of([&] { c.apply_override("E="); }), ("missing value"));
+}
+
+TEST(Config, ErrorsAfterOverrideMentionTheOverride) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  c.apply_override("E=-1");
+  std::string message = input_error_of([&] { c.require_positive("E", "Young's modulus"); });
+  EXPECT_CONTAINS(message, ("bar.yaml (with --set E=-1): E = -1: Young's modulus must be positive"));
+}
+
+TEST(Config, UnknownTopLevelKeyIsReportedWithKnownKeys) {
+  Config c = Config::from_string("E: 1\nnu: 0.3\nmaterails: []\n", "scene.yaml");
+  c.get<double>("E");
+  c.get<double>("nu");
+  c.get_or("materials", std::vector<double>{});
+  std::string message = input_error_of([&] { c.check_no_unknown_keys(); });
+  EXPECT_CONTAINS(message, ("unknown key 'materails' in scene.yaml (at top level)"));
+  EXPECT_CONTAINS(message, ("did you mean 'materials'?"));
+  EXPECT_CONTAINS(message, ("known keys: E, materials, nu"));
+}
+
+TEST(Config, UnknownNestedKeyIsReportedWithItsPath) {
+  Config c = Config::from_string(kScene, "bar.yaml");
+  c.get<std::string>("name");
+  c.get<double>("E");
+  c.get<int>("count");
+  c.get<bool>("enabled");
+  c.get<std::vector<int>>("grid.size");  // grid.spacing never read
+  Config boundary = c.child("boundary");
+  boundary.get<std::string>("type");
+  boundary.get<std::vector<std::string>>("faces");
+  for (const Config& m : c.children("materials")) {
+    m.get<double>("E");
+    m.get<double>("nu");
+  }
+  std::string message = input_error_of([&] { c.check_no_unknown_keys(); });
+  EXPECT_CONTAINS(message, ("unknown key 'spacing' in bar.yaml (under 'grid')"));
+  EXPECT_CONTAINS(message, ("known keys: size"));
+
+  c.get<double>("grid.spacing");
+  EXPECT_NO_THROW(c.check_no_unknown_keys());
+}
+
+TEST(Config, MisspelledKeyInsideListElementIsCaught) {
+  Config c = Config::from_string("materials:\n  - {E: 1, nu: 0.3}\n  - {E: 2, nuu: 0.3}\n", "m.yaml");
+  for (const Config& m : c.children("materials")) {
+    m.get<double>("E");
+    m.get_or("nu", 0.0);
+  }
+  std::string message = input_error_of([&] { c.check_no_unknown_keys(); });
+  EXPECT_CONTAINS(message, ("unknown key 'nuu' in m.yaml (under 'materials[1]')"));
+  EXPECT_CONTAINS(message, ("did you mean 'nu'?"));
+}
+
+TEST(Config, SectionOnlyEnteredStillHasItsKeysChecked) {
+  Config c = Config::from_string("solver:\n  tol: 1e-8\n  tolerance: 1e-6\n", "s.yaml");
+  EXPECT_DOUBLE_EQ(c.child("solver").get<double>("tolerance"), 1e-6);
+  EXPECT_CONTAINS(input_error_of([&] { c.check_no_unknown_keys(); }), ("unknown key 'tol' in s.yaml (under 'solver')"));
+  // raw() accepts a whole section for another parser.
+  Config d = Config::from_string("solver:\n  tol: 1e-8\n  anything: [1, 2]\n", "s.yaml");
+  EXPECT_EQ(d.raw("solver")["anything"].size(), 2u);
+  EXPECT_NO_THROW(d.check_no_unknown_keys());
+}
+
+TEST(Config, WrongTypesAreReportedAsSuch) {
+  Config c = Config::from_string("E: abc\nn: 2.5\nflag: maybe\nsize: 8\nlist: [1, x]\nquoted: \"3\"\n", "t.yaml");
+  EXPECT_CONTAINS(input_error_of([&] { c.get<double>("E"); }), ("t.yaml: E: expected a number, found 'abc'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<int>("n"); }), ("t.yaml: n: expected an integer, found '2.5'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<bool>("flag"); }), ("flag: expected true or false"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<std::vector<int>>("size"); }),
+                  ("size: expected a list of integers, found '8'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<std::vector<double>>("list"); }),
+                  ("list[1]: expected a number, found 'x'"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<double>("quoted"); }), ("found the quoted string \"3\""));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<std::string>("list"); }), ("list: expected a string"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<std::uint64_t>("n"); }), ("expected a non-negative integer"));
+}
+
+TEST(Config, MissingRequiredKeyNamesFileAndPath) {
+  Config c = Config::from_string(kScene, "configs/scenes/bar.yaml");
+  EXPECT_CONTAINS(input_error_of([&] { c.children("materials")[0].get<double>("density"); }),
+                  ("configs/scenes/bar.yaml: missing required key 'materials[0].density' (expected a number)"));
+  EXPECT_CONTAINS(input_error_of([&] { c.get<double>("grid.origin"); }), ("missing required key 'grid.origin'"));
+}
+
+TEST(Config, RangeChecksNameFileKeyValueAndRule) {
+  Config c =
+      Config::from_string("materials:\n  - {E: -3, nu: 0.3}\n  - {E: 1e6, nu: 0.5}\n", "configs/scenes/bar.yaml");
+  auto materials = c.children("materials");
+  EXPECT_CONTAINS(input_error_of([&] { materials[0].require_positive("E", "Young's modulus"); }),
+                  ("configs/scenes/bar.yaml: materials[0].E = -3: Young's modulus must be positive"));
+  EXPECT_DOUBLE_EQ(materials[0].require_range("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio"), 0.3);
+  EXPECT_DOUBLE_EQ(materials[1].require_positive("E"), 1e6);
+  EXPECT_CONTAINS(input_error_of([&] { materials[1].require_range("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio"); }),
+                  ("configs/scenes/bar.yaml: materials[1].nu = 0.5: Poisson's ratio must be in (-1, 0.5)"));
+  // Closed bounds include the end point.
+  EXPECT_DOUBLE_EQ(materials[1].require_range("nu", 0.0, 0.5, Bounds::Closed), 0.5);
+  EXPECT_CONTAINS(input_error_of([&] { materials[1].require_range("nu", 0.0, 0.5, Bounds::ClosedOpen); }),
+                  ("must be in [0, 0.5)"));
+}
+
+TEST(Config, NonFiniteAndChoiceChecks) {
+  Config c = Config::from_string("a: .nan\nb: .inf\nc: 2\nmode: static\nkind: modal\nn: 0\n", "f.yaml");
+  EXPECT_TRUE(std::isnan(c.get<double>("a")));
+  EXPECT_CONTAINS(input_error_of([&] { c.require_finite("a", "damping"); }),
+                  ("f.yaml: a = .nan: damping must be a finite number"));
+  EXPECT_CONTAINS(input_error_of([&] { c.require_positive("a"); }), ("must be positive"));
+  EXPECT_CONTAINS(input_error_of([&] { c.require_positive("b"); }), ("must be finite"));
+  EXPECT_CONTAINS(input_error_of([&] { c.require_range("a", 0.0, 1.0); }), ("must be in [0, 1]"));
+  EXPECT_DOUBLE_EQ(c.require_finite("c"), 2.0);
+  EXPECT_EQ(c.one_of("mode", {"static", "dynamic"}), "static");
+  EXPECT_CONTAINS(input_error_of([&] {
+                    c.one_of("kind", {"static", "dynamic"});
+                  }),
+                  ("f.yaml: kind = modal: must be one of: static, dynamic"));
+  EXPECT_CONTAINS(input_error_of([&] { c.require_positive<int>("n", "cell count"); }),
+                  ("n = 0: cell count must be positive"));
+}
+
+TEST(Config, MalformedYamlReportsLineAndColumn) {
+  std::string message = input_error_of([] { Config::from_string("a: 1\nb: [1, 2\nc: 3\n", "broken.yaml"); });
+  EXPECT_CONTAINS(message, ("broken.yaml: line "));
+  EXPECT_CONTAINS(message, ("YAML syntax error"));
+  // The unclosed flow list is detected on line 3 (yaml-cpp reports where it gave up).
+  EXPECT_TRUE(message.find("line 2") != std::string::npos || message.find("line 3") != std::string::npos) << message;
+  EXPECT_CONTAINS(input_error_of([] { Config::from_string("a: 1\n  b: 2\n", "indent.yaml"); }),
+                  "indent.yaml: line 2, column 4: YAML syntax error");
+  EXPECT_CONTAINS(input_error_of([] { Config::from_string("a: 1\na: 2\n", "dup.yaml"); }),
+                  ("dup.yaml: line 2: duplicate key 'a'"));
+  EXPECT_CONTAINS(input_error_of([] { Config::from_string("- 1\n- 2\n", "list.yaml"); }),
+                  ("list.yaml: expected a mapping"));
+}
+
+TEST(Config, LoadsFilesAndReportsMissingOnes) {
+  const auto dir = std::filesystem::temp_directory_path() / ("msfab_config_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "scene.yaml").string();
+  {
+    std::ofstream out(path);
+    out << "E: 3\nbad: [\n";
+  }
+  std::string message = input_error_of([&] { Config::load_file(path); });
+  EXPECT_CONTAINS(message, (path + ": line 3"));
+  {
+    std::ofstream out(path);
+    out << "E: 3\n";
+  }
+  Config c = Config::load_file(path);
+  EXPECT_EQ(c.source(), path);
+  EXPECT_EQ(c.get<int>("E"), 3);
+  EXPECT_CONTAINS(input_error_of([&] { Config::load_file((dir / "nope.yaml").string()); }),
+                  ((dir / "nope.yaml").string() + ": no such file"));
+  Config empty = Config::from_string("", "empty.yaml");  // an empty file is an empty mapping
+  EXPECT_TRUE(empty.keys().empty());
+  EXPECT_NO_THROW(empty.check_no_unknown_keys());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Config, RelativePathsAreTakenFromTheConfigFilesFolder) {
+  const auto dir = std::filesystem::temp_directory_path() / ("msfab_config_paths_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "scenes");
+  const std::string path = (dir / "scenes" / "bar.yaml").string();
+  std::ofstream(path) << "db: ../data/db.h5\nabsolute: /data/x.h5\nout: r.h5\nempty: \"\"\n";
+  Config c = Config::load_file(path);
+  c.apply_override("out=here.h5");
+  EXPECT_EQ(c.get_path("db"), (dir / "data" / "db.h5").string());
+  EXPECT_EQ(c.get_path("absolute"), "/data/x.h5");
+  EXPECT_EQ(c.get_path("out"), "here.h5");  // typed on the command line: relative to the working directory
+  EXPECT_CONTAINS(input_error_of([&] { c.get_path("empty"); }), "empty = : expected a file path");
+  EXPECT_EQ(Config::from_string("db: a/b.h5\n", "<defaults>").get_path("db"), "a/b.h5");
+  EXPECT_EQ(Config().source(), "<empty config>");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace msfab
