@@ -20,6 +20,18 @@ struct LinearSolverOptions {
   // CHOLMOD also sets the (process-wide) OpenBLAS thread count to this when
   // it is > 0; with 0 the BLAS follows OPENBLAS_NUM_THREADS.
   int threads = 0;
+
+  // pcg-mg (multigrid-preconditioned CG; also uses pcg_tolerance and
+  // pcg_max_iterations): the rest positions of the mesh nodes, one row per
+  // node in DOF order (a NodeArray of fem/hex_mesh.hpp). They must lie on a
+  // regular lattice, as the nodes of a voxel mesh do.
+  std::shared_ptr<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> node_positions;
+  // pcg-mg: coarsening stops at the first level with fewer unknowns than
+  // this; CHOLMOD factors that level.
+  int mg_coarse_unknowns = 3000;
+  // pcg-mg: degree of the Chebyshev smoother, applied before and after each
+  // coarse correction (matrix products per smoothing).
+  int mg_smoother_degree = 2;
 };
 
 struct LinearSolveStats {
@@ -62,7 +74,7 @@ void validate_linear_solver_options(const LinearSolverOptions& options);
 // The names make_linear_solver() accepts.
 std::vector<std::string> linear_solver_names();
 
-// name: "cholmod" | "pcg". Throws InputError for an unknown name or an
+// name: "cholmod" | "pcg" | "pcg-mg". Throws InputError for an unknown name or an
 // invalid option, naming the field and the valid choices.
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name,
                                                  const LinearSolverOptions& options = {});

@@ -149,7 +149,13 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
         if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
         if (!solver->factorize(K, shift)) continue;
         for (int i = 0; i < n; ++i) rhs[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
-        dx = solver->solve(rhs);
+        try {
+          dx = solver->solve(rhs);
+        } catch (const NumericalError& e) {
+          // An iterative solver meets indefiniteness only while solving.
+          spdlog::debug("linear solve failed with shift {:.2e}: {}", shift, e.what());
+          continue;
+        }
         if (!dx.allFinite()) continue;
         double slope = 0;
         for (int i = 0; i < n; ++i)
@@ -213,6 +219,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
     if (newton_at(s, step, why)) {
       spdlog::info("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
       s_done = s;
+      if (halvings > 0) ds = std::min(2 * ds, 1.0 / steps);  // recover after a cut
       halvings = 0;
       continue;
     }

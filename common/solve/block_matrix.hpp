@@ -1,0 +1,83 @@
+#pragma once
+// Symmetric matrices of 3x3 node blocks (3 unknowns per node, node-major),
+// stored by block rows. Elasticity stiffness matrices couple every unknown
+// of a node to every unknown of its neighbours, so one column index per
+// block instead of per entry cuts the memory traffic of a product by a third.
+#include <omp.h>
+
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace msfab {
+
+struct BlockMatrix {
+  int rows = 0;                 // block rows (nodes)
+  std::vector<int> row_start;   // size rows + 1
+  std::vector<int> column;      // block column of each stored block, ascending within a row
+  std::vector<int> diagonal;    // slot of block (i, i) in row i
+  std::vector<double> values;   // 9 per block, row-major: entry (a, b) at 9 * slot + 3 * a + b
+
+  int num_blocks() const { return row_start.empty() ? 0 : row_start.back(); }
+  Eigen::Index unknowns() const { return 3 * Eigen::Index(rows); }
+};
+
+// Calls body(begin, end) on contiguous row ranges that split [0, n) among
+// the OpenMP team. For kernels whose rows are independent (each output
+// written once), the result does not depend on the split.
+template <class RangeBody>
+void parallel_row_ranges(int n, int team, RangeBody&& body) {
+  if (team <= 1 || n < 2048) {
+    body(0, n);
+    return;
+  }
+#pragma omp parallel num_threads(team)
+  {
+    const int count = omp_get_num_threads();
+    const int me = omp_get_thread_num();
+    const long long begin = (long long)n * me / count;
+    const long long end = (long long)n * (me + 1) / count;
+    body(static_cast<int>(begin), static_cast<int>(end));
+  }
+}
+
+// Block row i of M times x: out[a] = sum_j M_ij(a, :) x_j.
+inline void block_row_product(const BlockMatrix& M, int i, const double* x, double out[3]) {
+  double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+  const int* column = M.column.data();
+  const double* values = M.values.data();
+  for (int slot = M.row_start[i]; slot < M.row_start[i + 1]; ++slot) {
+    const double* m = values + 9 * slot;
+    const double* xj = x + 3 * column[slot];
+    y0 += m[0] * xj[0] + m[1] * xj[1] + m[2] * xj[2];
+    y1 += m[3] * xj[0] + m[4] * xj[1] + m[5] * xj[2];
+    y2 += m[6] * xj[0] + m[7] * xj[1] + m[8] * xj[2];
+  }
+  out[0] = y0;
+  out[1] = y1;
+  out[2] = y2;
+}
+
+// Block pattern of A (n x n, n a multiple of 3, symmetric pattern): block
+// (I, J) is stored if any entry of it is, and every diagonal block is.
+// Throws std::invalid_argument if n is not a multiple of 3.
+BlockMatrix block_pattern(const SpMat& A);
+
+// Copies the values of A + shift I into M (built by block_pattern(A));
+// entries A does not store are zero. A is symmetric, so block row I is read
+// from columns 3I..3I+2 of the compressed column storage.
+void copy_block_values(const SpMat& A, double shift, BlockMatrix& M, int threads);
+
+// y = M x.
+void block_multiply(const BlockMatrix& M, const VecX& x, VecX& y, int threads);
+
+// Per unknown: 1 if its row holds no non-zero but the diagonal (a Dirichlet
+// unknown whose row and column were cleared), else 0.
+std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads);
+
+// M as compressed column storage with both triangles, every block stored in
+// full (the pattern; values are filled by copy_to_sparse()).
+SpMat sparse_pattern(const BlockMatrix& M);
+void copy_to_sparse(const BlockMatrix& M, SpMat& S);
+
+}  // namespace msfab

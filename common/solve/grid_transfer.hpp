@@ -1,0 +1,77 @@
+#pragma once
+// Transfer between two levels of a geometric multigrid hierarchy on a node
+// lattice, and the Galerkin coarse operator P^T A P.
+//
+// P interpolates each displacement component trilinearly: a fine node at
+// lattice point f takes weight 1/2^m from each of the 2^m coarse nodes of
+// its enclosing coarse cell, m the number of odd coordinates of f (weights
+// 1, 1/2, 1/4, 1/8). Rows of P for decoupled fine unknowns (Dirichlet
+// unknowns, whose matrix row holds only the diagonal) are zero, so coarse
+// corrections leave them alone and their diagonal does not leak into the
+// coarse operator.
+#include <cstdint>
+#include <vector>
+
+#include "solve/block_matrix.hpp"
+#include "solve/node_lattice.hpp"
+
+namespace msfab {
+
+class GridTransfer {
+ public:
+  // coarse = coarsen_lattice(fine); fine_operator holds the block pattern of
+  // the fine matrix (node order of `fine`). Builds P, the coarse pattern and
+  // the index tables of the triple product. Throws InputError if the fine
+  // pattern couples nodes that are not lattice neighbours (the matrix is not
+  // that of a trilinear hex mesh on this lattice).
+  GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
+               const BlockMatrix& fine_operator);
+
+  // The coarse operator's block pattern (values zero).
+  BlockMatrix coarse_pattern() const;
+
+  // coarse = P^T fine P, P with the rows of fine_decoupled unknowns zeroed.
+  // Coarse unknowns that P does not reach at all get a unit diagonal (their
+  // rows and columns are zero otherwise). `coarse` must have the coarse
+  // pattern. Exactly symmetric; deterministic for any thread count.
+  void galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
+                        BlockMatrix& coarse, int threads);
+
+  // coarse = P^T fine.
+  void restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled,
+                          VecX& coarse, int threads) const;
+  // fine += P coarse.
+  void add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled,
+                        VecX& fine, int threads) const;
+
+  // P as a sparse matrix (fine unknowns x coarse unknowns), for checks.
+  SpMat prolongation(const std::vector<char>& fine_decoupled) const;
+
+  int fine_nodes() const { return static_cast<int>(parent_start_.size()) - 1; }
+  int coarse_nodes() const { return static_cast<int>(child_start_.size()) - 1; }
+
+ private:
+  // Fine node -> its coarse parents (interpolation sources), weight 1/count.
+  std::vector<int> parent_start_, parent_node_;
+  // Coarse node -> fine children with weights; child_offset_ codes the
+  // child's position relative to twice the coarse point.
+  std::vector<int> child_start_, child_node_;
+  std::vector<double> child_weight_;
+  std::vector<std::uint8_t> child_offset_;
+  // Per fine node: parity of its coordinates (bit per axis).
+  std::vector<std::uint8_t> fine_parity_;
+  // Per fine block: lattice offset code of its column node relative to its
+  // row node, (dx+1) + 3 (dy+1) + 9 (dz+1).
+  std::vector<std::uint8_t> fine_block_offset_;
+  // A P, one dense box of coarse columns per fine row: the coarse points
+  // that can reach row f, 3 per axis for an even coordinate, else 2.
+  std::vector<int> box_start_;
+  std::vector<double> fine_times_p_;
+  // The coarse pattern; per coarse block its offset code (same coding) and
+  // the slot of its transpose.
+  BlockMatrix coarse_;
+  std::vector<std::uint8_t> coarse_block_offset_;
+  std::vector<int> mirror_slot_;
+};
+
+}  // namespace msfab
