@@ -2,6 +2,7 @@
 
 #include "core/errors.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/multigrid_solver.hpp"
 #include "solve/pcg_solver.hpp"
 
 namespace msfab {
@@ -27,12 +28,13 @@ void validate_linear_solver_options(const LinearSolverOptions& options) {
   }
 }
 
-std::vector<std::string> linear_solver_names() { return {"cholmod", "pcg"}; }
+std::vector<std::string> linear_solver_names() { return {"cholmod", "pcg", "pcg-mg"}; }
 
 std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name,
                                                  const LinearSolverOptions& options) {
   if (name == "cholmod") return std::make_unique<CholmodSolver>(options);
   if (name == "pcg") return std::make_unique<PcgSolver>(options);
+  if (name == "pcg-mg") return std::make_unique<MultigridSolver>(options);
   std::string valid;
   for (const std::string& known : linear_solver_names()) {
     valid += (valid.empty() ? "" : ", ") + known;
