@@ -163,6 +163,8 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
         ok = gap_norm > 0 || slope < 0;
       }
       result.timings.solve += seconds_since(t0);
+      spdlog::debug("linear solver {}: factorize {:.3f} s, solve {:.3f} s, {} iterations", solver->name(),
+                    solver->stats().factorize_seconds, solver->stats().solve_seconds, solver->stats().iterations);
       rec.shift = shift;
       rec.linear_iterations = solver->stats().iterations;
       if (!ok) {
