@@ -219,7 +219,8 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
     std::string why;
     ++step;
     if (newton_at(s, step, why)) {
-      spdlog::info("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
+      spdlog::debug("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
+      if (options.on_load_step) options.on_load_step(s);
       s_done = s;
       if (halvings > 0) ds = std::min(2 * ds, 1.0 / steps);  // recover after a cut
       halvings = 0;

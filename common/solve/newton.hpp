@@ -7,6 +7,7 @@
 // current and the prescribed position is part of the step), so a large
 // prescribed displacement moves the interior along with the boundary
 // instead of inverting the elements next to it.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,8 @@ struct NewtonOptions {
   int max_line_search = 40;
   std::string linear_solver = "cholmod";
   LinearSolverOptions linear;
+  // Called after each converged load increment with the load factor reached.
+  std::function<void(double load_factor)> on_load_step;
 };
 
 struct NewtonIteration {

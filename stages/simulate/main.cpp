@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "default_scene.hpp"
@@ -41,7 +42,11 @@ int main(int argc, char** argv) {
                  conditions.dirichlet.count_fixed(), scene.nonlinear ? "Neo-Hookean" : "linear");
 
     // 3. Newton.
-    const NewtonResult result = solve_static(assembler, conditions.dirichlet, conditions.force, scene.newton);
+    NewtonOptions newton = scene.newton;
+    Progress progress("load", 100);
+    newton.on_load_step = [&](double load) { progress.set(static_cast<std::uint64_t>(100 * load + 0.5)); };
+    const NewtonResult result = solve_static(assembler, conditions.dirichlet, conditions.force, newton);
+    progress.done();
     if (!result.converged)
       throw NumericalError(result.failure + "\nresidual history:\n" + format_history(result.history));
 
