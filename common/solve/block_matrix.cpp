@@ -22,8 +22,7 @@ inline Eigen::Index column_end(const SpMat& A, Eigen::Index j) {
 BlockMatrix block_pattern(const SpMat& A) {
   if (A.rows() != A.cols() || A.rows() % 3 != 0) {
     throw std::invalid_argument("block_pattern: matrix is " + std::to_string(A.rows()) + "x" +
-                                std::to_string(A.cols()) +
-                                ", not square with 3 unknowns per node");
+                                std::to_string(A.cols()) + ", not square with 3 unknowns per node");
   }
   BlockMatrix M;
   M.rows = static_cast<int>(A.rows() / 3);
@@ -35,23 +34,22 @@ BlockMatrix block_pattern(const SpMat& A) {
   for (int i = 0; i < M.rows; ++i) {
     row.clear();
     row.push_back(i);
-    seen[static_cast<std::size_t>(i)] = i;
+    seen[i] = i;
     for (int a = 0; a < 3; ++a) {
       const Eigen::Index col = 3 * Eigen::Index(i) + a;
       for (Eigen::Index k = A.outerIndexPtr()[col]; k < column_end(A, col); ++k) {
         const int j = inner[k] / 3;
-        if (seen[static_cast<std::size_t>(j)] != i) {
-          seen[static_cast<std::size_t>(j)] = i;
+        if (seen[j] != i) {
+          seen[j] = i;
           row.push_back(j);
         }
       }
     }
     std::sort(row.begin(), row.end());
-    M.diagonal[static_cast<std::size_t>(i)] =
-        M.row_start[static_cast<std::size_t>(i)] +
-        static_cast<int>(std::lower_bound(row.begin(), row.end(), i) - row.begin());
+    M.diagonal[i] = M.row_start[i] +
+                    static_cast<int>(std::lower_bound(row.begin(), row.end(), i) - row.begin());
     M.column.insert(M.column.end(), row.begin(), row.end());
-    M.row_start[static_cast<std::size_t>(i) + 1] = static_cast<int>(M.column.size());
+    M.row_start[i + 1] = static_cast<int>(M.column.size());
   }
   M.values.assign(9 * M.column.size(), 0.0);
   return M;
@@ -62,8 +60,8 @@ void copy_block_values(const SpMat& A, double shift, BlockMatrix& M, int threads
   const double* source = A.valuePtr();
   parallel_row_ranges(M.rows, resolve_thread_count(threads), [&](int begin, int end) {
     for (int i = begin; i < end; ++i) {
-      const int first = M.row_start[static_cast<std::size_t>(i)];
-      const int last = M.row_start[static_cast<std::size_t>(i) + 1];
+      const int first = M.row_start[i];
+      const int last = M.row_start[i + 1];
       double* row_values = M.values.data() + 9 * std::size_t(first);
       std::fill(row_values, row_values + 9 * std::size_t(last - first), 0.0);
       for (int a = 0; a < 3; ++a) {
@@ -71,13 +69,13 @@ void copy_block_values(const SpMat& A, double shift, BlockMatrix& M, int threads
         int slot = first;
         for (Eigen::Index k = A.outerIndexPtr()[col]; k < column_end(A, col); ++k) {
           const int j = inner[k] / 3;
-          while (M.column[static_cast<std::size_t>(slot)] < j) ++slot;
+          while (M.column[slot] < j) ++slot;
           // Entry (3j + b, 3i + a) of A is entry (a, b) of block (i, j) by symmetry.
           M.values[9 * std::size_t(slot) + 3 * std::size_t(a) + std::size_t(inner[k] % 3)] =
               source[k];
         }
       }
-      double* diagonal = M.values.data() + 9 * std::size_t(M.diagonal[static_cast<std::size_t>(i)]);
+      double* diagonal = M.values.data() + 9 * std::size_t(M.diagonal[i]);
       diagonal[0] += shift;
       diagonal[4] += shift;
       diagonal[8] += shift;
@@ -98,10 +96,9 @@ std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads) {
     for (int i = begin; i < end; ++i) {
       for (int a = 0; a < 3; ++a) {
         bool coupled = false;
-        for (int slot = M.row_start[static_cast<std::size_t>(i)];
-             slot < M.row_start[static_cast<std::size_t>(i) + 1] && !coupled; ++slot) {
+        for (int slot = M.row_start[i]; slot < M.row_start[i + 1] && !coupled; ++slot) {
           const double* m = M.values.data() + 9 * std::size_t(slot) + 3 * a;
-          const bool diagonal = slot == M.diagonal[static_cast<std::size_t>(i)];
+          const bool diagonal = slot == M.diagonal[i];
           for (int b = 0; b < 3; ++b) {
             if (m[b] != 0.0 && !(diagonal && b == a)) coupled = true;
           }
@@ -124,9 +121,8 @@ SpMat sparse_pattern(const BlockMatrix& M) {
     for (int b = 0; b < 3; ++b) {
       outer[3 * j + b] = position;
       // The pattern is symmetric: block column j holds the blocks of block row j.
-      for (int slot = M.row_start[static_cast<std::size_t>(j)];
-           slot < M.row_start[static_cast<std::size_t>(j) + 1]; ++slot) {
-        for (int a = 0; a < 3; ++a) inner[position++] = 3 * M.column[static_cast<std::size_t>(slot)] + a;
+      for (int slot = M.row_start[j]; slot < M.row_start[j + 1]; ++slot) {
+        for (int a = 0; a < 3; ++a) inner[position++] = 3 * M.column[slot] + a;
       }
     }
   }
@@ -139,8 +135,8 @@ void copy_to_sparse(const BlockMatrix& M, SpMat& S) {
   double* target = S.valuePtr();
   const int* outer = S.outerIndexPtr();
   for (int j = 0; j < M.rows; ++j) {
-    const int first = M.row_start[static_cast<std::size_t>(j)];
-    const int count = M.row_start[static_cast<std::size_t>(j) + 1] - first;
+    const int first = M.row_start[j];
+    const int count = M.row_start[j + 1] - first;
     for (int b = 0; b < 3; ++b) {
       double* column = target + outer[3 * j + b];
       // Entry (3i + a, 3j + b) = block (j, i) entry (b, a) by symmetry.

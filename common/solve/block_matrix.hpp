@@ -12,11 +12,11 @@
 namespace msfab {
 
 struct BlockMatrix {
-  int rows = 0;                 // block rows (nodes)
-  std::vector<int> row_start;   // size rows + 1
-  std::vector<int> column;      // block column of each stored block, ascending within a row
-  std::vector<int> diagonal;    // slot of block (i, i) in row i
-  std::vector<double> values;   // 9 per block, row-major: entry (a, b) at 9 * slot + 3 * a + b
+  int rows = 0;                // block rows (nodes)
+  std::vector<int> row_start;  // size rows + 1
+  std::vector<int> column;     // block column of each stored block, ascending within a row
+  std::vector<int> diagonal;   // slot of block (i, i) in row i
+  std::vector<double> values;  // 9 per block, row-major: entry (a, b) at 9 * slot + 3 * a + b
 
   int num_blocks() const { return row_start.empty() ? 0 : row_start.back(); }
   Eigen::Index unknowns() const { return 3 * Eigen::Index(rows); }
@@ -41,21 +41,26 @@ void parallel_row_ranges(int n, int team, RangeBody&& body) {
   }
 }
 
-// Block row i of M times x: out[a] = sum_j M_ij(a, :) x_j.
-inline void block_row_product(const BlockMatrix& M, int i, const double* x, double out[3]) {
+// Block row i of M times x: out[a] = sum_j M_ij(a, :) x_j, with the values
+// taken from `values` (laid out like M.values; float for a compact copy).
+template <class Value>
+inline void block_row_product(const BlockMatrix& M, const Value* values, int i, const double* x,
+                              double out[3]) {
   double y0 = 0.0, y1 = 0.0, y2 = 0.0;
   const int* column = M.column.data();
-  const double* values = M.values.data();
   for (int slot = M.row_start[i]; slot < M.row_start[i + 1]; ++slot) {
-    const double* m = values + 9 * slot;
-    const double* xj = x + 3 * column[slot];
-    y0 += m[0] * xj[0] + m[1] * xj[1] + m[2] * xj[2];
-    y1 += m[3] * xj[0] + m[4] * xj[1] + m[5] * xj[2];
-    y2 += m[6] * xj[0] + m[7] * xj[1] + m[8] * xj[2];
+    const Value* m = values + 9 * std::size_t(slot);
+    const double* xj = x + 3 * std::size_t(column[slot]);
+    y0 += double(m[0]) * xj[0] + double(m[1]) * xj[1] + double(m[2]) * xj[2];
+    y1 += double(m[3]) * xj[0] + double(m[4]) * xj[1] + double(m[5]) * xj[2];
+    y2 += double(m[6]) * xj[0] + double(m[7]) * xj[1] + double(m[8]) * xj[2];
   }
   out[0] = y0;
   out[1] = y1;
   out[2] = y2;
+}
+inline void block_row_product(const BlockMatrix& M, int i, const double* x, double out[3]) {
+  block_row_product(M, M.values.data(), i, x, out);
 }
 
 // Block pattern of A (n x n, n a multiple of 3, symmetric pattern): block

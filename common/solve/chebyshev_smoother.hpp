@@ -17,15 +17,22 @@ namespace msfab {
 
 class ChebyshevSmoother {
  public:
-  // Inverts the diagonal blocks of A and estimates the largest eigenvalue of
-  // D^-1 A. Returns false if a diagonal block is not positive definite.
+  // Takes A's values in single precision as the smoother's operator (a
+  // product then moves half the bytes; the smoother is only a
+  // preconditioner, and the rounded matrix is still exactly symmetric),
+  // inverts the diagonal blocks and estimates the largest eigenvalue of
+  // D^-1 A. A must stay alive (its pattern is used) until the next setup().
+  // Returns false if a diagonal block is not positive definite.
   bool setup(const BlockMatrix& A, int degree, int threads);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).
-  void smooth(const BlockMatrix& A, const VecX& b, VecX& x, bool zero_start);
+  void smooth(const VecX& b, VecX& x, bool zero_start);
+  // r = b - A x with the smoother's operator.
+  void residual(const VecX& b, const VecX& x, VecX& r) const;
 
   double max_eigenvalue() const { return max_eigenvalue_; }
+  int degree() const { return degree_; }
 
  private:
   // z = D^-1 r for node i.
@@ -35,8 +42,13 @@ class ChebyshevSmoother {
     z[1] = m[3] * r[0] + m[4] * r[1] + m[5] * r[2];
     z[2] = m[6] * r[0] + m[7] * r[1] + m[8] * r[2];
   }
-  double estimate_max_eigenvalue(const BlockMatrix& A) const;
+  void row_product(int i, const double* x, double out[3]) const {
+    block_row_product(*pattern_, values_.data(), i, x, out);
+  }
+  double estimate_max_eigenvalue() const;
 
+  const BlockMatrix* pattern_ = nullptr;
+  std::vector<float> values_;    // A in single precision, laid out like A.values
   std::vector<double> inverse_;  // inverse diagonal blocks, 9 per node, row-major
   double max_eigenvalue_ = 0.0;
   int degree_ = 2;

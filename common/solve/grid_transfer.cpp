@@ -16,7 +16,9 @@ namespace {
 // lattice order (x fastest), a code >= 13 means a column node >= the row node.
 constexpr int kCenter = 13;
 
-int offset_component(int code, int axis) { return (axis == 0 ? code : axis == 1 ? code / 3 : code / 9) % 3 - 1; }
+int offset_component(int code, int axis) {
+  return (axis == 0 ? code : axis == 1 ? code / 3 : code / 9) % 3 - 1;
+}
 
 // A fine node's box of coarse columns in A P: coarse points floor((c-1)/2)
 // onward, 3 per axis for an even coordinate c and 2 for an odd one.
@@ -44,7 +46,7 @@ const std::array<std::array<EntryList, 27>, 8>& parent_box_entries() {
       for (int code = 0; code < 27; ++code) {
         const int ox = offset_component(code, 0) + 1, oy = offset_component(code, 1) + 1,
                   oz = offset_component(code, 2) + 1;
-        EntryList& list = t[static_cast<std::size_t>(parity)][static_cast<std::size_t>(code)];
+        EntryList& list = t[parity][code];
         for (int w = first[pz][oz]; w <= last[pz][oz]; ++w) {
           for (int v = first[py][oy]; v <= last[py][oy]; ++v) {
             for (int u = first[px][ox]; u <= last[px][ox]; ++u) {
@@ -69,16 +71,16 @@ const std::array<EntryList, 27>& box_entry_offsets() {
       std::array<int, 3> extent{}, shift{};
       for (int axis = 0; axis < 3; ++axis) {
         const int delta = offset_component(child, axis);
-        extent[static_cast<std::size_t>(axis)] = box_extent(delta != 0);
+        extent[axis] = box_extent(delta != 0);
         // The box starts at floor((2C + delta - 1) / 2) = C - 1 (delta <= 0) or C (delta = 1).
-        shift[static_cast<std::size_t>(axis)] = delta == 1 ? 1 : 0;
+        shift[axis] = delta == 1 ? 1 : 0;
       }
-      EntryList& list = t[static_cast<std::size_t>(child)];
+      EntryList& list = t[child];
       for (int w = 0; w < extent[2]; ++w) {
         for (int v = 0; v < extent[1]; ++v) {
           for (int u = 0; u < extent[0]; ++u) {
-            list.entry[static_cast<std::size_t>(list.count++)] = static_cast<std::uint8_t>(
-                (u + shift[0]) + 3 * (v + shift[1]) + 9 * (w + shift[2]));
+            list.entry[static_cast<std::size_t>(list.count++)] =
+                static_cast<std::uint8_t>((u + shift[0]) + 3 * (v + shift[1]) + 9 * (w + shift[2]));
           }
         }
       }
@@ -105,24 +107,24 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
   fine_parity_.resize(static_cast<std::size_t>(fine_count));
   box_start_.assign(static_cast<std::size_t>(fine_count) + 1, 0);
   for (int f = 0; f < fine_count; ++f) {
-    const std::array<int, 3>& c = fine.coords[static_cast<std::size_t>(f)];
+    const std::array<int, 3>& c = fine.coords[f];
     const int parity = (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2;
-    fine_parity_[static_cast<std::size_t>(f)] = static_cast<std::uint8_t>(parity);
+    fine_parity_[f] = static_cast<std::uint8_t>(parity);
     for (int k = c[2] / 2; k <= (c[2] + 1) / 2; ++k) {
       for (int j = c[1] / 2; j <= (c[1] + 1) / 2; ++j) {
-        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i) parent_node_.push_back(coarse.node(i, j, k));
+        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i)
+          parent_node_.push_back(coarse.node(i, j, k));
       }
     }
-    parent_start_[static_cast<std::size_t>(f) + 1] = static_cast<int>(parent_node_.size());
-    box_start_[static_cast<std::size_t>(f) + 1] = box_start_[static_cast<std::size_t>(f)] + box_size(parity);
+    parent_start_[f + 1] = static_cast<int>(parent_node_.size());
+    box_start_[f + 1] = box_start_[f] + box_size(parity);
   }
   fine_block_offset_.resize(static_cast<std::size_t>(fine_operator.num_blocks()));
   for (int f = 0; f < fine_count; ++f) {
-    const std::array<int, 3>& c = fine.coords[static_cast<std::size_t>(f)];
-    for (int slot = fine_operator.row_start[static_cast<std::size_t>(f)];
-         slot < fine_operator.row_start[static_cast<std::size_t>(f) + 1]; ++slot) {
-      const int g = fine_operator.column[static_cast<std::size_t>(slot)];
-      const std::array<int, 3>& d = fine.coords[static_cast<std::size_t>(g)];
+    const std::array<int, 3>& c = fine.coords[f];
+    for (int slot = fine_operator.row_start[f]; slot < fine_operator.row_start[f + 1]; ++slot) {
+      const int g = fine_operator.column[slot];
+      const std::array<int, 3>& d = fine.coords[g];
       const int dx = d[0] - c[0], dy = d[1] - c[1], dz = d[2] - c[2];
       if (std::abs(dx) > 1 || std::abs(dy) > 1 || std::abs(dz) > 1) {
         throw InputError("pcg-mg needs a voxel mesh: the matrix couples nodes " +
@@ -130,8 +132,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
                          ", which are not neighbours on the node lattice (is node_positions "
                          "the rest configuration of this mesh?)");
       }
-      fine_block_offset_[static_cast<std::size_t>(slot)] =
-          static_cast<std::uint8_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1));
+      fine_block_offset_[slot] = static_cast<std::uint8_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1));
     }
   }
   fine_times_p_.assign(9 * static_cast<std::size_t>(box_start_.back()), 0.0);
@@ -139,7 +140,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
   // Children of the coarse nodes, in offset order.
   child_start_.assign(static_cast<std::size_t>(coarse_count) + 1, 0);
   for (int p = 0; p < coarse_count; ++p) {
-    const std::array<int, 3>& c = coarse.coords[static_cast<std::size_t>(p)];
+    const std::array<int, 3>& c = coarse.coords[p];
     for (int code = 0; code < 27; ++code) {
       const int dx = offset_component(code, 0), dy = offset_component(code, 1),
                 dz = offset_component(code, 2);
@@ -149,7 +150,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
       child_weight_.push_back(1.0 / double(1 << (std::abs(dx) + std::abs(dy) + std::abs(dz))));
       child_offset_.push_back(static_cast<std::uint8_t>(code));
     }
-    child_start_[static_cast<std::size_t>(p) + 1] = static_cast<int>(child_node_.size());
+    child_start_[p + 1] = static_cast<int>(child_node_.size());
   }
 
   // Coarse pattern: block (p, q) is stored if a child of p couples to a fine
@@ -162,39 +163,38 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
   std::vector<std::array<int, 27>> slot_of_offset(static_cast<std::size_t>(coarse_count));
   for (int p = 0; p < coarse_count; ++p) {
     std::array<bool, 27> reached{};
-    for (int k = child_start_[static_cast<std::size_t>(p)]; k < child_start_[static_cast<std::size_t>(p) + 1]; ++k) {
-      const int f = child_node_[static_cast<std::size_t>(k)];
-      const EntryList& to_code = box_offsets[child_offset_[static_cast<std::size_t>(k)]];
-      for (int slot = fine_operator.row_start[static_cast<std::size_t>(f)];
-           slot < fine_operator.row_start[static_cast<std::size_t>(f) + 1]; ++slot) {
-        const EntryList& entries =
-            parents[fine_parity_[static_cast<std::size_t>(f)]][fine_block_offset_[static_cast<std::size_t>(slot)]];
-        for (int e = 0; e < entries.count; ++e) reached[to_code.entry[entries.entry[static_cast<std::size_t>(e)]]] = true;
+    for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
+      const int f = child_node_[k];
+      const EntryList& to_code = box_offsets[child_offset_[k]];
+      for (int slot = fine_operator.row_start[f]; slot < fine_operator.row_start[f + 1]; ++slot) {
+        const EntryList& entries = parents[fine_parity_[f]][fine_block_offset_[slot]];
+        for (int e = 0; e < entries.count; ++e) reached[to_code.entry[entries.entry[e]]] = true;
       }
     }
     reached[kCenter] = true;
-    const std::array<int, 3>& c = coarse.coords[static_cast<std::size_t>(p)];
-    std::array<int, 27>& slots = slot_of_offset[static_cast<std::size_t>(p)];
+    const std::array<int, 3>& c = coarse.coords[p];
+    std::array<int, 27>& slots = slot_of_offset[p];
     slots.fill(-1);
     for (int code = 0; code < 27; ++code) {
-      if (!reached[static_cast<std::size_t>(code)]) continue;
+      if (!reached[code]) continue;
       const int q = coarse.node(c[0] + offset_component(code, 0), c[1] + offset_component(code, 1),
                                 c[2] + offset_component(code, 2));
       if (q < 0) throw std::logic_error("GridTransfer: a reached coarse point has no node");
-      slots[static_cast<std::size_t>(code)] = static_cast<int>(coarse_.column.size());
-      if (code == kCenter) coarse_.diagonal[static_cast<std::size_t>(p)] = static_cast<int>(coarse_.column.size());
+      slots[code] = static_cast<int>(coarse_.column.size());
+      if (code == kCenter) coarse_.diagonal[p] = static_cast<int>(coarse_.column.size());
       coarse_.column.push_back(q);
       coarse_block_offset_.push_back(static_cast<std::uint8_t>(code));
     }
-    coarse_.row_start[static_cast<std::size_t>(p) + 1] = static_cast<int>(coarse_.column.size());
+    coarse_.row_start[p + 1] = static_cast<int>(coarse_.column.size());
   }
   mirror_slot_.resize(coarse_.column.size());
   for (int p = 0; p < coarse_count; ++p) {
-    for (int slot = coarse_.row_start[static_cast<std::size_t>(p)]; slot < coarse_.row_start[static_cast<std::size_t>(p) + 1]; ++slot) {
-      const int q = coarse_.column[static_cast<std::size_t>(slot)];
-      const int mirror = slot_of_offset[static_cast<std::size_t>(q)][static_cast<std::size_t>(26 - coarse_block_offset_[static_cast<std::size_t>(slot)])];
+    for (int slot = coarse_.row_start[p]; slot < coarse_.row_start[p + 1]; ++slot) {
+      const int q = coarse_.column[slot];
+      const int mirror =
+          slot_of_offset[q][static_cast<std::size_t>(26 - coarse_block_offset_[slot])];
       if (mirror < 0) throw std::logic_error("GridTransfer: the coarse pattern is not symmetric");
-      mirror_slot_[static_cast<std::size_t>(slot)] = mirror;
+      mirror_slot_[slot] = mirror;
     }
   }
 }
@@ -216,16 +216,16 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
   // its column node, lands on the box entries of that node's parents.
   parallel_row_ranges(fine.rows, team, [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
-      const int parity = fine_parity_[static_cast<std::size_t>(f)];
-      double* box = fine_times_p_.data() + 9 * std::size_t(box_start_[static_cast<std::size_t>(f)]);
+      const int parity = fine_parity_[f];
+      double* box = fine_times_p_.data() + 9 * std::size_t(box_start_[f]);
       std::fill(box, box + 9 * box_size(parity), 0.0);
-      for (int slot = fine.row_start[static_cast<std::size_t>(f)]; slot < fine.row_start[static_cast<std::size_t>(f) + 1]; ++slot) {
-        const EntryList& entries = parents[static_cast<std::size_t>(parity)][fine_block_offset_[static_cast<std::size_t>(slot)]];
+      for (int slot = fine.row_start[f]; slot < fine.row_start[f + 1]; ++slot) {
+        const EntryList& entries = parents[parity][fine_block_offset_[slot]];
         const double weight = 1.0 / entries.count;  // a power of two: exact
         double scaled[9];
         const double* block = fine.values.data() + 9 * std::size_t(slot);
         for (int a = 0; a < 9; ++a) scaled[a] = weight * block[a];
-        if (slot == fine.diagonal[static_cast<std::size_t>(f)]) {
+        if (slot == fine.diagonal[f]) {
           // P has no row for a decoupled unknown: drop its diagonal (its
           // off-diagonal entries are zero already).
           for (int a = 0; a < 3; ++a) {
@@ -233,7 +233,7 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
           }
         }
         for (int e = 0; e < entries.count; ++e) {
-          double* target = box + 9 * std::size_t(entries.entry[static_cast<std::size_t>(e)]);
+          double* target = box + 9 * std::size_t(entries.entry[e]);
           for (int a = 0; a < 9; ++a) target[a] += scaled[a];
         }
       }
@@ -247,21 +247,22 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
     for (int p = begin; p < end; ++p) {
       for (int code = kCenter; code < 27; ++code) std::fill(sum[code], sum[code] + 9, 0.0);
       bool reached[3] = {false, false, false};
-      for (int k = child_start_[static_cast<std::size_t>(p)]; k < child_start_[static_cast<std::size_t>(p) + 1]; ++k) {
-        const int f = child_node_[static_cast<std::size_t>(k)];
-        const double weight = child_weight_[static_cast<std::size_t>(k)];
-        for (int a = 0; a < 3; ++a) reached[a] = reached[a] || !fine_decoupled[3 * std::size_t(f) + std::size_t(a)];
-        const EntryList& to_code = box_offsets[child_offset_[static_cast<std::size_t>(k)]];
-        const double* box = fine_times_p_.data() + 9 * std::size_t(box_start_[static_cast<std::size_t>(f)]);
+      for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
+        const int f = child_node_[k];
+        const double weight = child_weight_[k];
+        for (int a = 0; a < 3; ++a)
+          reached[a] = reached[a] || !fine_decoupled[3 * std::size_t(f) + std::size_t(a)];
+        const EntryList& to_code = box_offsets[child_offset_[k]];
+        const double* box = fine_times_p_.data() + 9 * std::size_t(box_start_[f]);
         for (int e = 0; e < to_code.count; ++e) {
-          const int code = to_code.entry[static_cast<std::size_t>(e)];
+          const int code = to_code.entry[e];
           if (code < kCenter) continue;
           const double* block = box + 9 * e;
           for (int a = 0; a < 9; ++a) sum[code][a] += weight * block[a];
         }
       }
-      for (int slot = coarse.row_start[static_cast<std::size_t>(p)]; slot < coarse.row_start[static_cast<std::size_t>(p) + 1]; ++slot) {
-        const int code = coarse_block_offset_[static_cast<std::size_t>(slot)];
+      for (int slot = coarse.row_start[p]; slot < coarse.row_start[p + 1]; ++slot) {
+        const int code = coarse_block_offset_[slot];
         if (code < kCenter) continue;
         double* target = coarse.values.data() + 9 * std::size_t(slot);
         std::copy(sum[code], sum[code] + 9, target);
@@ -283,9 +284,9 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
   // Lower triangle: transposes of the upper blocks.
   parallel_row_ranges(coarse.rows, team, [&](int begin, int end) {
     for (int p = begin; p < end; ++p) {
-      for (int slot = coarse.row_start[static_cast<std::size_t>(p)]; slot < coarse.row_start[static_cast<std::size_t>(p) + 1]; ++slot) {
-        if (coarse_block_offset_[static_cast<std::size_t>(slot)] >= kCenter) continue;
-        const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[static_cast<std::size_t>(slot)]);
+      for (int slot = coarse.row_start[p]; slot < coarse.row_start[p + 1]; ++slot) {
+        if (coarse_block_offset_[slot] >= kCenter) continue;
+        const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[slot]);
         double* target = coarse.values.data() + 9 * std::size_t(slot);
         for (int a = 0; a < 3; ++a) {
           for (int b = 0; b < 3; ++b) target[3 * a + b] = source[3 * b + a];
@@ -301,11 +302,12 @@ void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>&
   parallel_row_ranges(coarse_nodes(), resolve_thread_count(threads), [&](int begin, int end) {
     for (int p = begin; p < end; ++p) {
       double sum[3] = {0.0, 0.0, 0.0};
-      for (int k = child_start_[static_cast<std::size_t>(p)]; k < child_start_[static_cast<std::size_t>(p) + 1]; ++k) {
-        const std::size_t f = static_cast<std::size_t>(child_node_[static_cast<std::size_t>(k)]);
-        const double weight = child_weight_[static_cast<std::size_t>(k)];
+      for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
+        const std::size_t f = static_cast<std::size_t>(child_node_[k]);
+        const double weight = child_weight_[k];
         for (int a = 0; a < 3; ++a) {
-          if (!fine_decoupled[3 * f + std::size_t(a)]) sum[a] += weight * fine[Eigen::Index(3 * f) + a];
+          if (!fine_decoupled[3 * f + std::size_t(a)])
+            sum[a] += weight * fine[Eigen::Index(3 * f) + a];
         }
       }
       for (int a = 0; a < 3; ++a) coarse[3 * Eigen::Index(p) + a] = sum[a];
@@ -317,16 +319,17 @@ void GridTransfer::add_prolongation(const VecX& coarse, const std::vector<char>&
                                     VecX& fine, int threads) const {
   parallel_row_ranges(fine_nodes(), resolve_thread_count(threads), [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
-      const int first = parent_start_[static_cast<std::size_t>(f)];
-      const int last = parent_start_[static_cast<std::size_t>(f) + 1];
+      const int first = parent_start_[f];
+      const int last = parent_start_[f + 1];
       const double weight = 1.0 / (last - first);
       double sum[3] = {0.0, 0.0, 0.0};
       for (int k = first; k < last; ++k) {
-        const Eigen::Index p = 3 * Eigen::Index(parent_node_[static_cast<std::size_t>(k)]);
+        const Eigen::Index p = 3 * Eigen::Index(parent_node_[k]);
         for (int a = 0; a < 3; ++a) sum[a] += coarse[p + a];
       }
       for (int a = 0; a < 3; ++a) {
-        if (!fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) fine[3 * Eigen::Index(f) + a] += weight * sum[a];
+        if (!fine_decoupled[3 * std::size_t(f) + std::size_t(a)])
+          fine[3 * Eigen::Index(f) + a] += weight * sum[a];
       }
     }
   });
@@ -335,12 +338,12 @@ void GridTransfer::add_prolongation(const VecX& coarse, const std::vector<char>&
 SpMat GridTransfer::prolongation(const std::vector<char>& fine_decoupled) const {
   std::vector<Eigen::Triplet<double, int>> entries;
   for (int f = 0; f < fine_nodes(); ++f) {
-    const int first = parent_start_[static_cast<std::size_t>(f)];
-    const int last = parent_start_[static_cast<std::size_t>(f) + 1];
+    const int first = parent_start_[f];
+    const int last = parent_start_[f + 1];
     for (int k = first; k < last; ++k) {
       for (int a = 0; a < 3; ++a) {
         if (fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) continue;
-        entries.emplace_back(3 * f + a, 3 * parent_node_[static_cast<std::size_t>(k)] + a, 1.0 / (last - first));
+        entries.emplace_back(3 * f + a, 3 * parent_node_[k] + a, 1.0 / (last - first));
       }
     }
   }

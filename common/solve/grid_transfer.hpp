@@ -38,11 +38,11 @@ class GridTransfer {
                         BlockMatrix& coarse, int threads);
 
   // coarse = P^T fine.
-  void restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled,
-                          VecX& coarse, int threads) const;
+  void restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled, VecX& coarse,
+                          int threads) const;
   // fine += P coarse.
-  void add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled,
-                        VecX& fine, int threads) const;
+  void add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled, VecX& fine,
+                        int threads) const;
 
   // P as a sparse matrix (fine unknowns x coarse unknowns), for checks.
   SpMat prolongation(const std::vector<char>& fine_decoupled) const;

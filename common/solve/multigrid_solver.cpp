@@ -10,7 +10,6 @@
 #include "core/errors.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_smoother.hpp"
-#include "solve/cholmod_solver.hpp"
 #include "solve/grid_transfer.hpp"
 #include "solve/node_lattice.hpp"
 #include "solve/sparse_ops.hpp"
@@ -21,6 +20,10 @@ namespace {
 
 // Deeper hierarchies than this never occur for meshes that fit in memory.
 constexpr int kMaxLevels = 24;
+// Smoother degree on the coarse levels, relative to mg_smoother_degree.
+constexpr int kCoarseDegreeFactor = 2;
+// Coarse corrections per visit of a level below the finest (2: W-cycle).
+constexpr int kCoarseCorrections = 2;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -37,7 +40,7 @@ std::string format_number(double value) {
 struct MultigridSolver::Level {
   NodeLattice lattice;
   BlockMatrix matrix;
-  std::vector<char> decoupled;             // unknowns whose row holds only the diagonal
+  std::vector<char> decoupled;              // unknowns whose row holds only the diagonal
   std::unique_ptr<GridTransfer> to_coarse;  // null on the coarsest level
   ChebyshevSmoother smoother;
   VecX rhs, solution, residual;  // V-cycle workspace
@@ -60,12 +63,10 @@ MultigridSolver::~MultigridSolver() = default;
 void MultigridSolver::analyze(const SpMat& A) {
   const auto start = std::chrono::steady_clock::now();
   if (A.rows() != A.cols()) {
-    throw std::invalid_argument("MultigridSolver::analyze: matrix is " +
-                                std::to_string(A.rows()) + "x" + std::to_string(A.cols()) +
-                                ", not square");
+    throw std::invalid_argument("MultigridSolver::analyze: matrix is " + std::to_string(A.rows()) +
+                                "x" + std::to_string(A.cols()) + ", not square");
   }
   levels_.clear();
-  coarse_solver_.reset();
   ready_ = false;
   n_ = -1;
   stats_ = LinearSolveStats{};
@@ -76,8 +77,9 @@ void MultigridSolver::analyze(const SpMat& A) {
     return;
   }
   if (!options_.node_positions) {
-    throw InputError("pcg-mg needs a voxel mesh: LinearSolverOptions::node_positions is not set "
-                     "(give the rest positions of the mesh nodes, or use 'cholmod' or 'pcg')");
+    throw InputError(
+        "pcg-mg needs a voxel mesh: LinearSolverOptions::node_positions is not set "
+        "(give the rest positions of the mesh nodes, or use 'cholmod' or 'pcg')");
   }
   const Eigen::Index nodes = options_.node_positions->rows();
   if (3 * nodes != A.rows()) {
@@ -95,7 +97,8 @@ void MultigridSolver::analyze(const SpMat& A) {
     Level& level = *levels_.back();
     NodeLattice coarse_lattice = coarsen_lattice(level.lattice);
     // A lattice only one or two points thick in every direction stops shrinking.
-    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes())) break;
+    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes()))
+      break;
     level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix);
     auto coarse = std::make_unique<Level>();
     coarse->matrix = level.to_coarse->coarse_pattern();
@@ -104,12 +107,7 @@ void MultigridSolver::analyze(const SpMat& A) {
   }
 
   coarsest_ = sparse_pattern(levels_.back()->matrix);
-  // The coarse solver leaves the process-wide BLAS thread count alone
-  // (threads = 0), so the solution does not depend on options_.threads.
-  LinearSolverOptions coarse_options;
-  coarse_options.threads = 0;
-  coarse_solver_ = std::make_unique<CholmodSolver>(coarse_options);
-  coarse_solver_->analyze(coarsest_);
+  coarse_solver_.analyzePattern(coarsest_);
 
   n_ = A.rows();
   pattern_ = pattern_fingerprint(A);
@@ -139,14 +137,18 @@ bool MultigridSolver::factorize(const SpMat& A, double shift) {
     if (!level.to_coarse) break;
     level.to_coarse->galerkin_product(level.matrix, level.decoupled, levels_[l + 1]->matrix,
                                       threads);
-    if (!level.smoother.setup(level.matrix, options_.mg_smoother_degree, threads)) {
+    // Coarse levels are small: smoothing them harder costs little and keeps
+    // the under-resolved high-contrast coarse operators from slowing CG down.
+    const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * options_.mg_smoother_degree;
+    if (!level.smoother.setup(level.matrix, degree, threads)) {
       definite = false;
       break;
     }
   }
   if (definite) {
     copy_to_sparse(levels_.back()->matrix, coarsest_);
-    definite = coarse_solver_->factorize(coarsest_, 0.0);
+    coarse_solver_.factorize(coarsest_);
+    definite = coarse_solver_.info() == Eigen::Success;
   }
   stats_.positive_definite = definite;
   ready_ = definite;
@@ -154,27 +156,27 @@ bool MultigridSolver::factorize(const SpMat& A, double shift) {
   return definite;
 }
 
-void MultigridSolver::v_cycle(std::size_t index, const VecX& rhs, VecX& solution) {
+void MultigridSolver::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
   if (index + 1 == levels_.size()) {
-    solution = coarse_solver_->solve(rhs);
+    solution = coarse_solver_.solve(rhs);
     return;
   }
   Level& level = *levels_[index];
   Level& coarse = *levels_[index + 1];
   const int threads = options_.threads;
-  level.smoother.smooth(level.matrix, rhs, solution, /*zero_start=*/true);
-  level.residual.resize(rhs.size());
-  parallel_row_ranges(level.matrix.rows, resolve_thread_count(threads), [&](int begin, int end) {
-    for (int i = begin; i < end; ++i) {
-      double product[3];
-      block_row_product(level.matrix, i, solution.data(), product);
-      for (int a = 0; a < 3; ++a) level.residual[3 * i + a] = rhs[3 * i + a] - product[a];
-    }
-  });
-  level.to_coarse->restrict_to_coarse(level.residual, level.decoupled, coarse.rhs, threads);
-  v_cycle(index + 1, coarse.rhs, coarse.solution);
-  level.to_coarse->add_prolongation(coarse.solution, level.decoupled, solution, threads);
-  level.smoother.smooth(level.matrix, rhs, solution, /*zero_start=*/false);
+  level.smoother.smooth(rhs, solution, /*zero_start=*/true);
+  // Below the finest level two coarse corrections per visit (a W-cycle):
+  // the repeated correction is cheap there and keeps the cycle close to a
+  // two-grid method. Repeating the same symmetric correction keeps the
+  // cycle symmetric.
+  const int corrections = index == 0 ? 1 : kCoarseCorrections;
+  for (int c = 0; c < corrections; ++c) {
+    level.smoother.residual(rhs, solution, level.residual);
+    level.to_coarse->restrict_to_coarse(level.residual, level.decoupled, coarse.rhs, threads);
+    cycle(index + 1, coarse.rhs, coarse.solution);
+    level.to_coarse->add_prolongation(coarse.solution, level.decoupled, solution, threads);
+  }
+  level.smoother.smooth(rhs, solution, /*zero_start=*/false);
 }
 
 VecX MultigridSolver::apply_preconditioner(const VecX& r) {
@@ -187,7 +189,7 @@ VecX MultigridSolver::apply_preconditioner(const VecX& r) {
                                 std::to_string(n_) + " rows");
   }
   VecX z;
-  v_cycle(0, r, z);
+  cycle(0, r, z);
   return z;
 }
 
@@ -230,12 +232,12 @@ VecX MultigridSolver::solve(const VecX& b) {
   auto not_definite = [&](const std::string& what, double value) {
     stats_.positive_definite = false;
     fail("pcg-mg met " + what + " = " + format_number(value) + " at iteration " +
-         std::to_string(iteration) +
-         ": the matrix is not positive definite; factorize with a larger shift");
+         std::to_string(iteration) + " (relative residual " + format_number(r_norm / b_norm) +
+         "): the matrix is not positive definite; factorize with a larger shift");
   };
 
   VecX r = b, z, p, q(n);
-  v_cycle(0, r, z);
+  cycle(0, r, z);
   double rz = parallel_dot(r, z, threads);
   if (!(rz > 0.0) || !std::isfinite(rz)) not_definite("r' M^-1 r", rz);
   p = z;
@@ -248,7 +250,7 @@ VecX MultigridSolver::solve(const VecX& b) {
       });
       r_norm = std::sqrt(parallel_dot(r, r, threads));
       if (r_norm <= target) break;
-      v_cycle(0, r, z);
+      cycle(0, r, z);
       rz = parallel_dot(r, z, threads);
       if (!(rz > 0.0) || !std::isfinite(rz)) not_definite("r' M^-1 r", rz);
       p = z;
@@ -287,7 +289,7 @@ VecX MultigridSolver::solve(const VecX& b) {
     ++iteration;
     if (iteration % history_stride == 0) history += ", " + format_number(r_norm / b_norm);
     if (r_norm <= target) continue;
-    v_cycle(0, r, z);
+    cycle(0, r, z);
     const double rz_next = parallel_dot(r, z, threads);
     if (!(rz_next > 0.0) || !std::isfinite(rz_next)) not_definite("r' M^-1 r", rz_next);
     const double beta = rz_next / rz;

@@ -1,5 +1,5 @@
 #pragma once
-// Conjugate gradients preconditioned by one geometric multigrid V-cycle
+// Conjugate gradients preconditioned by one geometric multigrid cycle
 // ("pcg-mg"), for stiffness matrices of voxel meshes: 3 unknowns per node,
 // nodes on a regular lattice (given by LinearSolverOptions::node_positions).
 //
@@ -8,8 +8,13 @@
 // Trilinear prolongation per displacement component, Galerkin coarse
 // operators P^T A P (pattern and index tables built in analyze(), values in
 // factorize()), Chebyshev / block-Jacobi smoothing before and after each
-// coarse correction, and CHOLMOD on the coarsest level. Every kernel is
-// OpenMP-parallel and bitwise deterministic for any thread count.
+// coarse correction (one correction on the finest level, two on each level
+// below: a V-cycle on top of W-cycles), and a sparse Cholesky factorization
+// of the coarsest level. The cycle is a fixed symmetric positive definite
+// operator, so plain CG applies. Every kernel is OpenMP-parallel and
+// bitwise deterministic for any thread count.
+#include <Eigen/SparseCholesky>
+
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -17,8 +22,6 @@
 #include "solve/linear_solver.hpp"
 
 namespace msfab {
-
-class CholmodSolver;
 
 class MultigridSolver final : public LinearSolver {
  public:
@@ -50,18 +53,22 @@ class MultigridSolver final : public LinearSolver {
   SpMat level_operator(int level) const;
   // Prolongation from level + 1 to level.
   SpMat prolongation(int level) const;
-  // One V-cycle, z = M^-1 r, after a successful factorize().
+  // One multigrid cycle, z = M^-1 r, after a successful factorize().
   VecX apply_preconditioner(const VecX& r);
 
  private:
   struct Level;
-  void v_cycle(std::size_t level, const VecX& rhs, VecX& solution);
+  void cycle(std::size_t level, const VecX& rhs, VecX& solution);
 
   LinearSolverOptions options_;
   LinearSolveStats stats_;
   std::vector<std::unique_ptr<Level>> levels_;
-  SpMat coarsest_;  // the coarsest level's operator, as CHOLMOD reads it
-  std::unique_ptr<CholmodSolver> coarse_solver_;
+  SpMat coarsest_;  // the coarsest level's operator in compressed columns
+  // The coarsest level has a few thousand unknowns at most. A simplicial
+  // factorization calls no BLAS: a supernodal one (CHOLMOD) would start the
+  // multithreaded BLAS on every coarse solve, a large overhead at this size,
+  // and its last bits would depend on the BLAS thread count.
+  Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> coarse_solver_;
   Eigen::Index n_ = -1;  // -1: not analyzed
   std::uint64_t pattern_ = 0;
   bool ready_ = false;  // the last factorize() succeeded

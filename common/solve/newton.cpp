@@ -74,7 +74,10 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
   NewtonResult result;
   result.x = x0.size() == n ? x0 : X;
   SpMat K = assembler.pattern();
-  auto solver = make_linear_solver(options.linear_solver, options.linear);
+  LinearSolverOptions linear = options.linear;
+  if (options.linear_solver == "pcg-mg" && !linear.node_positions)
+    linear.node_positions = std::make_shared<const NodeArray>(assembler.mesh().nodes);  // the MG hierarchy's lattice
+  auto solver = make_linear_solver(options.linear_solver, linear);
   {
     const auto t0 = Clock::now();
     solver->analyze(K);

@@ -50,11 +50,11 @@ NodeLattice lattice_from_positions(const NodePositions& positions) {
   NodeLattice lattice;
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<double> values(static_cast<std::size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i) values[static_cast<std::size_t>(i)] = positions(i, axis);
+    for (Eigen::Index i = 0; i < n; ++i) values[i] = positions(i, axis);
     const double gap = smallest_gap(std::move(values), tolerance);
-    if (gap > 0.0) spacing[static_cast<std::size_t>(axis)] = gap;
-    const double points = std::round((high[axis] - low[axis]) / spacing[static_cast<std::size_t>(axis)]) + 1.0;
-    lattice.dims[static_cast<std::size_t>(axis)] = static_cast<int>(std::min(points, 2e9));
+    if (gap > 0.0) spacing[axis] = gap;
+    const double points = std::round((high[axis] - low[axis]) / spacing[axis]) + 1.0;
+    lattice.dims[axis] = static_cast<int>(std::min(points, 2e9));
   }
   const double lattice_points =
       double(lattice.dims[0]) * double(lattice.dims[1]) * double(lattice.dims[2]);
@@ -70,17 +70,16 @@ NodeLattice lattice_from_positions(const NodePositions& positions) {
   lattice.coords.resize(static_cast<std::size_t>(n));
   lattice.node_at.assign(static_cast<std::size_t>(lattice_points), -1);
   for (Eigen::Index node = 0; node < n; ++node) {
-    std::array<int, 3>& c = lattice.coords[static_cast<std::size_t>(node)];
+    std::array<int, 3>& c = lattice.coords[node];
     for (int axis = 0; axis < 3; ++axis) {
-      const double t = (positions(node, axis) - low[axis]) / spacing[static_cast<std::size_t>(axis)];
+      const double t = (positions(node, axis) - low[axis]) / spacing[axis];
       const double rounded = std::round(t);
       if (std::abs(t - rounded) > 1e-6) {
         not_a_lattice("node " + std::to_string(node) + " at " + format_point(positions, node) +
-                      " is off the regular lattice of spacing (" +
-                      std::to_string(spacing[0]) + ", " + std::to_string(spacing[1]) + ", " +
-                      std::to_string(spacing[2]) + ")");
+                      " is off the regular lattice of spacing (" + std::to_string(spacing[0]) +
+                      ", " + std::to_string(spacing[1]) + ", " + std::to_string(spacing[2]) + ")");
       }
-      c[static_cast<std::size_t>(axis)] = static_cast<int>(rounded);
+      c[axis] = static_cast<int>(rounded);
     }
     const std::size_t point =
         static_cast<std::size_t>(c[0]) +
@@ -100,9 +99,10 @@ NodeLattice coarsen_lattice(const NodeLattice& fine) {
   NodeLattice coarse;
   for (int axis = 0; axis < 3; ++axis) {
     // Fine coordinate m needs coarse points floor(m/2) and ceil(m/2).
-    coarse.dims[static_cast<std::size_t>(axis)] = fine.dims[static_cast<std::size_t>(axis)] / 2 + 1;
+    coarse.dims[axis] = fine.dims[axis] / 2 + 1;
   }
-  const std::size_t points = static_cast<std::size_t>(coarse.dims[0]) * coarse.dims[1] * coarse.dims[2];
+  const std::size_t points =
+      static_cast<std::size_t>(coarse.dims[0]) * coarse.dims[1] * coarse.dims[2];
   coarse.node_at.assign(points, -1);
   auto point_index = [&](int i, int j, int k) {
     return static_cast<std::size_t>(i) +
