@@ -216,8 +216,10 @@ Scene read_scene(const Config& config) {
     o.linear.pcg_tolerance = c.get_or<double>("pcg_tolerance", o.linear.pcg_tolerance);
     o.linear.pcg_max_iterations = c.get_or<int>("pcg_max_iterations", o.linear.pcg_max_iterations);
     o.linear.pcg_preconditioner = c.get_or<std::string>("pcg_preconditioner", o.linear.pcg_preconditioner);
-    const auto names = linear_solver_names();
+    auto names = linear_solver_names();
+    names.insert(names.begin(), "auto");
     if (std::find(names.begin(), names.end(), o.linear_solver) == names.end()) c.one_of("linear_solver", names);
+    o.auto_iterative_dofs = c.get_or<int>("auto_iterative_dofs", o.auto_iterative_dofs);
   }
   return s;
 }

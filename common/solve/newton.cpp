@@ -75,9 +75,12 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
   result.x = x0.size() == n ? x0 : X;
   SpMat K = assembler.pattern();
   LinearSolverOptions linear = options.linear;
-  if (options.linear_solver == "pcg-mg" && !linear.node_positions)
+  std::string solver_name = options.linear_solver;
+  if (solver_name == "auto") solver_name = n < options.auto_iterative_dofs ? "cholmod" : "pcg-mg";
+  if (solver_name == "pcg-mg" && !linear.node_positions)
     linear.node_positions = std::make_shared<const NodeArray>(assembler.mesh().nodes);  // the MG hierarchy's lattice
-  auto solver = make_linear_solver(options.linear_solver, linear);
+  auto solver = make_linear_solver(solver_name, linear);
+  spdlog::debug("linear solver: {}", solver->name());
   {
     const auto t0 = Clock::now();
     solver->analyze(K);

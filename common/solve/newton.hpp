@@ -33,7 +33,10 @@ struct NewtonOptions {
   int max_step_halvings = 8;         // adaptive cuts of a failing increment
   double armijo = 1e-4;
   int max_line_search = 40;
-  std::string linear_solver = "cholmod";
+  // "auto" picks CHOLMOD below auto_iterative_dofs unknowns and
+  // multigrid-preconditioned CG (pcg-mg) above; or name a solver.
+  std::string linear_solver = "auto";
+  int auto_iterative_dofs = 20000;
   LinearSolverOptions linear;
   // Called after each converged load increment with the load factor reached.
   std::function<void(double load_factor)> on_load_step;

@@ -20,4 +20,7 @@ check "no NaN in the displacement" -- bash -c "! h5dump -d /displacement '$WORK/
 expect_exit 0 "converged in" -- "$SIM" --config "$CFG" --out "$WORK/pcg.h5" --set solver.linear_solver=pcg \
   --set solver.pcg_preconditioner=block-jacobi3 --set solver.pcg_tolerance=1e-10
 check "pcg and cholmod agree" -- h5diff --relative=1e-5 "$WORK/t1.h5" "$WORK/pcg.h5" /displacement /displacement
+expect_exit 0 "converged in" -- "$SIM" --config "$CFG" --out "$WORK/mg.h5" --set solver.linear_solver=pcg-mg \
+  --set solver.pcg_tolerance=1e-10
+check "pcg-mg and cholmod agree" -- h5diff --relative=1e-5 "$WORK/t1.h5" "$WORK/mg.h5" /displacement /displacement
 finish
