@@ -6,10 +6,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <stdexcept>
 #include <string>
 
 #include "core/errors.hpp"
+#include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
 
 namespace msfab {
@@ -139,10 +139,7 @@ double CholmodSolver::factor_nonzeros() const { return cholmod_->factor_nonzeros
 
 void CholmodSolver::analyze(const SpMat& A) {
   const auto start = std::chrono::steady_clock::now();
-  if (A.rows() != A.cols()) {
-    throw std::invalid_argument("CholmodSolver::analyze: matrix is " + std::to_string(A.rows()) +
-                                "x" + std::to_string(A.cols()) + ", not square");
-  }
+  require_square(A, "CholmodSolver");
   Cholmod& c = *cholmod_;
   c.free_factor();
   factorized_ = nullptr;
@@ -183,11 +180,7 @@ void CholmodSolver::analyze(const SpMat& A) {
 bool CholmodSolver::factorize(const SpMat& A, double shift) {
   const auto start = std::chrono::steady_clock::now();
   Cholmod& c = *cholmod_;
-  if (c.n < 0) throw std::logic_error("CholmodSolver::factorize called before analyze");
-  if (A.rows() != c.n || A.cols() != c.n || pattern_fingerprint(A) != c.pattern) {
-    throw std::invalid_argument(
-        "CholmodSolver::factorize: the matrix pattern differs from the one given to analyze()");
-  }
+  require_analyzed_pattern(A, c.n, c.pattern, "CholmodSolver");
   c.factor_ready = false;
   factorized_ = nullptr;
   stats_.positive_definite = false;
@@ -221,11 +214,7 @@ VecX CholmodSolver::solve(const VecX& b) {
         "CHOLMOD solve without a valid factorization (the last factorize() found the matrix "
         "not positive definite, or none was done); factorize with a larger shift first");
   }
-  if (b.size() != c.n) {
-    throw std::invalid_argument("CholmodSolver::solve: right-hand side has " +
-                                std::to_string(b.size()) + " entries, matrix has " +
-                                std::to_string(c.n) + " rows");
-  }
+  require_rhs_size(b, c.n, "CholmodSolver");
   VecX x = VecX::Zero(c.n);
   if (c.n > 0) {
     cholmod_dense rhs = vector_view(b);

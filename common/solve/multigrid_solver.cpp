@@ -1,17 +1,16 @@
 #include "solve/multigrid_solver.hpp"
 
-#include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 #include "core/errors.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_smoother.hpp"
+#include "solve/conjugate_gradient.hpp"
 #include "solve/grid_transfer.hpp"
 #include "solve/node_lattice.hpp"
+#include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
 
 namespace msfab {
@@ -27,12 +26,6 @@ constexpr int kCoarseCorrections = 2;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-std::string format_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.3g", value);
-  return text;
 }
 
 }  // namespace
@@ -62,10 +55,7 @@ MultigridSolver::~MultigridSolver() = default;
 
 void MultigridSolver::analyze(const SpMat& A) {
   const auto start = std::chrono::steady_clock::now();
-  if (A.rows() != A.cols()) {
-    throw std::invalid_argument("MultigridSolver::analyze: matrix is " + std::to_string(A.rows()) +
-                                "x" + std::to_string(A.cols()) + ", not square");
-  }
+  require_square(A, "MultigridSolver");
   levels_.clear();
   ready_ = false;
   n_ = -1;
@@ -116,11 +106,7 @@ void MultigridSolver::analyze(const SpMat& A) {
 
 bool MultigridSolver::factorize(const SpMat& A, double shift) {
   const auto start = std::chrono::steady_clock::now();
-  if (n_ < 0) throw std::logic_error("MultigridSolver::factorize called before analyze");
-  if (A.rows() != n_ || A.cols() != n_ || pattern_fingerprint(A) != pattern_) {
-    throw std::invalid_argument(
-        "MultigridSolver::factorize: the matrix pattern differs from the one given to analyze()");
-  }
+  require_analyzed_pattern(A, n_, pattern_, "MultigridSolver");
   ready_ = false;
   stats_.positive_definite = false;
   if (n_ == 0) {
@@ -194,114 +180,45 @@ VecX MultigridSolver::apply_preconditioner(const VecX& r) {
 }
 
 VecX MultigridSolver::solve(const VecX& b) {
-  const auto start = std::chrono::steady_clock::now();
   if (!ready_) {
     throw NumericalError(
         "pcg-mg solve without a valid preconditioner (the last factorize() found a matrix "
         "that is not positive definite, or none was done); factorize with a larger shift first");
   }
-  if (b.size() != n_) {
-    throw std::invalid_argument("MultigridSolver::solve: right-hand side has " +
-                                std::to_string(b.size()) + " entries, matrix has " +
-                                std::to_string(n_) + " rows");
-  }
+  require_rhs_size(b, n_, "MultigridSolver");
   const int threads = options_.threads;
-  const Eigen::Index n = n_;
-  stats_.iterations = 0;
-  stats_.relative_residual = 0.0;
-  VecX x = VecX::Zero(n);
-  const double b_norm = std::sqrt(parallel_dot(b, b, threads));
-  if (b_norm == 0.0) {
-    stats_.solve_seconds = seconds_since(start);
-    return x;
-  }
-  const BlockMatrix& A = levels_.front()->matrix;  // A + shift I
-  const double target = options_.pcg_tolerance * b_norm;
-  const int max_iterations = options_.pcg_max_iterations;
-  const int history_stride = std::max(1, max_iterations / 8);
-  std::string history = "1";
-  int iteration = 0;
-  double r_norm = b_norm;
-
-  auto fail = [&](const std::string& why) {
-    stats_.iterations = iteration;
-    stats_.relative_residual = r_norm / b_norm;
-    stats_.solve_seconds = seconds_since(start);
-    throw NumericalError(why);
-  };
-  auto not_definite = [&](const std::string& what, double value) {
-    stats_.positive_definite = false;
-    fail("pcg-mg met " + what + " = " + format_number(value) + " at iteration " +
-         std::to_string(iteration) + " (relative residual " + format_number(r_norm / b_norm) +
-         "): the matrix is not positive definite; factorize with a larger shift");
-  };
-
-  VecX r = b, z, p, q(n);
-  cycle(0, r, z);
-  double rz = parallel_dot(r, z, threads);
-  if (!(rz > 0.0) || !std::isfinite(rz)) not_definite("r' M^-1 r", rz);
-  p = z;
-  for (;;) {
-    if (r_norm <= target) {
-      // The recursive residual drifts from b - A x; accept only the true one.
-      block_multiply(A, x, q, threads);
-      chunked_for(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-        for (Eigen::Index i = begin; i < end; ++i) r[i] = b[i] - q[i];
+  CgOperator op;
+  if (n_ > 0) {
+    const BlockMatrix& A = levels_.front()->matrix;  // A + shift I
+    op.multiply = [&A, threads](const VecX& x, VecX& y) { block_multiply(A, x, y, threads); };
+    // y = A x and x . y in one pass over the matrix.
+    op.multiply_dot = [&A, threads](const VecX& x, VecX& y) {
+      y.resize(A.unknowns());
+      return chunked_reduce(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
+        double sum = 0.0;
+        for (Eigen::Index i = begin; i < end; ++i) {
+          block_row_product(A, static_cast<int>(i), x.data(), y.data() + 3 * i);
+          sum += x[3 * i] * y[3 * i] + x[3 * i + 1] * y[3 * i + 1] + x[3 * i + 2] * y[3 * i + 2];
+        }
+        return sum;
       });
-      r_norm = std::sqrt(parallel_dot(r, r, threads));
-      if (r_norm <= target) break;
-      cycle(0, r, z);
-      rz = parallel_dot(r, z, threads);
-      if (!(rz > 0.0) || !std::isfinite(rz)) not_definite("r' M^-1 r", rz);
-      p = z;
-    }
-    if (iteration >= max_iterations) {
-      fail("pcg-mg did not converge: relative residual " + format_number(r_norm / b_norm) +
-           " after " + std::to_string(iteration) + " iterations (tolerance " +
-           format_number(options_.pcg_tolerance) + ", pcg_max_iterations " +
-           std::to_string(max_iterations) + "); relative residual every " +
-           std::to_string(history_stride) + " iterations: " + history);
-    }
-    // q = A p and p . q in one pass over the matrix.
-    const double curvature =
-        chunked_reduce(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
-          double sum = 0.0;
-          for (Eigen::Index i = begin; i < end; ++i) {
-            block_row_product(A, static_cast<int>(i), p.data(), q.data() + 3 * i);
-            sum += p[3 * i] * q[3 * i] + p[3 * i + 1] * q[3 * i + 1] + p[3 * i + 2] * q[3 * i + 2];
-          }
-          return sum;
-        });
-    if (!(curvature > 0.0) || !std::isfinite(curvature)) {
-      not_definite("non-positive curvature p'(A + shift I)p", curvature);
-    }
-    const double alpha = rz / curvature;
-    const double rr = chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-      double sum = 0.0;
-      for (Eigen::Index i = begin; i < end; ++i) {
-        x[i] += alpha * p[i];
-        r[i] -= alpha * q[i];
-        sum += r[i] * r[i];
-      }
-      return sum;
-    });
-    r_norm = std::sqrt(rr);
-    ++iteration;
-    if (iteration % history_stride == 0) history += ", " + format_number(r_norm / b_norm);
-    if (r_norm <= target) continue;
-    cycle(0, r, z);
-    const double rz_next = parallel_dot(r, z, threads);
-    if (!(rz_next > 0.0) || !std::isfinite(rz_next)) not_definite("r' M^-1 r", rz_next);
-    const double beta = rz_next / rz;
-    rz = rz_next;
-    chunked_for(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-      for (Eigen::Index i = begin; i < end; ++i) p[i] = z[i] + beta * p[i];
-    });
+    };
   }
-  stats_.iterations = iteration;
-  stats_.relative_residual = r_norm / b_norm;
-  stats_.solve_seconds = seconds_since(start);
-  return x;
+  CgPreconditioner preconditioner;
+  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
+    cycle(0, r, z);
+    return parallel_dot(r, z, threads);
+  };
+  // A cycle whose coarse operators lost definiteness shows up here first.
+  preconditioner.check_definite = true;
+  CgSettings settings;
+  settings.tolerance = options_.pcg_tolerance;
+  settings.max_iterations = options_.pcg_max_iterations;
+  settings.threads = threads;
+  settings.label = "pcg-mg";
+  settings.curvature_label = "pcg-mg";
+  settings.curvature_message_has_residual = true;
+  return conjugate_gradient(op, preconditioner, b, settings, stats_);
 }
 
 Eigen::Index MultigridSolver::level_unknowns(int level) const {

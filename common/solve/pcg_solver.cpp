@@ -2,14 +2,13 @@
 
 #include <Eigen/Cholesky>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <stdexcept>
 #include <string>
 
 #include "core/errors.hpp"
+#include "solve/conjugate_gradient.hpp"
+#include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
 
 namespace msfab {
@@ -23,12 +22,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::string format_number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.3g", value);
-  return text;
-}
-
 }  // namespace
 
 PcgSolver::PcgSolver(const LinearSolverOptions& options)
@@ -38,10 +31,7 @@ PcgSolver::PcgSolver(const LinearSolverOptions& options)
 
 void PcgSolver::analyze(const SpMat& A) {
   const auto start = std::chrono::steady_clock::now();
-  if (A.rows() != A.cols()) {
-    throw std::invalid_argument("PcgSolver::analyze: matrix is " + std::to_string(A.rows()) +
-                                "x" + std::to_string(A.cols()) + ", not square");
-  }
+  require_square(A, "PcgSolver");
   const Eigen::Index n = A.rows();
   if (block_jacobi_ && n % 3 != 0) {
     throw InputError("linear solver option pcg_preconditioner 'block-jacobi3' needs a multiple "
@@ -68,11 +58,7 @@ void PcgSolver::analyze(const SpMat& A) {
 
 bool PcgSolver::factorize(const SpMat& A, double shift) {
   const auto start = std::chrono::steady_clock::now();
-  if (n_ < 0) throw std::logic_error("PcgSolver::factorize called before analyze");
-  if (A.rows() != n_ || A.cols() != n_ || pattern_fingerprint(A) != pattern_) {
-    throw std::invalid_argument(
-        "PcgSolver::factorize: the matrix pattern differs from the one given to analyze()");
-  }
+  require_analyzed_pattern(A, n_, pattern_, "PcgSolver");
   matrix_ = nullptr;
   const double* values = A.valuePtr();
   auto entry = [&](std::size_t slot) {
@@ -142,104 +128,32 @@ double PcgSolver::apply_preconditioner(const VecX& r, VecX& z) const {
 }
 
 VecX PcgSolver::solve(const VecX& b) {
-  const auto start = std::chrono::steady_clock::now();
   if (matrix_ == nullptr) {
     throw NumericalError(
         "PCG solve without a valid preconditioner (the last factorize() found a diagonal "
         "entry or block not positive definite, or none was done)");
   }
-  if (b.size() != n_) {
-    throw std::invalid_argument("PcgSolver::solve: right-hand side has " +
-                                std::to_string(b.size()) + " entries, matrix has " +
-                                std::to_string(n_) + " rows");
-  }
+  require_rhs_size(b, n_, "PcgSolver");
   const SpMat& A = *matrix_;
   const int threads = options_.threads;
-  const Eigen::Index n = n_;
-  stats_.iterations = 0;
-  stats_.relative_residual = 0.0;
-
-  VecX x = VecX::Zero(n);
-  const double b_norm = std::sqrt(parallel_dot(b, b, threads));
-  if (b_norm == 0.0) {
-    stats_.solve_seconds = seconds_since(start);
-    return x;
-  }
-  const double target = options_.pcg_tolerance * b_norm;
-  VecX r = b;
-  VecX z, q;
-  double rz = apply_preconditioner(r, z);
-  VecX p = z;
-  double r_norm = b_norm;
-  std::string history = "1";
-  const int max_iterations = options_.pcg_max_iterations;
-  const int history_stride = std::max(1, max_iterations / 8);
-
-  int iteration = 0;
-  for (;;) {
-    if (r_norm <= target) {
-      // The recursively updated residual drifts from b - A x in floating
-      // point; accept only the true residual, else restart from it.
-      VecX ax;
-      symmetric_spmv(A, x, ax, shift_, threads);
-      chunked_for(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-        for (Eigen::Index i = begin; i < end; ++i) r[i] = b[i] - ax[i];
-      });
-      r_norm = std::sqrt(parallel_dot(r, r, threads));
-      if (r_norm <= target) break;
-      rz = apply_preconditioner(r, z);
-      p = z;
-    }
-    if (iteration >= max_iterations) {
-      stats_.iterations = iteration;
-      stats_.relative_residual = r_norm / b_norm;
-      stats_.solve_seconds = seconds_since(start);
-      throw NumericalError("PCG (" + options_.pcg_preconditioner + ") did not converge: "
-                           "relative residual " + format_number(r_norm / b_norm) + " after " +
-                           std::to_string(iteration) + " iterations (tolerance " +
-                           format_number(options_.pcg_tolerance) + ", pcg_max_iterations " +
-                           std::to_string(max_iterations) + "); relative residual every " +
-                           std::to_string(history_stride) + " iterations: " + history);
-    }
-    const double curvature = symmetric_spmv_dot(A, p, q, shift_, threads);
-    if (!(curvature > 0.0) || !std::isfinite(curvature)) {
-      stats_.positive_definite = false;
-      stats_.iterations = iteration;
-      stats_.relative_residual = r_norm / b_norm;
-      stats_.solve_seconds = seconds_since(start);
-      throw NumericalError("PCG met non-positive curvature p'(A + shift I)p = " +
-                           format_number(curvature) + " at iteration " +
-                           std::to_string(iteration) +
-                           ": the matrix is not positive definite; factorize with a larger shift");
-    }
-    const double alpha = rz / curvature;
-    // One pass: update x and r, precondition r, and sum r.r and r.z.
-    const Eigen::Vector2d sums =
-        chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-          double rr = 0.0;
-          for (Eigen::Index i = begin; i < end; ++i) {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * q[i];
-            rr += r[i] * r[i];
-          }
-          return Eigen::Vector2d(rr, precondition(r.data(), z.data(), begin, end));
-        });
-    r_norm = std::sqrt(sums[0]);
-    const double rz_next = sums[1];
-    const double beta = rz_next / rz;
-    rz = rz_next;
-    chunked_for(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-      for (Eigen::Index i = begin; i < end; ++i) p[i] = z[i] + beta * p[i];
-    });
-    ++iteration;
-    if (iteration % history_stride == 0) {
-      history += ", " + format_number(r_norm / b_norm);
-    }
-  }
-  stats_.iterations = iteration;
-  stats_.relative_residual = r_norm / b_norm;
-  stats_.solve_seconds = seconds_since(start);
-  return x;
+  CgOperator op;
+  op.multiply = [&](const VecX& x, VecX& y) { symmetric_spmv(A, x, y, shift_, threads); };
+  op.multiply_dot = [&](const VecX& x, VecX& y) {
+    return symmetric_spmv_dot(A, x, y, shift_, threads);
+  };
+  CgPreconditioner preconditioner;
+  preconditioner.apply = [this](const VecX& r, VecX& z) { return apply_preconditioner(r, z); };
+  preconditioner.apply_chunk = [this](const double* r, double* z, Eigen::Index begin,
+                                      Eigen::Index end) {
+    return precondition(r, z, begin, end);
+  };
+  CgSettings settings;
+  settings.tolerance = options_.pcg_tolerance;
+  settings.max_iterations = options_.pcg_max_iterations;
+  settings.threads = threads;
+  settings.label = "PCG (" + options_.pcg_preconditioner + ")";
+  settings.curvature_label = "PCG";
+  return conjugate_gradient(op, preconditioner, b, settings, stats_);
 }
 
 }  // namespace msfab

@@ -1,0 +1,125 @@
+#include "ddfem/baseline_coarsening.hpp"
+
+#include <cstdlib>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+namespace {
+
+const MaterialPtr& palette_material(const std::vector<MaterialPtr>& palette, int id) {
+  if (id <= 0 || id >= static_cast<int>(palette.size()) || !palette[id]) {
+    std::ostringstream msg;
+    msg << "coarsening baseline: fine material id " << id << " is not in the palette (ids 1.."
+        << static_cast<int>(palette.size()) - 1 << ")";
+    throw InputError(msg.str());
+  }
+  return palette[id];
+}
+
+// Fine ids of a block laid out n x n x n, index (a * n + b) * n + c with a
+// along x (slowest), the point order of hex8::gauss_rule(n).
+std::vector<int> block_level1(const ChildIds& child) { return std::vector<int>(child.begin(), child.end()); }
+
+std::vector<int> block_level2(const ChildIds& child, const std::vector<ChildIds>& level1) {
+  std::vector<int> ids(64, 0);
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 4; ++c) {
+        const int outer = 4 * (a >> 1) + 2 * (b >> 1) + (c >> 1);
+        const int inner = 4 * (a & 1) + 2 * (b & 1) + (c & 1);
+        const int comb = child[outer];
+        if (comb < 0 || comb > static_cast<int>(level1.size()))
+          throw InputError("coarsening baseline: level-2 child id " + std::to_string(comb) +
+                           " is not a level-1 combination");
+        ids[(a * 4 + b) * 4 + c] = comb == 0 ? 0 : level1[comb - 1][inner];
+      }
+  return ids;
+}
+
+QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
+  QuadratureMaterials m;
+  m.at_point.resize(ids.size());
+  auto coords = [n](int p, int out[3]) {
+    out[0] = p / (n * n);
+    out[1] = (p / n) % n;
+    out[2] = p % n;
+  };
+  for (int p = 0; p < static_cast<int>(ids.size()); ++p) {
+    if (ids[p] != 0) {
+      m.at_point[p] = palette_material(palette, ids[p]);
+      continue;
+    }
+    int cp[3];
+    coords(p, cp);
+    int best = -1, best_dist = 0;
+    for (int s = 0; s < static_cast<int>(ids.size()); ++s) {
+      if (ids[s] == 0) continue;
+      int cs[3];
+      coords(s, cs);
+      const int dist = std::abs(cs[0] - cp[0]) + std::abs(cs[1] - cp[1]) + std::abs(cs[2] - cp[2]);
+      const bool better = best < 0 || dist < best_dist ||
+                          (dist == best_dist && palette_material(palette, ids[s])->shear_modulus() <
+                                                    palette_material(palette, ids[best])->shear_modulus());
+      if (better) {
+        best = s;
+        best_dist = dist;
+      }
+    }
+    if (best < 0) throw InputError("coarsening baseline: every voxel of the block is void");
+    m.at_point[p] = palette_material(palette, ids[best]);
+  }
+  return m;
+}
+
+QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
+  double mu = 0, lambda = 0;
+  average_lame(palette, ids, &mu, &lambda);
+  if (!(mu > 0)) throw InputError("coarsening baseline: averaged shear modulus is not positive");
+  // Engineering constants of the averaged Lame pair.
+  const double E = mu * (3 * lambda + 2 * mu) / (lambda + mu);
+  const double nu = lambda / (2 * (lambda + mu));
+  return QuadratureMaterials{{std::make_shared<NeoHookean>(E, nu)}};
+}
+
+}  // namespace
+
+void average_lame(const std::vector<MaterialPtr>& palette, const std::vector<int>& fine_ids, double* mu,
+                  double* lambda) {
+  double sm = 0, sl = 0;
+  for (int id : fine_ids) {
+    if (id == 0) continue;
+    const MaterialPtr& m = palette_material(palette, id);
+    sm += m->shear_modulus();
+    sl += m->lame_lambda();
+  }
+  const double n = fine_ids.empty() ? 1.0 : double(fine_ids.size());
+  *mu = sm / n;
+  *lambda = sl / n;
+}
+
+CoarseMaterialLookup naive_coarsening(const std::vector<MaterialPtr>& palette) {
+  return [palette](const ChildIds& child) { return naive_block(palette, block_level1(child), 2); };
+}
+
+CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette) {
+  return [palette](const ChildIds& child) { return averaged_block(palette, block_level1(child)); };
+}
+
+CoarseMaterialLookup naive_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1) {
+  if (level1.level != 1) throw InputError("naive level-2 coarsening needs a level-1 grid");
+  return [palette, combos = level1.combinations](const ChildIds& child) {
+    return naive_block(palette, block_level2(child, combos), 4);
+  };
+}
+
+CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1) {
+  if (level1.level != 1) throw InputError("averaged level-2 coarsening needs a level-1 grid");
+  return [palette, combos = level1.combinations](const ChildIds& child) {
+    return averaged_block(palette, block_level2(child, combos));
+  };
+}
+
+}  // namespace msfab
