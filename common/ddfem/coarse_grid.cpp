@@ -111,10 +111,10 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   const hex8::QuadratureRule rule = hex8::gauss_rule(points_per_axis);
 
   // The node lattice, elements and colouring are those of a voxel mesh of the
-  // cell grid; a placeholder palette stands in until the lookups replace it.
-  const MaterialPtr placeholder = std::make_shared<NeoHookean>(1.0, 0.3);
+  // cell grid; a temporary palette is used for meshing and the lookups then set every element's materials.
+  const MaterialPtr meshing_material = std::make_shared<NeoHookean>(1.0, 0.3);
   VoxelMesh vm = build_voxel_mesh(grid.as_voxel_grid(),
-                                  std::vector<MaterialPtr>(grid.combinations.size() + 1, placeholder));
+                                  std::vector<MaterialPtr>(grid.combinations.size() + 1, meshing_material));
   HexMesh& mesh = vm.mesh;
 
   mesh.materials.clear();
