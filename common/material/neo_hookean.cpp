@@ -1,6 +1,9 @@
 #include "material/neo_hookean.hpp"
 
 #include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
 
 #include "material/voigt.hpp"
 
@@ -10,6 +13,22 @@ NeoHookean::NeoHookean(double E, double nu) : E_(E), nu_(nu) {
   check_elastic_constants(E, nu);
   mu_ = lame_mu(E, nu);
   lambda_ = msfab::lame_lambda(E, nu);
+}
+
+NeoHookean::NeoHookean(LameTag, double mu, double lambda) : mu_(mu), lambda_(lambda) {
+  if (!std::isfinite(mu) || !std::isfinite(lambda) || mu < 0.0 || lambda < 0.0) {
+    std::ostringstream os;
+    os.precision(10);
+    os << "Neo-Hookean Lame parameters must be finite and >= 0, got mu = " << mu << ", lambda = " << lambda;
+    throw InputError(os.str());
+  }
+  // Engineering constants for reporting only; mu = 0 gives E = 0.
+  E_ = (mu + lambda > 0.0) ? mu * (3.0 * lambda + 2.0 * mu) / (lambda + mu) : 0.0;
+  nu_ = (mu + lambda > 0.0) ? lambda / (2.0 * (lambda + mu)) : 0.0;
+}
+
+std::shared_ptr<const NeoHookean> NeoHookean::from_lame(double mu, double lambda) {
+  return std::shared_ptr<const NeoHookean>(new NeoHookean(LameTag{}, mu, lambda));
 }
 
 void NeoHookean::evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const {

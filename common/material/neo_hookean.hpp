@@ -12,6 +12,10 @@ class NeoHookean final : public Material {
  public:
   // Throws InputError unless E > 0 is finite and -1 < nu < 0.5.
   NeoHookean(double E, double nu);
+  // From Lame parameters, as fitted coarse materials are: accepts any finite
+  // mu >= 0, lambda >= 0 (mu = 0 is allowed: a fitted quadrature point may
+  // keep only its volumetric term). Throws InputError otherwise.
+  static std::shared_ptr<const NeoHookean> from_lame(double mu, double lambda);
 
   void evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const override;
   double shear_modulus() const override { return mu_; }
@@ -22,6 +26,9 @@ class NeoHookean final : public Material {
   double poisson_ratio() const { return nu_; }
 
  private:
+  struct LameTag {};
+  NeoHookean(LameTag, double mu, double lambda);
+
   double E_, nu_, mu_, lambda_;
 };
 

@@ -1,0 +1,238 @@
+#include "ddfem/coarse_fit.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "core/errors.hpp"
+#include "ddfem/nnls.hpp"
+#include "material/anisotropic_spring.hpp"
+#include "material/material_sum.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+namespace {
+
+// Deterministic held-out mask: a Fisher-Yates shuffle driven by the
+// standardized mt19937_64 sequence; the first round(fraction * n) indices
+// of the permutation are held out.
+std::vector<char> heldout_mask(int n, double fraction, std::uint64_t seed) {
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::mt19937_64 rng(seed);
+  for (int i = n - 1; i > 0; --i) std::swap(order[i], order[rng() % std::uint64_t(i + 1)]);
+  const int count = static_cast<int>(std::lround(fraction * n));
+  std::vector<char> mask(n, 0);
+  for (int i = 0; i < count; ++i) mask[order[i]] = 1;
+  return mask;
+}
+
+// Weighted RMS; weights need not be normalized.
+double weighted_rms(const std::vector<double>& rel, const std::vector<double>& weight) {
+  double s = 0, w = 0;
+  for (size_t i = 0; i < rel.size(); ++i) s += weight[i] * rel[i] * rel[i], w += weight[i];
+  return w > 0 ? std::sqrt(s / w) : 0.0;
+}
+
+}  // namespace
+
+bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
+                         const std::array<Vec3, 8>& v, CoarseEnergyBasis& out) {
+  const auto F = coarse_deformation_gradients(coarse, X, u);
+  for (int k = 0; k < 8; ++k) {
+    const double J = F[k].determinant();
+    if (!(J > 0.0)) return false;
+    const double logJ = std::log(J);
+    const double w = coarse.weight[k];
+    out.a[k] = w * (0.5 * (F[k].squaredNorm() - 3.0) - logJ);
+    out.b[k] = w * 0.5 * logJ * logJ;
+    const double l = (F[k] * v[k]).norm();
+    out.s[k] = w * (l - 1.0) * (l - 1.0);
+  }
+  return true;
+}
+
+double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
+                     const Vec24& u) {
+  CoarseEnergyBasis e;
+  if (!coarse_energy_basis(coarse, X, u, fit.v, e)) return kInfiniteEnergy;
+  double V = 0;
+  for (int k = 0; k < 8; ++k) V += fit.mu[k] * e.a[k] + fit.lambda[k] * e.b[k] + fit.C[k] * e.s[k];
+  return V;
+}
+
+CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
+                                   const std::array<Vec3, 8>& directions, const CoarseFitOptions& options) {
+  if (!(options.regularization >= 0.0)) throw InputError("coarse fit: regularization must be >= 0");
+  if (!(options.heldout_fraction >= 0.0 && options.heldout_fraction < 1.0))
+    throw InputError("coarse fit: heldout_fraction must be in [0, 1)");
+  const auto t0 = std::chrono::steady_clock::now();
+  CoarseMaterialFit fit;
+  fit.material_ids = block.material_ids;
+  fit.samples_attempted = set.attempted;
+  fit.samples_dropped = set.dropped;
+  for (int k = 0; k < 8; ++k) {
+    fit.v[k] = directions[k].normalized();
+    const MaterialPtr& m = block.child_material[FineBlock::child_of_coarse_point(k)];
+    fit.mu0[k] = m ? m->shear_modulus() : 0.0;
+    fit.lambda0[k] = m ? m->lame_lambda() : 0.0;
+  }
+  if (!block.has_all_corners()) {
+    fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
+    return fit;
+  }
+
+  // Basis energies of the samples the coarse element can represent.
+  const hex8::ElementGeometry coarse = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  std::vector<CoarseEnergyBasis> basis;
+  std::vector<double> V0;
+  std::vector<ForceKind> kind;
+  for (const ForceSample& s : set.samples) {
+    CoarseEnergyBasis e;
+    if (!coarse_energy_basis(coarse, X, s.corner_displacement, fit.v, e) || !(s.energy > 0.0)) {
+      ++fit.samples_coarse_inverted;
+      continue;
+    }
+    basis.push_back(e);
+    V0.push_back(s.energy);
+    kind.push_back(set.patterns[s.pattern].kind);
+  }
+  const int ns = static_cast<int>(V0.size());
+  const std::vector<char> held = heldout_mask(ns, options.heldout_fraction, options.split_seed);
+  for (char h : held) (h ? fit.samples_heldout : fit.samples_train) += 1;
+  if (fit.samples_train < 4) {
+    fit.not_fitted_reason = "fewer than 4 usable training samples";
+    return fit;
+  }
+
+  // Unknowns per point: mu, lambda (and C). Columns are scaled by the
+  // block's volume-averaged fine parameters (mean mu for mu and C, mean
+  // lambda for lambda), so scaled unknowns are O(1) and the regularizer of
+  // Eq. 2.9 measures every deviation in the same units. A per-point scale
+  // would forbid a soft point from stiffening, yet in a layered block the
+  // soft children's points must carry the stiff layer's in-plane stiffness.
+  const int per_point = options.anisotropic ? 3 : 2;
+  const int np = 8 * per_point;
+  double mu_mean = 0, lambda_mean = 0;
+  for (int k = 0; k < 8; ++k) mu_mean += fit.mu0[k] / 8, lambda_mean += fit.lambda0[k] / 8;
+  if (!(lambda_mean > 1e-6 * mu_mean)) lambda_mean = mu_mean;
+  VecX scale(np), target(np);
+  for (int k = 0; k < 8; ++k) {
+    scale[per_point * k] = mu_mean;
+    target[per_point * k] = fit.mu0[k] / mu_mean;
+    scale[per_point * k + 1] = lambda_mean;
+    target[per_point * k + 1] = fit.lambda0[k] / lambda_mean;
+    if (options.anisotropic) {
+      scale[per_point * k + 2] = mu_mean;
+      target[per_point * k + 2] = 0.0;
+    }
+  }
+  // Sample weights: kind weight / samples of that kind in the same split,
+  // normalized per split, so the data term is a weighted mean squared
+  // relative error.
+  for (double w : options.kind_weight)
+    if (!(w >= 0.0) || !std::isfinite(w)) throw InputError("coarse fit: kind weights must be finite and >= 0");
+  std::vector<double> weight(ns, 0.0);
+  for (int split = 0; split < 2; ++split) {
+    std::array<int, 5> count{};
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split) ++count[int(kind[s])];
+    double total = 0;
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split) {
+        weight[s] = options.kind_weight[int(kind[s])] / count[int(kind[s])];
+        total += weight[s];
+      }
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split && total > 0) weight[s] /= total;
+  }
+
+  // Rows: each training sample's residual relative to its own energy, times
+  // sqrt(weight); then sqrt(reg) * (p_j - p0_j) / scale_j.
+  const int rows = fit.samples_train + np;
+  MatX A = MatX::Zero(rows, np);
+  VecX b = VecX::Zero(rows);
+  int r = 0;
+  for (int s = 0; s < ns; ++s) {
+    if (held[s]) continue;
+    const double w = std::sqrt(weight[s]) / V0[s];
+    for (int k = 0; k < 8; ++k) {
+      A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
+      A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
+      if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
+    }
+    b[r] = w * V0[s];
+    ++r;
+  }
+  const double reg = std::sqrt(options.regularization);
+  for (int j = 0; j < np; ++j, ++r) {
+    A(r, j) = reg;
+    b[r] = reg * target[j];
+  }
+  const NnlsResult sol = solve_nnls(A, b);
+  if (!sol.converged) {
+    fit.not_fitted_reason = "NNLS did not converge";
+    return fit;
+  }
+  for (int k = 0; k < 8; ++k) {
+    fit.mu[k] = sol.x[per_point * k] * scale[per_point * k];
+    fit.lambda[k] = sol.x[per_point * k + 1] * scale[per_point * k + 1];
+    fit.C[k] = options.anisotropic ? sol.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
+  }
+  fit.fitted = true;
+  fit.objective = sol.residual * sol.residual;
+
+  std::vector<double> rel_train, rel_held, w_train, w_held;
+  double abs_held = 0, sum_held = 0;
+  for (int s = 0; s < ns; ++s) {
+    double V1 = 0;
+    for (int k = 0; k < 8; ++k)
+      V1 += fit.mu[k] * basis[s].a[k] + fit.lambda[k] * basis[s].b[k] + fit.C[k] * basis[s].s[k];
+    (held[s] ? rel_held : rel_train).push_back((V1 - V0[s]) / V0[s]);
+    (held[s] ? w_held : w_train).push_back(weight[s]);
+    if (held[s]) {
+      abs_held += std::abs(V1 - V0[s]);
+      sum_held += V0[s];
+    }
+  }
+  fit.residual = weighted_rms(rel_train, w_train);
+  fit.heldout_error = weighted_rms(rel_held, w_held);
+  fit.heldout_energy_error = sum_held > 0 ? abs_held / sum_held : 0.0;
+  fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return fit;
+}
+
+CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options) {
+  if (!block.has_all_corners()) {
+    CoarseMaterialFit fit;
+    fit.material_ids = block.material_ids;
+    fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
+    return fit;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const ForceSampleSet samples = sample_force_space(block, options.sampling);
+  std::array<Vec3, 8> directions;
+  directions.fill(Vec3::UnitX());
+  if (options.anisotropic) directions = estimate_anisotropy(block, options.anisotropy).direction;
+  CoarseMaterialFit fit = fit_from_samples(block, samples, directions, options);
+  fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return fit;
+}
+
+QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit) {
+  if (!fit.fitted) throw std::invalid_argument("coarse_quadrature_materials: the block was not fitted");
+  QuadratureMaterials q;
+  for (int k = 0; k < 8; ++k) {
+    MaterialPtr nh = NeoHookean::from_lame(fit.mu[k], fit.lambda[k]);
+    if (fit.C[k] > 0.0)
+      q.at_point.push_back(std::make_shared<MaterialSum>(
+          std::vector<MaterialPtr>{nh, std::make_shared<AnisotropicSpring>(fit.C[k], fit.v[k])}));
+    else
+      q.at_point.push_back(nh);
+  }
+  return q;
+}
+
+}  // namespace msfab

@@ -1,0 +1,89 @@
+#pragma once
+// Fitting the coarse material of one block (thesis Eq. 2.7-2.9).
+//
+// Coarse model: at each of the 8 Gauss points k of the coarse element a
+// Neo-Hookean density with (mu_k, lambda_k) plus the spring of Eq. 2.7 with
+// direction v_k (from anisotropy.hpp) and stiffness C_k. Here C_k is stored
+// as an energy DENSITY, weighted by w_k det J_k like the Neo-Hookean term;
+// Eq. 2.7's unweighted constant is w_k det J_k C_k. This keeps C_k in the
+// units of mu_k, independent of the element size, and makes
+// hex_energy(QuadratureMaterials) reproduce the fitted energy exactly.
+//
+// The energy is linear in p = (mu_k, lambda_k, C_k)_k:
+//   V^1(u) = sum_k w_k det J_k [mu_k ((I1 - 3)/2 - log J) + lambda_k (log J)^2 / 2
+//                               + C_k (||F_k v_k|| - 1)^2],
+// so Eq. 2.9 is a regularized linear least-squares problem with p >= 0,
+// solved by NNLS in scaled variables (see docs/ddfem.md, "Fitting").
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "ddfem/anisotropy.hpp"
+#include "ddfem/force_samples.hpp"
+#include "fem/hex_element.hpp"
+
+namespace msfab {
+
+struct CoarseFitOptions {
+  ForceSamplingOptions sampling;
+  AnisotropyOptions anisotropy;
+  bool anisotropic = true;        // fit C_k (else C_k = 0 and no direction solves)
+  double regularization = 0.02;   // lambda of Eq. 2.9, on the scaled problem
+  double heldout_fraction = 0.2;  // samples kept out of the fit for validation
+  // Weight of each force kind in the fit, indexed by ForceKind (stretch,
+  // shear, bend, twist, pinch), whatever its sample count. Pinching, a point
+  // load at two corners that a coarse element inside a body rarely sees,
+  // weighs a tenth (see docs/ddfem.md, "Fitting"). Zero drops a kind.
+  std::array<double, 5> kind_weight{1.0, 1.0, 1.0, 1.0, 0.1};
+  std::uint64_t split_seed = 11;
+};
+
+struct CoarseMaterialFit {
+  bool fitted = false;
+  std::string not_fitted_reason;   // why, when !fitted (e.g. a void child)
+  BlockMaterials material_ids{};
+  std::array<double, 8> mu{}, lambda{}, C{};  // per coarse quadrature point
+  std::array<Vec3, 8> v{};                    // spring directions (unit)
+  std::array<double, 8> mu0{}, lambda0{};     // fine parameters at each point (Eq. 2.9's p^0)
+  // Relative energy errors (V1 - V0) / V0, RMS with the fit's kind weights.
+  double residual = 0;             // over the training samples
+  double objective = 0;            // Eq. 2.9 as minimized: weighted data term + regularizer (scaled units)
+  double heldout_error = 0;        // over the held-out samples
+  double heldout_energy_error = 0; // sum |V1 - V0| / sum V0 over the held-out samples
+  int samples_attempted = 0;       // fine solves run
+  int samples_dropped = 0;         // fine solves that did not converge
+  int samples_coarse_inverted = 0; // converged samples the coarse element cannot represent (det F <= 0)
+  int samples_train = 0;
+  int samples_heldout = 0;
+  double seconds = 0;              // sampling + directions + fit
+};
+
+// The per-point basis energies of V^1 for corner displacements u: a_k, b_k,
+// s_k already multiplied by w_k det J_k. Returns false if the coarse element
+// is inverted at a point.
+struct CoarseEnergyBasis {
+  std::array<double, 8> a{}, b{}, s{};
+};
+bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
+                         const std::array<Vec3, 8>& v, CoarseEnergyBasis& out);
+
+// V^1 of a fit at corner displacements u (+inf if inverted).
+double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
+                     const hex8::NodeMatrix& X, const Vec24& u);
+
+// Whole pipeline for one block: sampling, directions, fit. Blocks with a
+// void child are returned with fitted = false (the online coarsening falls
+// back to naive coarsening for them).
+CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options);
+
+// The fit on given samples and directions (C_k = 0 unless
+// options.anisotropic). Lets callers compare models on identical samples.
+CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& samples,
+                                   const std::array<Vec3, 8>& directions, const CoarseFitOptions& options);
+
+// Materials for a coarse element using the fit: per point MaterialSum of
+// NeoHookean(mu_k, lambda_k) and AnisotropicSpring(C_k, v_k) (the spring is
+// omitted where C_k = 0). Throws std::invalid_argument if !fit.fitted.
+QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit);
+
+}  // namespace msfab

@@ -1,0 +1,74 @@
+#include "ddfem/fine_block.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+bool FineBlock::has_all_corners() const {
+  for (int n : corner_nodes)
+    if (n < 0) return false;
+  return true;
+}
+
+hex8::NodeMatrix FineBlock::coarse_rest_positions() const {
+  hex8::NodeMatrix X;
+  for (int c = 0; c < 8; ++c)
+    X.row(c) = 2.0 * voxel_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
+  return X;
+}
+
+hex8::ElementGeometry FineBlock::coarse_geometry() const {
+  return hex8::element_geometry(coarse_rest_positions(), hex8::gauss_rule(2));
+}
+
+int FineBlock::child_of_coarse_point(int q) {
+  const Vec3 chi = hex8::gauss_rule(2).points[q];
+  return 4 * (chi.x() > 0) + 2 * (chi.y() > 0) + (chi.z() > 0);
+}
+
+int FineBlock::lattice_node(int i, int j, int k) const {
+  return voxels.lattice_node[size_t(i) + 3 * (size_t(j) + 3 * size_t(k))];
+}
+
+FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
+                          double voxel_size) {
+  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
+    std::ostringstream os;
+    os << "fine block: voxel size must be positive and finite, got " << voxel_size;
+    throw InputError(os.str());
+  }
+  FineBlock block;
+  block.voxel_size = voxel_size;
+  block.material_ids = ids;
+  block.child_material.assign(8, nullptr);
+  VoxelGrid grid(2, 2, 2, voxel_size, 0);
+  bool any_solid = false;
+  for (int c = 0; c < 8; ++c) {
+    const int id = ids[c];
+    if (id < 0 || id >= static_cast<int>(palette.size())) {
+      std::ostringstream os;
+      os << "fine block: material id " << id << " of child " << c << " is outside the palette (size "
+         << palette.size() << ")";
+      throw InputError(os.str());
+    }
+    if (id == 0) continue;
+    if (!palette[id]) {
+      std::ostringstream os;
+      os << "fine block: palette entry " << id << " (child " << c << ") has no material";
+      throw InputError(os.str());
+    }
+    any_solid = true;
+    block.child_material[c] = palette[id];
+    grid.at(c >> 2 & 1, c >> 1 & 1, c & 1) = id;
+  }
+  if (!any_solid) throw InputError("fine block: all eight children are void");
+  block.voxels = build_voxel_mesh(grid, palette);
+  for (int c = 0; c < 8; ++c)
+    block.corner_nodes[c] = block.lattice_node(2 * (c >> 2 & 1), 2 * (c >> 1 & 1), 2 * (c & 1));
+  return block;
+}
+
+}  // namespace msfab

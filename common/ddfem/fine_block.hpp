@@ -1,0 +1,45 @@
+#pragma once
+// The 2 x 2 x 2 block of fine voxels that one coarse DDFEM element replaces
+// (thesis §2.3): its hex mesh, the materials of its children and the fine
+// nodes that coincide with the coarse element's eight corners.
+#include <array>
+#include <vector>
+
+#include "fem/voxel_grid.hpp"
+
+namespace msfab {
+
+// Child (i, j, k) of the block, i, j, k in {0, 1}, has index 4i + 2j + k:
+// the hex8 node order, so child c sits at coarse corner c.
+using BlockMaterials = std::array<int, 8>;
+
+struct FineBlock {
+  double voxel_size = 1.0;           // fine edge h; the coarse element has edge 2h
+  BlockMaterials material_ids{};     // palette ids per child, 0 = void
+  std::vector<MaterialPtr> child_material;  // per child, null for void
+  VoxelMesh voxels;                  // mesh of the non-void children, origin at 0
+  // Fine mesh node at coarse corner c (hex8 order), -1 where only void
+  // children touch that corner.
+  std::array<int, 8> corner_nodes{};
+
+  const HexMesh& mesh() const { return voxels.mesh; }
+  // Each coarse corner belongs to exactly one child, so this holds exactly
+  // when no child is void. Only such blocks are fitted (see docs/ddfem.md).
+  bool has_all_corners() const;
+  // Rest positions of the coarse element's corners (edge 2h, origin at 0).
+  hex8::NodeMatrix coarse_rest_positions() const;
+  // The coarse element's 2 x 2 x 2 Gauss geometry (its quadrature points k
+  // of Eq. 2.6-2.7), and the child containing each point.
+  hex8::ElementGeometry coarse_geometry() const;
+  static int child_of_coarse_point(int q);
+  // Mesh node at lattice position (i, j, k), i, j, k in {0, 1, 2}; -1 if absent.
+  int lattice_node(int i, int j, int k) const;
+};
+
+// Builds the block for material ids (palette[id], id 0 = void). Throws
+// InputError if h is not positive, an id is out of range, a non-void id has
+// no material, or every child is void.
+FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
+                          double voxel_size);
+
+}  // namespace msfab

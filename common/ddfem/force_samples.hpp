@@ -1,0 +1,126 @@
+#pragma once
+// Force-space sampling of a fine block's deformation space (thesis §2.3.2):
+// self-equilibrated nodal force sets (stretching, shearing, bending,
+// twisting along several directions, pinching along the twelve cube edges)
+// at several magnitudes and both signs, each solved as a nonlinear static
+// problem. A sample is the displacement of the eight block corners (the
+// coarse element's u^1 = r(u^0) of Eq. 2.8) and the fine elastic energy V^0.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ddfem/fine_block.hpp"
+#include "fem/elastic_assembler.hpp"
+
+namespace msfab {
+
+enum class ForceKind { stretch, shear, bend, twist, pinch };
+std::string force_kind_name(ForceKind kind);
+
+struct ForceSamplingOptions {
+  // Directions for stretch / shear / bend / twist: the three axes (if
+  // include_axes) plus `sphere_directions` points of a Fibonacci hemisphere
+  // turned by a rotation drawn from `seed`.
+  bool include_axes = true;
+  int sphere_directions = 3;
+  int magnitudes = 5;          // per sign; magnitude m of n is m/n of the largest
+  double max_strain = 0.15;    // small-strain estimate of the largest local strain at the largest magnitude
+  std::uint64_t seed = 1;
+  double newton_tolerance = 1e-9;
+};
+
+// A unit-norm, self-equilibrated nodal force set on the block's mesh.
+struct ForcePattern {
+  ForceKind kind = ForceKind::stretch;
+  Vec3 direction = Vec3::UnitX();  // stretch / shear / bend / twist axis; pinch: edge direction
+  Vec3 second = Vec3::Zero();      // shear / bend: the transverse direction; pinch: first corner's position
+  VecX force;                      // per DOF
+};
+
+struct ForceSample {
+  int pattern = 0;          // index into ForceSampleSet::patterns
+  double load = 0;          // signed multiple of the unit pattern applied
+  Vec24 corner_displacement = Vec24::Zero();  // coarse u^1, node-major (3*corner + axis)
+  double energy = 0;        // fine elastic energy V^0 at equilibrium
+  int newton_iterations = 0;
+};
+
+struct ForceSampleSet {
+  std::vector<ForcePattern> patterns;
+  std::vector<ForceSample> samples;  // converged samples, in pattern, sign, magnitude order
+  int attempted = 0;
+  int dropped = 0;                   // solves that did not converge
+  double seconds = 0;                // wall time of the solves
+};
+
+// The fine block's static problem with rigid motion removed by six linear
+// constraints on the displacement u: zero mean translation, sum_i u_i = 0,
+// and zero mean infinitesimal rotation, sum_i (X_i - c) x u_i = 0 (c the
+// node centroid). Unknowns live in an orthonormal basis Z of the
+// constraints' null space, x = X + Z y.
+//
+// Why not three pinned corners (a 3-2-1 support): with dead loads a
+// compressive or shearing pattern makes the block rotate about the pinned
+// corner once the strain reaches a few percent, since single nodes resist
+// moments only through local deformation, and Newton then lands on rotated
+// or flipped states whose corner displacements are not deformations. The
+// averaged rotation constraint acts on all nodes, like the rest of the body
+// around a coarse element would. Requires all eight corners
+// (std::invalid_argument otherwise). The block must outlive the solver.
+class BlockSolver {
+ public:
+  explicit BlockSolver(const FineBlock& block, double newton_tolerance = 1e-9);
+
+  const FineBlock& block() const { return block_; }
+  const ElasticAssembler& assembler() const { return assembler_; }
+  // The constraint matrix G (6 x DOFs): G u = 0. Its rows are the
+  // translation and rotation modes, so G f is the net force and moment of
+  // a nodal force set f.
+  const MatX& constraint_matrix() const { return G_; }
+  // Orthonormal null-space basis Z (DOFs x (DOFs - 6)).
+  const MatX& null_space() const { return Z_; }
+
+  // Largest local small strain (largest |eigenvalue| of sym grad u over the
+  // fine quadrature points) of the linearized response to `force`.
+  double linear_peak_strain(const VecX& force) const;
+
+  struct Solution {
+    bool converged = false;
+    VecX x;             // deformed positions
+    double energy = 0;  // fine elastic energy
+    int iterations = 0;
+  };
+  // Nonlinear solve under `force` by a dense Newton with backtracking line
+  // search, starting from x0 (rest if empty; x0 must satisfy the
+  // constraints, as every returned x does).
+  Solution solve(const VecX& force, const VecX& x0 = VecX()) const;
+
+  // Corner displacements (24) of a deformed configuration.
+  Vec24 corner_displacements(const VecX& x) const;
+
+ private:
+  const FineBlock& block_;
+  ElasticAssembler assembler_;
+  double tolerance_;
+  int max_iterations_ = 60;
+  MatX G_, Z_;
+  VecX rest_;
+  double stiffness_scale_ = 0;        // largest diagonal entry of Z^T K(X) Z
+  Eigen::LDLT<MatX> rest_stiffness_;  // Z^T K(X) Z
+};
+
+// Removes the net force and net moment (about the node centroid) of a nodal
+// force set with the least change, leaving it self-equilibrated.
+VecX self_equilibrate(const HexMesh& mesh, const VecX& force);
+
+// The unit force patterns for a block (deterministic for given options).
+std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const ForceSamplingOptions& options);
+// Sampling directions: axes then the seeded Fibonacci hemisphere.
+std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed);
+
+// Runs every pattern at options.magnitudes magnitudes in both signs. Each
+// pattern's largest load is scaled so its linear response peaks at
+// options.max_strain, so soft and stiff blocks deform comparably.
+ForceSampleSet sample_force_space(const FineBlock& block, const ForceSamplingOptions& options);
+
+}  // namespace msfab

@@ -1,0 +1,359 @@
+// DDFEM coarse-material fitting: fine blocks, force-space sampling,
+// anisotropy directions, NNLS and the regularized fit (thesis §2.3.1-2.3.3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "core/errors.hpp"
+#include "ddfem/anisotropy.hpp"
+#include "ddfem/coarse_fit.hpp"
+#include "ddfem/fine_block.hpp"
+#include "ddfem/force_samples.hpp"
+#include "ddfem/nnls.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+namespace {
+
+constexpr double kVoxel = 1e-3;
+
+std::vector<MaterialPtr> palette(double E_soft, double E_stiff) {
+  return {nullptr, std::make_shared<NeoHookean>(E_soft, 0.3), std::make_shared<NeoHookean>(E_stiff, 0.3)};
+}
+
+// Soft children below z = h, stiff above: layers normal to z.
+BlockMaterials layered_ids() {
+  BlockMaterials ids;
+  for (int c = 0; c < 8; ++c) ids[c] = (c & 1) ? 2 : 1;
+  return ids;
+}
+
+CoarseFitOptions test_options() {
+  CoarseFitOptions o;
+  o.sampling.sphere_directions = 1;
+  o.sampling.magnitudes = 2;
+  o.anisotropy.directions = 10;
+  return o;
+}
+
+void print_fit(const char* label, const CoarseMaterialFit& f) {
+  std::printf("[ddfem] %-28s train %.4f heldout %.4f (energy %.4f) samples %d/%d dropped %d inverted %d  %.2f s\n",
+              label, f.residual, f.heldout_error, f.heldout_energy_error, f.samples_train, f.samples_heldout,
+              f.samples_dropped, f.samples_coarse_inverted, f.seconds);
+}
+
+TEST(DdfemFineBlock, CornersAndChildOrder) {
+  const auto pal = palette(1e6, 1e8);
+  const FineBlock block = make_fine_block(layered_ids(), pal, kVoxel);
+  EXPECT_EQ(block.mesh().num_elements(), 8);
+  EXPECT_EQ(block.mesh().num_nodes(), 27);
+  ASSERT_TRUE(block.has_all_corners());
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 p = block.mesh().nodes.row(block.corner_nodes[c]).transpose();
+    EXPECT_NEAR((p - X.row(c).transpose()).norm(), 0.0, 1e-15);
+    EXPECT_EQ(block.child_material[c], pal[(c & 1) ? 2 : 1]);
+  }
+  // Coarse Gauss point k lies in child child_of_coarse_point(k).
+  const auto rule = hex8::gauss_rule(2);
+  for (int q = 0; q < 8; ++q) {
+    const int c = FineBlock::child_of_coarse_point(q);
+    const Vec3 pos = kVoxel * (rule.points[q] + Vec3::Ones());
+    EXPECT_EQ(int(pos.x() > kVoxel), c >> 2 & 1);
+    EXPECT_EQ(int(pos.y() > kVoxel), c >> 1 & 1);
+    EXPECT_EQ(int(pos.z() > kVoxel), c & 1);
+  }
+  BlockMaterials with_void = layered_ids();
+  with_void[5] = 0;
+  const FineBlock holed = make_fine_block(with_void, pal, kVoxel);
+  EXPECT_FALSE(holed.has_all_corners());
+  EXPECT_EQ(holed.corner_nodes[5], -1);
+  const CoarseMaterialFit f = fit_coarse_material(holed, test_options());
+  EXPECT_FALSE(f.fitted);
+  EXPECT_FALSE(f.not_fitted_reason.empty());
+  EXPECT_THROW(make_fine_block(BlockMaterials{}, pal, kVoxel), InputError);
+  EXPECT_THROW(make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 3}, pal, kVoxel), InputError);
+}
+
+TEST(DdfemSampling, RigidMotionConstraintsCarryNoReaction) {
+  const FineBlock block = make_fine_block(layered_ids(), palette(1e6, 1e8), kVoxel);
+  const BlockSolver solver(block);
+  // The null space is orthonormal and annihilated by the constraints.
+  const MatX& Z = solver.null_space();
+  EXPECT_EQ(Z.cols(), block.mesh().num_dofs() - 6);
+  EXPECT_LT((Z.transpose() * Z - MatX::Identity(Z.cols(), Z.cols())).norm(), 1e-12);
+  EXPECT_LT((solver.constraint_matrix() * Z).norm(), 1e-12 * kVoxel * Z.rows());
+  ForceSamplingOptions o;
+  o.sphere_directions = 1;
+  const auto patterns = make_force_patterns(block, o);
+  // 4 directions x 4 kinds + 12 edges.
+  EXPECT_EQ(patterns.size(), 4u * 4u + 12u);
+  const int n = block.mesh().num_nodes();
+  for (const ForcePattern& p : patterns) {
+    Vec3 net = Vec3::Zero(), moment = Vec3::Zero();
+    for (int i = 0; i < n; ++i) {
+      net += p.force.segment<3>(3 * i);
+      moment += block.mesh().nodes.row(i).transpose().cross(Vec3(p.force.segment<3>(3 * i)));
+    }
+    EXPECT_LT(net.norm(), 1e-12);
+    EXPECT_LT(moment.norm(), 1e-12 * kVoxel);
+  }
+  // Self-equilibrated dead loads have no net moment about the REST
+  // positions; about the deformed ones they do, by O(strain) x load, and the
+  // constraints carry it. So: reactions vanish in the linear limit and stay
+  // O(strain) relative to the load at finite strain. All kinds, both signs
+  // (compression included) converge to the branch that starts at rest.
+  const MatX& G = solver.constraint_matrix();
+  for (int which : {0, 1, 4 + 2, 4 * 3 + 3, 20}) {  // stretch, shear, bend, twist, pinch
+    const ForcePattern& p = patterns[which];
+    for (double strain : {1e-5, 0.1, -0.1}) {
+      const double load = strain / solver.linear_peak_strain(p.force);
+      const VecX f = load * p.force;
+      VecX start;
+      BlockSolver::Solution s;
+      for (int step = 1; step <= 5; ++step) {  // the continuation sample_force_space uses
+        s = solver.solve(step / 5.0 * f, start);
+        ASSERT_TRUE(s.converged) << force_kind_name(p.kind) << " strain " << strain << " step " << step;
+        start = s.x;
+      }
+      VecX g;
+      solver.assembler().evaluate(s.x, &g, nullptr);
+      const VecX reaction = g - f;
+      const double fnorm = f.norm();
+      // (At 1e-5 strain the solver stops at its round-off floor.)
+      EXPECT_LT((Z.transpose() * reaction).norm(), (std::abs(strain) < 1e-3 ? 1e-6 : 1e-8) * fnorm)
+          << force_kind_name(p.kind);
+      // Net reaction force, and moment in units of force (divided by h).
+      VecX net = G * reaction;
+      net.tail<3>() /= kVoxel;
+      EXPECT_LT(net.norm(), 10 * std::abs(strain) * fnorm) << force_kind_name(p.kind) << " strain " << strain;
+      EXPECT_GT(s.energy, 0.0);
+      // Equal and opposite small loads: nearly equal energies (no rotated
+      // or flipped branch, whose energy would be unrelated).
+      if (std::abs(strain) < 1e-3) {
+        const auto opposite = solver.solve(-f);
+        ASSERT_TRUE(opposite.converged);
+        EXPECT_NEAR(opposite.energy / s.energy, 1.0, 1e-3);
+      }
+    }
+  }
+}
+
+TEST(DdfemNnls, MatchesKnownAndBruteForceSolutions) {
+  // A = I: the solution clips negative entries of b.
+  const NnlsResult id = solve_nnls(MatX::Identity(3, 3), Vec3(1.0, -2.0, 3.0));
+  ASSERT_TRUE(id.converged);
+  EXPECT_NEAR((id.x - Vec3(1.0, 0.0, 3.0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(id.residual, 2.0, 1e-12);
+
+  // Random problems against enumeration of all passive sets.
+  std::mt19937_64 rng(5);
+  auto u = [&] { return double(rng() >> 11) * 0x1.0p-53 * 2.0 - 1.0; };
+  int with_active = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const int m = 9, n = 5;
+    MatX A(m, n);
+    VecX b(m);
+    for (int i = 0; i < m; ++i) {
+      b[i] = u();
+      for (int j = 0; j < n; ++j) A(i, j) = u();
+    }
+    double best = 1e300;
+    VecX best_x;
+    for (int mask = 0; mask < (1 << n); ++mask) {
+      std::vector<int> cols;
+      for (int j = 0; j < n; ++j)
+        if (mask >> j & 1) cols.push_back(j);
+      VecX x = VecX::Zero(n);
+      if (!cols.empty()) {
+        MatX Ap(m, cols.size());
+        for (size_t k = 0; k < cols.size(); ++k) Ap.col(k) = A.col(cols[k]);
+        const VecX z = Ap.colPivHouseholderQr().solve(b);
+        if (z.minCoeff() < 0) continue;
+        for (size_t k = 0; k < cols.size(); ++k) x[cols[k]] = z[k];
+      }
+      const double r = (A * x - b).norm();
+      if (r < best) best = r, best_x = x;
+    }
+    const NnlsResult s = solve_nnls(A, b);
+    ASSERT_TRUE(s.converged);
+    EXPECT_GE(s.x.minCoeff(), 0.0);
+    EXPECT_NEAR(s.residual, best, 1e-10);
+    EXPECT_NEAR((s.x - best_x).norm(), 0.0, 1e-8);
+    if ((best_x.array() == 0.0).any()) ++with_active;
+  }
+  EXPECT_GT(with_active, 5);  // the constraints were active in many trials
+}
+
+TEST(DdfemFit, HomogeneousBlockRecoversItsMaterial) {
+  const auto pal = palette(1e6, 1e8);
+  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel);
+  CoarseFitOptions o = test_options();
+  const ForceSampleSet samples = sample_force_space(block, o.sampling);
+  EXPECT_EQ(samples.dropped, 0);
+  std::array<Vec3, 8> dirs;
+  dirs.fill(Vec3::UnitX());
+  const double mu = pal[1]->shear_modulus(), lambda = pal[1]->lame_lambda();
+
+  // Stretching, shearing and twisting move a homogeneous block's corners
+  // like a trilinear element with the fine material would: the fit must
+  // return that material and predict held-out energies almost exactly.
+  o.kind_weight = {1.0, 1.0, 0.0, 1.0, 0.0};
+  const CoarseMaterialFit exact = fit_from_samples(block, samples, dirs, o);
+  print_fit("homogeneous, smooth kinds", exact);
+  ASSERT_TRUE(exact.fitted);
+  EXPECT_GT(exact.samples_heldout, 10);
+  EXPECT_LT(exact.heldout_error, 0.01);
+  for (int k = 0; k < 8; ++k) {
+    EXPECT_NEAR(exact.mu[k] / mu, 1.0, 0.02) << k;
+    EXPECT_NEAR(exact.lambda[k] / lambda, 1.0, 0.05) << k;
+  }
+
+  // Bending and pinching store energy the 24-DOF element cannot mirror
+  // (it locks in bending; a pinch is local): with every kind the fit trades
+  // these off, softening the element, and the held-out error says how much.
+  o.kind_weight = CoarseFitOptions().kind_weight;
+  const CoarseMaterialFit all = fit_from_samples(block, samples, dirs, o);
+  print_fit("homogeneous, all kinds", all);
+  ASSERT_TRUE(all.fitted);
+  EXPECT_GT(all.heldout_error, exact.heldout_error);
+  EXPECT_LT(all.heldout_error, 0.4);
+  for (int k = 0; k < 8; ++k) {
+    EXPECT_GT(all.mu[k], 0.3 * mu) << k;
+    EXPECT_LT(all.mu[k], 1.05 * mu) << k;
+  }
+}
+
+// A stiff fiber along x: children (i, 0, 0), soft elsewhere.
+BlockMaterials fiber_ids() {
+  BlockMaterials ids;
+  for (int c = 0; c < 8; ++c) ids[c] = (c & 3) == 0 ? 2 : 1;
+  return ids;
+}
+
+TEST(DdfemFit, FiberBlockDirectionIsTheFiberAndSpringsNeverHurt) {
+  const FineBlock block = make_fine_block(fiber_ids(), palette(1e6, 1e8), kVoxel);
+  CoarseFitOptions o = test_options();
+  const ForceSampleSet samples = sample_force_space(block, o.sampling);
+  std::printf("[ddfem] fiber sampling: %zu samples, %d dropped, %.3f s (%.0f samples/s)\n", samples.samples.size(),
+              samples.dropped, samples.seconds, samples.attempted / samples.seconds);
+  EXPECT_LE(samples.dropped, 2);
+  // The stiffest direction, found from stretch samples alone, is the fiber.
+  const AnisotropyEstimate dirs = estimate_anisotropy(block, o.anisotropy);
+  for (int k = 0; k < 8; ++k) EXPECT_GT(std::abs(dirs.direction[k].x()), 0.9) << k;
+
+  // The isotropic model is the anisotropic one with C = 0 (C's regularizer
+  // target), so the minimized objective can only drop.
+  const CoarseMaterialFit with = fit_from_samples(block, samples, dirs.direction, o);
+  o.anisotropic = false;
+  const CoarseMaterialFit without = fit_from_samples(block, samples, dirs.direction, o);
+  print_fit("fiber 100x anisotropic", with);
+  print_fit("fiber 100x isotropic", without);
+  ASSERT_TRUE(with.fitted && without.fitted);
+  EXPECT_LE(with.objective, without.objective * (1 + 1e-10));
+}
+
+TEST(DdfemFit, RecoversAKnownAnisotropicCoarseMaterial) {
+  // Energies generated by a coarse material with springs: the fit must find
+  // it (the regularizer off), and the isotropic model must not manage.
+  const auto pal = palette(1e6, 1e6);
+  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel);
+  CoarseMaterialFit truth;
+  truth.fitted = true;
+  std::mt19937_64 rng(9);
+  auto u01 = [&] { return double(rng() >> 11) * 0x1.0p-53; };
+  const double mu = pal[1]->shear_modulus(), lambda = pal[1]->lame_lambda();
+  for (int k = 0; k < 8; ++k) {
+    truth.mu[k] = mu * (0.5 + u01());
+    truth.lambda[k] = lambda * (0.5 + u01());
+    truth.C[k] = k % 2 ? 5 * mu * (0.5 + u01()) : 0.0;
+    truth.v[k] = Vec3(1.0, 0.3 * u01(), 0.3 * u01()).normalized();
+  }
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  ForceSampleSet set;
+  set.patterns.resize(1);
+  for (int i = 0; i < 200; ++i) {
+    ForceSample s;
+    for (int j = 0; j < 24; ++j) s.corner_displacement[j] = 0.1 * kVoxel * (2 * u01() - 1);
+    s.energy = coarse_energy(truth, geo, X, s.corner_displacement);
+    ASSERT_TRUE(std::isfinite(s.energy));
+    set.samples.push_back(s);
+  }
+  CoarseFitOptions o;
+  o.regularization = 0;
+  const CoarseMaterialFit fit = fit_from_samples(block, set, truth.v, o);
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_LT(fit.heldout_error, 1e-8);
+  for (int k = 0; k < 8; ++k) {
+    EXPECT_NEAR(fit.mu[k] / truth.mu[k], 1.0, 1e-6) << k;
+    EXPECT_NEAR(fit.lambda[k] / truth.lambda[k], 1.0, 1e-6) << k;
+    EXPECT_NEAR(fit.C[k], truth.C[k], 1e-6 * mu) << k;
+  }
+  o.anisotropic = false;
+  const CoarseMaterialFit iso = fit_from_samples(block, set, truth.v, o);
+  EXPECT_GT(iso.heldout_error, 1e-3);
+}
+
+TEST(DdfemFit, CoarseEnergyIsZeroAtRestAndRotationInvariant) {
+  const FineBlock block = make_fine_block(layered_ids(), palette(1e6, 1e8), kVoxel);
+  CoarseFitOptions o = test_options();
+  o.sampling.sphere_directions = 0;
+  o.sampling.magnitudes = 1;
+  const CoarseMaterialFit f = fit_coarse_material(block, o);
+  ASSERT_TRUE(f.fitted);
+  const QuadratureMaterials mats = coarse_quadrature_materials(f);
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  EXPECT_NEAR(hex_energy(geo, mats, X), 0.0, 1e-20);
+  EXPECT_NEAR(coarse_energy(f, geo, X, Vec24::Zero()), 0.0, 1e-20);
+
+  std::mt19937_64 rng(3);
+  auto u01 = [&] { return double(rng() >> 11) * 0x1.0p-53; };
+  for (int trial = 0; trial < 5; ++trial) {
+    Vec24 u;
+    for (int i = 0; i < 24; ++i) u[i] = 0.1 * kVoxel * (2 * u01() - 1);
+    hex8::NodeMatrix x = X;
+    for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
+    const double E = hex_energy(geo, mats, x);
+    ASSERT_GT(E, 0.0);
+    // The materials reproduce the fitted energy, spring weighting included.
+    EXPECT_NEAR(E, coarse_energy(f, geo, X, u), 1e-12 * E);
+    const Mat3 R = Eigen::AngleAxisd(3.0 * u01(), Vec3(u01(), u01(), 1.0).normalized()).toRotationMatrix();
+    const Vec3 d(u01(), u01(), u01());
+    hex8::NodeMatrix moved;
+    for (int c = 0; c < 8; ++c) moved.row(c) = (R * x.row(c).transpose() + kVoxel * d).transpose();
+    EXPECT_NEAR(hex_energy(geo, mats, moved), E, 1e-9 * E);
+  }
+}
+
+TEST(DdfemFit, SameSeedGivesIdenticalSamplesAndFit) {
+  const FineBlock block = make_fine_block(layered_ids(), palette(1e6, 1e7), kVoxel);
+  CoarseFitOptions o = test_options();
+  o.sampling.magnitudes = 1;
+  o.sampling.seed = 42;
+  const ForceSampleSet a = sample_force_space(block, o.sampling);
+  const ForceSampleSet b = sample_force_space(block, o.sampling);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (size_t s = 0; s < a.samples.size(); ++s) {
+    EXPECT_EQ(a.samples[s].energy, b.samples[s].energy);
+    EXPECT_EQ(a.samples[s].corner_displacement, b.samples[s].corner_displacement);
+  }
+  const CoarseMaterialFit fa = fit_coarse_material(block, o);
+  const CoarseMaterialFit fb = fit_coarse_material(block, o);
+  ASSERT_TRUE(fa.fitted);
+  EXPECT_EQ(fa.mu, fb.mu);
+  EXPECT_EQ(fa.lambda, fb.lambda);
+  EXPECT_EQ(fa.C, fb.C);
+  EXPECT_EQ(fa.heldout_error, fb.heldout_error);
+  // A different seed turns the sampling directions.
+  o.sampling.seed = 43;
+  const ForceSampleSet c = sample_force_space(block, o.sampling);
+  ASSERT_EQ(a.patterns.size(), c.patterns.size());
+  EXPECT_GT((a.patterns[3 * 4].direction - c.patterns[3 * 4].direction).norm(), 1e-3);
+}
+
+}  // namespace
+}  // namespace msfab
