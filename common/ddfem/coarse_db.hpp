@@ -1,0 +1,65 @@
+#pragma once
+// The DDFEM coarse-material database (thesis §2.3): for every combination of
+// solid palette materials in a 2 x 2 x 2 block, the fitted coarse material
+// of Eq. 2.7, stored in the `msfab.coarse_db` artifact (docs/artifacts.md).
+//
+// Combinations are keyed by the block's eight palette ids in hex8 child
+// order. Only all-solid combinations are stored; a block with a void child
+// has a coarse corner without a fine node and is coarsened naively online
+// (docs/ddfem.md, "Void").
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ddfem/coarse_fit.hpp"
+#include "ddfem/coarse_grid.hpp"
+
+namespace msfab {
+
+constexpr const char* kCoarseDbSchema = "msfab.coarse_db";
+constexpr int kCoarseDbSchemaVersion = 1;
+
+// One solid palette material (Neo-Hookean); palette id = index + 1, id 0 is void.
+struct DbMaterial {
+  std::string name;
+  double E = 0, nu = 0, density = 0;
+};
+
+struct CoarseDatabase {
+  int level = 1;
+  std::vector<DbMaterial> materials;          // ids 1..n
+  std::vector<CoarseMaterialFit> entries;     // index = combination_code(ids)
+  std::vector<int> orbit;                     // per entry: code of its orbit's representative
+  int num_orbits = 0;
+
+  int num_materials() const { return static_cast<int>(materials.size()); }
+  // Base-n digits of the ids minus one, child 0 least significant; -1 if a
+  // child is void or out of range.
+  std::int64_t combination_code(const BlockMaterials& ids) const;
+  BlockMaterials combination_ids(std::int64_t code) const;
+  std::int64_t num_combinations() const;  // n^8
+  // The fit for a combination, or nullptr for a void child / unknown id.
+  const CoarseMaterialFit* find(const BlockMaterials& ids) const;
+  // Palette as materials: [0] = nullptr (void), [i] = NeoHookean(E_i, nu_i).
+  std::vector<MaterialPtr> palette() const;
+};
+
+// Writes atomically (ArtifactWriter); `config_text` is the builder's
+// resolved config, recorded as provenance.
+void write_coarse_db(const std::string& path, const CoarseDatabase& db, const std::string& config_text,
+                     const std::string& command_line, std::uint64_t seed, const std::string& executable);
+// Reads and validates; InputError naming the file and field on any problem.
+CoarseDatabase read_coarse_db(const std::string& path);
+
+// The scene's palette must agree with the database's: each solid scene id i
+// used by the grid must be Neo-Hookean with the database's E and nu for id i
+// (relative tolerance 1e-9). InputError naming the id and the mismatch.
+void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
+                         const std::vector<MaterialPtr>& scene_palette, const std::vector<int>& used_ids);
+
+// Level-1 lookup for build_coarse_mesh: the database fit for all-solid
+// blocks, `fallback` (naive coarsening) for blocks with a void child.
+CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMaterialLookup fallback);
+
+}  // namespace msfab

@@ -1,0 +1,68 @@
+#include "build_options.hpp"
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+BuildOptions read_build_options(const Config& config) {
+  BuildOptions o;
+  const std::vector<Config> palette = config.children("palette");
+  if (palette.empty()) config.fail("palette", "must list at least one material");
+  for (const Config& m : palette) {
+    DbMaterial d;
+    d.name = m.get_or("name", "");
+    d.E = m.require_positive<double>("E", "Young's modulus");
+    d.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
+    d.density = m.get_or<double>("density", 1000.0);
+    if (!(d.density > 0)) m.fail("density", "must be > 0");
+    m.check_no_unknown_keys();
+    o.materials.push_back(d);
+  }
+  if (o.materials.size() > 15) config.fail("palette", "at most 15 materials (16^8 combinations)");
+  o.voxel_size = config.get_or<double>("voxel_size", 1e-3);
+  if (!(o.voxel_size > 0)) config.fail("voxel_size", "must be > 0");
+
+  if (config.has("sampling")) {
+    const Config s = config.child("sampling");
+    ForceSamplingOptions& f = o.fit.sampling;
+    f.include_axes = s.get_or<bool>("include_axes", f.include_axes);
+    f.sphere_directions = s.get_or<int>("sphere_directions", f.sphere_directions);
+    if (f.sphere_directions < 0) s.fail("sphere_directions", "must be >= 0");
+    f.magnitudes = s.get_or<int>("magnitudes", f.magnitudes);
+    if (f.magnitudes < 1) s.fail("magnitudes", "must be >= 1");
+    f.max_strain = s.get_or<double>("max_strain", f.max_strain);
+    if (!(f.max_strain > 0 && f.max_strain < 1)) s.fail("max_strain", "must be in (0, 1)");
+    f.seed = s.get_or<std::uint64_t>("seed", f.seed);
+    f.newton_tolerance = s.get_or<double>("newton_tolerance", f.newton_tolerance);
+    if (!(f.newton_tolerance > 0)) s.fail("newton_tolerance", "must be > 0");
+    s.check_no_unknown_keys();
+  }
+  if (config.has("anisotropy")) {
+    const Config a = config.child("anisotropy");
+    AnisotropyOptions& an = o.fit.anisotropy;
+    an.directions = a.get_or<int>("directions", an.directions);
+    if (an.directions < 3) a.fail("directions", "must be >= 3");
+    an.strain = a.get_or<double>("strain", an.strain);
+    if (!(an.strain > 0 && an.strain < 1)) a.fail("strain", "must be in (0, 1)");
+    an.seed = a.get_or<std::uint64_t>("seed", an.seed);
+    a.check_no_unknown_keys();
+  }
+  if (config.has("fit")) {
+    const Config f = config.child("fit");
+    o.fit.regularization = f.get_or<double>("regularization", o.fit.regularization);
+    if (!(o.fit.regularization >= 0)) f.fail("regularization", "must be >= 0");
+    o.fit.heldout_fraction = f.get_or<double>("heldout_fraction", o.fit.heldout_fraction);
+    if (!(o.fit.heldout_fraction >= 0 && o.fit.heldout_fraction < 1)) f.fail("heldout_fraction", "must be in [0, 1)");
+    o.fit.split_seed = f.get_or<std::uint64_t>("split_seed", o.fit.split_seed);
+    o.fit.anisotropic = f.get_or<bool>("anisotropic", o.fit.anisotropic);
+    o.fit.kind_weight[int(ForceKind::pinch)] = f.get_or<double>("pinch_weight", o.fit.kind_weight[4]);
+    if (!(o.fit.kind_weight[4] >= 0)) f.fail("pinch_weight", "must be >= 0");
+    f.check_no_unknown_keys();
+  }
+  o.use_symmetry = config.get_or<bool>("symmetry", o.use_symmetry);
+  o.orbits_per_round = config.get_or<int>("orbits_per_round", o.orbits_per_round);
+  if (o.orbits_per_round < 1) config.fail("orbits_per_round", "must be >= 1");
+  return o;
+}
+
+}  // namespace msfab

@@ -1,0 +1,20 @@
+#pragma once
+// The builder's checkpoint: the orbits fitted so far, next to the output as
+// "<out>.checkpoint.h5", rewritten atomically after every round. A resumed
+// build must use the same configuration (compared as resolved YAML text).
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "ddfem/coarse_fit.hpp"
+
+namespace msfab {
+
+using FittedOrbits = std::map<std::int64_t, CoarseMaterialFit>;  // representative code -> fit
+
+std::string checkpoint_path(const std::string& out);
+void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done);
+// InputError if the file is unreadable or was written for another config.
+FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text);
+
+}  // namespace msfab

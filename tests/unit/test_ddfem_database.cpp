@@ -1,0 +1,115 @@
+// DDFEM database pieces: cube symmetries and orbit mapping of fits, the
+// combination code, and the coarse_db artifact round trip.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <set>
+
+#include "core/errors.hpp"
+#include "ddfem/coarse_db.hpp"
+#include "ddfem/cube_symmetry.hpp"
+#include "ddfem/fine_block.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+namespace {
+
+CoarseMaterialFit random_fit(std::mt19937_64& rng, const BlockMaterials& ids) {
+  auto u01 = [&] { return double(rng() >> 11) * 0x1.0p-53; };
+  CoarseMaterialFit f;
+  f.fitted = true;
+  f.material_ids = ids;
+  for (int k = 0; k < 8; ++k) {
+    f.mu[k] = 1e5 * (0.5 + u01());
+    f.lambda[k] = 4e5 * (0.5 + u01());
+    f.C[k] = 2e5 * u01();
+    f.v[k] = Vec3(u01() - 0.5, u01() - 0.5, u01() - 0.5).normalized();
+  }
+  f.heldout_error = u01();
+  return f;
+}
+
+TEST(DdfemSymmetry, FortyEightDistinctSymmetriesActingOnChildren) {
+  const auto& all = cube_symmetries();
+  ASSERT_EQ(all.size(), 48u);
+  EXPECT_TRUE(all[0].matrix.isIdentity());
+  std::set<std::array<int, 8>> perms;
+  for (const CubeSymmetry& S : all) {
+    EXPECT_NEAR(std::abs(S.matrix.determinant()), 1.0, 1e-15);
+    perms.insert(S.child);
+  }
+  EXPECT_EQ(perms.size(), 48u);
+  // Orbits of 2-colourings of the cube's corners: 22 (Burnside).
+  std::set<BlockMaterials> reps;
+  for (int code = 0; code < 256; ++code) {
+    BlockMaterials ids;
+    for (int c = 0; c < 8; ++c) ids[c] = 1 + (code >> c & 1);
+    const CanonicalBlock canon = canonical_block(ids);
+    EXPECT_EQ(apply_symmetry(all[canon.symmetry], ids), canon.ids);
+    reps.insert(canon.ids);
+  }
+  EXPECT_EQ(reps.size(), 22u);
+}
+
+TEST(DdfemSymmetry, MappedFitGivesTheSameEnergyForTheMirroredDeformation) {
+  std::mt19937_64 rng(4);
+  auto u01 = [&] { return double(rng() >> 11) * 0x1.0p-53; };
+  const auto pal = std::vector<MaterialPtr>{nullptr, std::make_shared<NeoHookean>(1e6, 0.3)};
+  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, 1e-3);
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const BlockMaterials ids{1, 2, 2, 1, 3, 1, 2, 3};
+  for (const CubeSymmetry& S : cube_symmetries()) {
+    const BlockMaterials image_ids = apply_symmetry(S, ids);
+    const CoarseMaterialFit image = random_fit(rng, image_ids);
+    const CoarseMaterialFit fit = map_fit_back(S, image, ids);
+    EXPECT_EQ(fit.material_ids, ids);
+    Vec24 u, u_image;
+    for (int i = 0; i < 24; ++i) u[i] = 1e-4 * (2 * u01() - 1);
+    // The mirrored configuration: corner S.child[c] moves by S u_c.
+    for (int c = 0; c < 8; ++c) u_image.segment<3>(3 * S.child[c]) = S.matrix * u.segment<3>(3 * c);
+    const double E = coarse_energy(fit, geo, X, u), E_image = coarse_energy(image, geo, X, u_image);
+    ASSERT_GT(E, 0);
+    EXPECT_NEAR(E, E_image, 1e-12 * E);
+  }
+}
+
+TEST(DdfemDatabase, CombinationCodesRoundTripAndArtifactReadsBack) {
+  CoarseDatabase db;
+  db.materials = {{"soft", 1e5, 0.45, 1000}, {"stiff", 1e7, 0.45, 1200}};
+  ASSERT_EQ(db.num_combinations(), 256);
+  std::mt19937_64 rng(8);
+  for (std::int64_t c = 0; c < db.num_combinations(); ++c) {
+    const BlockMaterials ids = db.combination_ids(c);
+    EXPECT_EQ(db.combination_code(ids), c);
+    db.entries.push_back(random_fit(rng, ids));
+    db.orbit.push_back(static_cast<int>(db.combination_code(canonical_block(ids).ids)));
+  }
+  EXPECT_EQ(db.combination_code(BlockMaterials{1, 0, 1, 1, 1, 1, 1, 1}), -1);
+  EXPECT_EQ(db.combination_code(BlockMaterials{1, 3, 1, 1, 1, 1, 1, 1}), -1);
+  const std::string path = (std::filesystem::temp_directory_path() / "msfab_test_db.h5").string();
+  write_coarse_db(path, db, "palette: []\n", "test", 1, "msfab-test");
+  const CoarseDatabase back = read_coarse_db(path);
+  ASSERT_EQ(back.entries.size(), db.entries.size());
+  for (std::size_t e = 0; e < db.entries.size(); ++e) {
+    EXPECT_EQ(back.entries[e].mu, db.entries[e].mu);
+    EXPECT_EQ(back.entries[e].C, db.entries[e].C);
+    for (int k = 0; k < 8; ++k) EXPECT_EQ(back.entries[e].v[k], db.entries[e].v[k]);
+    EXPECT_EQ(back.orbit[e], db.orbit[e]);
+  }
+  EXPECT_EQ(back.find(BlockMaterials{1, 2, 1, 1, 1, 1, 1, 1}), &back.entries[2]);
+  EXPECT_EQ(back.find(BlockMaterials{0, 2, 1, 1, 1, 1, 1, 1}), nullptr);
+
+  // Palette checks against a scene.
+  const std::vector<MaterialPtr> scene = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
+                                          std::make_shared<NeoHookean>(1e7, 0.40)};
+  EXPECT_NO_THROW(check_scene_palette(back, path, scene, {0, 1}));
+  EXPECT_THROW(check_scene_palette(back, path, scene, {1, 2}), InputError);
+  const std::vector<MaterialPtr> three = {nullptr, scene[1], std::make_shared<NeoHookean>(1e7, 0.45), scene[1]};
+  EXPECT_THROW(check_scene_palette(back, path, three, {1, 3}), InputError);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace msfab
