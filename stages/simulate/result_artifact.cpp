@@ -70,6 +70,21 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
   f.write_attribute("/", "dofs", mesh.num_dofs());
   f.write_attribute("/", "free_dofs", mesh.num_dofs() - r.conditions->dirichlet.count_fixed());
   f.write_attribute("/", "elements", mesh.num_elements());
+  if (r.coarsen_level > 0) {
+    f.create_group("/coarsening");
+    f.write_attribute("/coarsening", "level", r.coarsen_level);
+    f.write_attribute("/coarsening", "material", r.coarse_material);
+    f.write_attribute("/coarsening", "database", r.database);
+    f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);
+    f.write_attribute("/coarsening", "fine_elements", r.fine_elements);
+    if (r.compared) {
+      f.write_attribute("/coarsening", "fine_newton_seconds", r.fine_seconds);
+      f.write_attribute("/coarsening", "error_vs_fine", r.error_vs_fine);
+      f.write_attribute("/coarsening", "error_definition",
+                        "mean fine-vertex distance of the trilinearly interpolated coarse displacement to the "
+                        "fine one, over the longest rest bounding-box side (thesis 2.5.2)");
+    }
+  }
   writer.commit();
 
   std::string xmf = path;

@@ -20,6 +20,15 @@ struct SimulationRecord {
   std::string config_text;
   std::string command_line;
   std::uint64_t seed = 0;
+  // Coarsened runs (level > 0): the mesh is the coarse one.
+  int coarsen_level = 0;
+  std::string coarse_material;       // ddfem | naive | averaged
+  std::string database;              // ddfem: the coarse_db path
+  double coarsening_seconds = 0;
+  int fine_elements = 0;
+  // With --compare-fine: the fine reference run and the §2.5.2 error.
+  bool compared = false;
+  double fine_seconds = 0, error_vs_fine = 0;
 };
 
 // Writes the artifact atomically to `path` and its XDMF sidecar next to it;

@@ -1,0 +1,50 @@
+#include "coarse_model.hpp"
+
+#include <chrono>
+#include <set>
+
+#include "core/errors.hpp"
+#include "ddfem/baseline_coarsening.hpp"
+
+namespace msfab {
+
+CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request) {
+  if (request.level < 1 || request.level > 2)
+    throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
+  if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged")
+    throw InputError("--coarse-material: expected ddfem, naive or averaged, got '" + request.material + "'");
+  CoarseModel m;
+  if (request.material == "ddfem") {
+    if (request.database.empty())
+      throw InputError("--coarse-material ddfem needs --database (a coarse_db from msfab-ddfem-build)");
+    m.database = std::make_shared<CoarseDatabase>(read_coarse_db(request.database));
+    if (request.level != m.database->level)
+      throw InputError(request.database + ": a level-" + std::to_string(m.database->level) +
+                       " database cannot coarsen to level " + std::to_string(request.level));
+    std::set<int> used(scene.grid.ids.begin(), scene.grid.ids.end());
+    check_scene_palette(*m.database, request.database, scene.material_by_id, std::vector<int>(used.begin(), used.end()));
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  m.level1 = coarsen_grid(scene.grid);
+  m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
+  CoarseMaterialLookup lookup;
+  if (request.material == "naive")
+    lookup = request.level == 2 ? naive_coarsening(scene.material_by_id, m.level1) : naive_coarsening(scene.material_by_id);
+  else if (request.material == "averaged")
+    lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
+                                : averaged_coarsening(scene.material_by_id);
+  else {
+    const CoarseMaterialLookup naive = naive_coarsening(scene.material_by_id);
+    int* fallbacks = &m.fallback_blocks;
+    lookup = database_coarsening(*m.database, [naive, fallbacks](const ChildIds& ids) {
+      ++*fallbacks;
+      return naive(ids);
+    });
+  }
+  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats);
+  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
+  return m;
+}
+
+}  // namespace msfab

@@ -1,0 +1,35 @@
+#pragma once
+// Online coarsening for msfab-simulate (thesis §2.4): the scene's voxel
+// grid in 2^level blocks, each one coarse element whose quadrature-point
+// materials come from the DDFEM database or from a baseline.
+#include <memory>
+#include <string>
+
+#include "ddfem/coarse_db.hpp"
+#include "ddfem/coarse_grid.hpp"
+#include "scene/scene.hpp"
+
+namespace msfab {
+
+struct CoarseningRequest {
+  int level = 0;                     // 0 = fine, 1, 2
+  std::string material = "ddfem";    // ddfem | naive | averaged
+  std::string database;              // coarse_db path (ddfem)
+};
+
+struct CoarseModel {
+  CoarseGrid level1, grid;           // grid = the level requested
+  VoxelMesh mesh;
+  StaticConditions conditions;
+  CoarseMeshStats stats;
+  double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
+  int fallback_blocks = 0;           // ddfem: distinct partly-void combinations coarsened naively
+  std::shared_ptr<CoarseDatabase> database;
+};
+
+// InputError for a bad request: unknown material, ddfem without a database
+// or at level 2 (no level-2 database yet), a database whose palette
+// disagrees with the scene.
+CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request);
+
+}  // namespace msfab
