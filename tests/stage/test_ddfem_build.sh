@@ -1,0 +1,38 @@
+#!/bin/bash
+# msfab-ddfem-build on the tiny palette: the database is identical for 1 and
+# 3 MPI ranks and after a stop and --resume; bad palettes exit 2.
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+BUILD="$BIN/msfab-ddfem-build"
+TINY="$SRC/configs/ddfem/tiny.yaml"
+# Compared datasets: everything but the timings.
+DATASETS="/palette/E /palette/nu /palette/density /combinations/ids /combinations/orbit /fit/fitted /fit/mu
+          /fit/lambda /fit/C /fit/v /fit/residual /fit/heldout_error /fit/heldout_energy_error /fit/samples_train"
+same_db() {  # same_db A B
+  local d
+  for d in $DATASETS; do h5diff -q "$1" "$2" "$d" "$d" || { echo "differs: $d"; return 1; }; done
+}
+
+check "one-rank build" -- "$BUILD" --config "$TINY" --out "$WORK/one.h5" --quiet
+check "artifact schema" -- bash -c "h5dump -a /schema '$WORK/one.h5' | grep -q msfab.coarse_db"
+check "no checkpoint left" -- test ! -e "$WORK/one.h5.checkpoint.h5"
+check "three-rank build" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$TINY" --out "$WORK/three.h5" --quiet
+check "1 and 3 ranks give the same database" -- same_db "$WORK/one.h5" "$WORK/three.h5"
+
+# Stop after two rounds (a batch job's time limit), then resume.
+expect_exit 0 "stopped after 2 rounds" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --max-rounds 2
+check "checkpoint kept" -- test -e "$WORK/part.h5.checkpoint.h5"
+check "no artifact before the end" -- test ! -e "$WORK/part.h5"
+expect_exit 2 "different configuration" -- "$BUILD" --config "$TINY" --set fit.regularization=0.5 --out "$WORK/part.h5" --resume
+expect_exit 0 "resuming: 8 of 22" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --resume
+check "resumed build gives the same database" -- same_db "$WORK/one.h5" "$WORK/part.h5"
+
+# Bad palettes.
+sed 's/nu: 0.45, density: 1200/nu: 0.5, density: 1200/' "$TINY" > "$WORK/nu05.yaml"
+expect_exit 2 "palette\[1\]\.nu.*Poisson" -- "$BUILD" --config "$WORK/nu05.yaml" --out "$WORK/bad.h5"
+sed 's/E: 1.0e5/E: -3/' "$TINY" > "$WORK/negE.yaml"
+expect_exit 2 "palette\[0\]\.E" -- "$BUILD" --config "$WORK/negE.yaml" --out "$WORK/bad.h5"
+expect_exit 2 "unknown key 'magnitude'" -- "$BUILD" --config "$TINY" --set sampling.magnitude=2 --out "$WORK/bad.h5"
+expect_exit 2 "folder does not exist" -- "$BUILD" --config "$TINY" --out "$WORK/nowhere/db.h5"
+check "nothing written on bad input" -- test ! -e "$WORK/bad.h5"
+finish
