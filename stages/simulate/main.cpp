@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"ddfem", "naive", "averaged"}));
   app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
   app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
+  std::string reference;
+  app.cli().add_option("--reference", reference,
+                       "a fine msfab.result of the same scene to compare with instead of solving it again");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t0 = std::chrono::steady_clock::now();
@@ -98,14 +101,24 @@ int main(int argc, char** argv) {
 
     // 5. Fine reference.
     SimulationRecord record;
-    if (coarsened && compare_fine) {
-      const ElasticAssembler fine_assembler(fine.mesh);
-      const NewtonResult ref = solve_or_throw(fine_assembler, fine_conditions, scene.newton, "fine load");
-      VecX uf = ref.x, uc = result.x;
-      for (int n = 0; n < fine.mesh.num_nodes(); ++n) uf.segment<3>(3 * n) -= fine.mesh.nodes.row(n).transpose();
+    if (!reference.empty() && !coarsened) throw InputError("--reference needs --coarsen 1 or 2");
+    if (!reference.empty() && compare_fine) throw InputError("--reference and --compare-fine exclude each other");
+    if (coarsened && (compare_fine || !reference.empty())) {
+      VecX uf;
+      if (compare_fine) {
+        const ElasticAssembler fine_assembler(fine.mesh);
+        const NewtonResult ref = solve_or_throw(fine_assembler, fine_conditions, scene.newton, "fine load");
+        uf = ref.x;
+        for (int n = 0; n < fine.mesh.num_nodes(); ++n) uf.segment<3>(3 * n) -= fine.mesh.nodes.row(n).transpose();
+        record.fine_seconds = ref.timings.total;
+      } else {
+        const FineReference ref = read_fine_reference(reference, fine);
+        uf = ref.displacement;
+        record.fine_seconds = ref.newton_seconds;
+      }
+      VecX uc = result.x;
       for (int n = 0; n < vm.mesh.num_nodes(); ++n) uc.segment<3>(3 * n) -= vm.mesh.nodes.row(n).transpose();
       record.compared = true;
-      record.fine_seconds = ref.timings.total;
       record.error_vs_fine = mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, uc);
     }
 

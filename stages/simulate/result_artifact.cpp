@@ -3,6 +3,7 @@
 #include "io/artifact.hpp"
 #include "io/mesh_io.hpp"
 #include "io/xdmf.hpp"
+#include "core/errors.hpp"
 
 namespace msfab {
 
@@ -55,6 +56,9 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
   f.write_attribute("/newton/energy", "units", "J");
   f.write_vector("/newton/step_length", alpha);
   f.write_vector("/newton/shift", shift);
+  std::vector<int> linear_iterations;
+  for (const auto& h : nr.history) linear_iterations.push_back(h.linear_iterations);
+  f.write_vector("/newton/linear_iterations", linear_iterations);
   f.write_attribute("/newton", "converged", int(nr.converged));
   f.write_attribute("/newton", "iterations", nr.iterations);
   f.write_attribute("/newton", "load_steps", nr.load_steps);
@@ -102,6 +106,23 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
                        {"external_force", "/external_force", 3, H5Dtype::kFloat64}},
                       {{"material_id", "/mesh/element_tag", 1, H5Dtype::kInt32}});
   return xmf;
+}
+
+FineReference read_fine_reference(const std::string& path, const VoxelMesh& fine) {
+  const ArtifactReader in(path, kResultSchema, kResultSchemaVersion);
+  if (in.file().exists("/coarsening")) throw InputError(path + ": --reference must be a fine (uncoarsened) result");
+  const MatX u = in.file().read_matrix<double>("/displacement");
+  const MatX X = in.file().read_matrix<double>("/mesh/nodes");
+  if (u.rows() != fine.mesh.num_nodes() || u.cols() != 3 || X.rows() != u.rows() ||
+      X.cols() != 3 || (X - MatX(fine.mesh.nodes)).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + fine.mesh.nodes.cwiseAbs().maxCoeff()))
+    throw InputError(path + ": /displacement and /mesh/nodes do not belong to this scene's fine mesh (" +
+                     std::to_string(fine.mesh.num_nodes()) + " nodes)");
+  FineReference ref;
+  ref.displacement.resize(3 * u.rows());
+  for (int n = 0; n < u.rows(); ++n)
+    for (int a = 0; a < 3; ++a) ref.displacement[3 * n + a] = u(n, a);
+  ref.newton_seconds = in.file().read_attribute<double>("/timings", "newton_total");
+  return ref;
 }
 
 }  // namespace msfab

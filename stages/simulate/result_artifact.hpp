@@ -31,6 +31,15 @@ struct SimulationRecord {
   double fine_seconds = 0, error_vs_fine = 0;
 };
 
+// A fine run read back for comparison: displacements (3 per node of `fine`)
+// and its Newton time. InputError if the file is not a fine result of a mesh
+// with the same nodes.
+struct FineReference {
+  VecX displacement;
+  double newton_seconds = 0;
+};
+FineReference read_fine_reference(const std::string& path, const VoxelMesh& fine);
+
 // Writes the artifact atomically to `path` and its XDMF sidecar next to it;
 // returns the sidecar's path.
 std::string write_result_artifact(const std::string& path, const SimulationRecord& record);

@@ -1,0 +1,107 @@
+#!/bin/bash
+# DDFEM speed-versus-error benchmark, the analogue of thesis Table 2.2 (with
+# the assembly / solve split of Table 2.3 and the CG-iteration comparison of
+# Figure 2-13). Every scene is solved fine once; each coarse run is compared
+# with that fine result (msfab-simulate --reference), so all numbers of one
+# row come from the same run of this script.
+#
+#   tools/bench_ddfem.sh BIN OUTDIR BENCHMARKS.md DATABASE [scene ...]
+# DATABASE: a level-1 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
+# nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`.
+set -euo pipefail
+BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
+shift 4
+SCENES=("$@")
+[ ${#SCENES[@]} -gt 0 ] || SCENES=(pushing bending twisting buckling fibers)
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$OUTDIR"
+
+attr() {  # attr FILE OBJECT NAME -> value
+  h5dump -a "$2/$3" "$1" | sed -n 's/^ *(0): *//p' | head -n1
+}
+run() {  # run OUT ARGS...: msfab-simulate quietly, log kept next to OUT
+  local out=$1
+  shift
+  "$BIN/msfab-simulate" --out "$out" --log-level warn "$@" > "${out%.h5}.log" 2>&1 ||
+    { echo "bench: failed, see ${out%.h5}.log" >&2; tail -3 "${out%.h5}.log" >&2; return 1; }
+}
+grid_of() {  # the grid size as NxMxK from a result
+  h5dump -a /grid/size "$1" | sed -n 's/^ *(0): *//p' | head -n1 | tr -d ' ' | tr ',' 'x'
+}
+mean_linear_its() {  # mean CG iterations per Newton iteration
+  h5dump -d /newton/linear_iterations "$1" | sed -n 's/^ *([0-9]*): *//p' | tr ',' '\n' |
+    awk 'NF { s += $1; n++ } END { printf "%.0f", n ? s / n : 0 }'
+}
+
+rows="" cg_rows=""
+for scene in "${SCENES[@]}"; do
+  cfg="$SRC/configs/scenes/$scene.yaml"
+  echo "bench: $scene fine ..." >&2
+  fine="$OUTDIR/$scene-L0.h5"
+  run "$fine" --config "$cfg"
+  f_tot=$(attr "$fine" /timings newton_total) f_its=$(attr "$fine" /newton iterations)
+  f_asm=$(attr "$fine" /timings assembly) f_sol=$(attr "$fine" /timings solve)
+  rows+=$(awk -v s="$scene" -v g="$(grid_of "$fine")" -v d="$(attr "$fine" / dofs)" -v t="$f_tot" -v i="$f_its" \
+    -v a="$f_asm" -v b="$f_sol" \
+    'BEGIN { printf "| %s | 0 | %s | %d | 1.0 | %.3f | %d | %.3f | %.3f | — | — | — | — |\n", s, g, d, t/i, i, a/i, b/i }')
+  rows+=$'\n'
+  for level in 1 2; do
+    declare -A err=() tot=() its=() asm=() sol=() crs=()
+    for m in ddfem naive averaged; do
+      if [ "$m" = ddfem ] && [ "$level" = 2 ]; then continue; fi
+      out="$OUTDIR/$scene-L$level-$m.h5"
+      echo "bench: $scene level $level $m ..." >&2
+      run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" --database "$DB" --reference "$fine"
+      err[$m]=$(attr "$out" /coarsening error_vs_fine)
+      tot[$m]=$(attr "$out" /timings newton_total) its[$m]=$(attr "$out" /newton iterations)
+      asm[$m]=$(attr "$out" /timings assembly) sol[$m]=$(attr "$out" /timings solve)
+      crs[$m]=$(attr "$out" /coarsening seconds)
+      dofs[$level]=$(attr "$out" / dofs)
+    done
+    # The speed columns are DDFEM's at level 1; level 2 has no DDFEM
+    # database yet, so they are naive coarsening's there (marked).
+    k=ddfem mark=""
+    [ "$level" = 2 ] && k=naive mark="*"
+    rows+=$(awk -v s="$scene" -v L="$level$mark" -v d="${dofs[$level]}" -v ft="$f_tot" -v t="${tot[$k]}" -v i="${its[$k]}" \
+      -v a="${asm[$k]}" -v b="${sol[$k]}" -v ed="${err[ddfem]:-}" -v en="${err[naive]}" -v ea="${err[averaged]}" \
+      -v c="${crs[$k]}" -v g="$(awk -v l=$level -v s="$(grid_of "$fine")" 'BEGIN { split(s, n, "x"); f = 2^l;
+          printf "%dx%dx%d", int((n[1]+f-1)/f), int((n[2]+f-1)/f), int((n[3]+f-1)/f) }')" \
+      'BEGIN { printf "| %s | %s | %s | %d | %.1f | %.3f | %d | %.3f | %.3f | %s | %.2e | %.2e | %.2f |\n",
+               s, L, g, d, ft/t, t/i, i, a/i, b/i, (ed == "" ? "—" : sprintf("%.2e", ed)), en, ea, 1e3*c }')
+    rows+=$'\n'
+    unset err tot its asm sol crs
+  done
+  # Figure 2-13: Jacobi-preconditioned CG, fine against DDFEM level 1.
+  if [ "$scene" != fibers ] && [ "$scene" != buckling ]; then
+    echo "bench: $scene CG iterations ..." >&2
+    run "$OUTDIR/$scene-cg-L0.h5" --config "$cfg" --set solver.linear_solver=pcg
+    run "$OUTDIR/$scene-cg-L1.h5" --config "$cfg" --set solver.linear_solver=pcg --coarsen 1 --database "$DB"
+    cg_rows+="| $scene | $(mean_linear_its "$OUTDIR/$scene-cg-L0.h5") | $(mean_linear_its "$OUTDIR/$scene-cg-L1.h5") |"$'\n'
+  fi
+done
+
+machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), database $(basename "$DB").
+
+| scene | level | grid | DOFs | speedup | s/it | its | assembly s/it | solve s/it | DDFEM error | naive error | averaged error | coarsening ms |
+|---|---|---|---|---|---|---|---|---|---|---|---|---|
+${rows}
+\* level 2: no DDFEM database of that level yet; speed columns are naive coarsening's.
+
+Jacobi-preconditioned CG iterations per Newton iteration (Figure 2-13):
+
+| scene | fine | DDFEM level 1 |
+|---|---|---|
+${cg_rows}"
+python3 - "$DOC" "$table" <<'PY'
+import sys
+path, table = sys.argv[1], sys.argv[2]
+text = open(path).read()
+begin, end = "<!-- bench:ddfem:begin -->", "<!-- bench:ddfem:end -->"
+if begin in text and end in text:
+    text = text[: text.index(begin) + len(begin)] + "\n" + table + "\n" + text[text.index(end):]
+else:
+    text += "\n" + begin + "\n" + table + "\n" + end + "\n"
+open(path, "w").write(text)
+PY
+echo "bench: table written to $DOC" >&2
