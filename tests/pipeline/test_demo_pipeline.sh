@@ -18,4 +18,8 @@ expect_exit 0 "up to date|Nothing to be done" -- run_make "$WORK/out/demo/bar.re
 sleep 1; touch configs/scenes/demo_bar.yaml
 expect_exit 0 "converged in" -- run_make "$WORK/out/demo/bar.result.h5"
 expect_exit 0 "schema +msfab.result" -- "$BIN/msfab-inspect" out/demo/bar.result.h5
+# The coarsened demo: tiny database, then the DDFEM run against the fine one.
+expect_exit 0 "vs fine: error" -- run_make "$WORK/out/demo/bar.ddfem.result.h5"
+check "database built" -- test -s out/ddfem/tiny.coarse_db.h5
+expect_exit 0 "up to date|Nothing to be done" -- run_make "$WORK/out/demo/bar.ddfem.result.h5"
 finish

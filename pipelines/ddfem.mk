@@ -1,0 +1,22 @@
+# DDFEM (thesis ch. 2): coarse-material databases and the Table 2.2 benchmark.
+#
+#   make -f Makefile.pipeline ddfem-db-tiny      2 materials, seconds (demo, tests)
+#   make -f Makefile.pipeline ddfem-db-level1    3 materials (Table 2.2 palette), minutes; MPI fan-out
+#   make -f Makefile.pipeline ddfem-table        regenerate the Table 2.2 analogue in docs/BENCHMARKS.md
+#
+# RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
+# cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
+# interrupted resumes from its checkpoint when the target is made again.
+RANKS  ?= 1
+MPIRUN ?= mpirun --oversubscribe -np $(RANKS)
+
+$(OUT)/ddfem/%.coarse_db.h5: configs/ddfem/%.yaml $(BIN)/msfab-ddfem-build
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< --out $@ --resume
+
+.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-table
+ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
+ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
+
+ddfem-table: build $(OUT)/ddfem/palette3.coarse_db.h5
+	bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem docs/BENCHMARKS.md $(OUT)/ddfem/palette3.coarse_db.h5
