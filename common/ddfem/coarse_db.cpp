@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
@@ -36,8 +37,9 @@ BlockMaterials CoarseDatabase::combination_ids(std::int64_t code) const {
 
 const CoarseMaterialFit* CoarseDatabase::find(const BlockMaterials& ids) const {
   const std::int64_t code = combination_code(ids);
-  if (code < 0 || code >= static_cast<std::int64_t>(entries.size())) return nullptr;
-  return entries[code].fitted ? &entries[code] : nullptr;
+  if (code < 0 || code >= static_cast<std::int64_t>(entry_of.size()) || entry_of[code] < 0) return nullptr;
+  const CoarseMaterialFit& fit = entries[entry_of[code]];
+  return fit.fitted ? &fit : nullptr;
 }
 
 std::vector<MaterialPtr> CoarseDatabase::palette() const {
@@ -67,27 +69,39 @@ void write_coarse_db(const std::string& path, const CoarseDatabase& db, const st
   f.write_attribute("/palette", "model", "neo-hookean");
   f.write_attribute("/palette", "ids", "row i is palette id i + 1; id 0 is void");
 
-  const std::int64_t N = static_cast<std::int64_t>(db.entries.size());
+  const std::int64_t N = db.num_combinations();
+  if (static_cast<std::int64_t>(db.entry_of.size()) != N || static_cast<std::int64_t>(db.orbit.size()) != N)
+    throw std::invalid_argument("write_coarse_db: entry_of and orbit need one value per combination");
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> ids(N, 8);
-  MatX mu(N, 8), lambda(N, 8), C(N, 8), v(N, 24);
-  VecX residual(N), heldout(N), heldout_energy(N), seconds(N);
-  std::vector<int> fitted(N), orbit(N), train(N), held(N), dropped(N), attempted(N);
-  for (std::int64_t e = 0; e < N; ++e) {
+  for (std::int64_t c = 0; c < N; ++c) {
+    const BlockMaterials b = db.combination_ids(c);
+    for (int k = 0; k < 8; ++k) ids(c, k) = b[k];
+  }
+  const std::int64_t K = static_cast<std::int64_t>(db.entries.size());
+  Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> entry_ids(K, 8);
+  MatX mu(K, 8), lambda(K, 8), C(K, 8), v(K, 24);
+  VecX residual(K), heldout(K), heldout_energy(K), seconds(K);
+  std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
+  for (std::int64_t e = 0; e < K; ++e) {
     const CoarseMaterialFit& fit = db.entries[e];
     for (int k = 0; k < 8; ++k) {
-      ids(e, k) = fit.material_ids[k];
+      entry_ids(e, k) = fit.material_ids[k];
       mu(e, k) = fit.mu[k], lambda(e, k) = fit.lambda[k], C(e, k) = fit.C[k];
       v.block<1, 3>(e, 3 * k) = fit.v[k].transpose();
     }
     residual[e] = fit.residual, heldout[e] = fit.heldout_error, heldout_energy[e] = fit.heldout_energy_error;
     seconds[e] = fit.seconds;
-    fitted[e] = fit.fitted, orbit[e] = db.orbit[e];
+    fitted[e] = fit.fitted;
     train[e] = fit.samples_train, held[e] = fit.samples_heldout;
     dropped[e] = fit.samples_dropped, attempted[e] = fit.samples_attempted;
   }
+  f.write_attribute("/", "compressed", int(db.compressed()));
   f.write_matrix("/combinations/ids", ids);
-  f.write_vector("/combinations/orbit", orbit);
+  f.write_vector("/combinations/orbit", db.orbit);
+  f.write_vector("/combinations/entry", db.entry_of);
   f.write_attribute("/combinations", "order", "row = sum_c (id_c - 1) n^c, child c in hex8 order");
+  f.write_attribute("/combinations/entry", "meaning", "row of /fit/* holding the combination's coarse material");
+  f.write_matrix("/fit/ids", entry_ids);
   f.write_vector("/fit/fitted", fitted);
   f.write_matrix("/fit/mu", mu);
   f.write_matrix("/fit/lambda", lambda);
@@ -140,6 +154,9 @@ CoarseDatabase read_coarse_db(const std::string& path) {
                   "), expected (" + std::to_string(N) + ", 8) for " + std::to_string(db.num_materials()) +
                   " materials");
   const auto orbit = f.read_vector<int>("/combinations/orbit");
+  const auto entry_of = f.read_vector<int>("/combinations/entry");
+  const auto entry_ids = f.read_matrix<int>("/fit/ids");
+  const std::int64_t K = entry_ids.rows();
   const auto fitted = f.read_vector<int>("/fit/fitted");
   const MatX mu = f.read_matrix<double>("/fit/mu"), lambda = f.read_matrix<double>("/fit/lambda"),
              C = f.read_matrix<double>("/fit/C"), v = f.read_matrix<double>("/fit/v");
@@ -148,30 +165,47 @@ CoarseDatabase read_coarse_db(const std::string& path) {
   const auto heldout_energy = f.read_vector<double>("/fit/heldout_energy_error");
   const auto train = f.read_vector<int>("/fit/samples_train");
   const auto held = f.read_vector<int>("/fit/samples_heldout");
-  auto rows_ok = [&](const std::string& name, std::int64_t rows, std::int64_t cols, std::int64_t want_cols) {
-    if (rows != N || cols != want_cols)
+  auto shape_ok = [&](const std::string& name, std::int64_t rows, std::int64_t cols, std::int64_t want_rows,
+                      std::int64_t want_cols) {
+    if (rows != want_rows || cols != want_cols)
       bad(path, name + " has " + std::to_string(rows) + " x " + std::to_string(cols) + " entries, expected " +
-                    std::to_string(N) + " x " + std::to_string(want_cols));
+                    std::to_string(want_rows) + " x " + std::to_string(want_cols));
   };
-  rows_ok("/combinations/orbit", orbit.size(), 1, 1);
-  rows_ok("/fit/fitted", fitted.size(), 1, 1);
-  rows_ok("/fit/mu", mu.rows(), mu.cols(), 8);
-  rows_ok("/fit/lambda", lambda.rows(), lambda.cols(), 8);
-  rows_ok("/fit/C", C.rows(), C.cols(), 8);
-  rows_ok("/fit/v", v.rows(), v.cols(), 24);
-  rows_ok("/fit/residual", residual.size(), 1, 1);
-  rows_ok("/fit/heldout_error", heldout.size(), 1, 1);
-  rows_ok("/fit/heldout_energy_error", heldout_energy.size(), 1, 1);
-  rows_ok("/fit/samples_train", train.size(), 1, 1);
-  rows_ok("/fit/samples_heldout", held.size(), 1, 1);
-  db.entries.resize(N);
+  shape_ok("/combinations/orbit", orbit.size(), 1, N, 1);
+  shape_ok("/combinations/entry", entry_of.size(), 1, N, 1);
+  if (K < 1 || K > N) bad(path, "/fit/ids must have between 1 and " + std::to_string(N) + " rows");
+  shape_ok("/fit/ids", K, entry_ids.cols(), K, 8);
+  shape_ok("/fit/fitted", fitted.size(), 1, K, 1);
+  shape_ok("/fit/mu", mu.rows(), mu.cols(), K, 8);
+  shape_ok("/fit/lambda", lambda.rows(), lambda.cols(), K, 8);
+  shape_ok("/fit/C", C.rows(), C.cols(), K, 8);
+  shape_ok("/fit/v", v.rows(), v.cols(), K, 24);
+  shape_ok("/fit/residual", residual.size(), 1, K, 1);
+  shape_ok("/fit/heldout_error", heldout.size(), 1, K, 1);
+  shape_ok("/fit/heldout_energy_error", heldout_energy.size(), 1, K, 1);
+  shape_ok("/fit/samples_train", train.size(), 1, K, 1);
+  shape_ok("/fit/samples_heldout", held.size(), 1, K, 1);
+  for (std::int64_t c = 0; c < N; ++c) {
+    BlockMaterials b;
+    for (int k = 0; k < 8; ++k) b[k] = ids(c, k);
+    if (b != db.combination_ids(c))
+      bad(path, "/combinations/ids row " + std::to_string(c) + " is not combination " + std::to_string(c));
+    if (entry_of[c] < -1 || entry_of[c] >= K)
+      bad(path, "/combinations/entry row " + std::to_string(c) + " = " + std::to_string(entry_of[c]) +
+                    " is outside /fit (" + std::to_string(K) + " rows)");
+  }
+  db.entries.resize(K);
+  db.entry_of = entry_of;
   db.orbit = orbit;
   const auto pal = db.palette();
-  for (std::int64_t e = 0; e < N; ++e) {
+  for (std::int64_t e = 0; e < K; ++e) {
     CoarseMaterialFit& fit = db.entries[e];
-    for (int k = 0; k < 8; ++k) fit.material_ids[k] = ids(e, k);
-    if (fit.material_ids != db.combination_ids(e))
-      bad(path, "/combinations/ids row " + std::to_string(e) + " is not combination " + std::to_string(e));
+    for (int k = 0; k < 8; ++k) {
+      fit.material_ids[k] = entry_ids(e, k);
+      if (fit.material_ids[k] < 1 || fit.material_ids[k] > db.num_materials())
+        bad(path, "/fit/ids row " + std::to_string(e) + " has material id " + std::to_string(fit.material_ids[k]) +
+                      " outside the palette");
+    }
     fit.fitted = fitted[e] != 0;
     for (int k = 0; k < 8; ++k) {
       fit.mu[k] = mu(e, k), fit.lambda[k] = lambda(e, k), fit.C[k] = C(e, k);

@@ -29,11 +29,17 @@ struct DbMaterial {
 struct CoarseDatabase {
   int level = 1;
   std::vector<DbMaterial> materials;          // ids 1..n
-  std::vector<CoarseMaterialFit> entries;     // index = combination_code(ids)
-  std::vector<int> orbit;                     // per entry: code of its orbit's representative
+  // The stored coarse materials: one per combination in a full database,
+  // the representatives in a compressed one (msfab-ddfem-compress).
+  std::vector<CoarseMaterialFit> entries;
+  // Per combination code: the index of its entry (its own, or its
+  // representative's), -1 if none.
+  std::vector<int> entry_of;
+  std::vector<int> orbit;                     // per combination code: code of its symmetry orbit's representative
   int num_orbits = 0;
 
   int num_materials() const { return static_cast<int>(materials.size()); }
+  bool compressed() const { return entries.size() < entry_of.size(); }
   // Base-n digits of the ids minus one, child 0 least significant; -1 if a
   // child is void or out of range.
   std::int64_t combination_code(const BlockMaterials& ids) const;

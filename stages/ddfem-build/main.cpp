@@ -154,6 +154,7 @@ int main(int argc, char** argv) {
     // 4. Every combination from its orbit's representative.
     const auto& symmetries = cube_symmetries();
     db.entries.resize(db.num_combinations());
+    db.entry_of.resize(db.num_combinations());
     db.orbit.resize(db.num_combinations());
     double fit_seconds = 0;
     int unfitted = 0;
@@ -165,6 +166,7 @@ int main(int argc, char** argv) {
       const BlockMaterials ids = db.combination_ids(c);
       const std::int64_t rep = orbits.representative_of[c];
       db.orbit[c] = static_cast<int>(rep);
+      db.entry_of[c] = static_cast<int>(c);
       const CoarseMaterialFit& image = done.at(rep);
       if (rep == c) {
         db.entries[c] = image;

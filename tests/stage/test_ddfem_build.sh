@@ -6,7 +6,7 @@ source "$SRC/tests/stage/lib.sh"
 BUILD="$BIN/msfab-ddfem-build"
 TINY="$SRC/configs/ddfem/tiny.yaml"
 # Compared datasets: everything but the timings.
-DATASETS="/palette/E /palette/nu /palette/density /combinations/ids /combinations/orbit /fit/fitted /fit/mu
+DATASETS="/palette/E /palette/nu /palette/density /combinations/ids /combinations/orbit /combinations/entry /fit/ids /fit/fitted /fit/mu
           /fit/lambda /fit/C /fit/v /fit/residual /fit/heldout_error /fit/heldout_energy_error /fit/samples_train"
 same_db() {  # same_db A B
   local d
@@ -26,6 +26,14 @@ check "no artifact before the end" -- test ! -e "$WORK/part.h5"
 expect_exit 2 "different configuration" -- "$BUILD" --config "$TINY" --set fit.regularization=0.5 --out "$WORK/part.h5" --resume
 expect_exit 0 "resuming: 8 of 22" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --resume
 check "resumed build gives the same database" -- same_db "$WORK/one.h5" "$WORK/part.h5"
+
+# Compression to k representatives (thesis 2.3.4).
+COMPRESS="$BIN/msfab-ddfem-compress"
+expect_exit 0 "256 -> 16 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=16 --out "$WORK/k16.h5"
+check "compressed database holds 16 materials" -- bash -c "h5dump -H -d /fit/mu '$WORK/k16.h5' | grep -q '( 16, 8 )'"
+expect_exit 2 "exceeds the 256 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=300 --out "$WORK/bad.h5"
+expect_exit 2 "already compressed" -- "$COMPRESS" --database "$WORK/k16.h5" --set representatives=4 --out "$WORK/bad.h5"
+expect_exit 2 "tiny.yaml: not a valid HDF5" -- "$COMPRESS" --database "$SRC/configs/ddfem/tiny.yaml" --out "$WORK/bad.h5"
 
 # Bad palettes.
 sed 's/nu: 0.45, density: 1200/nu: 0.5, density: 1200/' "$TINY" > "$WORK/nu05.yaml"

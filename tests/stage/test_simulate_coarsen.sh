@@ -20,6 +20,19 @@ echo "errors: ddfem $ddfem, naive $naive"
 check "ddfem error below 0.02" -- awk -v e="$ddfem" 'BEGIN { exit !(e > 0 && e < 0.02) }'
 check "ddfem error below a third of naive" -- awk -v d="$ddfem" -v n="$naive" 'BEGIN { exit !(d < n / 3) }'
 
+# A compressed database (64 of 256 materials) still beats naive coarsening.
+check "compressed database" -- "$BIN/msfab-ddfem-compress" --database "$WORK/db.h5" --set representatives=64 --out "$WORK/k64.h5"
+"$SIM" --config "$BAR" --coarsen 1 --database "$WORK/k64.h5" --reference "$WORK/naive.h5" --out "$WORK/k64run.h5" --quiet >/dev/null 2>&1
+check "--reference needs a fine result" -- test ! -e "$WORK/k64run.h5"
+"$SIM" --config "$BAR" --out "$WORK/fine.h5" --quiet >/dev/null
+"$SIM" --config "$BAR" --coarsen 1 --database "$WORK/k64.h5" --reference "$WORK/fine.h5" --out "$WORK/k64run.h5" --quiet >/dev/null
+k64=$(h5dump -a /coarsening/error_vs_fine "$WORK/k64run.h5" | sed -n 's/.*(0): *//p')
+echo "errors: compressed (64) $k64"
+check "same error from --reference as from --compare-fine" -- awk -v a="$ddfem" -v b="$(
+  "$SIM" --config "$BAR" --coarsen 1 --database "$WORK/db.h5" --reference "$WORK/fine.h5" --out "$WORK/ref.h5" --quiet >/dev/null &&
+  h5dump -a /coarsening/error_vs_fine "$WORK/ref.h5" | sed -n 's/.*(0): *//p')" 'BEGIN { exit !(a == b) }'
+check "compressed ddfem error below naive" -- awk -v d="$k64" -v n="$naive" 'BEGIN { exit !(d > 0 && d < n) }'
+
 # Bad requests.
 expect_exit 2 "needs --database" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material ddfem --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \

@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "ddfem/coarse_db.hpp"
 #include "ddfem/cube_symmetry.hpp"
+#include "ddfem/db_compression.hpp"
 #include "ddfem/fine_block.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -84,6 +85,7 @@ TEST(DdfemDatabase, CombinationCodesRoundTripAndArtifactReadsBack) {
     const BlockMaterials ids = db.combination_ids(c);
     EXPECT_EQ(db.combination_code(ids), c);
     db.entries.push_back(random_fit(rng, ids));
+    db.entry_of.push_back(static_cast<int>(c));
     db.orbit.push_back(static_cast<int>(db.combination_code(canonical_block(ids).ids)));
   }
   EXPECT_EQ(db.combination_code(BlockMaterials{1, 0, 1, 1, 1, 1, 1, 1}), -1);
@@ -109,6 +111,70 @@ TEST(DdfemDatabase, CombinationCodesRoundTripAndArtifactReadsBack) {
   const std::vector<MaterialPtr> three = {nullptr, scene[1], std::make_shared<NeoHookean>(1e7, 0.45), scene[1]};
   EXPECT_THROW(check_scene_palette(back, path, three, {1, 3}), InputError);
   std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace msfab
+
+namespace msfab {
+namespace {
+
+TEST(DdfemCompression, FarthestPointSetMatchesBruteForceAndRepresentativesMapToThemselves) {
+  // Points on a line: from 0 the farthest is 10, then 4 (distance 4 to 0,
+  // 6 to 10), then 7 (3 to 4, 3 to 10: tie broken by the lower row).
+  MatX f(6, 1);
+  f << 0.0, 1.0, 4.0, 7.0, 9.5, 10.0;
+  const FarthestPointSet s = farthest_point_sampling(f, 4, 0);
+  EXPECT_EQ(s.representatives, (std::vector<int>{0, 5, 2, 3}));
+  for (std::size_t r = 0; r < s.representatives.size(); ++r) {
+    EXPECT_EQ(s.nearest[s.representatives[r]], int(r));
+    EXPECT_EQ(s.distance[s.representatives[r]], 0.0);
+  }
+  EXPECT_EQ(s.nearest[1], 0);  // 1 is closest to 0
+  EXPECT_EQ(s.nearest[4], 1);  // 9.5 to 10
+
+  // Random 3-D points against a direct implementation of the definition.
+  std::mt19937_64 rng(12);
+  MatX g(40, 3);
+  for (int i = 0; i < g.size(); ++i) g.data()[i] = double(rng() >> 11) * 0x1.0p-53;
+  const FarthestPointSet t = farthest_point_sampling(g, 7, 5);
+  std::vector<int> chosen{5};
+  while (chosen.size() < 7) {
+    int best = -1;
+    double best_d = -1;
+    for (int i = 0; i < g.rows(); ++i) {
+      double d = 1e300;
+      for (int c : chosen) d = std::min(d, (g.row(i) - g.row(c)).norm());
+      if (d > best_d) best_d = d, best = i;
+    }
+    chosen.push_back(best);
+  }
+  EXPECT_EQ(t.representatives, chosen);
+  EXPECT_THROW(farthest_point_sampling(g, 41, 0), InputError);
+}
+
+TEST(DdfemCompression, CompressedDatabaseLooksEveryCombinationUpToARepresentative) {
+  CoarseDatabase db;
+  db.materials = {{"soft", 1e5, 0.45, 1000}, {"stiff", 1e7, 0.45, 1200}};
+  std::mt19937_64 rng(8);
+  for (std::int64_t c = 0; c < db.num_combinations(); ++c) {
+    CoarseMaterialFit f = random_fit(rng, db.combination_ids(c));
+    for (int k = 0; k < 8; ++k) f.C[k] = 0;  // energies stay positive for every deformation
+    db.entries.push_back(f);
+    db.entry_of.push_back(static_cast<int>(c));
+    db.orbit.push_back(static_cast<int>(c));
+  }
+  CompressionReport report;
+  const CoarseDatabase small = compress_database(db, 10, 16, 0.05, 3, &report);
+  ASSERT_EQ(small.entries.size(), 10u);
+  EXPECT_TRUE(small.compressed());
+  for (const CoarseMaterialFit& rep : small.entries) EXPECT_EQ(small.find(rep.material_ids), &rep);
+  for (std::int64_t c = 0; c < db.num_combinations(); ++c) ASSERT_NE(small.find(db.combination_ids(c)), nullptr);
+  EXPECT_GT(report.max_distance, 0);
+  EXPECT_THROW(compress_database(small, 5, 16, 0.05, 3), InputError);
+  // Same seed, same result.
+  const CoarseDatabase again = compress_database(db, 10, 16, 0.05, 3);
+  EXPECT_EQ(again.entry_of, small.entry_of);
 }
 
 }  // namespace

@@ -1,0 +1,118 @@
+#include "ddfem/db_compression.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+namespace {
+double uniform_pm1(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-52 - 1.0; }
+}  // namespace
+
+std::vector<Vec24> common_deformations(const hex8::NodeMatrix& coarse_rest, int count, double strain,
+                                       std::uint64_t seed) {
+  if (count < 1) throw InputError("compression: the number of common deformations must be >= 1");
+  if (!(strain > 0 && strain < 0.5)) throw InputError("compression: deformation strain must be in (0, 0.5)");
+  std::mt19937_64 rng(seed);
+  const Vec3 center = coarse_rest.colwise().mean().transpose();
+  const double edge = (coarse_rest.row(7) - coarse_rest.row(0)).maxCoeff();
+  std::vector<Vec24> out;
+  for (int s = 0; s < count; ++s) {
+    Mat3 G;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) G(i, j) = uniform_pm1(rng);
+    G = 0.5 * (G + G.transpose());
+    G *= strain / G.norm();
+    Vec24 u;
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 r = coarse_rest.row(c).transpose() - center;
+      Vec3 extra(uniform_pm1(rng), uniform_pm1(rng), uniform_pm1(rng));
+      u.segment<3>(3 * c) = G * r + (strain / 3.0) * 0.5 * edge * extra;
+    }
+    out.push_back(u);
+  }
+  return out;
+}
+
+MatX energy_features(const std::vector<CoarseMaterialFit>& entries, const std::vector<Vec24>& deformations,
+                     double voxel_size) {
+  std::vector<MaterialPtr> one{nullptr};
+  FineBlock unit;
+  unit.voxel_size = voxel_size;
+  const hex8::ElementGeometry geo = unit.coarse_geometry();
+  const hex8::NodeMatrix X = unit.coarse_rest_positions();
+  MatX features(entries.size(), deformations.size());
+  for (std::size_t e = 0; e < entries.size(); ++e)
+    for (std::size_t s = 0; s < deformations.size(); ++s) {
+      const double V = coarse_energy(entries[e], geo, X, deformations[s]);
+      if (!(V > 0) || !std::isfinite(V)) {
+        std::ostringstream os;
+        os << "compression: coarse material " << e << " has energy " << V << " at common deformation " << s
+           << " (must be positive and finite)";
+        throw InputError(os.str());
+      }
+      features(e, s) = std::log(V);
+    }
+  return features;
+}
+
+FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first) {
+  const int n = static_cast<int>(features.rows());
+  if (k < 1 || k > n) throw InputError("compression: representatives must be in [1, " + std::to_string(n) + "]");
+  if (first < 0 || first >= n) throw std::invalid_argument("farthest_point_sampling: first out of range");
+  FarthestPointSet out;
+  out.nearest.assign(n, 0);
+  out.distance.assign(n, std::numeric_limits<double>::infinity());
+  auto add = [&](int row) {
+    const int index = static_cast<int>(out.representatives.size());
+    out.representatives.push_back(row);
+    for (int i = 0; i < n; ++i) {
+      const double d = (features.row(i) - features.row(row)).norm();
+      if (d < out.distance[i]) out.distance[i] = d, out.nearest[i] = index;  // strict: earlier wins ties
+    }
+  };
+  add(first);
+  while (static_cast<int>(out.representatives.size()) < k) {
+    int far = 0;
+    for (int i = 1; i < n; ++i)
+      if (out.distance[i] > out.distance[far]) far = i;
+    add(far);
+  }
+  return out;
+}
+
+CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
+                                 std::uint64_t seed, CompressionReport* report) {
+  if (full.compressed()) throw InputError("compression: the input database is already compressed");
+  FineBlock unit;
+  unit.voxel_size = 1e-3;
+  const auto defs = common_deformations(unit.coarse_rest_positions(), deformations, strain, seed);
+  const MatX features = energy_features(full.entries, defs, unit.voxel_size);
+  std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  const int first = static_cast<int>(rng() % full.entries.size());
+  const FarthestPointSet fps = farthest_point_sampling(features, k, first);
+
+  CoarseDatabase out = full;
+  out.entries.clear();
+  for (int row : fps.representatives) out.entries.push_back(full.entries[row]);
+  for (auto& e : out.entry_of)
+    if (e >= 0) e = fps.nearest[e];
+  if (report) {
+    *report = CompressionReport();
+    double n = 0, err = 0;
+    for (std::size_t i = 0; i < fps.distance.size(); ++i) {
+      report->mean_distance += fps.distance[i];
+      report->max_distance = std::max(report->max_distance, fps.distance[i]);
+      const int rep = fps.representatives[fps.nearest[i]];
+      for (int s = 0; s < features.cols(); ++s, ++n) err += std::abs(std::exp(features(rep, s) - features(i, s)) - 1);
+    }
+    report->mean_distance /= fps.distance.size();
+    report->mean_energy_error = err / n;
+  }
+  return out;
+}
+
+}  // namespace msfab

@@ -1,0 +1,48 @@
+#pragma once
+// Compression of a coarse-material database (thesis §2.3.4): every coarse
+// material gets a feature vector of log-energies on a common set of
+// deformations of the coarse element; k representatives are chosen by
+// farthest-point sampling in the distance of Eq. 2.10, and every
+// combination is looked up to its nearest representative.
+#include <cstdint>
+#include <vector>
+
+#include "ddfem/coarse_db.hpp"
+#include "ddfem/fine_block.hpp"
+
+namespace msfab {
+
+// Common deformations: corner displacements (24) of the coarse element of
+// `coarse_rest` (edge 2h), each a random small strain (Frobenius norm
+// `strain`) plus a non-affine corner perturbation of a third of it, drawn
+// from the standardized mt19937_64 sequence of `seed`.
+std::vector<Vec24> common_deformations(const hex8::NodeMatrix& coarse_rest, int count, double strain,
+                                       std::uint64_t seed);
+
+// Row e: log V_s of entry e at deformation s (Eq. 2.10's feature vector).
+// InputError if an entry's energy is not positive and finite at a deformation.
+MatX energy_features(const std::vector<CoarseMaterialFit>& entries, const std::vector<Vec24>& deformations,
+                     double voxel_size);
+
+struct FarthestPointSet {
+  std::vector<int> representatives;  // rows, in the order chosen
+  std::vector<int> nearest;          // per row: position in `representatives` of the closest one
+  std::vector<double> distance;      // per row: Eq. 2.10 distance to it
+};
+// Starts at row `first`, then repeatedly adds the row farthest from all
+// chosen ones (ties: lowest row) until k are chosen. Nearest ties: the
+// earlier representative. A representative's nearest is itself.
+FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first);
+
+struct CompressionReport {
+  double mean_distance = 0, max_distance = 0;  // combinations to their representative (Eq. 2.10)
+  double mean_energy_error = 0;               // mean |V_rep / V_own - 1| over combinations and deformations
+};
+
+// A database whose entries are k representatives of `full` (which must be
+// uncompressed), with entry_of mapping every combination to its
+// representative. The first representative is drawn from `seed`.
+CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
+                                 std::uint64_t seed, CompressionReport* report = nullptr);
+
+}  // namespace msfab
