@@ -7,7 +7,8 @@
 #
 #   tools/bench_ddfem.sh BIN OUTDIR BENCHMARKS.md DATABASE [scene ...]
 # DATABASE: a level-1 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
-# nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`.
+# nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`. A run that
+# does not converge within BENCH_RUN_LIMIT seconds (default 900) is "failed".
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
 shift 4
@@ -22,7 +23,7 @@ attr() {  # attr FILE OBJECT NAME -> value
 run() {  # run OUT ARGS...: msfab-simulate quietly, log kept next to OUT
   local out=$1
   shift
-  "$BIN/msfab-simulate" --out "$out" --log-level warn "$@" > "${out%.h5}.log" 2>&1 ||
+  timeout "${BENCH_RUN_LIMIT:-900}" "$BIN/msfab-simulate" --out "$out" --log-level warn "$@" > "${out%.h5}.log" 2>&1 ||
     { echo "bench: failed, see ${out%.h5}.log" >&2; tail -3 "${out%.h5}.log" >&2; return 1; }
 }
 grid_of() {  # the grid size as NxMxK from a result
@@ -51,7 +52,12 @@ for scene in "${SCENES[@]}"; do
       if [ "$m" = ddfem ] && [ "$level" = 2 ]; then continue; fi
       out="$OUTDIR/$scene-L$level-$m.h5"
       echo "bench: $scene level $level $m ..." >&2
-      run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" --database "$DB" --reference "$fine"
+      if ! run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" --database "$DB" --reference "$fine"; then
+        # A baseline that does not converge is a result too (the naive
+        # model is pathologically stiff); the row says so.
+        err[$m]=nan tot[$m]=nan its[$m]=0 asm[$m]=nan sol[$m]=nan crs[$m]=nan dofs[$level]=0
+        continue
+      fi
       err[$m]=$(attr "$out" /coarsening error_vs_fine)
       tot[$m]=$(attr "$out" /timings newton_total) its[$m]=$(attr "$out" /newton iterations)
       asm[$m]=$(attr "$out" /timings assembly) sol[$m]=$(attr "$out" /timings solve)
@@ -66,8 +72,10 @@ for scene in "${SCENES[@]}"; do
       -v a="${asm[$k]}" -v b="${sol[$k]}" -v ed="${err[ddfem]:-}" -v en="${err[naive]}" -v ea="${err[averaged]}" \
       -v c="${crs[$k]}" -v g="$(awk -v l=$level -v s="$(grid_of "$fine")" 'BEGIN { split(s, n, "x"); f = 2^l;
           printf "%dx%dx%d", int((n[1]+f-1)/f), int((n[2]+f-1)/f), int((n[3]+f-1)/f) }')" \
-      'BEGIN { printf "| %s | %s | %s | %d | %.1f | %.3f | %d | %.3f | %.3f | %s | %.2e | %.2e | %.2f |\n",
-               s, L, g, d, ft/t, t/i, i, a/i, b/i, (ed == "" ? "—" : sprintf("%.2e", ed)), en, ea, 1e3*c }')
+      'function e(x) { return x == "" ? "—" : (x == "nan" ? "failed" : sprintf("%.2e", x)) }
+       BEGIN { if (i == 0) { printf "| %s | %s | %s | — | failed | — | — | — | — | %s | %s | %s | — |\n", s, L, g, e(ed), e(en), e(ea); exit }
+               printf "| %s | %s | %s | %d | %.1f | %.3f | %d | %.3f | %.3f | %s | %s | %s | %.2f |\n",
+               s, L, g, d, ft/t, t/i, i, a/i, b/i, e(ed), e(en), e(ea), 1e3*c }')
     rows+=$'\n'
     unset err tot its asm sol crs
   done
