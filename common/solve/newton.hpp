@@ -36,7 +36,7 @@ struct NewtonOptions {
   // "auto" picks CHOLMOD below auto_iterative_dofs unknowns and
   // multigrid-preconditioned CG (pcg-mg) above; or name a solver.
   std::string linear_solver = "auto";
-  int auto_iterative_dofs = 20000;
+  int auto_iterative_dofs = 4000;  // measured crossover, docs/solvers.md
   LinearSolverOptions linear;
   // Called after each converged load increment with the load factor reached.
   std::function<void(double load_factor)> on_load_step;
