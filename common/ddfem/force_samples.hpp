@@ -102,7 +102,7 @@ class BlockSolver {
   const FineBlock& block_;
   ElasticAssembler assembler_;
   double tolerance_;
-  int max_iterations_ = 60;
+  int max_iterations_ = 200;  // slow cases: a soft corner next to stiff children
   MatX G_, Z_;
   VecX rest_;
   double stiffness_scale_ = 0;        // largest diagonal entry of Z^T K(X) Z
