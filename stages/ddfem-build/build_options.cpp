@@ -57,6 +57,12 @@ BuildOptions read_build_options(const Config& config) {
     o.fit.anisotropic = f.get_or<bool>("anisotropic", o.fit.anisotropic);
     o.fit.kind_weight[int(ForceKind::pinch)] = f.get_or<double>("pinch_weight", o.fit.kind_weight[4]);
     if (!(o.fit.kind_weight[4] >= 0)) f.fail("pinch_weight", "must be >= 0");
+    for (ForceKind kind : {ForceKind::stretch, ForceKind::shear, ForceKind::bend, ForceKind::twist}) {
+      const std::string key = force_kind_name(kind) + "_weight";
+      double& w = o.fit.kind_weight[int(kind)];
+      w = f.get_or<double>(key, w);
+      if (!(w >= 0)) f.fail(key, "must be >= 0");
+    }
     f.check_no_unknown_keys();
   }
   o.use_symmetry = config.get_or<bool>("symmetry", o.use_symmetry);
