@@ -5,12 +5,12 @@
 
 namespace msfab {
 
-std::array<Mat3, 8> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
+std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
                                                  const hex8::NodeMatrix& X, const Vec24& u) {
   hex8::NodeMatrix x = X;
   for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
-  std::array<Mat3, 8> F;
-  for (int q = 0; q < 8; ++q) F[q] = hex8::deformation_gradient(x, coarse.dNdX[q]);
+  std::vector<Mat3> F(coarse.size());
+  for (int q = 0; q < coarse.size(); ++q) F[q] = hex8::deformation_gradient(x, coarse.dNdX[q]);
   return F;
 }
 
@@ -34,8 +34,11 @@ AnisotropyEstimate estimate_anisotropy(const FineBlock& block, const AnisotropyO
 
   const hex8::ElementGeometry coarse = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
-  std::array<std::vector<Vec3>, 8> cloud;
+  const int points = coarse.size();
+  std::vector<std::vector<Vec3>> cloud(points);
   AnisotropyEstimate out;
+  out.direction.resize(points);
+  out.singular_values.resize(points);
   for (const ForcePattern& p : stretches) {
     ++out.solves;
     const BlockSolver::Solution s = solver.solve(load * p.force);
@@ -44,14 +47,14 @@ AnisotropyEstimate estimate_anisotropy(const FineBlock& block, const AnisotropyO
       continue;
     }
     const auto F = coarse_deformation_gradients(coarse, X, solver.corner_displacements(s.x));
-    for (int q = 0; q < 8; ++q) {
+    for (int q = 0; q < points; ++q) {
       const double l = (F[q] * p.direction).norm();
       cloud[q].push_back(l * p.direction);
       cloud[q].push_back(-l * p.direction);
     }
   }
   if (cloud[0].size() < 6) throw NumericalError("anisotropy: too few stretching solves converged");
-  for (int q = 0; q < 8; ++q) {
+  for (int q = 0; q < points; ++q) {
     MatX M(cloud[q].size(), 3);
     for (size_t i = 0; i < cloud[q].size(); ++i) M.row(i) = cloud[q][i].transpose();
     Eigen::JacobiSVD<MatX> svd(M, Eigen::ComputeThinV);

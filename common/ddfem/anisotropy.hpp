@@ -9,6 +9,7 @@
 // stiffness, so it belongs where the block is stiffer than an isotropic
 // coarse point would be (in-plane for a layered block).
 #include <array>
+#include <vector>
 #include <cstdint>
 
 #include "ddfem/fine_block.hpp"
@@ -23,15 +24,15 @@ struct AnisotropyOptions {
 };
 
 struct AnisotropyEstimate {
-  std::array<Vec3, 8> direction;        // unit, per coarse quadrature point
-  std::array<Vec3, 8> singular_values;  // of the point cloud, descending
+  std::vector<Vec3> direction;        // unit, per coarse quadrature point
+  std::vector<Vec3> singular_values;  // of the point cloud, descending
   int solves = 0;
   int dropped = 0;                      // stretching solves that did not converge
 };
 
 // Deformation gradient at each coarse quadrature point for corner
 // displacements u (24, node-major).
-std::array<Mat3, 8> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
+std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
                                                  const hex8::NodeMatrix& X, const Vec24& u);
 
 // Requires a block with all corners (std::invalid_argument otherwise).

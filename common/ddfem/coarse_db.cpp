@@ -84,6 +84,7 @@ void write_coarse_db(const std::string& path, const CoarseDatabase& db, const st
   std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
   for (std::int64_t e = 0; e < K; ++e) {
     const CoarseMaterialFit& fit = db.entries[e];
+    if (fit.points() != 8) throw std::invalid_argument("write_coarse_db: level-1 fits have 8 points");
     for (int k = 0; k < 8; ++k) {
       entry_ids(e, k) = fit.material_ids[k];
       mu(e, k) = fit.mu[k], lambda(e, k) = fit.lambda[k], C(e, k) = fit.C[k];

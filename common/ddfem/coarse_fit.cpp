@@ -37,10 +37,20 @@ double weighted_rms(const std::vector<double>& rel, const std::vector<double>& w
 
 }  // namespace
 
+void CoarseMaterialFit::resize(int points) {
+  mu.assign(points, 0.0), lambda.assign(points, 0.0), C.assign(points, 0.0);
+  mu0.assign(points, 0.0), lambda0.assign(points, 0.0);
+  v.assign(points, Vec3::UnitX());
+}
+
 bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
-                         const std::array<Vec3, 8>& v, CoarseEnergyBasis& out) {
+                         const std::vector<Vec3>& v, CoarseEnergyBasis& out) {
+  if (static_cast<int>(v.size()) != coarse.size())
+    throw std::invalid_argument("coarse_energy_basis: one direction per quadrature point needed");
   const auto F = coarse_deformation_gradients(coarse, X, u);
-  for (int k = 0; k < 8; ++k) {
+  const int points = coarse.size();
+  out.a.resize(points), out.b.resize(points), out.s.resize(points);
+  for (int k = 0; k < points; ++k) {
     const double J = F[k].determinant();
     if (!(J > 0.0)) return false;
     const double logJ = std::log(J);
@@ -56,27 +66,31 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
                      const Vec24& u) {
   CoarseEnergyBasis e;
+  if (fit.points() != coarse.size())
+    throw std::invalid_argument("coarse_energy: the fit and the geometry have different point counts");
   if (!coarse_energy_basis(coarse, X, u, fit.v, e)) return kInfiniteEnergy;
   double V = 0;
-  for (int k = 0; k < 8; ++k) V += fit.mu[k] * e.a[k] + fit.lambda[k] * e.b[k] + fit.C[k] * e.s[k];
+  for (int k = 0; k < fit.points(); ++k) V += fit.mu[k] * e.a[k] + fit.lambda[k] * e.b[k] + fit.C[k] * e.s[k];
   return V;
 }
 
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
-                                   const std::array<Vec3, 8>& directions, const CoarseFitOptions& options) {
+                                   const std::vector<Vec3>& directions, const CoarseFitOptions& options) {
   if (!(options.regularization >= 0.0)) throw InputError("coarse fit: regularization must be >= 0");
   if (!(options.heldout_fraction >= 0.0 && options.heldout_fraction < 1.0))
     throw InputError("coarse fit: heldout_fraction must be in [0, 1)");
   const auto t0 = std::chrono::steady_clock::now();
-  CoarseMaterialFit fit;
+  const int points = block.coarse_points();
+  if (static_cast<int>(directions.size()) != points)
+    throw std::invalid_argument("fit_from_samples: one direction per coarse quadrature point needed");
+  CoarseMaterialFit fit(points);
   fit.material_ids = block.material_ids;
   fit.samples_attempted = set.attempted;
   fit.samples_dropped = set.dropped;
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < points; ++k) {
     fit.v[k] = directions[k].normalized();
-    const MaterialPtr& m = block.child_material[FineBlock::child_of_coarse_point(k)];
-    fit.mu0[k] = m ? m->shear_modulus() : 0.0;
-    fit.lambda0[k] = m ? m->lame_lambda() : 0.0;
+    fit.mu0[k] = block.point_mu0[k];
+    fit.lambda0[k] = block.point_lambda0[k];
   }
   if (!block.has_all_corners()) {
     fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
@@ -114,12 +128,12 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   // would forbid a soft point from stiffening, yet in a layered block the
   // soft children's points must carry the stiff layer's in-plane stiffness.
   const int per_point = options.anisotropic ? 3 : 2;
-  const int np = 8 * per_point;
+  const int np = points * per_point;
   double mu_mean = 0, lambda_mean = 0;
-  for (int k = 0; k < 8; ++k) mu_mean += fit.mu0[k] / 8, lambda_mean += fit.lambda0[k] / 8;
+  for (int k = 0; k < points; ++k) mu_mean += fit.mu0[k] / points, lambda_mean += fit.lambda0[k] / points;
   if (!(lambda_mean > 1e-6 * mu_mean)) lambda_mean = mu_mean;
   VecX scale(np), target(np);
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < points; ++k) {
     scale[per_point * k] = mu_mean;
     target[per_point * k] = fit.mu0[k] / mu_mean;
     scale[per_point * k + 1] = lambda_mean;
@@ -158,7 +172,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   for (int s = 0; s < ns; ++s) {
     if (held[s]) continue;
     const double w = std::sqrt(weight[s]) / V0[s];
-    for (int k = 0; k < 8; ++k) {
+    for (int k = 0; k < points; ++k) {
       A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
       A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
       if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
@@ -176,7 +190,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.not_fitted_reason = "NNLS did not converge";
     return fit;
   }
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < points; ++k) {
     fit.mu[k] = sol.x[per_point * k] * scale[per_point * k];
     fit.lambda[k] = sol.x[per_point * k + 1] * scale[per_point * k + 1];
     fit.C[k] = options.anisotropic ? sol.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
@@ -188,7 +202,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   double abs_held = 0, sum_held = 0;
   for (int s = 0; s < ns; ++s) {
     double V1 = 0;
-    for (int k = 0; k < 8; ++k)
+    for (int k = 0; k < points; ++k)
       V1 += fit.mu[k] * basis[s].a[k] + fit.lambda[k] * basis[s].b[k] + fit.C[k] * basis[s].s[k];
     (held[s] ? rel_held : rel_train).push_back((V1 - V0[s]) / V0[s]);
     (held[s] ? w_held : w_train).push_back(weight[s]);
@@ -206,15 +220,14 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 
 CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options) {
   if (!block.has_all_corners()) {
-    CoarseMaterialFit fit;
+    CoarseMaterialFit fit(block.coarse_points());
     fit.material_ids = block.material_ids;
     fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
     return fit;
   }
   const auto t0 = std::chrono::steady_clock::now();
   const ForceSampleSet samples = sample_force_space(block, options.sampling);
-  std::array<Vec3, 8> directions;
-  directions.fill(Vec3::UnitX());
+  std::vector<Vec3> directions(block.coarse_points(), Vec3::UnitX());
   if (options.anisotropic) directions = estimate_anisotropy(block, options.anisotropy).direction;
   CoarseMaterialFit fit = fit_from_samples(block, samples, directions, options);
   fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -224,7 +237,7 @@ CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOpt
 QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit) {
   if (!fit.fitted) throw std::invalid_argument("coarse_quadrature_materials: the block was not fitted");
   QuadratureMaterials q;
-  for (int k = 0; k < 8; ++k) {
+  for (int k = 0; k < fit.points(); ++k) {
     MaterialPtr nh = NeoHookean::from_lame(fit.mu[k], fit.lambda[k]);
     if (fit.C[k] > 0.0)
       q.at_point.push_back(std::make_shared<MaterialSum>(

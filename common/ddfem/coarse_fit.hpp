@@ -42,9 +42,11 @@ struct CoarseMaterialFit {
   bool fitted = false;
   std::string not_fitted_reason;   // why, when !fitted (e.g. a void child)
   BlockMaterials material_ids{};
-  std::array<double, 8> mu{}, lambda{}, C{};  // per coarse quadrature point
-  std::array<Vec3, 8> v{};                    // spring directions (unit)
-  std::array<double, 8> mu0{}, lambda0{};     // fine parameters at each point (Eq. 2.9's p^0)
+  // Per coarse quadrature point: 8 at level 1 (2 x 2 x 2 Gauss points),
+  // 64 for a 4-point rule.
+  std::vector<double> mu, lambda, C;
+  std::vector<Vec3> v;                        // spring directions (unit)
+  std::vector<double> mu0, lambda0;           // fine parameters at each point (Eq. 2.9's p^0)
   // Relative energy errors (V1 - V0) / V0, RMS with the fit's kind weights.
   double residual = 0;             // over the training samples
   double objective = 0;            // Eq. 2.9 as minimized: weighted data term + regularizer (scaled units)
@@ -56,16 +58,20 @@ struct CoarseMaterialFit {
   int samples_train = 0;
   int samples_heldout = 0;
   double seconds = 0;              // sampling + directions + fit
+
+  explicit CoarseMaterialFit(int points = 8) { resize(points); }
+  int points() const { return static_cast<int>(mu.size()); }
+  void resize(int points);         // zero parameters, unit-x directions
 };
 
 // The per-point basis energies of V^1 for corner displacements u: a_k, b_k,
 // s_k already multiplied by w_k det J_k. Returns false if the coarse element
 // is inverted at a point.
 struct CoarseEnergyBasis {
-  std::array<double, 8> a{}, b{}, s{};
+  std::vector<double> a, b, s;
 };
 bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
-                         const std::array<Vec3, 8>& v, CoarseEnergyBasis& out);
+                         const std::vector<Vec3>& v, CoarseEnergyBasis& out);
 
 // V^1 of a fit at corner displacements u (+inf if inverted).
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
@@ -79,7 +85,7 @@ CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOpt
 // The fit on given samples and directions (C_k = 0 unless
 // options.anisotropic). Lets callers compare models on identical samples.
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& samples,
-                                   const std::array<Vec3, 8>& directions, const CoarseFitOptions& options);
+                                   const std::vector<Vec3>& directions, const CoarseFitOptions& options);
 
 // Materials for a coarse element using the fit: per point MaterialSum of
 // NeoHookean(mu_k, lambda_k) and AnisotropicSpring(C_k, v_k) (the spring is

@@ -1,6 +1,7 @@
 #include "ddfem/cube_symmetry.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace msfab {
 
@@ -44,6 +45,7 @@ CanonicalBlock canonical_block(const BlockMaterials& ids) {
 }
 
 CoarseMaterialFit map_fit_back(const CubeSymmetry& S, const CoarseMaterialFit& image, const BlockMaterials& ids) {
+  if (image.points() != 8) throw std::invalid_argument("map_fit_back: level-1 fits (8 points) only");
   CoarseMaterialFit fit = image;
   fit.material_ids = ids;
   for (int k = 0; k < 8; ++k) {

@@ -21,7 +21,12 @@ hex8::NodeMatrix FineBlock::coarse_rest_positions() const {
 }
 
 hex8::ElementGeometry FineBlock::coarse_geometry() const {
-  return hex8::element_geometry(coarse_rest_positions(), hex8::gauss_rule(2));
+  return hex8::element_geometry(coarse_rest_positions(), hex8::gauss_rule(coarse_points_per_axis));
+}
+
+int FineBlock::child_of_point(int q) const {
+  const Vec3 chi = hex8::gauss_rule(coarse_points_per_axis).points[q];
+  return 4 * (chi.x() > 0) + 2 * (chi.y() > 0) + (chi.z() > 0);
 }
 
 int FineBlock::child_of_coarse_point(int q) {
@@ -34,7 +39,9 @@ int FineBlock::lattice_node(int i, int j, int k) const {
 }
 
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size) {
+                          double voxel_size, int coarse_points_per_axis) {
+  if (coarse_points_per_axis != 2 && coarse_points_per_axis != 4)
+    throw InputError("fine block: the coarse element takes 2 or 4 Gauss points per axis");
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
     std::ostringstream os;
     os << "fine block: voxel size must be positive and finite, got " << voxel_size;
@@ -42,6 +49,7 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
   }
   FineBlock block;
   block.voxel_size = voxel_size;
+  block.coarse_points_per_axis = coarse_points_per_axis;
   block.material_ids = ids;
   block.child_material.assign(8, nullptr);
   VoxelGrid grid(2, 2, 2, voxel_size, 0);
@@ -68,6 +76,11 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
   block.voxels = build_voxel_mesh(grid, palette);
   for (int c = 0; c < 8; ++c)
     block.corner_nodes[c] = block.lattice_node(2 * (c >> 2 & 1), 2 * (c >> 1 & 1), 2 * (c & 1));
+  for (int q = 0; q < block.coarse_points(); ++q) {
+    const MaterialPtr& m = block.child_material[block.child_of_point(q)];
+    block.point_mu0.push_back(m ? m->shear_modulus() : 0.0);
+    block.point_lambda0.push_back(m ? m->lame_lambda() : 0.0);
+  }
   return block;
 }
 

@@ -21,6 +21,11 @@ struct FineBlock {
   // Fine mesh node at coarse corner c (hex8 order), -1 where only void
   // children touch that corner.
   std::array<int, 8> corner_nodes{};
+  // The coarse element's Gauss rule: 2 points per axis at level 1 (one per
+  // child), 4 for a 64-point element. Eq. 2.9's p^0 at each coarse point:
+  // the Lame parameters of the material under it (0 in a void child).
+  int coarse_points_per_axis = 2;
+  std::vector<double> point_mu0, point_lambda0;
 
   const HexMesh& mesh() const { return voxels.mesh; }
   // Each coarse corner belongs to exactly one child, so this holds exactly
@@ -28,10 +33,12 @@ struct FineBlock {
   bool has_all_corners() const;
   // Rest positions of the coarse element's corners (edge 2h, origin at 0).
   hex8::NodeMatrix coarse_rest_positions() const;
-  // The coarse element's 2 x 2 x 2 Gauss geometry (its quadrature points k
-  // of Eq. 2.6-2.7), and the child containing each point.
+  // The coarse element's Gauss geometry (its quadrature points k of
+  // Eq. 2.6-2.7), and the child containing each point.
   hex8::ElementGeometry coarse_geometry() const;
-  static int child_of_coarse_point(int q);
+  int coarse_points() const { return coarse_points_per_axis * coarse_points_per_axis * coarse_points_per_axis; }
+  int child_of_point(int q) const;
+  static int child_of_coarse_point(int q);  // the 2-point rule
   // Mesh node at lattice position (i, j, k), i, j, k in {0, 1, 2}; -1 if absent.
   int lattice_node(int i, int j, int k) const;
 };
@@ -40,6 +47,6 @@ struct FineBlock {
 // InputError if h is not positive, an id is out of range, a non-void id has
 // no material, or every child is void.
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size);
+                          double voxel_size, int coarse_points_per_axis = 2);
 
 }  // namespace msfab

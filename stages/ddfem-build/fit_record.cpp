@@ -1,8 +1,11 @@
 #include "fit_record.hpp"
 
+#include <stdexcept>
+
 namespace msfab {
 
 void pack_fit(const CoarseMaterialFit& fit, double* row) {
+  if (fit.points() != 8) throw std::invalid_argument("pack_fit: level-1 fits have 8 points");
   double* p = row;
   for (int k = 0; k < 8; ++k) *p++ = fit.material_ids[k];
   for (int k = 0; k < 8; ++k) *p++ = fit.mu[k];
@@ -28,7 +31,7 @@ void pack_fit(const CoarseMaterialFit& fit, double* row) {
 }
 
 CoarseMaterialFit unpack_fit(const double* row) {
-  CoarseMaterialFit fit;
+  CoarseMaterialFit fit(8);
   const double* p = row;
   for (int k = 0; k < 8; ++k) fit.material_ids[k] = static_cast<int>(*p++);
   for (int k = 0; k < 8; ++k) fit.mu[k] = *p++;
