@@ -11,7 +11,9 @@
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
+#include "ddfem/level2_block.hpp"
 #include "ddfem/nnls.hpp"
+#include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
 
 namespace msfab {
@@ -428,6 +430,57 @@ TEST(DdfemFit, SixtyFourPointElementRecoversAHomogeneousMaterial) {
   const double E = hex_energy(geo, mats, x);
   EXPECT_NEAR(E, coarse_energy(fit, geo, X, u), 1e-12 * E);
   EXPECT_THROW(make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel, 3), InputError);
+}
+
+}  // namespace
+}  // namespace msfab
+
+namespace msfab {
+namespace {
+
+TEST(DdfemLevel2Block, PointsMapToTheLevel1PointInTheSameFineVoxel) {
+  const double h = kVoxel;  // fine voxel; level-1 children have edge 2h
+  const hex8::QuadratureRule r4 = hex8::gauss_rule(4), r2 = hex8::gauss_rule(2);
+  for (int q = 0; q < 64; ++q) {
+    int c = -1;
+    const int k = level1_point_of(q, &c);
+    // Positions in the 4h block: level-2 point, and level-1 point k of child c.
+    const Vec3 p2 = 2 * h * (r4.points[q] + Vec3::Ones());
+    const Vec3 origin(2 * h * (c >> 2 & 1), 2 * h * (c >> 1 & 1), 2 * h * (c & 1));
+    const Vec3 p1 = origin + h * (r2.points[k] + Vec3::Ones());
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(std::floor(p2[a] / h), std::floor(p1[a] / h)) << q << " axis " << a;
+  }
+}
+
+TEST(DdfemLevel2Block, BlockOfCoarseMaterialsFitsLikeItsMaterial) {
+  // Eight copies of a level-1 material that is exactly a Neo-Hookean one:
+  // the level-2 fit on the smooth kinds must recover it at all 64 points.
+  const double mu = 4e5, lambda = 9e5;
+  CoarseMaterialFit l1;
+  l1.fitted = true;
+  for (int k = 0; k < 8; ++k) l1.mu[k] = mu, l1.lambda[k] = lambda;
+  std::array<const CoarseMaterialFit*, 8> children;
+  children.fill(&l1);
+  const FineBlock block = make_block_of_coarse_materials(children, BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, 2 * kVoxel);
+  ASSERT_EQ(block.coarse_points(), 64);
+  EXPECT_EQ(block.point_mu0[17], mu);
+  CoarseFitOptions o = test_options();
+  o.kind_weight = {1.0, 1.0, 0.0, 1.0, 0.0};
+  const CoarseMaterialFit fit = fit_coarse_material(block, o);
+  print_fit("level-2 block, homogeneous", fit);
+  ASSERT_TRUE(fit.fitted);
+  EXPECT_LT(fit.heldout_error, 0.03);
+  double mu_mean = 0;
+  for (int k = 0; k < 64; ++k) mu_mean += fit.mu[k] / 64;
+  EXPECT_NEAR(mu_mean / mu, 1.0, 0.02);
+  // Its energy at rest is zero and the children's materials are in place.
+  EXPECT_EQ(block.mesh().materials.size(), 8u);
+  const ElasticAssembler assembler(block.mesh());
+  EXPECT_NEAR(assembler.energy(assembler.rest_positions()), 0.0, 1e-20);
+
+  CoarseMaterialFit unfitted;
+  children[3] = &unfitted;
+  EXPECT_THROW(make_block_of_coarse_materials(children, BlockMaterials{}, 2 * kVoxel), InputError);
 }
 
 }  // namespace

@@ -1,0 +1,57 @@
+#include "ddfem/level2_block.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+
+int level1_point_of(int q, int* child) {
+  const Vec3 chi = hex8::gauss_rule(4).points[q];
+  int c = 0, k = 0;
+  for (int a = 0; a < 3; ++a) {
+    const int upper = chi[a] > 0;
+    // The child spans [-1, 0] or [0, 1]; its local coordinate in [-1, 1].
+    const double local = 2.0 * chi[a] + (upper ? -1.0 : 1.0);
+    c = 2 * c + upper;
+    k = 2 * k + (local > 0);
+  }
+  *child = c;
+  return k;
+}
+
+FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
+                                         const BlockMaterials& ids, double child_size) {
+  for (int c = 0; c < 8; ++c) {
+    if (!children[c] || !children[c]->fitted || children[c]->points() != 8) {
+      std::ostringstream os;
+      os << "level-2 block: child " << c << " is not a fitted level-1 coarse material";
+      throw InputError(os.str());
+    }
+  }
+  // Geometry and topology of a 2 x 2 x 2 voxel block; the materials are
+  // replaced by the children's fitted ones below.
+  const std::vector<MaterialPtr> shape_only = {nullptr, std::make_shared<NeoHookean>(1.0, 0.3)};
+  FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, shape_only, child_size, 4);
+  block.material_ids = ids;
+  block.child_material.assign(8, nullptr);
+  HexMesh& mesh = block.voxels.mesh;
+  mesh.materials.clear();
+  for (int c = 0; c < 8; ++c) mesh.materials.push_back(coarse_quadrature_materials(*children[c]));
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int v = block.voxels.element_voxel[e];  // x fastest in a 2 x 2 x 2 grid
+    const int i = v & 1, j = (v >> 1) & 1, k = (v >> 2) & 1;
+    mesh.element_material[e] = 4 * i + 2 * j + k;
+    mesh.element_tag[e] = ids[4 * i + 2 * j + k];
+  }
+  for (int q = 0; q < block.coarse_points(); ++q) {
+    int c = 0;
+    const int k = level1_point_of(q, &c);
+    block.point_mu0[q] = children[c]->mu[k];
+    block.point_lambda0[q] = children[c]->lambda[k];
+  }
+  return block;
+}
+
+}  // namespace msfab

@@ -1,0 +1,27 @@
+#pragma once
+// The block a level-2 coarse material is fitted to (thesis §2.3.5 / §2.5):
+// 2 x 2 x 2 level-1 coarse elements, each carrying its fitted level-1
+// material (8 Gauss points), coarsened into one element with the 4-point
+// Gauss rule (64 points, one in each fine voxel of the 4 x 4 x 4 voxels the
+// element covers). Sampling and fitting run on it unchanged: its "fine"
+// mesh is again 2 x 2 x 2 hexahedra.
+#include <array>
+
+#include "ddfem/coarse_fit.hpp"
+
+namespace msfab {
+
+// `children[c]` is the level-1 fit of child c (hex8 order), fitted and with
+// 8 points; `child_size` the level-1 element edge (2 fine voxels). `ids`
+// labels the block (e.g. the children's level-1 entry indices + 1). Eq.
+// 2.9's p^0 at each of the 64 points: the child's fitted mu and lambda at
+// the level-1 point in the same fine voxel. Throws InputError on an unfitted
+// child or a child with another point count.
+FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
+                                         const BlockMaterials& ids, double child_size);
+
+// Level-1 point of child `child` that lies in the same fine voxel as point
+// q of the 4-point rule (both in hex8 bit order).
+int level1_point_of(int q, int* child);
+
+}  // namespace msfab
