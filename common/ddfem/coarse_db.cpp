@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "ddfem/level2_block.hpp"
 #include "io/artifact.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -35,6 +36,11 @@ BlockMaterials CoarseDatabase::combination_ids(std::int64_t code) const {
   return ids;
 }
 
+const CoarseMaterialFit& CoarseDatabase::find_level2(const Arrangement& level1_entries) const {
+  if (level != 2) throw std::logic_error("CoarseDatabase::find_level2 on a level-1 database");
+  return entries.at(hierarchy.lookup(level1_entries));
+}
+
 const CoarseMaterialFit* CoarseDatabase::find(const BlockMaterials& ids) const {
   const std::int64_t code = combination_code(ids);
   if (code < 0 || code >= static_cast<std::int64_t>(entry_of.size()) || entry_of[code] < 0) return nullptr;
@@ -48,13 +54,11 @@ std::vector<MaterialPtr> CoarseDatabase::palette() const {
   return p;
 }
 
-void write_coarse_db(const std::string& path, const CoarseDatabase& db, const std::string& config_text,
-                     const std::string& command_line, std::uint64_t seed, const std::string& executable) {
-  ArtifactWriter out(path, kCoarseDbSchema, kCoarseDbSchemaVersion, executable, config_text, {}, seed);
-  H5File& f = out.file();
-  f.write_attribute("/", "command_line", command_line);
-  f.write_attribute("/", "level", db.level);
-  f.write_attribute("/", "num_orbits", db.num_orbits);
+namespace {
+
+[[noreturn]] void bad(const std::string& path, const std::string& what) { throw InputError(path + ": " + what); }
+
+void write_palette(H5File& f, const CoarseDatabase& db) {
   const int n = db.num_materials();
   std::vector<double> E(n), nu(n), rho(n);
   std::string names;
@@ -68,25 +72,21 @@ void write_coarse_db(const std::string& path, const CoarseDatabase& db, const st
   f.write_attribute("/palette", "names", names);
   f.write_attribute("/palette", "model", "neo-hookean");
   f.write_attribute("/palette", "ids", "row i is palette id i + 1; id 0 is void");
+}
 
-  const std::int64_t N = db.num_combinations();
-  if (static_cast<std::int64_t>(db.entry_of.size()) != N || static_cast<std::int64_t>(db.orbit.size()) != N)
-    throw std::invalid_argument("write_coarse_db: entry_of and orbit need one value per combination");
-  Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> ids(N, 8);
-  for (std::int64_t c = 0; c < N; ++c) {
-    const BlockMaterials b = db.combination_ids(c);
-    for (int k = 0; k < 8; ++k) ids(c, k) = b[k];
-  }
-  const std::int64_t K = static_cast<std::int64_t>(db.entries.size());
+// `<prefix>/fit/*`: one row per entry, one column per quadrature point.
+void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMaterialFit>& entries) {
+  const std::int64_t K = static_cast<std::int64_t>(entries.size());
+  const int P = K > 0 ? entries[0].points() : 8;
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> entry_ids(K, 8);
-  MatX mu(K, 8), lambda(K, 8), C(K, 8), v(K, 24);
+  MatX mu(K, P), lambda(K, P), C(K, P), v(K, 3 * P);
   VecX residual(K), heldout(K), heldout_energy(K), seconds(K);
   std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
   for (std::int64_t e = 0; e < K; ++e) {
-    const CoarseMaterialFit& fit = db.entries[e];
-    if (fit.points() != 8) throw std::invalid_argument("write_coarse_db: level-1 fits have 8 points");
-    for (int k = 0; k < 8; ++k) {
-      entry_ids(e, k) = fit.material_ids[k];
+    const CoarseMaterialFit& fit = entries[e];
+    if (fit.points() != P) throw std::invalid_argument("write_coarse_db: entries differ in their point count");
+    for (int k = 0; k < 8; ++k) entry_ids(e, k) = fit.material_ids[k];
+    for (int k = 0; k < P; ++k) {
       mu(e, k) = fit.mu[k], lambda(e, k) = fit.lambda[k], C(e, k) = fit.C[k];
       v.block<1, 3>(e, 3 * k) = fit.v[k].transpose();
     }
@@ -96,43 +96,93 @@ void write_coarse_db(const std::string& path, const CoarseDatabase& db, const st
     train[e] = fit.samples_train, held[e] = fit.samples_heldout;
     dropped[e] = fit.samples_dropped, attempted[e] = fit.samples_attempted;
   }
-  f.write_attribute("/", "compressed", int(db.compressed()));
-  f.write_matrix("/combinations/ids", ids);
-  f.write_vector("/combinations/orbit", db.orbit);
-  f.write_vector("/combinations/entry", db.entry_of);
-  f.write_attribute("/combinations", "order", "row = sum_c (id_c - 1) n^c, child c in hex8 order");
-  f.write_attribute("/combinations/entry", "meaning", "row of /fit/* holding the combination's coarse material");
-  f.write_matrix("/fit/ids", entry_ids);
-  f.write_vector("/fit/fitted", fitted);
-  f.write_matrix("/fit/mu", mu);
-  f.write_matrix("/fit/lambda", lambda);
-  f.write_matrix("/fit/C", C);
-  f.write_matrix("/fit/v", v);
-  f.write_attribute("/fit", "units", "mu, lambda, C: Pa (energy densities, Eq. 2.7 per quadrature point); v: unit");
-  f.write_vector("/fit/residual", residual);
-  f.write_vector("/fit/heldout_error", heldout);
-  f.write_vector("/fit/heldout_energy_error", heldout_energy);
-  f.write_vector("/fit/seconds", seconds);
-  f.write_vector("/fit/samples_train", train);
-  f.write_vector("/fit/samples_heldout", held);
-  f.write_vector("/fit/samples_dropped", dropped);
-  f.write_vector("/fit/samples_attempted", attempted);
+  const std::string g = prefix + "/fit";
+  f.write_matrix(g + "/ids", entry_ids);
+  f.write_vector(g + "/fitted", fitted);
+  f.write_matrix(g + "/mu", mu);
+  f.write_matrix(g + "/lambda", lambda);
+  f.write_matrix(g + "/C", C);
+  f.write_matrix(g + "/v", v);
+  f.write_attribute(g, "units", "mu, lambda, C: Pa (energy densities, Eq. 2.7 per quadrature point); v: unit");
+  f.write_attribute(g, "points", P);
+  f.write_vector(g + "/residual", residual);
+  f.write_vector(g + "/heldout_error", heldout);
+  f.write_vector(g + "/heldout_energy_error", heldout_energy);
+  f.write_vector(g + "/seconds", seconds);
+  f.write_vector(g + "/samples_train", train);
+  f.write_vector(g + "/samples_heldout", held);
+  f.write_vector(g + "/samples_dropped", dropped);
+  f.write_vector(g + "/samples_attempted", attempted);
+}
+
+// A level-1 database's combinations and fits under `prefix`.
+void write_level1(H5File& f, const std::string& prefix, const CoarseDatabase& db) {
+  const std::int64_t N = db.num_combinations();
+  if (static_cast<std::int64_t>(db.entry_of.size()) != N || static_cast<std::int64_t>(db.orbit.size()) != N)
+    throw std::invalid_argument("write_coarse_db: entry_of and orbit need one value per combination");
+  Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> ids(N, 8);
+  for (std::int64_t c = 0; c < N; ++c) {
+    const BlockMaterials b = db.combination_ids(c);
+    for (int k = 0; k < 8; ++k) ids(c, k) = b[k];
+  }
+  for (const CoarseMaterialFit& fit : db.entries)
+    if (fit.points() != 8) throw std::invalid_argument("write_coarse_db: level-1 fits have 8 points");
+  const std::string g = prefix + "/combinations";
+  f.write_matrix(g + "/ids", ids);
+  f.write_vector(g + "/orbit", db.orbit);
+  f.write_vector(g + "/entry", db.entry_of);
+  f.write_attribute(g, "order", "row = sum_c (id_c - 1) n^c, child c in hex8 order");
+  f.write_attribute(g + "/entry", "meaning", "row of " + prefix + "/fit/* holding the combination's coarse material");
+  write_fits(f, prefix, db.entries);
+}
+
+void write_hierarchy(H5File& f, const Level2Hierarchy& h) {
+  for (int s = 0; s < 3; ++s) {
+    const PairStage& stage = h.stages[s];
+    const std::string g = "/hierarchy/stage" + std::to_string(s);
+    Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> pairs(stage.outputs(), 2);
+    for (int r = 0; r < stage.outputs(); ++r) pairs(r, 0) = stage.pairs[r][0], pairs(r, 1) = stage.pairs[r][1];
+    f.write_vector(g + "/table", stage.table);
+    f.write_matrix(g + "/pairs", pairs);
+    f.write_attribute(g, "axis", std::string(1, "xyz"[s]));
+    f.write_attribute(g, "inputs", stage.inputs);
+    f.write_attribute(g, "mean_distance", stage.mean_distance);
+    f.write_attribute(g, "max_distance", stage.max_distance);
+  }
+  f.write_attribute("/hierarchy", "meaning",
+                    "stage s pairs its inputs along axis s: table[a * inputs + b] = representative of (a, b), b on "
+                    "the +axis side; pairs[r] = (a, b) of representative r. Stage-0 inputs are rows of "
+                    "/level1/fit; stage-2 representatives are rows of /fit");
+}
+
+}  // namespace
+
+void write_coarse_db(const std::string& path, const CoarseDatabase& db, const std::string& config_text,
+                     const std::string& command_line, std::uint64_t seed, const std::string& executable) {
+  ArtifactWriter out(path, kCoarseDbSchema, kCoarseDbSchemaVersion, executable, config_text, {}, seed);
+  H5File& f = out.file();
+  f.write_attribute("/", "command_line", command_line);
+  f.write_attribute("/", "level", db.level);
+  write_palette(f, db);
+  if (db.level == 1) {
+    f.write_attribute("/", "num_orbits", db.num_orbits);
+    f.write_attribute("/", "compressed", int(db.compressed()));
+    write_level1(f, "", db);
+  } else {
+    if (!db.level1 || db.hierarchy.num_final() != static_cast<int>(db.entries.size()))
+      throw std::invalid_argument("write_coarse_db: a level-2 database needs its level-1 database and hierarchy");
+    f.write_attribute("/", "num_orbits", db.level1->num_orbits);
+    f.write_attribute("/", "compressed", 1);
+    write_level1(f, "/level1", *db.level1);
+    write_hierarchy(f, db.hierarchy);
+    write_fits(f, "", db.entries);
+  }
   out.commit();
 }
 
 namespace {
-[[noreturn]] void bad(const std::string& path, const std::string& what) {
-  throw InputError(path + ": " + what);
-}
-}  // namespace
 
-CoarseDatabase read_coarse_db(const std::string& path) {
-  const ArtifactReader in(path, kCoarseDbSchema, kCoarseDbSchemaVersion);
-  const H5File& f = in.file();
-  CoarseDatabase db;
-  db.level = f.read_attribute<int>("/", "level");
-  if (db.level != 1) bad(path, "level " + std::to_string(db.level) + " is not supported (only level 1)");
-  db.num_orbits = f.read_attribute<int>("/", "num_orbits");
+void read_palette(const H5File& f, const std::string& path, CoarseDatabase& db) {
   const auto E = f.read_vector<double>("/palette/E");
   const auto nu = f.read_vector<double>("/palette/nu");
   const auto rho = f.read_vector<double>("/palette/density");
@@ -148,79 +198,168 @@ CoarseDatabase read_coarse_db(const std::string& path) {
       bad(path, "/palette: material id " + std::to_string(i + 1) + " has invalid E or nu");
     db.materials.push_back({i < names.size() ? names[i] : "", E[i], nu[i], rho[i]});
   }
-  const auto ids = f.read_matrix<int>("/combinations/ids");
-  const std::int64_t N = db.num_combinations();
-  if (ids.rows() != N || ids.cols() != 8)
-    bad(path, "/combinations/ids has shape (" + std::to_string(ids.rows()) + ", " + std::to_string(ids.cols()) +
-                  "), expected (" + std::to_string(N) + ", 8) for " + std::to_string(db.num_materials()) +
-                  " materials");
-  const auto orbit = f.read_vector<int>("/combinations/orbit");
-  const auto entry_of = f.read_vector<int>("/combinations/entry");
-  const auto entry_ids = f.read_matrix<int>("/fit/ids");
+}
+
+void shape_ok(const std::string& path, const std::string& name, std::int64_t rows, std::int64_t cols,
+              std::int64_t want_rows, std::int64_t want_cols) {
+  if (rows != want_rows || cols != want_cols)
+    bad(path, name + " has " + std::to_string(rows) + " x " + std::to_string(cols) + " entries, expected " +
+                  std::to_string(want_rows) + " x " + std::to_string(want_cols));
+}
+
+// `<prefix>/fit/*` with P points per entry; material ids must be in [1, max_id].
+// mu0 / lambda0 are left for the caller (they come from the palette).
+std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& path, const std::string& prefix,
+                                         int P, int max_id, std::int64_t max_rows) {
+  const std::string g = prefix + "/fit";
+  const auto entry_ids = f.read_matrix<int>(g + "/ids");
   const std::int64_t K = entry_ids.rows();
-  const auto fitted = f.read_vector<int>("/fit/fitted");
-  const MatX mu = f.read_matrix<double>("/fit/mu"), lambda = f.read_matrix<double>("/fit/lambda"),
-             C = f.read_matrix<double>("/fit/C"), v = f.read_matrix<double>("/fit/v");
-  const auto residual = f.read_vector<double>("/fit/residual");
-  const auto heldout = f.read_vector<double>("/fit/heldout_error");
-  const auto heldout_energy = f.read_vector<double>("/fit/heldout_energy_error");
-  const auto train = f.read_vector<int>("/fit/samples_train");
-  const auto held = f.read_vector<int>("/fit/samples_heldout");
-  auto shape_ok = [&](const std::string& name, std::int64_t rows, std::int64_t cols, std::int64_t want_rows,
-                      std::int64_t want_cols) {
-    if (rows != want_rows || cols != want_cols)
-      bad(path, name + " has " + std::to_string(rows) + " x " + std::to_string(cols) + " entries, expected " +
-                    std::to_string(want_rows) + " x " + std::to_string(want_cols));
-  };
-  shape_ok("/combinations/orbit", orbit.size(), 1, N, 1);
-  shape_ok("/combinations/entry", entry_of.size(), 1, N, 1);
-  if (K < 1 || K > N) bad(path, "/fit/ids must have between 1 and " + std::to_string(N) + " rows");
-  shape_ok("/fit/ids", K, entry_ids.cols(), K, 8);
-  shape_ok("/fit/fitted", fitted.size(), 1, K, 1);
-  shape_ok("/fit/mu", mu.rows(), mu.cols(), K, 8);
-  shape_ok("/fit/lambda", lambda.rows(), lambda.cols(), K, 8);
-  shape_ok("/fit/C", C.rows(), C.cols(), K, 8);
-  shape_ok("/fit/v", v.rows(), v.cols(), K, 24);
-  shape_ok("/fit/residual", residual.size(), 1, K, 1);
-  shape_ok("/fit/heldout_error", heldout.size(), 1, K, 1);
-  shape_ok("/fit/heldout_energy_error", heldout_energy.size(), 1, K, 1);
-  shape_ok("/fit/samples_train", train.size(), 1, K, 1);
-  shape_ok("/fit/samples_heldout", held.size(), 1, K, 1);
-  for (std::int64_t c = 0; c < N; ++c) {
-    BlockMaterials b;
-    for (int k = 0; k < 8; ++k) b[k] = ids(c, k);
-    if (b != db.combination_ids(c))
-      bad(path, "/combinations/ids row " + std::to_string(c) + " is not combination " + std::to_string(c));
-    if (entry_of[c] < -1 || entry_of[c] >= K)
-      bad(path, "/combinations/entry row " + std::to_string(c) + " = " + std::to_string(entry_of[c]) +
-                    " is outside /fit (" + std::to_string(K) + " rows)");
-  }
-  db.entries.resize(K);
-  db.entry_of = entry_of;
-  db.orbit = orbit;
-  const auto pal = db.palette();
+  const auto fitted = f.read_vector<int>(g + "/fitted");
+  const MatX mu = f.read_matrix<double>(g + "/mu"), lambda = f.read_matrix<double>(g + "/lambda"),
+             C = f.read_matrix<double>(g + "/C"), v = f.read_matrix<double>(g + "/v");
+  const auto residual = f.read_vector<double>(g + "/residual");
+  const auto heldout = f.read_vector<double>(g + "/heldout_error");
+  const auto heldout_energy = f.read_vector<double>(g + "/heldout_energy_error");
+  const auto train = f.read_vector<int>(g + "/samples_train");
+  const auto held = f.read_vector<int>(g + "/samples_heldout");
+  if (K < 1 || K > max_rows) bad(path, g + "/ids must have between 1 and " + std::to_string(max_rows) + " rows");
+  shape_ok(path, g + "/ids", K, entry_ids.cols(), K, 8);
+  shape_ok(path, g + "/fitted", fitted.size(), 1, K, 1);
+  shape_ok(path, g + "/mu", mu.rows(), mu.cols(), K, P);
+  shape_ok(path, g + "/lambda", lambda.rows(), lambda.cols(), K, P);
+  shape_ok(path, g + "/C", C.rows(), C.cols(), K, P);
+  shape_ok(path, g + "/v", v.rows(), v.cols(), K, 3 * P);
+  shape_ok(path, g + "/residual", residual.size(), 1, K, 1);
+  shape_ok(path, g + "/heldout_error", heldout.size(), 1, K, 1);
+  shape_ok(path, g + "/heldout_energy_error", heldout_energy.size(), 1, K, 1);
+  shape_ok(path, g + "/samples_train", train.size(), 1, K, 1);
+  shape_ok(path, g + "/samples_heldout", held.size(), 1, K, 1);
+  std::vector<CoarseMaterialFit> entries(K, CoarseMaterialFit(P));
   for (std::int64_t e = 0; e < K; ++e) {
-    CoarseMaterialFit& fit = db.entries[e];
+    CoarseMaterialFit& fit = entries[e];
     for (int k = 0; k < 8; ++k) {
       fit.material_ids[k] = entry_ids(e, k);
-      if (fit.material_ids[k] < 1 || fit.material_ids[k] > db.num_materials())
-        bad(path, "/fit/ids row " + std::to_string(e) + " has material id " + std::to_string(fit.material_ids[k]) +
-                      " outside the palette");
+      if (fit.material_ids[k] < 1 || fit.material_ids[k] > max_id)
+        bad(path, g + "/ids row " + std::to_string(e) + " has id " + std::to_string(fit.material_ids[k]) +
+                      " outside 1.." + std::to_string(max_id));
     }
     fit.fitted = fitted[e] != 0;
-    for (int k = 0; k < 8; ++k) {
+    for (int k = 0; k < P; ++k) {
       fit.mu[k] = mu(e, k), fit.lambda[k] = lambda(e, k), fit.C[k] = C(e, k);
       fit.v[k] = v.block<1, 3>(e, 3 * k).transpose();
-      fit.mu0[k] = pal[fit.material_ids[k]]->shear_modulus();
-      fit.lambda0[k] = pal[fit.material_ids[k]]->lame_lambda();
       if (fit.fitted && (!(fit.mu[k] >= 0) || !(fit.lambda[k] >= 0) || !(fit.C[k] >= 0) ||
                          std::abs(fit.v[k].norm() - 1) > 1e-6))
-        bad(path, "/fit row " + std::to_string(e) + " point " + std::to_string(k) +
+        bad(path, g + " row " + std::to_string(e) + " point " + std::to_string(k) +
                       ": parameters must be >= 0 and v a unit vector");
     }
     fit.residual = residual[e], fit.heldout_error = heldout[e], fit.heldout_energy_error = heldout_energy[e];
     fit.samples_train = train[e], fit.samples_heldout = held[e];
   }
+  return entries;
+}
+
+// A level-1 database under `prefix`; the palette must already be in `db`.
+void read_level1(const H5File& f, const std::string& path, const std::string& prefix, CoarseDatabase& db) {
+  const std::string g = prefix + "/combinations";
+  const auto ids = f.read_matrix<int>(g + "/ids");
+  const std::int64_t N = db.num_combinations();
+  if (ids.rows() != N || ids.cols() != 8)
+    bad(path, g + "/ids has shape (" + std::to_string(ids.rows()) + ", " + std::to_string(ids.cols()) +
+                  "), expected (" + std::to_string(N) + ", 8) for " + std::to_string(db.num_materials()) +
+                  " materials");
+  db.orbit = f.read_vector<int>(g + "/orbit");
+  db.entry_of = f.read_vector<int>(g + "/entry");
+  shape_ok(path, g + "/orbit", db.orbit.size(), 1, N, 1);
+  shape_ok(path, g + "/entry", db.entry_of.size(), 1, N, 1);
+  db.entries = read_fits(f, path, prefix, 8, db.num_materials(), N);
+  const std::int64_t K = static_cast<std::int64_t>(db.entries.size());
+  for (std::int64_t c = 0; c < N; ++c) {
+    BlockMaterials b;
+    for (int k = 0; k < 8; ++k) b[k] = ids(c, k);
+    if (b != db.combination_ids(c))
+      bad(path, g + "/ids row " + std::to_string(c) + " is not combination " + std::to_string(c));
+    if (db.entry_of[c] < -1 || db.entry_of[c] >= K)
+      bad(path, g + "/entry row " + std::to_string(c) + " = " + std::to_string(db.entry_of[c]) + " is outside " +
+                    prefix + "/fit (" + std::to_string(K) + " rows)");
+  }
+  const auto pal = db.palette();
+  for (CoarseMaterialFit& fit : db.entries)
+    for (int k = 0; k < 8; ++k) {
+      fit.mu0[k] = pal[fit.material_ids[k]]->shear_modulus();
+      fit.lambda0[k] = pal[fit.material_ids[k]]->lame_lambda();
+    }
+}
+
+Level2Hierarchy read_hierarchy(const H5File& f, const std::string& path, int level1_entries) {
+  Level2Hierarchy h;
+  int inputs = level1_entries;
+  for (int s = 0; s < 3; ++s) {
+    PairStage& stage = h.stages[s];
+    const std::string g = "/hierarchy/stage" + std::to_string(s);
+    stage.inputs = f.read_attribute<int>(g, "inputs");
+    if (stage.inputs != inputs)
+      bad(path, g + ": inputs = " + std::to_string(stage.inputs) + ", expected " + std::to_string(inputs) +
+                    " (the previous stage's representatives)");
+    stage.table = f.read_vector<int>(g + "/table");
+    const auto pairs = f.read_matrix<int>(g + "/pairs");
+    shape_ok(path, g + "/table", stage.table.size(), 1, std::int64_t(inputs) * inputs, 1);
+    if (pairs.rows() < 1 || pairs.cols() != 2) bad(path, g + "/pairs must have at least one row of 2 columns");
+    for (int r = 0; r < pairs.rows(); ++r) {
+      if (pairs(r, 0) < 0 || pairs(r, 0) >= inputs || pairs(r, 1) < 0 || pairs(r, 1) >= inputs)
+        bad(path, g + "/pairs row " + std::to_string(r) + " names an input outside 0.." + std::to_string(inputs - 1));
+      stage.pairs.push_back({pairs(r, 0), pairs(r, 1)});
+    }
+    for (std::size_t i = 0; i < stage.table.size(); ++i)
+      if (stage.table[i] < 0 || stage.table[i] >= stage.outputs())
+        bad(path, g + "/table row " + std::to_string(i) + " = " + std::to_string(stage.table[i]) +
+                      " is not a representative");
+    stage.mean_distance = f.read_attribute<double>(g, "mean_distance");
+    stage.max_distance = f.read_attribute<double>(g, "max_distance");
+    inputs = stage.outputs();
+  }
+  return h;
+}
+
+}  // namespace
+
+CoarseDatabase read_coarse_db(const std::string& path) {
+  const ArtifactReader in(path, kCoarseDbSchema, kCoarseDbSchemaVersion);
+  const H5File& f = in.file();
+  CoarseDatabase db;
+  db.level = f.read_attribute<int>("/", "level");
+  if (db.level != 1 && db.level != 2) bad(path, "level " + std::to_string(db.level) + " is not 1 or 2");
+  db.num_orbits = f.read_attribute<int>("/", "num_orbits");
+  read_palette(f, path, db);
+  if (db.level == 1) {
+    read_level1(f, path, "", db);
+    return db;
+  }
+  auto level1 = std::make_shared<CoarseDatabase>();
+  level1->level = 1;
+  level1->materials = db.materials;
+  level1->num_orbits = db.num_orbits;
+  read_level1(f, path, "/level1", *level1);
+  db.hierarchy = read_hierarchy(f, path, static_cast<int>(level1->entries.size()));
+  const int K = db.hierarchy.num_final();
+  db.entries = read_fits(f, path, "", 64, static_cast<int>(level1->entries.size()), K);
+  if (static_cast<int>(db.entries.size()) != K)
+    bad(path, "/fit has " + std::to_string(db.entries.size()) + " rows, expected one per final representative (" +
+                  std::to_string(K) + ")");
+  for (int r = 0; r < K; ++r) {
+    CoarseMaterialFit& fit = db.entries[r];
+    const Arrangement arr = db.hierarchy.arrangement(2, r);
+    for (int c = 0; c < 8; ++c)
+      if (fit.material_ids[c] != arr[c] + 1)
+        bad(path, "/fit/ids row " + std::to_string(r) + " does not match the arrangement of representative " +
+                      std::to_string(r) + " in /hierarchy");
+    for (int q = 0; q < 64; ++q) {
+      int child = 0;
+      const int k = level1_point_of(q, &child);
+      fit.mu0[q] = level1->entries[arr[child]].mu[k];
+      fit.lambda0[q] = level1->entries[arr[child]].lambda[k];
+    }
+  }
+  db.level1 = level1;
   return db;
 }
 
@@ -254,6 +393,23 @@ CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMateria
     for (int c = 0; c < 8; ++c) b[c] = ids[c];
     if (const CoarseMaterialFit* fit = db.find(b)) return coarse_quadrature_materials(*fit);
     return fallback(ids);
+  };
+}
+
+CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const CoarseGrid& level1_grid,
+                                                CoarseMaterialLookup fallback) {
+  if (db.level != 2 || !db.level1) throw std::invalid_argument("database_coarsening_level2: not a level-2 database");
+  if (level1_grid.level != 1) throw std::invalid_argument("database_coarsening_level2: needs the level-1 grid");
+  return [&db, combos = level1_grid.combinations, fallback](const ChildIds& ids) {
+    Arrangement entries;
+    for (int c = 0; c < 8; ++c) {
+      if (ids[c] == 0) return fallback(ids);  // a void level-1 child
+      const std::array<int, 8>& fine = combos.at(ids[c] - 1);
+      const std::int64_t code = db.level1->combination_code(fine);
+      if (code < 0 || db.level1->entry_of[code] < 0) return fallback(ids);  // a void voxel in the child
+      entries[c] = db.level1->entry_of[code];
+    }
+    return coarse_quadrature_materials(db.find_level2(entries));
   };
 }
 

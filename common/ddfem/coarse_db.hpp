@@ -4,7 +4,7 @@
 // of Eq. 2.7, stored in the `msfab.coarse_db` artifact (docs/artifacts.md).
 //
 // Combinations are keyed by the block's eight palette ids in hex8 child
-// order. Only all-solid combinations are stored; a block with a void child
+// order (level 1; level 2 goes through the hierarchy of hierarchy.hpp). Only all-solid combinations are stored; a block with a void child
 // has a coarse corner without a fine node and is coarsened naively online
 // (docs/ddfem.md, "Void").
 #include <array>
@@ -12,8 +12,11 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/coarse_grid.hpp"
+#include "ddfem/hierarchy.hpp"
 
 namespace msfab {
 
@@ -37,6 +40,13 @@ struct CoarseDatabase {
   std::vector<int> entry_of;
   std::vector<int> orbit;                     // per combination code: code of its symmetry orbit's representative
   int num_orbits = 0;
+  // Level 2 only (§2.3.5): the level-1 database whose coarse materials are
+  // this level's palette, and the pairing stages that look the level-1
+  // entries of a cell's 8 children up to a row of `entries` (the 64-point
+  // fit of hierarchy.arrangement(2, row)). A level-2 fit's material_ids are
+  // its children's level-1 entries + 1. `entry_of` and `orbit` stay empty.
+  std::shared_ptr<const CoarseDatabase> level1;
+  Level2Hierarchy hierarchy;
 
   int num_materials() const { return static_cast<int>(materials.size()); }
   bool compressed() const { return entries.size() < entry_of.size(); }
@@ -47,6 +57,8 @@ struct CoarseDatabase {
   std::int64_t num_combinations() const;  // n^8
   // The fit for a combination, or nullptr for a void child / unknown id.
   const CoarseMaterialFit* find(const BlockMaterials& ids) const;
+  // Level 2: the fit for the level-1 entries of a cell's children.
+  const CoarseMaterialFit& find_level2(const Arrangement& level1_entries) const;
   // Palette as materials: [0] = nullptr (void), [i] = NeoHookean(E_i, nu_i).
   std::vector<MaterialPtr> palette() const;
 };
@@ -67,5 +79,12 @@ void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
 // Level-1 lookup for build_coarse_mesh: the database fit for all-solid
 // blocks, `fallback` (naive coarsening) for blocks with a void child.
 CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMaterialLookup fallback);
+
+// Level-2 lookup for build_coarse_mesh on coarsen_grid(level1_grid): each
+// child's level-1 combination to its level-1 entry, then the pairing
+// stages. `fallback` (naive level-2 coarsening) where a child is void or
+// has a void voxel (no level-1 entry).
+CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const CoarseGrid& level1_grid,
+                                                CoarseMaterialLookup fallback);
 
 }  // namespace msfab

@@ -69,6 +69,8 @@ FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first)
   auto add = [&](int row) {
     const int index = static_cast<int>(out.representatives.size());
     out.representatives.push_back(row);
+    // Each row is updated on its own, so threads cannot change the result.
+#pragma omp parallel for schedule(static)
     for (int i = 0; i < n; ++i) {
       const double d = (features.row(i) - features.row(row)).norm();
       if (d < out.distance[i]) out.distance[i] = d, out.nearest[i] = index;  // strict: earlier wins ties

@@ -6,8 +6,34 @@ namespace msfab {
 
 BuildOptions read_build_options(const Config& config) {
   BuildOptions o;
-  const std::vector<Config> palette = config.children("palette");
-  if (palette.empty()) config.fail("palette", "must list at least one material");
+  if (config.has("base_database")) o.base_database = config.get_path("base_database");
+  if (!o.base_database.empty()) {
+    if (config.has("palette")) config.fail("palette", "a level-2 build takes its palette from base_database");
+    if (config.has("symmetry")) config.fail("symmetry", "applies to level-1 builds only");
+    if (config.has("level2")) {
+      const Config l = config.child("level2");
+      HierarchyOptions& h = o.hierarchy;
+      if (l.has("representatives")) {
+        const auto k = l.get<std::vector<int>>("representatives");
+        if (k.size() != 3) l.fail("representatives", "expected three counts [x, y, z], got " + std::to_string(k.size()));
+        for (int i = 0; i < 3; ++i) {
+          if (k[i] < 1) l.fail("representatives", "counts must be >= 1");
+          h.representatives[i] = k[i];
+        }
+      }
+      h.deformations = l.get_or<int>("deformations", h.deformations);
+      if (h.deformations < 1) l.fail("deformations", "must be >= 1");
+      h.strain = l.get_or<double>("strain", h.strain);
+      if (!(h.strain > 0 && h.strain < 0.5)) l.fail("strain", "must be in (0, 0.5)");
+      h.seed = l.get_or<std::uint64_t>("seed", h.seed);
+      l.check_no_unknown_keys();
+    }
+  } else if (config.has("level2")) {
+    config.fail("level2", "needs base_database (a level-1 database)");
+  }
+  const std::vector<Config> palette = o.base_database.empty() ? config.children("palette") : std::vector<Config>{};
+  if (palette.empty() && o.base_database.empty())
+    config.fail("palette", "must list at least one material (or give base_database for a level-2 build)");
   for (const Config& m : palette) {
     DbMaterial d;
     d.name = m.get_or("name", "");

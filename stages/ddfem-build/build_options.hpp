@@ -9,7 +9,11 @@
 namespace msfab {
 
 struct BuildOptions {
-  std::vector<DbMaterial> materials;  // palette ids 1..n
+  std::vector<DbMaterial> materials;  // palette ids 1..n (level 1)
+  // Level 2 (§2.3.5): a level-1 database, compressed to at most 1024
+  // coarse materials, is the palette; the hierarchy's options.
+  std::string base_database;
+  HierarchyOptions hierarchy;
   double voxel_size = 1e-3;           // of the sampled block; the fit is scale-invariant
   CoarseFitOptions fit;
   bool use_symmetry = true;           // fit one block per cube-symmetry orbit

@@ -12,19 +12,20 @@ namespace msfab {
 
 std::string checkpoint_path(const std::string& out) { return out + ".checkpoint.h5"; }
 
-void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done) {
+void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done, int points) {
+  const int size = fit_record_size(points);
   const std::string tmp = path + ".tmp";
   {
     H5File f = H5File::create(tmp);
     f.write_attribute("/", "schema", "msfab.coarse_db.checkpoint");
     f.write_attribute("/", "config", config_text);
-    MatX rows(done.size(), 1 + kFitRecordSize);
+    MatX rows(done.size(), 1 + size);
     int r = 0;
     for (const auto& [code, fit] : done) {
-      std::vector<double> record(kFitRecordSize);
+      std::vector<double> record(size);
       pack_fit(fit, record.data());
       rows(r, 0) = static_cast<double>(code);
-      for (int j = 0; j < kFitRecordSize; ++j) rows(r, 1 + j) = record[j];
+      for (int j = 0; j < size; ++j) rows(r, 1 + j) = record[j];
       ++r;
     }
     f.write_matrix("/orbits", rows);
@@ -33,20 +34,20 @@ void write_checkpoint(const std::string& path, const std::string& config_text, c
   std::filesystem::rename(tmp, path);
 }
 
-FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text) {
+FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text, int points) {
   const H5File f = H5File::open(path);
   if (!f.exists("/orbits") || f.read_string_attribute("/", "schema") != "msfab.coarse_db.checkpoint")
     throw InputError(path + ": not a database-builder checkpoint");
   if (f.read_string_attribute("/", "config") != config_text)
     throw InputError(path + ": checkpoint was written with a different configuration; delete it or rerun without --resume");
   const MatX rows = f.read_matrix<double>("/orbits");
-  if (rows.cols() != 1 + kFitRecordSize)
+  if (rows.cols() != 1 + fit_record_size(points))
     throw InputError(path + ": /orbits has " + std::to_string(rows.cols()) + " columns, expected " +
-                     std::to_string(1 + kFitRecordSize));
+                     std::to_string(1 + fit_record_size(points)) + " (fits of " + std::to_string(points) + " points)");
   FittedOrbits done;
   for (int r = 0; r < rows.rows(); ++r) {
     const Eigen::Matrix<double, 1, Eigen::Dynamic> row = rows.row(r);
-    done[static_cast<std::int64_t>(row[0])] = unpack_fit(row.data() + 1);
+    done[static_cast<std::int64_t>(row[0])] = unpack_fit(row.data() + 1, points);
   }
   return done;
 }

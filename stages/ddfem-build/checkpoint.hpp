@@ -10,11 +10,12 @@
 
 namespace msfab {
 
-using FittedOrbits = std::map<std::int64_t, CoarseMaterialFit>;  // representative code -> fit
+using FittedOrbits = std::map<std::int64_t, CoarseMaterialFit>;  // orbit representative code (level 2: final representative) -> fit
 
 std::string checkpoint_path(const std::string& out);
-void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done);
-// InputError if the file is unreadable or was written for another config.
-FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text);
+// All fits in `done` have `points` quadrature points (8 at level 1, 64 at level 2).
+void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done, int points);
+// InputError if the file is unreadable or was written for another config or point count.
+FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text, int points);
 
 }  // namespace msfab

@@ -1,19 +1,14 @@
 #include "fit_record.hpp"
 
-#include <stdexcept>
-
 namespace msfab {
 
 void pack_fit(const CoarseMaterialFit& fit, double* row) {
-  if (fit.points() != 8) throw std::invalid_argument("pack_fit: level-1 fits have 8 points");
+  const int P = fit.points();
   double* p = row;
   for (int k = 0; k < 8; ++k) *p++ = fit.material_ids[k];
-  for (int k = 0; k < 8; ++k) *p++ = fit.mu[k];
-  for (int k = 0; k < 8; ++k) *p++ = fit.lambda[k];
-  for (int k = 0; k < 8; ++k) *p++ = fit.C[k];
-  for (int k = 0; k < 8; ++k) *p++ = fit.mu0[k];
-  for (int k = 0; k < 8; ++k) *p++ = fit.lambda0[k];
-  for (int k = 0; k < 8; ++k)
+  for (const auto* values : {&fit.mu, &fit.lambda, &fit.C, &fit.mu0, &fit.lambda0})
+    for (int k = 0; k < P; ++k) *p++ = (*values)[k];
+  for (int k = 0; k < P; ++k)
     for (int a = 0; a < 3; ++a) *p++ = fit.v[k][a];
   *p++ = fit.fitted;
   *p++ = fit.residual;
@@ -30,16 +25,13 @@ void pack_fit(const CoarseMaterialFit& fit, double* row) {
   *p++ = 0;
 }
 
-CoarseMaterialFit unpack_fit(const double* row) {
-  CoarseMaterialFit fit(8);
+CoarseMaterialFit unpack_fit(const double* row, int points) {
+  CoarseMaterialFit fit(points);
   const double* p = row;
   for (int k = 0; k < 8; ++k) fit.material_ids[k] = static_cast<int>(*p++);
-  for (int k = 0; k < 8; ++k) fit.mu[k] = *p++;
-  for (int k = 0; k < 8; ++k) fit.lambda[k] = *p++;
-  for (int k = 0; k < 8; ++k) fit.C[k] = *p++;
-  for (int k = 0; k < 8; ++k) fit.mu0[k] = *p++;
-  for (int k = 0; k < 8; ++k) fit.lambda0[k] = *p++;
-  for (int k = 0; k < 8; ++k)
+  for (auto* values : {&fit.mu, &fit.lambda, &fit.C, &fit.mu0, &fit.lambda0})
+    for (int k = 0; k < points; ++k) (*values)[k] = *p++;
+  for (int k = 0; k < points; ++k)
     for (int a = 0; a < 3; ++a) fit.v[k][a] = *p++;
   fit.fitted = *p++ != 0;
   fit.residual = *p++;

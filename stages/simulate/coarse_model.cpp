@@ -34,12 +34,16 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
                                 : averaged_coarsening(scene.material_by_id);
   else {
-    const CoarseMaterialLookup naive = naive_coarsening(scene.material_by_id);
+    // Blocks the database cannot key (a void voxel or child) are coarsened naively.
+    const CoarseMaterialLookup naive = request.level == 2 ? naive_coarsening(scene.material_by_id, m.level1)
+                                                          : naive_coarsening(scene.material_by_id);
     int* fallbacks = &m.fallback_blocks;
-    lookup = database_coarsening(*m.database, [naive, fallbacks](const ChildIds& ids) {
+    const CoarseMaterialLookup counted = [naive, fallbacks](const ChildIds& ids) {
       ++*fallbacks;
       return naive(ids);
-    });
+    };
+    lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
+                                : database_coarsening(*m.database, counted);
   }
   m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats);
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

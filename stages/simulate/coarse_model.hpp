@@ -28,8 +28,8 @@ struct CoarseModel {
 };
 
 // InputError for a bad request: unknown material, ddfem without a database
-// or at level 2 (no level-2 database yet), a database whose palette
-// disagrees with the scene.
+// or with a database of another level, a database whose palette disagrees
+// with the scene.
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request);
 
 }  // namespace msfab

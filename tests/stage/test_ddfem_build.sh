@@ -1,6 +1,7 @@
 #!/bin/bash
-# msfab-ddfem-build on the tiny palette: the database is identical for 1 and
-# 3 MPI ranks and after a stop and --resume; bad palettes exit 2.
+# msfab-ddfem-build on the tiny palette, level 1 and level 2: the database is
+# identical for 1 and 3 MPI ranks and after a stop and --resume; bad
+# palettes and bases exit 2.
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 BUILD="$BIN/msfab-ddfem-build"
@@ -34,6 +35,31 @@ check "compressed database holds 16 materials" -- bash -c "h5dump -H -d /fit/mu 
 expect_exit 2 "exceeds the 256 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=300 --out "$WORK/bad.h5"
 expect_exit 2 "already compressed" -- "$COMPRESS" --database "$WORK/k16.h5" --set representatives=4 --out "$WORK/bad.h5"
 expect_exit 2 "tiny.yaml: not a valid HDF5" -- "$COMPRESS" --database "$SRC/configs/ddfem/tiny.yaml" --out "$WORK/bad.h5"
+
+# Level 2 over the tiny database (thesis 2.3.5): same for 1 and 3 ranks and after a resume.
+L2="$SRC/configs/ddfem/tiny_level2.yaml"
+L2SETS="/fit/ids /fit/mu /fit/lambda /fit/C /fit/v /fit/heldout_error /hierarchy/stage0/table /hierarchy/stage1/pairs
+        /hierarchy/stage2/table /level1/fit/mu /level1/combinations/entry"
+same_db2() {
+  local d
+  for d in $L2SETS; do h5diff -q "$1" "$2" "$d" "$d" || { echo "differs: $d"; return 1; }; done
+}
+expect_exit 0 "16 level-2 coarse materials over 256 level-1 materials" -- \
+  "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" --out "$WORK/l2one.h5"
+check "level-2 fits have 64 points" -- bash -c "h5dump -H -d /fit/mu '$WORK/l2one.h5' | grep -q '( 16, 64 )'"
+check "three-rank level-2 build" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$L2" \
+  --set base_database="$WORK/one.h5" --out "$WORK/l2three.h5" --quiet
+check "level 2: 1 and 3 ranks give the same database" -- same_db2 "$WORK/l2one.h5" "$WORK/l2three.h5"
+expect_exit 0 "stopped after 1 rounds" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" --out "$WORK/l2part.h5" --max-rounds 1
+expect_exit 2 "different configuration" -- "$BUILD" --config "$L2" --set base_database="$WORK/k16.h5" --out "$WORK/l2part.h5" --resume
+expect_exit 0 "resuming: 4 of 16" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" --out "$WORK/l2part.h5" --resume
+check "level 2: resumed build gives the same database" -- same_db2 "$WORK/l2one.h5" "$WORK/l2part.h5"
+expect_exit 2 "must be a level-1 database" -- "$BUILD" --config "$L2" --set base_database="$WORK/l2one.h5" --out "$WORK/bad.h5"
+expect_exit 2 "takes its palette from base_database" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
+  --set 'palette=[{E: 1, nu: 0.3}]' --out "$WORK/bad.h5"
+expect_exit 2 "level2.representatives" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
+  --set 'level2.representatives=[4, 4]' --out "$WORK/bad.h5"
+expect_exit 2 "needs base_database" -- "$BUILD" --config "$TINY" --set 'level2.deformations=4' --out "$WORK/bad.h5"
 
 # Bad palettes.
 sed 's/nu: 0.45, density: 1200/nu: 0.5, density: 1200/' "$TINY" > "$WORK/nu05.yaml"

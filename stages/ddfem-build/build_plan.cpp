@@ -1,0 +1,121 @@
+#include "build_plan.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <fstream>
+#include <iterator>
+
+#include "core/errors.hpp"
+#include "ddfem/cube_symmetry.hpp"
+#include "ddfem/level2_block.hpp"
+
+namespace msfab {
+namespace {
+
+// FNV-1a of the file's bytes: a resumed level-2 build must see the same base.
+std::string file_fingerprint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t h = 1469598103934665603ULL;
+  for (std::istreambuf_iterator<char> it(in), end; it != end; ++it)
+    h = (h ^ static_cast<unsigned char>(*it)) * 1099511628211ULL;
+  char text[32];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+}  // namespace
+
+BuildPlan plan_level1(const BuildOptions& options) {
+  BuildPlan plan;
+  plan.db.level = 1;
+  plan.db.materials = options.materials;
+  const std::int64_t N = plan.db.num_combinations();
+  plan.item_of.resize(N);
+  for (std::int64_t code = 0; code < N; ++code) {
+    const std::int64_t rep = options.use_symmetry
+                                 ? plan.db.combination_code(canonical_block(plan.db.combination_ids(code)).ids)
+                                 : code;
+    plan.item_of[code] = rep;
+    if (rep == code) plan.items.push_back(code);
+  }
+  plan.db.num_orbits = static_cast<int>(plan.items.size());
+  plan.points = 8;
+  const auto palette = plan.db.palette();
+  CoarseDatabase codes;  // only the palette size matters for decoding
+  codes.materials = plan.db.materials;
+  plan.block = [palette, codes, h = options.voxel_size](std::int64_t code) {
+    return make_fine_block(codes.combination_ids(code), palette, h);
+  };
+  return plan;
+}
+
+BuildPlan plan_level2(const BuildOptions& options) {
+  auto base = std::make_shared<CoarseDatabase>(read_coarse_db(options.base_database));
+  if (base->level != 1)
+    throw InputError(options.base_database + ": base_database must be a level-1 database, this one is level " +
+                     std::to_string(base->level));
+  const int k1 = static_cast<int>(base->entries.size());
+  if (k1 > 1024)
+    throw InputError(options.base_database + ": " + std::to_string(k1) +
+                     " coarse materials (k1^2 pair candidates); compress it to at most 1024 with msfab-ddfem-compress");
+  BuildPlan plan;
+  plan.db.level = 2;
+  plan.db.materials = base->materials;
+  plan.db.num_orbits = base->num_orbits;
+  plan.db.level1 = base;
+  const auto t0 = std::chrono::steady_clock::now();
+  plan.db.hierarchy = build_level2_hierarchy(base->entries, 2 * options.voxel_size, options.hierarchy);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  int inputs = k1;
+  for (int s = 0; s < 3; ++s) {
+    const PairStage& stage = plan.db.hierarchy.stages[s];
+    spdlog::info("level 2, pairs along {}: {} candidates -> {} representatives (Eq. 2.10 distance mean {:.4f}, max {:.4f})",
+                 "xyz"[s], std::int64_t(inputs) * inputs, stage.outputs(), stage.mean_distance, stage.max_distance);
+    inputs = stage.outputs();
+  }
+  spdlog::info("level 2 hierarchy: {:.2f} s", seconds);
+  for (int r = 0; r < plan.db.hierarchy.num_final(); ++r) plan.items.push_back(r);
+  plan.points = 64;
+  plan.fingerprint = "base_database " + file_fingerprint(options.base_database);
+  plan.block = [base, hierarchy = plan.db.hierarchy, h = options.voxel_size](std::int64_t r) {
+    const Arrangement arr = hierarchy.arrangement(2, static_cast<int>(r));
+    std::array<const CoarseMaterialFit*, 8> children;
+    BlockMaterials ids;
+    for (int c = 0; c < 8; ++c) children[c] = &base->entries[arr[c]], ids[c] = arr[c] + 1;
+    return make_block_of_coarse_materials(children, ids, 2 * h);
+  };
+  return plan;
+}
+
+CoarseDatabase assemble_database(BuildPlan plan, const FittedOrbits& done) {
+  CoarseDatabase& db = plan.db;
+  int unfitted = 0;
+  for (const auto& [item, fit] : done) unfitted += !fit.fitted;
+  if (unfitted > 0) throw NumericalError(std::to_string(unfitted) + " block(s) could not be fitted");
+  if (db.level == 2) {
+    for (std::int64_t r : plan.items) db.entries.push_back(done.at(r));
+    return db;
+  }
+  // Level 1: every combination from its orbit's representative.
+  const auto& symmetries = cube_symmetries();
+  const std::int64_t N = db.num_combinations();
+  db.entries.resize(N);
+  db.entry_of.resize(N);
+  db.orbit.resize(N);
+  for (std::int64_t c = 0; c < N; ++c) {
+    const std::int64_t rep = plan.item_of[c];
+    db.orbit[c] = static_cast<int>(rep);
+    db.entry_of[c] = static_cast<int>(c);
+    const CoarseMaterialFit& image = done.at(rep);
+    if (rep == c) {
+      db.entries[c] = image;
+    } else {
+      const BlockMaterials ids = db.combination_ids(c);
+      db.entries[c] = map_fit_back(symmetries[canonical_block(ids).symmetry], image, ids);
+    }
+  }
+  return db;
+}
+
+}  // namespace msfab
