@@ -7,12 +7,15 @@
 #
 #   tools/bench_ddfem.sh BIN OUTDIR BENCHMARKS.md DATABASE [scene ...]
 # DATABASE: a level-1 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
-# nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`. A run that
+# nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`;
+# DATABASE2 (environment, optional): a level-2 coarse_db of the same palette
+# (`ddfem-db-level2`), without it level 2 has only the baselines. A run that
 # does not converge within BENCH_RUN_LIMIT seconds (default 900) is "failed".
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
 shift 4
 SCENES=("$@")
+DB2=${DATABASE2:-}
 [ ${#SCENES[@]} -gt 0 ] || SCENES=(pushing bending twisting buckling fibers)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
@@ -48,11 +51,13 @@ for scene in "${SCENES[@]}"; do
   rows+=$'\n'
   for level in 1 2; do
     declare -A err=() tot=() its=() asm=() sol=() crs=()
+    db=$DB
+    [ "$level" = 2 ] && db=$DB2
     for m in ddfem naive averaged; do
-      if [ "$m" = ddfem ] && [ "$level" = 2 ]; then continue; fi
+      if [ "$m" = ddfem ] && [ -z "$db" ]; then continue; fi
       out="$OUTDIR/$scene-L$level-$m.h5"
       echo "bench: $scene level $level $m ..." >&2
-      if ! run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" --database "$DB" --reference "$fine"; then
+      if ! run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" ${db:+--database "$db"} --reference "$fine"; then
         # A baseline that does not converge is a result too (the naive
         # model is pathologically stiff); the row says so.
         err[$m]=nan tot[$m]=nan its[$m]=0 asm[$m]=nan sol[$m]=nan crs[$m]=nan dofs[$level]=0
@@ -64,10 +69,10 @@ for scene in "${SCENES[@]}"; do
       crs[$m]=$(attr "$out" /coarsening seconds)
       dofs[$level]=$(attr "$out" / dofs)
     done
-    # The speed columns are DDFEM's at level 1; level 2 has no DDFEM
-    # database yet, so they are naive coarsening's there (marked).
+    # The speed columns are DDFEM's; naive coarsening's where there is no
+    # database of that level (marked).
     k=ddfem mark=""
-    [ "$level" = 2 ] && k=naive mark="*"
+    [ -z "$db" ] && k=naive mark="*"
     rows+=$(awk -v s="$scene" -v L="$level$mark" -v d="${dofs[$level]}" -v ft="$f_tot" -v t="${tot[$k]}" -v i="${its[$k]}" \
       -v a="${asm[$k]}" -v b="${sol[$k]}" -v ed="${err[ddfem]:-}" -v en="${err[naive]}" -v ea="${err[averaged]}" \
       -v c="${crs[$k]}" -v g="$(awk -v l=$level -v s="$(grid_of "$fine")" 'BEGIN { split(s, n, "x"); f = 2^l;
@@ -100,13 +105,15 @@ for scene in "${SCENES[@]}"; do
   fi
 done
 
+star_note=""
+[ -n "$DB2" ] || star_note="\* level 2 without a level-2 database: speed columns are naive coarsening's."
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), database $(basename "$DB").
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB")${DB2:+ (level 1) and $(basename "$DB2") (level 2)}.
 
 | scene | level | grid | DOFs | speedup | s/it | its | assembly s/it | solve s/it | DDFEM error | naive error | averaged error | coarsening ms |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|
 ${rows}
-\* level 2: no DDFEM database of that level yet; speed columns are naive coarsening's.
+${star_note}
 Speed columns use the default linear solver (\`auto\`: CHOLMOD below 4 000 DOFs, pcg-mg above).
 
 The thesis's set-up, a direct solver (CHOLMOD) at both levels:

@@ -355,8 +355,8 @@ CoarseDatabase read_coarse_db(const std::string& path) {
     for (int q = 0; q < 64; ++q) {
       int child = 0;
       const int k = level1_point_of(q, &child);
-      fit.mu0[q] = level1->entries[arr[child]].mu[k];
-      fit.lambda0[q] = level1->entries[arr[child]].lambda[k];
+      fit.mu0[q] = level1->entries[arr[child]].mu0[k];
+      fit.lambda0[q] = level1->entries[arr[child]].lambda0[k];
     }
   }
   db.level1 = level1;

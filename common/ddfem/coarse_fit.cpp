@@ -180,7 +180,10 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     b[r] = w * V0[s];
     ++r;
   }
-  const double reg = std::sqrt(options.regularization);
+  // lambda is Eq. 2.9's for the 8 points of a level-1 element; with more
+  // points (64 at level 2) each weighs 8 / points, so the regularizer's pull
+  // on a uniform relative change of the material is the same at every level.
+  const double reg = std::sqrt(options.regularization * 8.0 / points);
   for (int j = 0; j < np; ++j, ++r) {
     A(r, j) = reg;
     b[r] = reg * target[j];

@@ -28,7 +28,7 @@ struct CoarseFitOptions {
   ForceSamplingOptions sampling;
   AnisotropyOptions anisotropy;
   bool anisotropic = true;        // fit C_k (else C_k = 0 and no direction solves)
-  double regularization = 0.02;   // lambda of Eq. 2.9, on the scaled problem
+  double regularization = 0.02;   // lambda of Eq. 2.9, on the scaled problem, per 8 points
   double heldout_fraction = 0.2;  // samples kept out of the fit for validation
   // Weight of each force kind in the fit, indexed by ForceKind (stretch,
   // shear, bend, twist, pinch), whatever its sample count. Pinching, a point

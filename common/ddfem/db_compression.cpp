@@ -59,10 +59,18 @@ MatX energy_features(const std::vector<CoarseMaterialFit>& entries, const std::v
   return features;
 }
 
-FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first) {
+bool is_homogeneous(const BlockMaterials& ids) {
+  for (int c = 1; c < 8; ++c)
+    if (ids[c] != ids[0]) return false;
+  return ids[0] > 0;
+}
+
+FarthestPointSet farthest_point_sampling(const MatX& features, int k, const std::vector<int>& seeds) {
   const int n = static_cast<int>(features.rows());
   if (k < 1 || k > n) throw InputError("compression: representatives must be in [1, " + std::to_string(n) + "]");
-  if (first < 0 || first >= n) throw std::invalid_argument("farthest_point_sampling: first out of range");
+  if (seeds.empty()) throw std::invalid_argument("farthest_point_sampling: no seed");
+  for (int row : seeds)
+    if (row < 0 || row >= n) throw std::invalid_argument("farthest_point_sampling: seed out of range");
   FarthestPointSet out;
   out.nearest.assign(n, 0);
   out.distance.assign(n, std::numeric_limits<double>::infinity());
@@ -76,7 +84,8 @@ FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first)
       if (d < out.distance[i]) out.distance[i] = d, out.nearest[i] = index;  // strict: earlier wins ties
     }
   };
-  add(first);
+  for (int row : seeds)
+    if (static_cast<int>(out.representatives.size()) < k && out.distance[row] > 0) add(row);
   while (static_cast<int>(out.representatives.size()) < k) {
     int far = 0;
     for (int i = 1; i < n; ++i)
@@ -93,9 +102,11 @@ CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformat
   unit.voxel_size = 1e-3;
   const auto defs = common_deformations(unit.coarse_rest_positions(), deformations, strain, seed);
   const MatX features = energy_features(full.entries, defs, unit.voxel_size);
-  std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
-  const int first = static_cast<int>(rng() % full.entries.size());
-  const FarthestPointSet fps = farthest_point_sampling(features, k, first);
+  std::vector<int> seeds;
+  for (std::size_t e = 0; e < full.entries.size(); ++e)
+    if (is_homogeneous(full.entries[e].material_ids)) seeds.push_back(static_cast<int>(e));
+  if (seeds.empty()) seeds.push_back(0);
+  const FarthestPointSet fps = farthest_point_sampling(features, k, seeds);
 
   CoarseDatabase out = full;
   out.entries.clear();

@@ -29,10 +29,19 @@ struct FarthestPointSet {
   std::vector<int> nearest;          // per row: position in `representatives` of the closest one
   std::vector<double> distance;      // per row: Eq. 2.10 distance to it
 };
-// Starts at row `first`, then repeatedly adds the row farthest from all
-// chosen ones (ties: lowest row) until k are chosen. Nearest ties: the
-// earlier representative. A representative's nearest is itself.
-FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first);
+// Starts with the rows `seeds` (in order, repeats skipped), then repeatedly
+// adds the row farthest from all chosen ones (ties: lowest row) until k are
+// chosen. Nearest ties: the earlier representative. A representative's
+// nearest is itself.
+FarthestPointSet farthest_point_sampling(const MatX& features, int k, const std::vector<int>& seeds);
+inline FarthestPointSet farthest_point_sampling(const MatX& features, int k, int first) {
+  return farthest_point_sampling(features, k, std::vector<int>{first});
+}
+
+// Blocks of one material are kept exactly: they are the common case in a
+// design (every uniform region), so compression seeds farthest-point
+// sampling with them instead of a random start (docs/ddfem.md).
+bool is_homogeneous(const BlockMaterials& ids);
 
 struct CompressionReport {
   double mean_distance = 0, max_distance = 0;  // combinations to their representative (Eq. 2.10)
@@ -41,7 +50,8 @@ struct CompressionReport {
 
 // A database whose entries are k representatives of `full` (which must be
 // uncompressed), with entry_of mapping every combination to its
-// representative. The first representative is drawn from `seed`.
+// representative. The homogeneous combinations come first (if k allows),
+// then farthest-point sampling; `seed` draws the common deformations.
 CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
                                  std::uint64_t seed, CompressionReport* report = nullptr);
 

@@ -1,5 +1,6 @@
 #include "ddfem/hierarchy.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -45,41 +46,64 @@ std::vector<SmoothDeformation> smooth_deformations(double length, int count, dou
   return out;
 }
 
-std::vector<std::array<std::vector<double>, 8>> child_energies(const std::vector<CoarseMaterialFit>& level1,
-                                                               double child_size,
-                                                               const std::vector<SmoothDeformation>& defs) {
+std::vector<Mat24> level1_rest_stiffness(const std::vector<CoarseMaterialFit>& level1, double child_size) {
   FineBlock element;  // geometry of one level-1 element (edge 2 voxels = child_size)
   element.voxel_size = 0.5 * child_size;
   const hex8::ElementGeometry geo = element.coarse_geometry();
   const hex8::NodeMatrix X = element.coarse_rest_positions();
-  const int n = static_cast<int>(level1.size());
-  std::vector<std::array<std::vector<double>, 8>> out(n);
-  // Corner displacements of child c under deformation d, shared by all entries.
-  std::vector<std::array<Vec24, 8>> u(defs.size());
-  for (std::size_t d = 0; d < defs.size(); ++d)
-    for (int c = 0; c < 8; ++c) {
-      const Vec3 origin = child_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1);
-      for (int a = 0; a < 8; ++a) u[d][c].segment<3>(3 * a) = defs[d].at(origin + X.row(a).transpose());
-    }
-  std::string failure;
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int e = 0; e < n; ++e)
-    for (int c = 0; c < 8; ++c) {
-      out[e][c].resize(defs.size());
-      for (std::size_t d = 0; d < defs.size(); ++d) {
-        const double V = coarse_energy(level1[e], geo, X, u[d][c]);
-        out[e][c][d] = V;
-        if (!(V > 0) || !std::isfinite(V)) {
-          std::ostringstream os;
-          os << "level 2: level-1 coarse material " << e << " has energy " << V << " at common deformation " << d
-             << " (must be positive and finite)";
-#pragma omp critical(msfab_child_energy_failure)
-          if (failure.empty()) failure = os.str();
-        }
-      }
-    }
-  if (!failure.empty()) throw InputError(failure);
-  return out;
+  std::vector<Mat24> K(level1.size());
+  for (std::size_t e = 0; e < level1.size(); ++e) {
+    hex_evaluate(geo, coarse_quadrature_materials(level1[e]), X, nullptr, &K[e]);
+    if (!K[e].allFinite()) throw InputError("level 2: level-1 coarse material " + std::to_string(e) + " has a non-finite stiffness");
+  }
+  return K;
+}
+
+Mat24 condensed_stiffness(const Arrangement& arr, const std::vector<Mat24>& K1, Eigen::Vector3i* extent) {
+  // Lattice nodes (i, j, k), i, j, k in 0..2, used by the arrangement.
+  auto lattice = [](int c, int n) {  // node n of child c
+    return Eigen::Vector3i((c >> 2 & 1) + (n >> 2 & 1), (c >> 1 & 1) + (n >> 1 & 1), (c & 1) + (n & 1));
+  };
+  Eigen::Vector3i hi(0, 0, 0);
+  for (int c = 0; c < 8; ++c)
+    if (arr[c] >= 0) hi = hi.cwiseMax(lattice(c, 7));
+  if (extent) *extent = hi;
+  // Number the nodes: the 8 box corners first (hex8 order), then the rest.
+  std::array<int, 27> dof_node;
+  dof_node.fill(-1);
+  auto key = [](const Eigen::Vector3i& p) { return p.x() * 9 + p.y() * 3 + p.z(); };
+  for (int n = 0; n < 8; ++n)
+    dof_node[key(Eigen::Vector3i((n >> 2 & 1) * hi.x(), (n >> 1 & 1) * hi.y(), (n & 1) * hi.z()))] = n;
+  int nodes = 8;
+  for (int c = 0; c < 8; ++c)
+    if (arr[c] >= 0)
+      for (int n = 0; n < 8; ++n)
+        if (dof_node[key(lattice(c, n))] < 0) dof_node[key(lattice(c, n))] = nodes++;
+  MatX K = MatX::Zero(3 * nodes, 3 * nodes);
+  for (int c = 0; c < 8; ++c) {
+    if (arr[c] < 0) continue;
+    const Mat24& Ke = K1.at(arr[c]);
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        K.block<3, 3>(3 * dof_node[key(lattice(c, a))], 3 * dof_node[key(lattice(c, b))]) += Ke.block<3, 3>(3 * a, 3 * b);
+  }
+  const int ni = 3 * (nodes - 8);
+  if (ni == 0) return K.topLeftCorner<24, 24>();
+  // A relative shift keeps K_ii invertible where a level-1 material has a
+  // zero-energy mode; it is far below any physical stiffness.
+  MatX Kii = K.bottomRightCorner(ni, ni);
+  Kii.diagonal().array() += 1e-12 * Kii.diagonal().cwiseAbs().maxCoeff();
+  const Eigen::LDLT<MatX> ldlt(Kii);
+  const MatX Kic = K.bottomLeftCorner(ni, 24);
+  return K.topLeftCorner<24, 24>() - Kic.transpose() * ldlt.solve(Kic);
+}
+
+Vec24 box_corner_displacements(const SmoothDeformation& d, const Eigen::Vector3i& extent, double child_size) {
+  Vec24 u;
+  for (int n = 0; n < 8; ++n)
+    u.segment<3>(3 * n) =
+        d.at(child_size * Vec3((n >> 2 & 1) * extent.x(), (n >> 1 & 1) * extent.y(), (n & 1) * extent.z()));
+  return u;
 }
 
 int Level2Hierarchy::lookup(const Arrangement& e) const {
@@ -118,36 +142,70 @@ Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& lev
   for (int k : options.representatives)
     if (k < 1) throw InputError("level 2: representatives per stage must be >= 1");
   const auto defs = smooth_deformations(2 * child_size, options.deformations, options.strain, options.seed);
-  const auto E1 = child_energies(level1, child_size, defs);
+  const std::vector<Mat24> K1 = level1_rest_stiffness(level1, child_size);
   const int D = static_cast<int>(defs.size());
 
   Level2Hierarchy h;
   int inputs = static_cast<int>(level1.size());
+  // Seeds (kept exactly, docs/ddfem.md): the homogeneous level-1 materials;
+  // then at each stage every seed paired with itself and every two uniform
+  // items paired with each other: all cells of one material, and all
+  // layerings of uniform level-1 elements along one axis.
+  std::vector<int> seeds, uniform;
+  for (int e = 0; e < inputs; ++e)
+    if (is_homogeneous(level1[e].material_ids)) seeds.push_back(e), uniform.push_back(e);
   for (int s = 0; s < 3; ++s) {
-    // Energy of each input item at its own place and shifted one cell along the axis.
-    std::vector<std::array<std::vector<double>, 2>> item(inputs);
-    for (int t = 0; t < inputs; ++t) {
-      const Arrangement arr = h.arrangement(s - 1, t);
-      for (int shift = 0; shift < 2; ++shift) {
-        item[t][shift].assign(D, 0.0);
-        for (int c = 0; c < 8; ++c)
-          if (arr[c] >= 0)
-            for (int d = 0; d < D; ++d) item[t][shift][d] += E1[arr[c]][c + shift * kAxisOffset[s]][d];
-      }
-    }
+    std::vector<Arrangement> items(inputs);
+    for (int t = 0; t < inputs; ++t) items[t] = h.arrangement(s - 1, t);
     const std::int64_t candidates = static_cast<std::int64_t>(inputs) * inputs;
+    // Every candidate of a stage spans the same box, so the corner
+    // displacements are shared.
+    Arrangement probe = items[0];
+    for (int c = 0; c < 8; ++c)
+      if (items[0][c] >= 0) probe[c + kAxisOffset[s]] = items[0][c];
+    Eigen::Vector3i extent;
+    condensed_stiffness(probe, K1, &extent);
+    Eigen::Matrix<double, 24, Eigen::Dynamic> U(24, D);
+    for (int d = 0; d < D; ++d) U.col(d) = box_corner_displacements(defs[d], extent, child_size);
     MatX features(candidates, D);
 #pragma omp parallel for schedule(static)
-    for (std::int64_t ab = 0; ab < candidates; ++ab)
-      for (int d = 0; d < D; ++d) features(ab, d) = std::log(item[ab / inputs][0][d] + item[ab % inputs][1][d]);
+    for (std::int64_t ab = 0; ab < candidates; ++ab) {
+      Arrangement arr = items[ab / inputs];
+      const Arrangement& high = items[ab % inputs];
+      for (int c = 0; c < 8; ++c)
+        if (high[c] >= 0) arr[c + kAxisOffset[s]] = high[c];
+      const Mat24 S = condensed_stiffness(arr, K1);
+      const VecX energy = 0.5 * (U.transpose() * S * U).diagonal();
+      // A floor keeps log finite for a mode the candidate does not resist.
+      for (int d = 0; d < D; ++d) features(ab, d) = std::log(std::max(energy[d], 1e-300));
+    }
 
     PairStage& stage = h.stages[s];
     stage.inputs = inputs;
     const int k = static_cast<int>(std::min<std::int64_t>(options.representatives[s], candidates));
-    std::mt19937_64 rng(options.seed + 0x9e3779b97f4a7c15ULL * (s + 1));
-    const FarthestPointSet fps = farthest_point_sampling(features, k, static_cast<int>(rng() % candidates));
+    std::vector<int> rows;
+    for (int a : seeds) rows.push_back(a * inputs + a);
+    for (int a : uniform)
+      for (int b : uniform)
+        if (a != b) rows.push_back(a * inputs + b);
+    if (rows.empty()) {  // no homogeneous material: a seeded random start
+      std::mt19937_64 rng(options.seed + 0x9e3779b97f4a7c15ULL * (s + 1));
+      rows.push_back(static_cast<int>(rng() % candidates));
+    }
+    const FarthestPointSet fps = farthest_point_sampling(features, k, rows);
     stage.table = fps.nearest;
     for (int row : fps.representatives) stage.pairs.push_back({row / inputs, row % inputs});
+    // The seeds that made it in, and which of them are one material.
+    const std::vector<int> kept_uniform = uniform;
+    seeds.clear();
+    uniform.clear();
+    for (int p = 0; p < k && p < static_cast<int>(rows.size()); ++p) {
+      const int row = fps.representatives[p];
+      if (std::find(rows.begin(), rows.end(), row) == rows.end()) break;  // past the seeds
+      seeds.push_back(p);
+      const int a = row / inputs, b = row % inputs;
+      if (a == b && std::find(kept_uniform.begin(), kept_uniform.end(), a) != kept_uniform.end()) uniform.push_back(p);
+    }
     for (double d : fps.distance) {
       stage.mean_distance += d / candidates;
       stage.max_distance = std::max(stage.max_distance, d);

@@ -12,11 +12,15 @@
 // database stores.
 //
 // Features of a candidate (Eq. 2.10): log of its elastic energy under common
-// smooth deformations of the level-2 cell, summed over the level-1 elements
-// it is made of. The thesis fits a coarse material to each intermediate
-// candidate and compares those; we compare the arrangements' own energies,
-// which the intermediate fit would only approximate, and save the
-// k1^2 + kx^2 + ky^2 intermediate fits (docs/ddfem.md, "Level 2").
+// smooth deformations of its bounding box's 8 corners, its other nodes
+// relaxed (linear elasticity about the rest state: the candidate's stiffness
+// condensed onto those corners). That is the energy a coarse element
+// spanning the candidate would have to store, and what the thesis's
+// intermediate fits approximate; we use it directly and save the
+// k1^2 + kx^2 + ky^2 intermediate fits (docs/ddfem.md, "Level 2"). Imposing
+// the deformation on every node instead made a soft half next to a stiff
+// half invisible (the stiff half's energy dominates), and a soft/stiff cell
+// was looked up to an almost all-stiff one.
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -71,12 +75,20 @@ struct SmoothDeformation {
 };
 std::vector<SmoothDeformation> smooth_deformations(double length, int count, double strain, std::uint64_t seed);
 
-// Energy of each level-1 entry placed at each child position of the cell
-// (child edge `child_size`) under each deformation: [entry][child][def].
-// InputError if an energy is not positive and finite.
-std::vector<std::array<std::vector<double>, 8>> child_energies(const std::vector<CoarseMaterialFit>& level1,
-                                                               double child_size,
-                                                               const std::vector<SmoothDeformation>& defs);
+// Rest stiffness (Hessian at rest) of each level-1 material as an element of
+// edge `child_size`. InputError if one is not finite.
+std::vector<Mat24> level1_rest_stiffness(const std::vector<CoarseMaterialFit>& level1, double child_size);
+
+// Stiffness of a (partial) arrangement condensed onto the 8 corners of its
+// bounding box (hex8 order), all other nodes relaxed; `extent` receives the
+// box size in children per axis. Nodes are those of the 3 x 3 x 3 lattice of
+// the cell; child c's element has the stiffness K1[arrangement[c]].
+Mat24 condensed_stiffness(const Arrangement& arrangement, const std::vector<Mat24>& K1,
+                          Eigen::Vector3i* extent = nullptr);
+
+// Corner displacements (hex8 order) of a box of `extent` children of edge
+// `child_size` at the cell's origin under a deformation.
+Vec24 box_corner_displacements(const SmoothDeformation& d, const Eigen::Vector3i& extent, double child_size);
 
 // Builds the three stages. A stage with at least as many representatives as
 // candidates keeps every candidate (an exact lookup).

@@ -48,8 +48,8 @@ FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFi
   for (int q = 0; q < block.coarse_points(); ++q) {
     int c = 0;
     const int k = level1_point_of(q, &c);
-    block.point_mu0[q] = children[c]->mu[k];
-    block.point_lambda0[q] = children[c]->lambda[k];
+    block.point_mu0[q] = children[c]->mu0[k];
+    block.point_lambda0[q] = children[c]->lambda0[k];
   }
   return block;
 }

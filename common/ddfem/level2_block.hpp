@@ -14,8 +14,11 @@ namespace msfab {
 // `children[c]` is the level-1 fit of child c (hex8 order), fitted and with
 // 8 points; `child_size` the level-1 element edge (2 fine voxels). `ids`
 // labels the block (e.g. the children's level-1 entry indices + 1). Eq.
-// 2.9's p^0 at each of the 64 points: the child's fitted mu and lambda at
-// the level-1 point in the same fine voxel. Throws InputError on an unfitted
+// 2.9's p^0 at each of the 64 points: the palette material of the fine
+// voxel the point lies in (the child's own p^0 at its level-1 point in that
+// voxel), not the child's fitted parameters, which are a poor prior: a
+// level-1 fit often moves its stiffness between points and parameters
+// (docs/ddfem.md, "Level 2"). Throws InputError on an unfitted
 // child or a child with another point count.
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
                                          const BlockMaterials& ids, double child_size);

@@ -25,17 +25,21 @@ VecX solve_on(const MatX& A, const VecX& b, const std::vector<char>& passive) {
 NnlsResult solve_nnls(const MatX& A, const VecX& b, int max_iterations) {
   if (A.rows() != b.size()) throw std::invalid_argument("solve_nnls: A and b sizes differ");
   const int n = static_cast<int>(A.cols());
-  if (max_iterations <= 0) max_iterations = 3 * n + 10;
+  if (max_iterations <= 0) max_iterations = 10 * n + 10;
   NnlsResult r;
   r.x = VecX::Zero(n);
   std::vector<char> passive(n, 0);
   const double tol = 1e-12 * std::max(1.0, A.norm() * b.norm());
   VecX w = A.transpose() * (b - A * r.x);
+  // Lawson and Hanson's guard against cycling: a variable whose least-squares
+  // value comes out <= 0 the moment it is freed (round-off on a nearly
+  // dependent column) is skipped until x changes.
+  std::vector<char> blocked(n, 0);
   while (r.iterations < max_iterations) {
     // The most promising variable still held at zero.
     int best = -1;
     for (int j = 0; j < n; ++j)
-      if (!passive[j] && w[j] > tol && (best < 0 || w[j] > w[best])) best = j;
+      if (!passive[j] && !blocked[j] && w[j] > tol && (best < 0 || w[j] > w[best])) best = j;
     if (best < 0) {
       r.converged = true;
       break;
@@ -44,6 +48,12 @@ NnlsResult solve_nnls(const MatX& A, const VecX& b, int max_iterations) {
     passive[best] = 1;
     for (int inner = 0; inner <= n; ++inner) {
       const VecX z = solve_on(A, b, passive);
+      if (inner == 0 && z[best] <= 0) {
+        passive[best] = 0;
+        blocked[best] = 1;
+        break;
+      }
+      std::fill(blocked.begin(), blocked.end(), 0);
       bool feasible = true;
       for (int j = 0; j < n; ++j)
         if (passive[j] && z[j] <= 0) feasible = false;

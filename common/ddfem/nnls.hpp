@@ -14,7 +14,8 @@ struct NnlsResult {
 };
 
 // Columns of A should be of comparable scale (the dual tolerance is
-// relative to ||A|| ||b||). max_iterations <= 0 means 3 * columns.
+// relative to ||A|| ||b||). max_iterations <= 0 means 10 * columns + 10 (3 * columns, the
+// textbook cap, was hit by one 192-unknown level-2 fit).
 NnlsResult solve_nnls(const MatX& A, const VecX& b, int max_iterations = 0);
 
 }  // namespace msfab

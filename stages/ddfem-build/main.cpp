@@ -53,6 +53,7 @@ void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::ve
       fit = CoarseMaterialFit(plan.points);
       spdlog::error("block {}: {}", todo[begin + i], e.what());
     }
+    if (!fit.fitted) spdlog::warn("block {}: not fitted: {}", todo[begin + i], fit.not_fitted_reason);
     pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
   }
   // Rows not owned are zero, so a sum over ranks assembles the round exactly.
@@ -118,10 +119,10 @@ int main(int argc, char** argv) {
       spdlog::warn("--resume: no checkpoint {} yet, starting from the beginning", ckpt);
     }
     std::vector<std::int64_t> todo;
-    for (std::int64_t item : plan.items)
-      if (!done.count(item)) todo.push_back(item);
+    for (std::int64_t item : plan.items)  // a resume retries blocks that failed
+      if (!done.count(item) || !done.at(item).fitted) todo.push_back(item);
     Progress progress(level2 ? "fitting level-2 blocks" : "fitting orbits", plan.items.size());
-    progress.set(done.size());
+    progress.set(plan.items.size() - todo.size());
     int rounds = 0;
     const std::size_t per_round = static_cast<std::size_t>(options.orbits_per_round);
     for (std::size_t begin = 0; begin < todo.size(); begin += per_round) {
@@ -134,7 +135,7 @@ int main(int argc, char** argv) {
       const std::size_t end = std::min(todo.size(), begin + per_round);
       fit_round(plan, options, todo, begin, end, rank, size, done);
       if (rank == 0) write_checkpoint(ckpt, config_text, done, plan.points);
-      progress.set(done.size());
+      progress.set(plan.items.size() - (todo.size() - end));
       ++rounds;
     }
     progress.done();

@@ -169,6 +169,11 @@ TEST(DdfemCompression, CompressedDatabaseLooksEveryCombinationUpToARepresentativ
   ASSERT_EQ(small.entries.size(), 10u);
   EXPECT_TRUE(small.compressed());
   for (const CoarseMaterialFit& rep : small.entries) EXPECT_EQ(small.find(rep.material_ids), &rep);
+  // Uniform blocks are kept exactly.
+  for (int m = 1; m <= 2; ++m) {
+    const BlockMaterials uniform{m, m, m, m, m, m, m, m};
+    EXPECT_EQ(small.find(uniform)->material_ids, uniform);
+  }
   for (std::int64_t c = 0; c < db.num_combinations(); ++c) ASSERT_NE(small.find(db.combination_ids(c)), nullptr);
   EXPECT_GT(report.max_distance, 0);
   EXPECT_THROW(compress_database(small, 5, 16, 0.05, 3), InputError);

@@ -458,7 +458,7 @@ TEST(DdfemLevel2Block, BlockOfCoarseMaterialsFitsLikeItsMaterial) {
   const double mu = 4e5, lambda = 9e5;
   CoarseMaterialFit l1;
   l1.fitted = true;
-  for (int k = 0; k < 8; ++k) l1.mu[k] = mu, l1.lambda[k] = lambda;
+  for (int k = 0; k < 8; ++k) l1.mu[k] = l1.mu0[k] = mu, l1.lambda[k] = l1.lambda0[k] = lambda;
   std::array<const CoarseMaterialFit*, 8> children;
   children.fill(&l1);
   const FineBlock block = make_block_of_coarse_materials(children, BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, 2 * kVoxel);
