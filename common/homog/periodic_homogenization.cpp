@@ -1,0 +1,160 @@
+#include "homog/periodic_homogenization.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "fem/hex_element.hpp"
+#include "solve/cholmod_solver.hpp"
+
+namespace msfab {
+namespace {
+
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+int find_root(std::vector<int>& parent, int v) {
+  while (parent[v] != v) v = parent[v] = parent[parent[v]];
+  return v;
+}
+
+}  // namespace
+
+int count_periodic_pieces(const VoxelGrid& cell) {
+  const int nx = cell.nx, ny = cell.ny, nz = cell.nz;
+  std::vector<int> parent(cell.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        if (cell.at(i, j, k) == 0) continue;
+        const int v = static_cast<int>(cell.index(i, j, k));
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const int w = static_cast<int>(cell.index(wrap(i + di, nx), wrap(j + dj, ny), wrap(k + dk, nz)));
+              if (cell.ids[w] != 0) parent[find_root(parent, v)] = find_root(parent, w);
+            }
+      }
+  int pieces = 0;
+  for (std::size_t v = 0; v < cell.size(); ++v)
+    if (cell.ids[v] != 0 && find_root(parent, static_cast<int>(v)) == static_cast<int>(v)) ++pieces;
+  return pieces;
+}
+
+HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
+                                const HomogenizationOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int nx = cell.nx, ny = cell.ny, nz = cell.nz;
+  if (nx < 1 || ny < 1 || nz < 1 || cell.size() != std::size_t(nx) * ny * nz)
+    throw InputError("homogenization: the cell has no voxels");
+  if (!(options.void_stiffness > 0)) throw InputError("homogenization: void_stiffness must be > 0");
+  const double h = cell.voxel_size;
+  HomogenizationResult out;
+  out.volume_fraction.assign(palette.size(), 0.0);
+  for (int id : cell.ids) {
+    if (id < 0 || id >= static_cast<int>(palette.size()) || (id > 0 && !palette[id])) {
+      std::ostringstream os;
+      os << "homogenization: voxel material id " << id << " is not in the palette (ids 1.." << palette.size() - 1
+         << ", 0 = void)";
+      throw InputError(os.str());
+    }
+    out.volume_fraction[id] += 1.0 / cell.size();
+  }
+  if (out.volume_fraction[0] >= 1.0) throw InputError("homogenization: the cell is all void");
+  out.pieces = count_periodic_pieces(cell);
+
+  // Element stiffness per palette id (at rest); void: a fraction of the stiffest.
+  hex8::NodeMatrix X;
+  for (int a = 0; a < 8; ++a) X.row(a) = h * Vec3(a >> 2 & 1, a >> 1 & 1, a & 1).transpose();
+  const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
+  std::vector<Mat24> Ke(palette.size(), Mat24::Zero());
+  int stiffest = -1;
+  for (std::size_t id = 1; id < palette.size(); ++id) {
+    if (!palette[id] || out.volume_fraction[id] == 0) continue;
+    hex_evaluate(geo, QuadratureMaterials{{palette[id]}}, X, nullptr, &Ke[id]);
+    if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus()) stiffest = static_cast<int>(id);
+  }
+  Ke[0] = options.void_stiffness * Ke[stiffest];
+
+  // Periodic lattice: node (i, j, k) mod n; element (i, j, k) has node a at
+  // (i, j, k) + (a>>2&1, a>>1&1, a&1). Node 0 is pinned (translation).
+  const std::int64_t N = std::int64_t(nx) * ny * nz;
+  auto node = [&](int i, int j, int k) -> std::int64_t { return wrap(i, nx) + nx * (wrap(j, ny) + std::int64_t(ny) * wrap(k, nz)); };
+  out.unknowns = 3 * N - 3;
+  // Assemble node by node (each column gathers its 8 elements): deterministic for any thread count.
+  std::vector<std::vector<Eigen::Triplet<double>>> per_node(N);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < N; ++p) {
+    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny), k = static_cast<int>(p / (std::int64_t(nx) * ny));
+    auto& trip = per_node[p];
+    if (p == 0) continue;
+    for (int a = 0; a < 8; ++a) {  // p is node a of element e = (i, j, k) - offset(a)
+      const int ei = i - (a >> 2 & 1), ej = j - (a >> 1 & 1), ek = k - (a & 1);
+      const Mat24& K = Ke[cell.at(wrap(ei, nx), wrap(ej, ny), wrap(ek, nz))];
+      for (int b = 0; b < 8; ++b) {
+        const std::int64_t q = node(ei + (b >> 2 & 1), ej + (b >> 1 & 1), ek + (b & 1));
+        if (q == 0) continue;
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            trip.emplace_back(static_cast<int>(3 * q + r - 3), static_cast<int>(3 * p + c - 3), K(3 * b + r, 3 * a + c));
+      }
+    }
+  }
+  std::vector<Eigen::Triplet<double>> all;
+  for (auto& t : per_node) all.insert(all.end(), t.begin(), t.end()), std::vector<Eigen::Triplet<double>>().swap(t);
+  SpMat A(out.unknowns, out.unknowns);
+  A.setFromTriplets(all.begin(), all.end());
+  std::vector<Eigen::Triplet<double>>().swap(all);
+
+  // Affine corner displacements of a voxel for each unit strain (the same
+  // for every voxel up to a rigid translation, which K_e ignores).
+  std::array<Vec24, 6> ua;
+  for (int m = 0; m < 6; ++m) {
+    Vec6 e = Vec6::Zero();
+    e[m] = 1;
+    const Mat3 eps = strain_tensor(e);
+    for (int a = 0; a < 8; ++a) ua[m].segment<3>(3 * a) = eps * X.row(a).transpose();
+  }
+  CholmodSolver solver;
+  solver.analyze(A);
+  if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
+  for (int m = 0; m < 6; ++m) {
+    VecX b = VecX::Zero(out.unknowns);
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const Vec24 f = -(Ke[cell.at(i, j, k)] * ua[m]);
+          for (int a = 0; a < 8; ++a) {
+            const std::int64_t q = node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1));
+            if (q != 0) b.segment<3>(3 * q - 3) += f.segment<3>(3 * a);
+          }
+        }
+    const VecX x = solver.solve(b);
+    out.fluctuation[m] = VecX::Zero(3 * N);
+    out.fluctuation[m].tail(3 * N - 3) = x;
+  }
+  // C^H from the element energies of the total fields, summed per element
+  // first and then in element order (deterministic).
+  std::vector<Mat6> contribution(cell.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t v = 0; v < static_cast<std::int64_t>(cell.size()); ++v) {
+    const int i = static_cast<int>(v % nx), j = static_cast<int>((v / nx) % ny), k = static_cast<int>(v / (std::int64_t(nx) * ny));
+    Eigen::Matrix<double, 24, 6> U;
+    for (int m = 0; m < 6; ++m) {
+      U.col(m) = ua[m];
+      for (int a = 0; a < 8; ++a)
+        U.col(m).segment<3>(3 * a) += out.fluctuation[m].segment<3>(3 * node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1)));
+    }
+    contribution[v] = U.transpose() * Ke[cell.ids[v]] * U;
+  }
+  for (const Mat6& c : contribution) out.C += c;
+  out.C /= double(cell.size()) * h * h * h;
+  out.C = 0.5 * (out.C + out.C.transpose());
+  out.G = out.C.inverse();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace msfab
