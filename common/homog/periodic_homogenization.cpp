@@ -117,7 +117,11 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
     const Mat3 eps = strain_tensor(e);
     for (int a = 0; a < 8; ++a) ua[m].segment<3>(3 * a) = eps * X.row(a).transpose();
   }
-  CholmodSolver solver;
+  // One BLAS thread: a multithreaded supernodal factorization rounds
+  // differently per thread count, and C^H must not depend on it.
+  LinearSolverOptions solver_options;
+  solver_options.threads = 1;
+  CholmodSolver solver(solver_options);
   solver.analyze(A);
   if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
   for (int m = 0; m < 6; ++m) {

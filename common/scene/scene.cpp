@@ -74,39 +74,59 @@ Region read_region(const Config& parent, const VoxelGrid& grid) {
   return r;
 }
 
-void paint_layout(const Config& config, Scene& s) {
+}  // namespace
+
+std::vector<PaletteEntry> read_materials(const Config& config, std::vector<MaterialPtr>* material_by_id) {
+  std::vector<PaletteEntry> palette;
+  material_by_id->assign(1, nullptr);
+  for (const Config& m : config.children("materials")) {
+    PaletteEntry p;
+    p.id = m.get<int>("id");
+    if (p.id <= 0 || p.id > 65535) m.fail("id", "material ids are 1..65535 (0 is void)");
+    p.name = m.get_or<std::string>("name", "material" + std::to_string(p.id));
+    p.material = make_material(m, p);
+    if (p.id >= static_cast<int>(material_by_id->size())) material_by_id->resize(p.id + 1);
+    if ((*material_by_id)[p.id]) m.fail("id", "material id " + std::to_string(p.id) + " is defined twice");
+    (*material_by_id)[p.id] = p.material;
+    palette.push_back(p);
+  }
+  if (palette.empty()) config.fail("materials", "the palette is empty");
+  return palette;
+}
+
+void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
   for (const Config& item : config.children("layout")) {
     auto id_of = [&](const std::string& key) {
       const int id = item.get<int>(key);
-      if (id < 0 || id >= static_cast<int>(s.material_by_id.size()) || (id > 0 && !s.material_by_id[id]))
+      if (id < 0 || id >= static_cast<int>(material_by_id.size()) || (id > 0 && !material_by_id[id]))
         item.fail(key, "material id " + std::to_string(id) + " is not in the palette (0 = void)");
       return id;
     };
     if (item.has("fill")) {
-      std::fill(s.grid.ids.begin(), s.grid.ids.end(), id_of("fill"));
+      std::fill(grid.ids.begin(), grid.ids.end(), id_of("fill"));
     } else if (item.has("box")) {
       const Config b = item.child("box");
-      paint_box(s.grid, read_vec3(b, "min"), read_vec3(b, "max"), id_of("id"));
+      paint_box(grid, read_vec3(b, "min"), read_vec3(b, "max"), id_of("id"));
     } else if (item.has("layers")) {
       const Config l = item.child("layers");
       const auto t = l.get<std::vector<double>>("thickness");
       std::vector<int> ids = l.get<std::vector<int>>("ids");
       if (t.size() != ids.size() || t.empty()) l.fail("ids", "need one id per thickness");
       for (size_t k = 0; k < ids.size(); ++k)
-        if (ids[k] < 0 || ids[k] >= static_cast<int>(s.material_by_id.size()) ||
-            (ids[k] > 0 && !s.material_by_id[ids[k]]))
+        if (ids[k] < 0 || ids[k] >= static_cast<int>(material_by_id.size()) ||
+            (ids[k] > 0 && !material_by_id[ids[k]]))
           l.fail("ids", "material id " + std::to_string(ids[k]) + " is not in the palette");
       for (double x : t)
         if (!(x > 0)) l.fail("thickness", "layer thicknesses must be positive");
-      paint_layers(s.grid, read_axis(l, "axis"), t, ids);
+      paint_layers(grid, read_axis(l, "axis"), t, ids);
     } else if (item.has("cylinder")) {
       const Config c = item.child("cylinder");
       const int axis = read_axis(c, "axis");
-      paint_cylinder(s.grid, axis, read_vec3(c, "center"), c.require_positive("radius"),
+      paint_cylinder(grid, axis, read_vec3(c, "center"), c.require_positive("radius"),
                      c.get_or<double>("from", -1e300), c.get_or<double>("to", 1e300), id_of("id"));
     } else if (item.has("helical_fibers")) {
       const Config c = item.child("helical_fibers");
-      paint_helical_fibers(s.grid, read_axis(c, "axis"), read_vec3(c, "center"), c.require_positive("helix_radius"),
+      paint_helical_fibers(grid, read_axis(c, "axis"), read_vec3(c, "center"), c.require_positive("helix_radius"),
                            c.require_positive("pitch"), c.require_positive("fiber_radius"),
                            c.require_positive<int>("count"), id_of("id"));
     } else {
@@ -115,7 +135,6 @@ void paint_layout(const Config& config, Scene& s) {
   }
 }
 
-}  // namespace
 
 std::string Region::describe() const {
   std::ostringstream o;
@@ -140,22 +159,11 @@ Scene read_scene(const Config& config) {
     s.grid = VoxelGrid(size[0], size[1], size[2], g.require_positive("voxel_size", "voxel size"));
     if (g.has("origin")) s.grid.origin = read_vec3(g, "origin");
   }
-  for (const Config& m : config.children("materials")) {
-    PaletteEntry p;
-    p.id = m.get<int>("id");
-    if (p.id <= 0 || p.id > 65535) m.fail("id", "material ids are 1..65535 (0 is void)");
-    p.name = m.get_or<std::string>("name", "material" + std::to_string(p.id));
-    p.material = make_material(m, p);
-    if (p.id >= static_cast<int>(s.material_by_id.size())) s.material_by_id.resize(p.id + 1);
-    if (s.material_by_id[p.id]) m.fail("id", "material id " + std::to_string(p.id) + " is defined twice");
-    s.material_by_id[p.id] = p.material;
-    s.palette.push_back(p);
-  }
-  if (s.palette.empty()) config.fail("materials", "the palette is empty");
+  s.palette = read_materials(config, &s.material_by_id);
   s.nonlinear = false;
   for (const auto& p : s.palette) s.nonlinear |= p.model == "neo-hookean";
 
-  paint_layout(config, s);
+  paint_layout(config, s.grid, s.material_by_id);
   if (s.grid.count_solid() == 0) config.fail("layout", "the layout leaves every voxel void (empty grid)");
 
   if (config.has("boundary")) {

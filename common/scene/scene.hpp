@@ -62,6 +62,14 @@ struct Scene {
 // check_no_unknown_keys() so stage-specific sections can sit beside it.
 Scene read_scene(const Config& config);
 
+// The pieces of read_scene that other stages share. `materials` (a list of
+// {id, name, model, E, nu, ...}) -> palette entries and material_by_id
+// ([0] = void = nullptr); InputError naming the key on bad input.
+std::vector<PaletteEntry> read_materials(const Config& config, std::vector<MaterialPtr>* material_by_id);
+// Paints the `layout` list (fill, box, layers, cylinder, helical_fibers)
+// onto the grid, in physical coordinates.
+void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id);
+
 // Boundary conditions and external forces on the mesh of a scene. Throws
 // InputError for a region that selects no solid node (a load on void), for a
 // scene without Dirichlet conditions, and for a mesh part whose rigid motion

@@ -1,0 +1,71 @@
+#include "cell_input.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+VoxelGrid read_voxel_text(const std::string& path, double voxel_size) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the voxel file");
+  std::vector<long long> numbers;
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    const std::size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream is(line);
+    std::string token;
+    while (is >> token) {
+      try {
+        std::size_t used = 0;
+        numbers.push_back(std::stoll(token, &used));
+        if (used != token.size()) throw std::invalid_argument(token);
+      } catch (const std::exception&) {
+        throw InputError(path + ": line " + std::to_string(line_no) + ": '" + token + "' is not an integer");
+      }
+    }
+  }
+  if (numbers.size() < 3) throw InputError(path + ": expected 'nx ny nz' and then the voxel ids");
+  for (int a = 0; a < 3; ++a)
+    if (numbers[a] < 1 || numbers[a] > 4096) throw InputError(path + ": cell size must be 1..4096 per axis");
+  VoxelGrid g(static_cast<int>(numbers[0]), static_cast<int>(numbers[1]), static_cast<int>(numbers[2]), voxel_size, 0);
+  if (numbers.size() - 3 != g.size())
+    throw InputError(path + ": " + std::to_string(numbers.size() - 3) + " voxel ids for a " +
+                     std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.nz) + " cell (" +
+                     std::to_string(g.size()) + " expected)");
+  for (std::size_t v = 0; v < g.size(); ++v) {
+    if (numbers[3 + v] < 0 || numbers[3 + v] > 65535) throw InputError(path + ": voxel ids must be 0..65535");
+    g.ids[v] = static_cast<int>(numbers[3 + v]);
+  }
+  return g;
+}
+
+CellInput read_cell_input(const Config& config) {
+  CellInput in;
+  in.palette = read_materials(config, &in.material_by_id);
+  const Config c = config.child("cell");
+  const bool has_voxels = c.has("voxels"), has_layout = config.has("layout");
+  if (has_voxels == has_layout) config.fail("layout", "give either cell.voxels (a voxel file) or a layout, not both");
+  if (has_voxels) {
+    in.cell = read_voxel_text(c.get_path("voxels"), 1.0);
+    if (c.has("size")) c.fail("size", "comes from the voxel file; drop it");
+  } else {
+    const auto size = c.get<std::vector<int>>("size");
+    if (size.size() != 3) c.fail("size", "expected [nx, ny, nz]");
+    for (int n : size)
+      if (n < 1 || n > 4096) c.fail("size", "cell dimensions must be 1..4096");
+    in.cell = VoxelGrid(size[0], size[1], size[2], 1.0, 0);
+  }
+  // The cell spans [0, 1] along x by default: C^H does not depend on the scale.
+  in.cell.voxel_size = c.get_or<double>("voxel_size", 1.0 / in.cell.nx);
+  if (!(in.cell.voxel_size > 0)) c.fail("voxel_size", "must be > 0");
+  if (has_layout) paint_layout(config, in.cell, in.material_by_id);
+  for (int id : in.cell.ids)
+    if (id > 0 && (id >= static_cast<int>(in.material_by_id.size()) || !in.material_by_id[id]))
+      config.fail("materials", "the cell uses material id " + std::to_string(id) + ", which is not defined");
+  return in;
+}
+
+}  // namespace msfab

@@ -1,0 +1,26 @@
+#pragma once
+// The voxel cell of msfab-homogenize: a `cell` section with its size and
+// either a `layout` (the scene painting of docs/scenes.md, in cell
+// coordinates [0, size * voxel_size]) or a `voxels` text file.
+#include <vector>
+
+#include "fem/voxel_grid.hpp"
+#include "io/config.hpp"
+#include "scene/scene.hpp"
+
+namespace msfab {
+
+struct CellInput {
+  VoxelGrid cell;
+  std::vector<PaletteEntry> palette;
+  std::vector<MaterialPtr> material_by_id;  // [0] = void
+};
+
+// InputError naming the key (or the voxel file and line) on bad input.
+CellInput read_cell_input(const Config& config);
+
+// Voxel text file: "nx ny nz" then nx*ny*nz integer ids, x fastest; '#'
+// starts a comment. InputError naming the file and what is wrong.
+VoxelGrid read_voxel_text(const std::string& path, double voxel_size);
+
+}  // namespace msfab

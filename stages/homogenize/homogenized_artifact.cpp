@@ -1,0 +1,39 @@
+#include "homogenized_artifact.hpp"
+
+#include "io/artifact.hpp"
+
+namespace msfab {
+
+void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
+                       const std::string& config_text, const std::string& command_line, std::uint64_t seed) {
+  ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, {}, seed);
+  H5File& f = out.file();
+  f.write_attribute("/", "command_line", command_line);
+  f.write_matrix("/C", r.C);
+  f.write_attribute("/C", "order", "Voigt xx, yy, zz, yz, xz, xy; engineering shear strains (sigma = C eps)");
+  f.write_attribute("/C", "units", "Pa (the materials' units)");
+  f.write_matrix("/G", r.G);
+  f.write_attribute("/G", "meaning", "harmonic displacements: strains under unit Voigt stresses, C^-1");
+  f.write_vector("/volume_fraction", r.volume_fraction);
+  f.write_attribute("/volume_fraction", "index", "material id; 0 = void");
+  f.write_attribute("/", "pieces", r.pieces);
+  f.write_attribute("/", "unknowns", static_cast<std::int64_t>(r.unknowns));
+  f.write_attribute("/", "seconds", r.seconds);
+  std::vector<std::int32_t> ids32(in.cell.ids.begin(), in.cell.ids.end());
+  f.write_vector("/cell/ids", ids32);
+  f.write_vector("/cell/size", std::vector<int>{in.cell.nx, in.cell.ny, in.cell.nz});
+  f.write_attribute("/cell/ids", "order", "x fastest: i + nx (j + ny k)");
+  f.write_attribute("/cell", "voxel_size", in.cell.voxel_size);
+  const double dev = cubic_deviation(r.C);
+  f.write_attribute("/", "cubic_deviation", dev);
+  if (dev < kCubicTolerance) {
+    const CubicModuli m = cubic_moduli(r.C);
+    f.write_attribute("/C", "cubic_E", m.E);
+    f.write_attribute("/C", "cubic_nu", m.nu);
+    f.write_attribute("/C", "cubic_G", m.G);
+    f.write_attribute("/C", "cubic_shear_ratio", m.shear_ratio);
+  }
+  out.commit();
+}
+
+}  // namespace msfab

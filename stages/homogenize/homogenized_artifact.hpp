@@ -1,0 +1,18 @@
+#pragma once
+// The `msfab.homogenized` artifact (docs/artifacts.md).
+#include <string>
+
+#include "cell_input.hpp"
+#include "homog/periodic_homogenization.hpp"
+
+namespace msfab {
+
+constexpr const char* kHomogenizedSchema = "msfab.homogenized";
+constexpr int kHomogenizedSchemaVersion = 1;
+// Relative deviation below which a tensor is reported as cubic.
+constexpr double kCubicTolerance = 1e-6;
+
+void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
+                       const std::string& config_text, const std::string& command_line, std::uint64_t seed);
+
+}  // namespace msfab
