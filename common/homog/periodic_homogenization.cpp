@@ -161,4 +161,28 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   return out;
 }
 
+PlaneStrainResult homogenize_plane_strain(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
+                                          const HomogenizationOptions& options) {
+  if (cell.nz != 1)
+    throw InputError("homogenization: a 2D (plane strain) cell has one voxel along z, this one has " +
+                     std::to_string(cell.nz));
+  PlaneStrainResult r;
+  r.full = homogenize(cell, palette, options);
+  const int in_plane[3] = {0, 1, 5};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) r.C(a, b) = r.full.C(in_plane[a], in_plane[b]);
+  r.G = r.C.inverse();
+  return r;
+}
+
+PlaneModuli plane_moduli(const Mat3& C) {
+  const Mat3 S = C.inverse();
+  PlaneModuli m;
+  m.Ex = 1 / S(0, 0);
+  m.Ey = 1 / S(1, 1);
+  m.nu_xy = -S(0, 1) / S(0, 0);
+  m.G = 1 / S(2, 2);
+  return m;
+}
+
 }  // namespace msfab

@@ -42,6 +42,26 @@ struct HomogenizationResult {
 HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
                                 const HomogenizationOptions& options = {});
 
+// 2D, plane strain: the cell must have nz = 1. With one voxel across z and
+// periodicity in z, every field is independent of z: the 3D cell problem
+// is exactly the plane-strain problem of bilinear quadrilaterals (plus a
+// decoupled anti-plane one). Voigt order xx, yy, xy (engineering shear).
+struct PlaneStrainResult {
+  Mat3 C = Mat3::Zero();   // in-plane block (xx, yy, xy) of the 3D C^H
+  Mat3 G = Mat3::Zero();   // C^-1
+  HomogenizationResult full;
+};
+PlaneStrainResult homogenize_plane_strain(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
+                                          const HomogenizationOptions& options = {});
+
+// Engineering constants of a 2D tensor from its compliance S = C^-1:
+// E_x = 1/S11, E_y = 1/S22, nu_xy = -S12/S11, G = 1/S33 (square symmetry:
+// E_x = E_y).
+struct PlaneModuli {
+  double Ex = 0, Ey = 0, nu_xy = 0, G = 0;
+};
+PlaneModuli plane_moduli(const Mat3& C);
+
 // Number of connected pieces of non-void voxels, two voxels being
 // connected when they share a node across the periodic boundary too.
 int count_periodic_pieces(const VoxelGrid& cell);

@@ -5,7 +5,8 @@
 namespace msfab {
 
 void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
-                       const std::string& config_text, const std::string& command_line, std::uint64_t seed) {
+                       const PlaneStrainResult* plane, const std::string& config_text,
+                       const std::string& command_line, std::uint64_t seed) {
   ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, {}, seed);
   H5File& f = out.file();
   f.write_attribute("/", "command_line", command_line);
@@ -32,6 +33,16 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
     f.write_attribute("/C", "cubic_nu", m.nu);
     f.write_attribute("/C", "cubic_G", m.G);
     f.write_attribute("/C", "cubic_shear_ratio", m.shear_ratio);
+  }
+  if (plane) {
+    const PlaneModuli m = plane_moduli(plane->C);
+    f.write_matrix("/C2", plane->C);
+    f.write_attribute("/C2", "order", "plane strain, Voigt xx, yy, xy; engineering shear");
+    f.write_attribute("/C2", "Ex", m.Ex);
+    f.write_attribute("/C2", "Ey", m.Ey);
+    f.write_attribute("/C2", "nu_xy", m.nu_xy);
+    f.write_attribute("/C2", "G", m.G);
+    f.write_matrix("/G2", plane->G);
   }
   out.commit();
 }

@@ -12,7 +12,9 @@ constexpr int kHomogenizedSchemaVersion = 1;
 // Relative deviation below which a tensor is reported as cubic.
 constexpr double kCubicTolerance = 1e-6;
 
+// `plane`: the 2D (plane strain) result of a cell one voxel thick, or null.
 void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
-                       const std::string& config_text, const std::string& command_line, std::uint64_t seed);
+                       const PlaneStrainResult* plane, const std::string& config_text,
+                       const std::string& command_line, std::uint64_t seed);
 
 }  // namespace msfab

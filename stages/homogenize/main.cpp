@@ -1,7 +1,8 @@
 // msfab-homogenize: periodic linear-elastic homogenization of a voxel cell
 // (thesis §3.2, the property evaluation of the gamut sampler).
 //
-//   1. read the materials and the cell (a layout or a voxel file)
+//   1. read the materials and the cell (a layout or a voxel file; one
+//      voxel along z = a 2D cell, plane strain)
 //   2. count the cell's connected pieces (a floating piece carries no load)
 //   3. solve the six periodic cell problems, one per unit Voigt strain
 //   4. C^H by the energy form, G = (C^H)^-1, volume fractions, and for a
@@ -11,6 +12,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "cell_input.hpp"
 #include "cli/stage_app.hpp"
@@ -54,18 +56,25 @@ int main(int argc, char** argv) {
     spdlog::info("cell {} x {} x {}, {} materials", in.cell.nx, in.cell.ny, in.cell.nz, in.palette.size());
 
     // 2-4. Pieces, cell problems, tensors.
-    const HomogenizationResult r = homogenize(in.cell, in.material_by_id, options);
+    // A cell one voxel thick along z is a 2D cell (plane strain).
+    std::optional<PlaneStrainResult> plane;
+    if (in.cell.nz == 1) plane = homogenize_plane_strain(in.cell, in.material_by_id, options);
+    const HomogenizationResult r = plane ? plane->full : homogenize(in.cell, in.material_by_id, options);
     if (r.pieces > 1)
       spdlog::warn("the cell has {} disconnected pieces; floating ones carry no load (void_stiffness holds them)",
                    r.pieces);
 
     // 5. Artifact.
-    write_homogenized(out, in, r, ctx.config.resolved_text(), ctx.command_line, ctx.options.seed);
+    write_homogenized(out, in, r, plane ? &*plane : nullptr, ctx.config.resolved_text(), ctx.command_line,
+                      ctx.options.seed);
     std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns, %.3f s\n", in.cell.nx, in.cell.ny, in.cell.nz,
                 static_cast<long long>(r.unknowns), r.seconds);
     std::printf("  solid fraction %.4f, pieces %d\n", 1.0 - r.volume_fraction[0], r.pieces);
     const double dev = cubic_deviation(r.C);
-    if (dev < kCubicTolerance) {
+    if (plane) {
+      const PlaneModuli m = plane_moduli(plane->C);
+      std::printf("  2D plane strain: Ex %.6g, Ey %.6g, nu_xy %.6f, G %.6g\n", m.Ex, m.Ey, m.nu_xy, m.G);
+    } else if (dev < kCubicTolerance) {
       const CubicModuli m = cubic_moduli(r.C);
       std::printf("  cubic: E %.6g, nu %.6f, G %.6g, G' %.4f\n", m.E, m.nu, m.G, m.shear_ratio);
     } else {

@@ -20,6 +20,12 @@ cell: {voxels: solid.txt}
 Y
 expect_exit 0 "cubic: E 1e\+06, nu 0\.300000" -- "$H" --config "$WORK/file.yaml" --out "$WORK/solid.h5"
 
+# A 2D cell (one voxel along z): plane strain, Ex = E / (1 - nu^2).
+{ echo "2 2 1"; echo "1 1 1 1"; } > "$WORK/flat.txt"
+sed 's/solid.txt/flat.txt/' "$WORK/file.yaml" > "$WORK/flat.yaml"
+expect_exit 0 "2D plane strain: Ex 1\.0989e\+06" -- "$H" --config "$WORK/flat.yaml" --out "$WORK/flat.h5"
+check "2D tensor written" -- bash -c "h5dump -H -d /C2 '$WORK/flat.h5' | grep -q '( 3, 3 )'"
+
 # Bad input.
 { echo "2 2 2"; echo "1 1 1 1 1 1 1"; } > "$WORK/short.txt"
 sed 's/solid.txt/short.txt/' "$WORK/file.yaml" > "$WORK/short.yaml"

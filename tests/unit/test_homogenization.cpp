@@ -183,5 +183,34 @@ TEST(Homogenization, BadCellsAreInputErrors) {
   EXPECT_THROW(homogenize(VoxelGrid(2, 2, 2, 1e-3, 1), pal, o), InputError);
 }
 
+TEST(Homogenization, PlaneStrainMatchesTheExtrudedCellAndTheExactCases) {
+  const double E1 = 1e6, nu1 = 0.3, E2 = 3e4, nu2 = 0.45;
+  const auto pal = two_phases(E1, nu1, E2, nu2);
+  // Homogeneous: the plane-strain tensor of the material.
+  const PlaneStrainResult h = homogenize_plane_strain(VoxelGrid(3, 3, 1, 1e-3, 1), pal);
+  const Mat6 C3 = isotropic_tensor(E1, nu1);
+  Mat3 expected;
+  expected << C3(0, 0), C3(0, 1), 0, C3(1, 0), C3(1, 1), 0, 0, 0, C3(5, 5);
+  EXPECT_LT((h.C - expected).norm(), 1e-9 * expected.norm());
+  const PlaneModuli m = plane_moduli(h.C);
+  EXPECT_NEAR(m.Ex, E1 / (1 - nu1 * nu1), 1e-6 * E1);  // plane-strain modulus
+  EXPECT_NEAR(m.nu_xy, nu1 / (1 - nu1), 1e-9);
+  // A random 2D pattern against the same pattern extruded 3 voxels along z.
+  std::mt19937_64 rng(5);
+  VoxelGrid flat(7, 5, 1, 1e-3, 1), tall(7, 5, 3, 1e-3, 1);
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 7; ++i) {
+      const int id = 1 + int(rng() % 2);
+      flat.at(i, j, 0) = id;
+      for (int k = 0; k < 3; ++k) tall.at(i, j, k) = id;
+    }
+  const PlaneStrainResult p = homogenize_plane_strain(flat, pal);
+  const HomogenizationResult t = homogenize(tall, pal);
+  const int in_plane[3] = {0, 1, 5};
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) EXPECT_NEAR(p.C(a, b), t.C(in_plane[a], in_plane[b]), 1e-9 * p.C.norm());
+  EXPECT_THROW(homogenize_plane_strain(tall, pal), InputError);
+}
+
 }  // namespace
 }  // namespace msfab
