@@ -25,7 +25,7 @@ for dims in "16 16 1" "32 32 1" "64 64 1" "8 8 8" "16 16 16" "32 32 32"; do
   "$BIN/msfab-homogenize" --config "$OUTDIR/cell.yaml" --out "$OUTDIR/cell.h5" --quiet > /dev/null
   s=$(h5dump -a /seconds "$OUTDIR/cell.h5" | sed -n 's/^ *(0): *//p')
   u=$(h5dump -a /unknowns "$OUTDIR/cell.h5" | sed -n 's/^ *(0): *//p')
-  rows+=$(awk -v d="${nx}x${ny}x${nz}" -v u="$u" -v s="$s" 'BEGIN { printf "| %s | %d | %.4f | %.1f |\n", d, u, s, 1 / s }')
+  rows+=$(awk -v d="${nx}x${ny}x${nz}" -v u="$u" -v s="$s" 'BEGIN { printf "| %s | %d | %.4f | %.3g |\n", d, u, s, 1 / s }')
   rows+=$'\n'
 done
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores"
