@@ -1,0 +1,58 @@
+#pragma once
+// The gamut as a level set (thesis §3.2.3): a signed distance Phi on a
+// cell-centred Cartesian grid over the n-dimensional unit cube of
+// normalized material properties, negative inside the achievable set.
+//
+//   1. Zhu-Bridson implicit function near the samples:
+//      Phi(x) = |x - xbar(x)| - r, xbar the kernel-weighted mean of the
+//      sample points within 2r (kernel (1 - s^2)^3, s = distance / 2r)
+//   2. fast marching from the grid nodes next to the zero crossing, in
+//      both directions, to a signed distance everywhere
+//   3. a few explicit steps of dPhi/dt = Laplacian(Phi) (the thesis's
+//      smoothing, §3.2.3)
+//
+// Queries are the multilinear interpolant and its exact gradient, so a
+// gradient always matches finite differences of value(). The topology
+// optimizer's per-cell constraint is value(p) <= 0.
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace msfab {
+
+struct LevelSetOptions {
+  int cells = 32;              // grid cells per axis
+  double margin = 0.1;         // the grid covers [-margin, 1 + margin] per axis
+  double radius = 0.0;         // r of the implicit function; 0: 1.5 grid cells
+  int smoothing_steps = 2;     // explicit Laplacian steps (dt = h^2 / (4 d))
+};
+
+class GamutLevelSet {
+ public:
+  GamutLevelSet() = default;
+  // Points (each of size d, 1 <= d <= 6) in the unit cube. InputError on
+  // no points, mixed dimensions, a coordinate outside [0, 1], a grid of
+  // more than 2^26 nodes, or bad options.
+  static GamutLevelSet from_points(const std::vector<VecX>& points, const LevelSetOptions& options = {});
+
+  int dimension() const { return dim_; }
+  int cells() const { return cells_; }
+  double spacing() const { return h_; }
+  double lower() const { return lo_; }
+  const std::vector<double>& values() const { return phi_; }  // axis 0 fastest
+
+  // Multilinear interpolation of the node values; beyond the outermost
+  // node centres the nearest in-range value plus the distance to it.
+  double value(const VecX& p) const;
+  // Gradient of that interpolant (inside the node range).
+  VecX gradient(const VecX& p) const;
+
+ private:
+  int dim_ = 0, cells_ = 0;
+  double lo_ = 0, h_ = 0;
+  std::vector<double> phi_;
+  std::vector<long long> stride_;
+  double node(const std::vector<int>& index) const;
+};
+
+}  // namespace msfab
