@@ -1,0 +1,42 @@
+#pragma once
+// Editing microstructure cells for the gamut sampler (thesis §3.2.1):
+// cubic symmetry by mirroring the fundamental domain, random beams, and the
+// clean-up that keeps a structure printable and load-bearing.
+//
+// A cell with nz = 1 is 2D: its symmetry is the square's (8 elements), and
+// connectivity and wrapping are in the plane.
+#include <array>
+
+#include "fem/voxel_grid.hpp"
+
+namespace msfab {
+
+// The voxel of the fundamental domain that symmetry maps voxel (i, j, k)
+// onto: each index folded onto the lower half (min(i, n - 1 - i)), then
+// the folded indices sorted (3D; 2D sorts i, j and keeps k = 0). The cell
+// must be cubic (nx = ny = nz) or square (nx = ny, nz = 1).
+std::array<int, 3> fundamental_voxel(const VoxelGrid& cell, int i, int j, int k);
+
+// Copies every voxel from its fundamental-domain voxel, making the cell
+// invariant under the 48 (2D: 8) symmetries of the cube (square).
+// InputError for a cell that is neither cubic nor square.
+void mirror_fundamental_domain(VoxelGrid& cell);
+bool has_cubic_symmetry(const VoxelGrid& cell);
+
+// Sets to `id` every voxel whose centre lies within `radius` of the
+// segment a-b (cell coordinates: voxel units, voxel (i, j, k) centred at
+// (i + 0.5, j + 0.5, k + 0.5)). Returns the number of voxels changed.
+int paint_beam(VoxelGrid& cell, const Vec3& a, const Vec3& b, double radius, int id);
+
+struct CleanupReport {
+  int removed_voxels = 0;  // solid voxels in pieces that do not wrap around the cell
+  int filled_voxels = 0;   // void voxels in enclosed cavities
+};
+// Keeps only the solid pieces (face-connected) that wrap around the
+// periodic cell along every axis (the load-bearing network), and in 3D
+// fills enclosed void pieces (void that does not wrap along any axis: it
+// would trap support material) with the most frequent solid id around
+// them. A 2D cell keeps its holes.
+CleanupReport clean_structure(VoxelGrid& cell);
+
+}  // namespace msfab
