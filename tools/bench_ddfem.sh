@@ -127,15 +127,5 @@ Jacobi-preconditioned CG iterations per Newton iteration (Figure 2-13):
 | scene | fine | DDFEM level 1 |
 |---|---|---|
 ${cg_rows}"
-python3 - "$DOC" "$table" <<'PY'
-import sys
-path, table = sys.argv[1], sys.argv[2]
-text = open(path).read()
-begin, end = "<!-- bench:ddfem:begin -->", "<!-- bench:ddfem:end -->"
-if begin in text and end in text:
-    text = text[: text.index(begin) + len(begin)] + "\n" + table + "\n" + text[text.index(end):]
-else:
-    text += "\n" + begin + "\n" + table + "\n" + end + "\n"
-open(path, "w").write(text)
-PY
+python3 "$SRC/tools/replace_bench_section.py" "$DOC" ddfem "$table"
 echo "bench: table written to $DOC" >&2

@@ -34,15 +34,5 @@ table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THRE
 | cell | unknowns | seconds per cell | cells per second |
 |---|---|---|---|
 ${rows}"
-python3 - "$DOC" "$table" <<'PY'
-import sys
-path, table = sys.argv[1], sys.argv[2]
-text = open(path).read()
-begin, end = "<!-- bench:homogenize:begin -->", "<!-- bench:homogenize:end -->"
-if begin in text and end in text:
-    text = text[: text.index(begin) + len(begin)] + "\n" + table + "\n" + text[text.index(end):]
-else:
-    text += "\n" + begin + "\n" + table + "\n" + end + "\n"
-open(path, "w").write(text)
-PY
+python3 "$SRC/tools/replace_bench_section.py" "$DOC" homogenize "$table"
 echo "bench: table written to $DOC" >&2
