@@ -1,0 +1,114 @@
+#include "gamut/material_space.hpp"
+
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+MaterialSpace::MaterialSpace(MaterialSpaceKind kind, double E_stiff, double decades)
+    : kind_(kind), E_stiff_(E_stiff), decades_(decades) {
+  if (!(E_stiff > 0) || !(decades > 0)) throw InputError("material space: E_stiff and decades must be > 0");
+}
+
+MaterialSpaceKind MaterialSpace::parse_kind(const std::string& name) {
+  if (name == "cubic3d") return MaterialSpaceKind::cubic3d;
+  if (name == "cubic2d") return MaterialSpaceKind::cubic2d;
+  if (name == "orthotropic2d") return MaterialSpaceKind::orthotropic2d;
+  throw InputError("material space '" + name + "': expected cubic3d, cubic2d or orthotropic2d");
+}
+
+int MaterialSpace::dimension() const { return kind_ == MaterialSpaceKind::orthotropic2d ? 5 : 4; }
+
+std::vector<std::string> MaterialSpace::names() const {
+  if (kind_ == MaterialSpaceKind::orthotropic2d) return {"Ex", "Ey", "nu_xy", "G", "rho"};
+  return {"E", "nu", "G", "rho"};
+}
+
+bool MaterialSpace::is_modulus(int i) const {
+  if (kind_ == MaterialSpaceKind::orthotropic2d) return i == 0 || i == 1 || i == 3;
+  return i == 0 || i == 2;
+}
+
+VecX MaterialSpace::properties(const Mat6& C, double rho) const {
+  if (kind_ != MaterialSpaceKind::cubic3d) throw std::logic_error("MaterialSpace::properties: a 2D space");
+  const CubicModuli m = cubic_moduli(C);
+  VecX p(4);
+  p << m.E, m.nu, m.G, rho;
+  return p;
+}
+
+VecX MaterialSpace::properties_2d(const Mat3& C, double rho) const {
+  if (kind_ == MaterialSpaceKind::cubic3d) throw std::logic_error("MaterialSpace::properties_2d: a 3D space");
+  const Mat3 S = C.inverse();
+  if (kind_ == MaterialSpaceKind::orthotropic2d) {
+    VecX p(5);
+    p << 1 / S(0, 0), 1 / S(1, 1), -S(0, 1) / S(0, 0), 1 / S(2, 2), rho;
+    return p;
+  }
+  // Square symmetry: average the two axes.
+  const double s11 = 0.5 * (S(0, 0) + S(1, 1));
+  VecX p(4);
+  p << 1 / s11, -S(0, 1) / s11, 1 / S(2, 2), rho;
+  return p;
+}
+
+Mat6 MaterialSpace::tensor_3d(const VecX& raw) const {
+  if (kind_ != MaterialSpaceKind::cubic3d || raw.size() != 4) throw std::logic_error("MaterialSpace::tensor_3d");
+  const double E = raw[0], nu = raw[1], G = raw[2];
+  // Cubic compliance: S11 = 1/E, S12 = -nu/E, S44 = 1/G.
+  Mat6 S = Mat6::Zero();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) S(i, j) = -nu / E;
+    S(i, i) = 1 / E;
+    S(3 + i, 3 + i) = 1 / G;
+  }
+  return S.inverse();
+}
+
+Mat3 MaterialSpace::tensor_2d(const VecX& raw) const {
+  Mat3 S = Mat3::Zero();
+  if (kind_ == MaterialSpaceKind::orthotropic2d && raw.size() == 5) {
+    S(0, 0) = 1 / raw[0];
+    S(1, 1) = 1 / raw[1];
+    S(0, 1) = S(1, 0) = -raw[2] / raw[0];
+    S(2, 2) = 1 / raw[3];
+  } else if (kind_ == MaterialSpaceKind::cubic2d && raw.size() == 4) {
+    S(0, 0) = S(1, 1) = 1 / raw[0];
+    S(0, 1) = S(1, 0) = -raw[1] / raw[0];
+    S(2, 2) = 1 / raw[2];
+  } else {
+    throw std::logic_error("MaterialSpace::tensor_2d");
+  }
+  return S.inverse();
+}
+
+VecX MaterialSpace::normalize(const VecX& raw) const {
+  if (raw.size() != dimension()) throw std::invalid_argument("MaterialSpace::normalize: wrong dimension");
+  VecX u(raw.size());
+  for (int i = 0; i < raw.size(); ++i) {
+    if (i == raw.size() - 1)
+      u[i] = raw[i];
+    else if (is_modulus(i))
+      u[i] = 1 + std::log10(raw[i] / E_stiff_) / decades_;
+    else
+      u[i] = (raw[i] - nu_low()) / (nu_high() - nu_low());
+  }
+  return u;
+}
+
+VecX MaterialSpace::denormalize(const VecX& u) const {
+  if (u.size() != dimension()) throw std::invalid_argument("MaterialSpace::denormalize: wrong dimension");
+  VecX raw(u.size());
+  for (int i = 0; i < u.size(); ++i) {
+    if (i == u.size() - 1)
+      raw[i] = u[i];
+    else if (is_modulus(i))
+      raw[i] = E_stiff_ * std::pow(10.0, (u[i] - 1) * decades_);
+    else
+      raw[i] = nu_low() + u[i] * (nu_high() - nu_low());
+  }
+  return raw;
+}
+
+}  // namespace msfab

@@ -1,0 +1,57 @@
+#pragma once
+// The material property spaces of the gamut (thesis §3.2.3, Fig. 3-14) and
+// their normalization to the unit cube that the level set lives in.
+//
+//   3D cubic:        (E, nu, G, rho)          from a cubic C^H
+//   2D cubic:        (E, nu, G, rho)          from a square-symmetric plane-strain C
+//   2D orthotropic:  (Ex, Ey, nu_xy, G, rho)  from an orthotropic plane-strain C
+//
+// rho is the volume fraction of the stiffest base material. Moduli are
+// normalized on a log scale over `decades` decades below the stiffest base
+// material's E (they span orders of magnitude, §3.2.3); Poisson's ratios
+// linearly over [-1, 0.5] in 3D and [-1, 1] in 2D (plane strain allows
+// nu_xy up to 1); rho over [0, 1].
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "homog/elastic_tensor.hpp"
+
+namespace msfab {
+
+enum class MaterialSpaceKind { cubic3d, cubic2d, orthotropic2d };
+
+class MaterialSpace {
+ public:
+  // InputError for E_stiff <= 0 or decades <= 0.
+  MaterialSpace(MaterialSpaceKind kind, double E_stiff, double decades = 4.0);
+  // "cubic3d" | "cubic2d" | "orthotropic2d"; InputError naming the choices.
+  static MaterialSpaceKind parse_kind(const std::string& name);
+
+  MaterialSpaceKind kind() const { return kind_; }
+  int dimension() const;
+  std::vector<std::string> names() const;
+
+  // Raw properties of a homogenized tensor (6 x 6 in 3D; the 3 x 3 plane
+  // block in 2D) and its stiff-material fraction.
+  VecX properties(const Mat6& C, double rho) const;
+  VecX properties_2d(const Mat3& C, double rho) const;
+  // The tensor with given raw properties (the inverse of the above, used by
+  // the topology optimizer): 6 x 6 cubic, or 3 x 3 plane strain.
+  Mat6 tensor_3d(const VecX& raw) const;
+  Mat3 tensor_2d(const VecX& raw) const;
+
+  // Raw <-> unit cube. normalize() does not clamp: values outside [0, 1]
+  // mean the property lies outside the space's box.
+  VecX normalize(const VecX& raw) const;
+  VecX denormalize(const VecX& unit) const;
+
+ private:
+  MaterialSpaceKind kind_;
+  double E_stiff_, decades_;
+  bool is_modulus(int coordinate) const;
+  double nu_low() const { return -1.0; }
+  double nu_high() const { return kind_ == MaterialSpaceKind::cubic3d ? 0.5 : 1.0; }
+};
+
+}  // namespace msfab
