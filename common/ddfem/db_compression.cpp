@@ -8,9 +8,7 @@
 #include "core/errors.hpp"
 
 namespace msfab {
-namespace {
 double uniform_pm1(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-52 - 1.0; }
-}  // namespace
 
 std::vector<Vec24> common_deformations(const hex8::NodeMatrix& coarse_rest, int count, double strain,
                                        std::uint64_t seed) {

@@ -5,12 +5,17 @@
 // farthest-point sampling in the distance of Eq. 2.10, and every
 // combination is looked up to its nearest representative.
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "ddfem/coarse_db.hpp"
 #include "ddfem/fine_block.hpp"
 
 namespace msfab {
+
+// A uniform draw in [-1, 1) from the standardized mt19937_64 sequence (the
+// same on every platform, unlike std::uniform_real_distribution).
+double uniform_pm1(std::mt19937_64& rng);
 
 // Common deformations: corner displacements (24) of the coarse element of
 // `coarse_rest` (edge 2h), each a random small strain (Frobenius norm

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 
 #include "core/errors.hpp"
@@ -15,8 +14,6 @@ namespace {
 
 // Child-index step of one cell along the stage's axis (x, y, z).
 constexpr std::array<int, 3> kAxisOffset{4, 2, 1};
-
-double uniform_pm1(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-52 - 1.0; }
 
 }  // namespace
 

@@ -125,11 +125,14 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   solver.analyze(A);
   if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
   for (int m = 0; m < 6; ++m) {
+    // The element load of the affine field depends only on the voxel's material.
+    std::vector<Vec24> load(palette.size());
+    for (std::size_t id = 0; id < palette.size(); ++id) load[id] = -(Ke[id] * ua[m]);
     VecX b = VecX::Zero(out.unknowns);
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {
-          const Vec24 f = -(Ke[cell.at(i, j, k)] * ua[m]);
+          const Vec24& f = load[cell.at(i, j, k)];
           for (int a = 0; a < 8; ++a) {
             const std::int64_t q = node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1));
             if (q != 0) b.segment<3>(3 * q - 3) += f.segment<3>(3 * a);

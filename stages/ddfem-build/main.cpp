@@ -38,7 +38,7 @@ namespace {
 
 // Fits this rank's share of items [begin, end) and gathers all of them on
 // every rank (allreduce keeps ranks in step; the payload is small).
-void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::vector<std::int64_t>& todo,
+void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::vector<std::int64_t>& pending,
                std::size_t begin, std::size_t end, int rank, int size, FittedOrbits& done) {
   const int count = static_cast<int>(end - begin);
   const std::size_t record = fit_record_size(plan.points);
@@ -48,19 +48,19 @@ void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::ve
     if (i % size != rank) continue;
     CoarseMaterialFit fit(plan.points);
     try {
-      fit = fit_coarse_material(plan.block(todo[begin + i]), options.fit);
+      fit = fit_coarse_material(plan.block(pending[begin + i]), options.fit);
     } catch (const std::exception& e) {  // must not escape the parallel region
       fit = CoarseMaterialFit(plan.points);
-      spdlog::error("block {}: {}", todo[begin + i], e.what());
+      spdlog::error("block {}: {}", pending[begin + i], e.what());
     }
-    if (!fit.fitted) spdlog::warn("block {}: not fitted: {}", todo[begin + i], fit.not_fitted_reason);
+    if (!fit.fitted) spdlog::warn("block {}: not fitted: {}", pending[begin + i], fit.not_fitted_reason);
     pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
   }
   // Rows not owned are zero, so a sum over ranks assembles the round exactly.
   std::vector<double> all(mine.size());
   MPI_Allreduce(mine.data(), all.data(), static_cast<int>(mine.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
   for (int i = 0; i < count; ++i)
-    done[todo[begin + i]] = unpack_fit(&all[static_cast<std::size_t>(i) * record], plan.points);
+    done[pending[begin + i]] = unpack_fit(&all[static_cast<std::size_t>(i) * record], plan.points);
 }
 
 }  // namespace
@@ -118,24 +118,24 @@ int main(int argc, char** argv) {
     } else if (resume && rank == 0) {
       spdlog::warn("--resume: no checkpoint {} yet, starting from the beginning", ckpt);
     }
-    std::vector<std::int64_t> todo;
+    std::vector<std::int64_t> pending;
     for (std::int64_t item : plan.items)  // a resume retries blocks that failed
-      if (!done.count(item) || !done.at(item).fitted) todo.push_back(item);
+      if (!done.count(item) || !done.at(item).fitted) pending.push_back(item);
     Progress progress(level2 ? "fitting level-2 blocks" : "fitting orbits", plan.items.size());
-    progress.set(plan.items.size() - todo.size());
+    progress.set(plan.items.size() - pending.size());
     int rounds = 0;
     const std::size_t per_round = static_cast<std::size_t>(options.orbits_per_round);
-    for (std::size_t begin = 0; begin < todo.size(); begin += per_round) {
+    for (std::size_t begin = 0; begin < pending.size(); begin += per_round) {
       if (max_rounds > 0 && rounds == max_rounds) {
         if (rank == 0)
           std::printf("msfab-ddfem-build: stopped after %d rounds (%zu of %zu blocks fitted); continue with --resume\n",
                       rounds, done.size(), plan.items.size());
         return;
       }
-      const std::size_t end = std::min(todo.size(), begin + per_round);
-      fit_round(plan, options, todo, begin, end, rank, size, done);
+      const std::size_t end = std::min(pending.size(), begin + per_round);
+      fit_round(plan, options, pending, begin, end, rank, size, done);
       if (rank == 0) write_checkpoint(ckpt, config_text, done, plan.points);
-      progress.set(plan.items.size() - (todo.size() - end));
+      progress.set(plan.items.size() - (pending.size() - end));
       ++rounds;
     }
     progress.done();
