@@ -74,8 +74,9 @@ Pieces face_pieces(const VoxelGrid& c, Member member) {
 
 }  // namespace
 
-std::array<int, 3> fundamental_voxel(const VoxelGrid& c, int i, int j, int k) {
+std::array<int, 3> fundamental_voxel(const VoxelGrid& c, int i, int j, int k, CellSymmetry symmetry) {
   std::array<int, 3> f{std::min(i, c.nx - 1 - i), std::min(j, c.ny - 1 - j), std::min(k, c.nz - 1 - k)};
+  if (symmetry == CellSymmetry::orthotropic) return f;
   if (is_2d(c)) {
     if (f[0] > f[1]) std::swap(f[0], f[1]);
   } else {
@@ -84,26 +85,28 @@ std::array<int, 3> fundamental_voxel(const VoxelGrid& c, int i, int j, int k) {
   return f;
 }
 
-void mirror_fundamental_domain(VoxelGrid& c) {
-  require_symmetric_shape(c);
+void mirror_fundamental_domain(VoxelGrid& c, CellSymmetry symmetry) {
+  if (symmetry == CellSymmetry::cubic) require_symmetric_shape(c);
   for (int k = 0; k < c.nz; ++k)
     for (int j = 0; j < c.ny; ++j)
       for (int i = 0; i < c.nx; ++i) {
-        const auto f = fundamental_voxel(c, i, j, k);
+        const auto f = fundamental_voxel(c, i, j, k, symmetry);
         c.at(i, j, k) = c.at(f[0], f[1], f[2]);
       }
 }
 
-bool has_cubic_symmetry(const VoxelGrid& c) {
-  if (c.nx != c.ny || (c.nz != c.nx && c.nz != 1)) return false;
+bool has_symmetry(const VoxelGrid& c, CellSymmetry symmetry) {
+  if (symmetry == CellSymmetry::cubic && (c.nx != c.ny || (c.nz != c.nx && c.nz != 1))) return false;
   for (int k = 0; k < c.nz; ++k)
     for (int j = 0; j < c.ny; ++j)
       for (int i = 0; i < c.nx; ++i) {
-        const auto f = fundamental_voxel(c, i, j, k);
+        const auto f = fundamental_voxel(c, i, j, k, symmetry);
         if (c.at(i, j, k) != c.at(f[0], f[1], f[2])) return false;
       }
   return true;
 }
+
+bool has_cubic_symmetry(const VoxelGrid& c) { return has_symmetry(c, CellSymmetry::cubic); }
 
 int paint_beam(VoxelGrid& c, const Vec3& a, const Vec3& b, double radius, int id) {
   const Vec3 ab = b - a;

@@ -11,17 +11,25 @@
 
 namespace msfab {
 
+// cubic: the 48 (2D: 8) symmetries of the cube (square), for cubic
+// materials; orthotropic: the mirror planes through the cell centre
+// normal to each axis (8; 2D: 4), for orthotropic materials.
+enum class CellSymmetry { cubic, orthotropic };
+
 // The voxel of the fundamental domain that symmetry maps voxel (i, j, k)
-// onto: each index folded onto the lower half (min(i, n - 1 - i)), then
-// the folded indices sorted (3D; 2D sorts i, j and keeps k = 0). The cell
-// must be cubic (nx = ny = nz) or square (nx = ny, nz = 1).
-std::array<int, 3> fundamental_voxel(const VoxelGrid& cell, int i, int j, int k);
+// onto: each index folded onto the lower half (min(i, n - 1 - i)), then,
+// for cubic symmetry, the folded indices sorted (3D; 2D sorts i, j and
+// keeps k = 0). A cubic cell must be cubic (nx = ny = nz) or square
+// (nx = ny, nz = 1).
+std::array<int, 3> fundamental_voxel(const VoxelGrid& cell, int i, int j, int k,
+                                     CellSymmetry symmetry = CellSymmetry::cubic);
 
 // Copies every voxel from its fundamental-domain voxel, making the cell
-// invariant under the 48 (2D: 8) symmetries of the cube (square).
-// InputError for a cell that is neither cubic nor square.
-void mirror_fundamental_domain(VoxelGrid& cell);
+// invariant under the symmetry group. InputError for a cubic symmetry on a
+// cell that is neither cubic nor square.
+void mirror_fundamental_domain(VoxelGrid& cell, CellSymmetry symmetry = CellSymmetry::cubic);
 bool has_cubic_symmetry(const VoxelGrid& cell);
+bool has_symmetry(const VoxelGrid& cell, CellSymmetry symmetry);
 
 // Sets to `id` every voxel whose centre lies within `radius` of the
 // segment a-b (cell coordinates: voxel units, voxel (i, j, k) centred at

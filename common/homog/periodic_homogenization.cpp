@@ -45,14 +45,11 @@ int count_periodic_pieces(const VoxelGrid& cell) {
 
 HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
                                 const HomogenizationOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
   const int nx = cell.nx, ny = cell.ny, nz = cell.nz;
   if (nx < 1 || ny < 1 || nz < 1 || cell.size() != std::size_t(nx) * ny * nz)
     throw InputError("homogenization: the cell has no voxels");
   if (!(options.void_stiffness > 0)) throw InputError("homogenization: void_stiffness must be > 0");
-  const double h = cell.voxel_size;
-  HomogenizationResult out;
-  out.volume_fraction.assign(palette.size(), 0.0);
+  std::vector<double> fraction(palette.size(), 0.0);
   for (int id : cell.ids) {
     if (id < 0 || id >= static_cast<int>(palette.size()) || (id > 0 && !palette[id])) {
       std::ostringstream os;
@@ -60,28 +57,65 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
          << ", 0 = void)";
       throw InputError(os.str());
     }
-    out.volume_fraction[id] += 1.0 / cell.size();
+    fraction[id] += 1.0 / cell.size();
   }
-  if (out.volume_fraction[0] >= 1.0) throw InputError("homogenization: the cell is all void");
-  out.pieces = count_periodic_pieces(cell);
+  if (fraction[0] >= 1.0) throw InputError("homogenization: the cell is all void");
 
   // Element stiffness per palette id (at rest); void: a fraction of the stiffest.
-  hex8::NodeMatrix X;
-  for (int a = 0; a < 8; ++a) X.row(a) = h * Vec3(a >> 2 & 1, a >> 1 & 1, a & 1).transpose();
+  const hex8::NodeMatrix X = voxel_corners(cell.voxel_size);
   const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
   std::vector<Mat24> Ke(palette.size(), Mat24::Zero());
   int stiffest = -1;
   for (std::size_t id = 1; id < palette.size(); ++id) {
-    if (!palette[id] || out.volume_fraction[id] == 0) continue;
+    if (!palette[id] || fraction[id] == 0) continue;
     hex_evaluate(geo, QuadratureMaterials{{palette[id]}}, X, nullptr, &Ke[id]);
     if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus()) stiffest = static_cast<int>(id);
   }
   Ke[0] = options.void_stiffness * Ke[stiffest];
+  HomogenizationResult out = homogenize_elements(nx, ny, nz, cell.voxel_size,
+                                                 [&](std::int64_t v) -> Mat24 { return Ke[cell.ids[v]]; });
+  out.volume_fraction = fraction;
+  out.pieces = count_periodic_pieces(cell);
+  return out;
+}
+
+hex8::NodeMatrix voxel_corners(double h) {
+  hex8::NodeMatrix X;
+  for (int a = 0; a < 8; ++a) X.row(a) = h * Vec3(a >> 2 & 1, a >> 1 & 1, a & 1).transpose();
+  return X;
+}
+
+Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationResult& r, int nx, int ny, int nz, double h,
+                                                         std::int64_t voxel) {
+  const hex8::NodeMatrix X = voxel_corners(h);
+  const int i = static_cast<int>(voxel % nx), j = static_cast<int>((voxel / nx) % ny),
+            k = static_cast<int>(voxel / (std::int64_t(nx) * ny));
+  Eigen::Matrix<double, 24, 6> U;
+  for (int m = 0; m < 6; ++m) {
+    Vec6 e = Vec6::Zero();
+    e[m] = 1;
+    const Mat3 eps = strain_tensor(e);
+    for (int a = 0; a < 8; ++a) {
+      const std::int64_t q = wrap(i + (a >> 2 & 1), nx) + nx * (wrap(j + (a >> 1 & 1), ny) + std::int64_t(ny) * wrap(k + (a & 1), nz));
+      U.col(m).segment<3>(3 * a) = eps * X.row(a).transpose() + r.fluctuation[m].segment<3>(3 * q);
+    }
+  }
+  return U;
+}
+
+HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const ElementStiffness& element_stiffness) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (nx < 1 || ny < 1 || nz < 1 || !(h > 0)) throw InputError("homogenization: the cell has no voxels");
+  const std::int64_t cells = std::int64_t(nx) * ny * nz;
+  HomogenizationResult out;
+  // Element matrices are asked for when needed, never stored per voxel
+  // (64^3 voxels would take 1.2 GB).
 
   // Periodic lattice: node (i, j, k) mod n; element (i, j, k) has node a at
   // (i, j, k) + (a>>2&1, a>>1&1, a&1). Node 0 is pinned (translation).
-  const std::int64_t N = std::int64_t(nx) * ny * nz;
+  const std::int64_t N = cells;
   auto node = [&](int i, int j, int k) -> std::int64_t { return wrap(i, nx) + nx * (wrap(j, ny) + std::int64_t(ny) * wrap(k, nz)); };
+  auto element = [&](int i, int j, int k) -> std::int64_t { return node(i, j, k); };
   out.unknowns = 3 * N - 3;
   // Assemble node by node (each column gathers its 8 elements): deterministic for any thread count.
   std::vector<std::vector<Eigen::Triplet<double>>> per_node(N);
@@ -92,7 +126,7 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
     if (p == 0) continue;
     for (int a = 0; a < 8; ++a) {  // p is node a of element e = (i, j, k) - offset(a)
       const int ei = i - (a >> 2 & 1), ej = j - (a >> 1 & 1), ek = k - (a & 1);
-      const Mat24& K = Ke[cell.at(wrap(ei, nx), wrap(ej, ny), wrap(ek, nz))];
+      const Mat24 K = element_stiffness(element(ei, ej, ek));
       for (int b = 0; b < 8; ++b) {
         const std::int64_t q = node(ei + (b >> 2 & 1), ej + (b >> 1 & 1), ek + (b & 1));
         if (q == 0) continue;
@@ -110,6 +144,7 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
 
   // Affine corner displacements of a voxel for each unit strain (the same
   // for every voxel up to a rigid translation, which K_e ignores).
+  const hex8::NodeMatrix X = voxel_corners(h);
   std::array<Vec24, 6> ua;
   for (int m = 0; m < 6; ++m) {
     Vec6 e = Vec6::Zero();
@@ -124,40 +159,33 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   CholmodSolver solver(solver_options);
   solver.analyze(A);
   if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
-  for (int m = 0; m < 6; ++m) {
-    // The element load of the affine field depends only on the voxel's material.
-    std::vector<Vec24> load(palette.size());
-    for (std::size_t id = 0; id < palette.size(); ++id) load[id] = -(Ke[id] * ua[m]);
-    VecX b = VecX::Zero(out.unknowns);
-    for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-          const Vec24& f = load[cell.at(i, j, k)];
-          for (int a = 0; a < 8; ++a) {
-            const std::int64_t q = node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1));
-            if (q != 0) b.segment<3>(3 * q - 3) += f.segment<3>(3 * a);
-          }
+  Eigen::Matrix<double, 24, 6> UA;
+  for (int m = 0; m < 6; ++m) UA.col(m) = ua[m];
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(out.unknowns, 6);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const Eigen::Matrix<double, 24, 6> F = -(element_stiffness(element(i, j, k)) * UA);
+        for (int a = 0; a < 8; ++a) {
+          const std::int64_t q = node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1));
+          if (q != 0) B.middleRows<3>(3 * q - 3) += F.middleRows<3>(3 * a);
         }
-    const VecX x = solver.solve(b);
+      }
+  for (int m = 0; m < 6; ++m) {
+    const VecX x = solver.solve(B.col(m));
     out.fluctuation[m] = VecX::Zero(3 * N);
     out.fluctuation[m].tail(3 * N - 3) = x;
   }
   // C^H from the element energies of the total fields, summed per element
   // first and then in element order (deterministic).
-  std::vector<Mat6> contribution(cell.size());
+  std::vector<Mat6> contribution(cells);
 #pragma omp parallel for schedule(static)
-  for (std::int64_t v = 0; v < static_cast<std::int64_t>(cell.size()); ++v) {
-    const int i = static_cast<int>(v % nx), j = static_cast<int>((v / nx) % ny), k = static_cast<int>(v / (std::int64_t(nx) * ny));
-    Eigen::Matrix<double, 24, 6> U;
-    for (int m = 0; m < 6; ++m) {
-      U.col(m) = ua[m];
-      for (int a = 0; a < 8; ++a)
-        U.col(m).segment<3>(3 * a) += out.fluctuation[m].segment<3>(3 * node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1)));
-    }
-    contribution[v] = U.transpose() * Ke[cell.ids[v]] * U;
+  for (std::int64_t v = 0; v < cells; ++v) {
+    const Eigen::Matrix<double, 24, 6> U = total_element_displacements(out, nx, ny, nz, h, v);
+    contribution[v] = U.transpose() * element_stiffness(v) * U;
   }
   for (const Mat6& c : contribution) out.C += c;
-  out.C /= double(cell.size()) * h * h * h;
+  out.C /= double(cells) * h * h * h;
   out.C = 0.5 * (out.C + out.C.transpose());
   out.G = out.C.inverse();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

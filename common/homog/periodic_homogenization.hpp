@@ -9,9 +9,11 @@
 // is linearized at F = I. docs/homogenization.md.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "fem/voxel_grid.hpp"
+#include "fem/hex8.hpp"
 #include "homog/elastic_tensor.hpp"
 
 namespace msfab {
@@ -41,6 +43,25 @@ struct HomogenizationResult {
 // positive definite.
 HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
                                 const HomogenizationOptions& options = {});
+
+// The cell problem for any per-voxel element stiffness (voxel v = i + nx
+// (j + ny k), element matrices of the 8-node hexahedron with corners
+// voxel_corners(h)): the core of homogenize(), and of the continuous
+// sampling step, whose voxels mix two materials. The stiffness must be
+// positive definite up to rigid motions. volume_fraction and pieces are
+// left empty.
+using ElementStiffness = std::function<Mat24(std::int64_t voxel)>;
+HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const ElementStiffness& element_stiffness);
+
+// Corner positions of one voxel of size h (corner a at (a>>2&1, a>>1&1, a&1) h).
+hex8::NodeMatrix voxel_corners(double h);
+
+// Columns m = 0..5: the total displacement (affine eps^m x plus the
+// periodic fluctuation) at the 8 corners of `voxel`. Then
+// C^H_mn = sum_v U_v^T K_v U_v / |Y|, and because the fluctuations are
+// stationary, dC^H_mn / dK_v = U_v(:, m)^T dK_v U_v(:, n) / |Y| (no adjoint solve).
+Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationResult& r, int nx, int ny, int nz,
+                                                         double h, std::int64_t voxel);
 
 // 2D, plane strain: the cell must have nz = 1. With one voxel across z and
 // periodicity in z, every field is independent of z: the 3D cell problem

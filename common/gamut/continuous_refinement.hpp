@@ -1,0 +1,97 @@
+#pragma once
+// The continuous step of the gamut sampler (thesis §3.2.2, Eq. 3.4): a
+// structure near the gamut boundary is relaxed to densities 0.5 +- 0.3 and
+// pushed towards a target tensor just outside the gamut by topology
+// optimization, then thresholded back to voxels.
+//
+//   x        one density in [0, 1] per orbit of the cell symmetry (the
+//            fundamental domain), so every iterate keeps the symmetry
+//   x~       the densities filtered with a periodic cone of radius R voxels
+//            (x~ = H x / sum H), the filter against thin features
+//   K_v      K_soft + x~_v^p (K_stiff - K_soft), SIMP with p = 3; a void
+//            soft phase is the stiff one scaled by void_stiffness
+//   f(x)     |W (G(x) - G0) W|_F^2 + w_rho (rho(x) - rho0)^2, W = G0^(-1/2),
+//            G = (C^H)^-1 (the in-plane 3 x 3 block for a 2D cell); the
+//            thesis writes (G - G0)^2; weighting by the target makes
+//            every eigenmode count relative to its own size (the shear
+//            compliance of a soft cell would otherwise decide alone)
+//            rho = mean of x~ (the stiff fraction)
+//   min f    NLopt MMA, at most max_iterations evaluations, bounds [0, 1];
+//            the best iterate is kept (MMA's objective oscillates)
+//
+// The gradient is exact: dC^H/dx~_v = p x~_v^(p-1) U_v^T (K_stiff - K_soft)
+// U_v / |Y| with U_v the total corner displacements (the fluctuations are
+// stationary), dG = -G dC G, then the filter and the orbit sums by the
+// chain rule. We filter densities rather than sensitivities: MMA's
+// conservative inner iterations compare objective values, and a filtered
+// sensitivity is not the gradient of any objective (docs/gamut.md).
+#include <Eigen/Eigenvalues>
+#include <vector>
+
+#include "core/types.hpp"
+#include "fem/voxel_grid.hpp"
+#include "gamut/structure_ops.hpp"
+#include "material/material.hpp"
+
+namespace msfab {
+
+struct ContinuousOptions {
+  int max_iterations = 50;      // objective evaluations
+  double penalty = 3.0;         // SIMP exponent p
+  double filter_radius = 1.5;   // voxels; <= 1: no filtering
+  double density_weight = 1.0;  // w_rho
+  double start_offset = 0.3;    // stiff voxels start at 0.5 + offset, others at 0.5 - offset
+  double void_stiffness = 1e-6; // when the soft phase is void
+  CellSymmetry symmetry = CellSymmetry::cubic;
+};
+
+struct RefinementTarget {
+  MatX G;            // 6 x 6 (3D) or the 3 x 3 plane block (2D cell), Voigt, engineering shear
+  double rho = 0.5;  // stiff volume fraction
+};
+
+// The objective of one cell, for a two-phase structure of `stiff` and
+// `soft` (soft == nullptr: void). Cells are cubic/square (cubic
+// symmetry) or any box (orthotropic). InputError on bad options or a
+// target of the wrong size.
+class ContinuousCellProblem {
+ public:
+  ContinuousCellProblem(int nx, int ny, int nz, double h, MaterialPtr stiff, MaterialPtr soft,
+                        const RefinementTarget& target, const ContinuousOptions& options);
+
+  int variables() const { return static_cast<int>(orbit_voxels_.size()); }
+  // Densities of the voxels of a structure (stiff id -> 0.5 + offset, others 0.5 - offset), one per orbit.
+  std::vector<double> start(const VoxelGrid& structure, int stiff_id) const;
+  // Filtered per-voxel densities x~.
+  std::vector<double> filtered(const std::vector<double>& x) const;
+  // f(x); fills `gradient` (size variables()) when non-null.
+  double objective(const std::vector<double>& x, std::vector<double>* gradient) const;
+  // Voxel ids of the thresholded design: x~ >= 0.5 -> stiff_id, else soft_id.
+  VoxelGrid threshold(const std::vector<double>& x, int stiff_id, int soft_id) const;
+
+ private:
+  int nx_, ny_, nz_;
+  double h_;
+  Mat24 K_stiff_, K_soft_;
+  RefinementTarget target_;
+  MatX W_;
+  ContinuousOptions options_;
+  std::vector<int> orbit_of_voxel_;
+  std::vector<std::vector<int>> orbit_voxels_;
+  // Filter rows: per voxel, (neighbour voxel, weight / row sum).
+  std::vector<std::vector<std::pair<int, double>>> filter_;
+};
+
+struct ContinuousResult {
+  VoxelGrid structure;               // thresholded, mirrored and cleaned
+  double start_objective = 0, best_objective = 0;
+  int evaluations = 0;
+  std::vector<double> history;       // f per evaluation
+};
+
+// Runs MMA from `structure` towards `target`. Deterministic.
+ContinuousResult refine_structure(const VoxelGrid& structure, int stiff_id, int soft_id, MaterialPtr stiff,
+                                  MaterialPtr soft, const RefinementTarget& target,
+                                  const ContinuousOptions& options = {});
+
+}  // namespace msfab
