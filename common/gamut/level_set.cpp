@@ -27,6 +27,25 @@ double GamutLevelSet::node(const std::vector<int>& index) const {
   return phi_[flat];
 }
 
+GamutLevelSet GamutLevelSet::from_values(int d, int cells, double lower, double spacing, std::vector<double> values) {
+  if (d < 1 || d > 6 || cells < 2 || !(spacing > 0) || !std::isfinite(lower))
+    throw InputError("gamut level set: need dimension 1..6, cells >= 2, spacing > 0");
+  GamutLevelSet ls;
+  ls.dim_ = d;
+  ls.cells_ = cells;
+  ls.lo_ = lower;
+  ls.h_ = spacing;
+  ls.stride_.assign(d, 1);
+  for (int a = 1; a < d; ++a) ls.stride_[a] = ls.stride_[a - 1] * cells;
+  if (static_cast<long long>(values.size()) != ls.stride_[d - 1] * cells)
+    throw InputError("gamut level set: " + std::to_string(values.size()) + " node values for " +
+                     std::to_string(cells) + "^" + std::to_string(d) + " nodes");
+  for (double v : values)
+    if (!std::isfinite(v)) throw InputError("gamut level set: a node value is not finite");
+  ls.phi_ = std::move(values);
+  return ls;
+}
+
 GamutLevelSet GamutLevelSet::from_points(const std::vector<VecX>& points, const LevelSetOptions& o) {
   if (points.empty()) throw InputError("gamut level set: no sample points");
   const int d = static_cast<int>(points[0].size());

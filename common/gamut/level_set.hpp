@@ -35,6 +35,11 @@ class GamutLevelSet {
   // more than 2^26 nodes, or bad options.
   static GamutLevelSet from_points(const std::vector<VecX>& points, const LevelSetOptions& options = {});
 
+  // A level set from stored node values (an artifact): `values` has
+  // cells^dimension entries, axis 0 fastest, node centres at
+  // lower + (i + 1/2) spacing. InputError on a size mismatch.
+  static GamutLevelSet from_values(int dimension, int cells, double lower, double spacing, std::vector<double> values);
+
   int dimension() const { return dim_; }
   int cells() const { return cells_; }
   double spacing() const { return h_; }

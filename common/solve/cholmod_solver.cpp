@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <string>
 
 #include "core/errors.hpp"
@@ -148,6 +149,11 @@ void CholmodSolver::analyze(const SpMat& A) {
 
   if (A.rows() > 0) {
     cholmod_sparse view = lower_triangle_view(A);
+    // METIS keeps its random-number state in globals: two threads ordering
+    // at once disturb each other's orderings, and with them the round-off
+    // of every solve. One analysis at a time keeps results reproducible.
+    static std::mutex analysis_mutex;
+    std::lock_guard<std::mutex> lock(analysis_mutex);
     c.use_ordering(CHOLMOD_METIS);
     c.factor = cholmod_analyze(&view, &c.common);
     if (c.factor == nullptr || c.common.status < CHOLMOD_OK) {

@@ -1,0 +1,98 @@
+#include "gamut/gamut_artifact.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "io/artifact.hpp"
+
+namespace msfab {
+
+double coverage(const GamutLevelSet& ls) {
+  const int d = ls.dimension(), n = ls.cells();
+  std::vector<int> index(d, 0);
+  long long inside = 0, total = 0;
+  const std::vector<double>& phi = ls.values();
+  for (std::size_t v = 0; v < phi.size(); ++v) {
+    long long flat = static_cast<long long>(v);
+    bool in_cube = true;
+    for (int a = 0; a < d; ++a) {
+      const double x = ls.lower() + (flat % n + 0.5) * ls.spacing();
+      flat /= n;
+      in_cube &= x >= 0 && x <= 1;
+    }
+    if (!in_cube) continue;
+    ++total;
+    inside += phi[v] <= 0;
+  }
+  return total > 0 ? double(inside) / total : 0.0;
+}
+
+void write_gamut_artifact(const std::string& path, const Gamut& g, const std::string& executable,
+                          const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
+  ArtifactWriter out(path, kGamutSchema, kGamutSchemaVersion, executable, config_text, inputs, seed);
+  H5File& f = out.file();
+  f.write_attribute("/", "space", g.space);
+  std::string names;
+  for (const auto& name : g.property_names) names += (names.empty() ? "" : ",") + name;
+  f.write_attribute("/", "property_names", names);
+  f.write_attribute("/", "E_stiff", g.E_stiff);
+  f.write_attribute("/", "decades", g.decades);
+  const GamutLevelSet& ls = g.level_set;
+  std::vector<hsize_t> shape(ls.dimension(), hsize_t(ls.cells()));
+  f.write_dataset("/level_set/phi", ls.values(), shape);
+  f.write_attribute("/level_set/phi", "order",
+                    "C order over (p_{d-1}, ..., p_0): the first property varies fastest in memory");
+  f.write_attribute("/level_set", "dimension", static_cast<std::int32_t>(ls.dimension()));
+  f.write_attribute("/level_set", "cells", static_cast<std::int32_t>(ls.cells()));
+  f.write_attribute("/level_set", "lower", ls.lower());
+  f.write_attribute("/level_set", "spacing", ls.spacing());
+  f.write_attribute("/level_set", "meaning",
+                    "signed distance in normalized property space, negative inside; node i at lower + (i + 1/2) spacing");
+  std::vector<std::int32_t> cycle, samples, discrete, continuous;
+  std::vector<double> cover, seconds;
+  for (const GamutCycle& c : g.history) {
+    cycle.push_back(c.cycle), samples.push_back(c.samples), discrete.push_back(c.discrete_added);
+    continuous.push_back(c.continuous_added), cover.push_back(c.coverage), seconds.push_back(c.seconds);
+  }
+  if (!cycle.empty()) {
+    f.write_vector("/history/cycle", cycle);
+    f.write_vector("/history/samples", samples);
+    f.write_vector("/history/discrete_added", discrete);
+    f.write_vector("/history/continuous_added", continuous);
+    f.write_vector("/history/coverage", cover);
+    f.write_vector("/history/seconds", seconds);
+  }
+  out.commit();
+}
+
+Gamut read_gamut_artifact(const std::string& path) {
+  const ArtifactReader in(path, kGamutSchema, kGamutSchemaVersion);
+  const H5File& f = in.file();
+  Gamut g;
+  g.space = f.read_string_attribute("/", "space");
+  std::stringstream names(f.read_string_attribute("/", "property_names"));
+  for (std::string name; std::getline(names, name, ',');) g.property_names.push_back(name);
+  g.E_stiff = f.read_attribute<double>("/", "E_stiff");
+  g.decades = f.read_attribute<double>("/", "decades");
+  const int d = f.read_attribute<std::int32_t>("/level_set", "dimension");
+  if (d != static_cast<int>(g.property_names.size()))
+    throw InputError(path + ": /level_set dimension " + std::to_string(d) + " differs from the " +
+                     std::to_string(g.property_names.size()) + " property names");
+  const NdArray<double> phi = f.read_dataset<double>("/level_set/phi");
+  g.level_set = GamutLevelSet::from_values(d, f.read_attribute<std::int32_t>("/level_set", "cells"),
+                                           f.read_attribute<double>("/level_set", "lower"),
+                                           f.read_attribute<double>("/level_set", "spacing"), phi.values);
+  if (f.exists("/history/cycle")) {
+    const auto cycle = f.read_vector<std::int32_t>("/history/cycle");
+    const auto samples = f.read_vector<std::int32_t>("/history/samples");
+    const auto discrete = f.read_vector<std::int32_t>("/history/discrete_added");
+    const auto continuous = f.read_vector<std::int32_t>("/history/continuous_added");
+    const auto cover = f.read_vector<double>("/history/coverage");
+    const auto seconds = f.read_vector<double>("/history/seconds");
+    for (std::size_t i = 0; i < cycle.size(); ++i)
+      g.history.push_back({cycle[i], samples.at(i), discrete.at(i), continuous.at(i), cover.at(i), seconds.at(i)});
+  }
+  return g;
+}
+
+}  // namespace msfab

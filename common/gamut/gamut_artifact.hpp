@@ -1,0 +1,41 @@
+#pragma once
+// The `msfab.gamut` artifact (docs/artifacts.md): the level set of the
+// achievable properties, with the material space and normalization it
+// lives in, and the sampler's per-cycle history. The topology optimizer
+// reads it for its per-cell constraint Phi(p) <= 0.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gamut/level_set.hpp"
+
+namespace msfab {
+
+inline constexpr const char* kGamutSchema = "msfab.gamut";
+inline constexpr int kGamutSchemaVersion = 1;
+
+struct GamutCycle {
+  int cycle = 0;
+  int samples = 0;             // structures in the set after the cycle
+  int discrete_added = 0, continuous_added = 0;
+  double coverage = 0;         // fraction of the unit cube inside the gamut (coverage())
+  double seconds = 0;          // wall time of the cycle
+};
+
+struct Gamut {
+  std::string space;           // MaterialSpace kind name
+  std::vector<std::string> property_names;
+  double E_stiff = 0, decades = 4;
+  GamutLevelSet level_set;
+  std::vector<GamutCycle> history;
+};
+
+// Fraction of the level-set nodes inside the unit cube with Phi <= 0: the
+// volume of the sampled gamut in normalized property space.
+double coverage(const GamutLevelSet& level_set);
+
+void write_gamut_artifact(const std::string& path, const Gamut& gamut, const std::string& executable,
+                          const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
+Gamut read_gamut_artifact(const std::string& path);
+
+}  // namespace msfab

@@ -1,0 +1,20 @@
+#pragma once
+// PNG plots of a sampling run (like thesis Fig. 3-14): the structures'
+// Young's modulus (log, relative to the stiff material) against Poisson's
+// ratio with the projected gamut boundary, and coverage per cycle.
+#include <string>
+#include <vector>
+
+#include "gamut/gamut_artifact.hpp"
+#include "gamut/material_space.hpp"
+#include "gamut/microstructure_set.hpp"
+
+namespace msfab {
+
+// The boundary drawn is the zero contour of min Phi over the other
+// properties (the projection of the gamut onto the E-nu plane).
+void plot_gamut_projection(const std::string& path, const MicrostructureSet& set, const GamutLevelSet& gamut,
+                           const MaterialSpace& space, const std::string& title);
+void plot_coverage(const std::string& path, const std::vector<GamutCycle>& history);
+
+}  // namespace msfab

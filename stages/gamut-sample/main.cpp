@@ -1,0 +1,189 @@
+// msfab-gamut-sample: the material-property gamut of two-material
+// microstructures (thesis §3.2), MPI-parallel.
+//
+//   1. read the material space, base materials and sampler settings
+//   2. cycle 0: the solid cell and random beam cuts of it, homogenized;
+//      the gamut level set; the particle population by systematic
+//      resampling (or continue from the checkpoint with --resume)
+//   3. each cycle:
+//        discrete step    every particle changed by random beams, made
+//                         symmetric and cleaned; new structures homogenized
+//        level set        Zhu-Bridson + fast marching + smoothing (§3.2.3)
+//        continuous step  structures nearest the boundary pushed along the
+//                         normal, q = p + step grad Phi, by SIMP + MMA
+//        level set, coverage, resampling by Eq. 3.1-3.2, checkpoint
+//   4. write `msfab.microstructures` and `msfab.gamut`, and the plots
+//
+// Homogenizations and continuous optimizations are spread over MPI ranks;
+// every random draw is keyed by (seed, cycle, item), so the result is the
+// same for any rank or thread count and after --resume.
+#include <mpi.h>
+#include <omp.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "cli/progress.hpp"
+#include "cli/stage_app.hpp"
+#include "core/errors.hpp"
+#include "fan_out.hpp"
+#include "gamut_plots.hpp"
+#include "sampler.hpp"
+#include "sampler_checkpoint.hpp"
+
+using namespace msfab;
+
+namespace {
+
+std::string stem_of(const std::string& out) {
+  const std::string suffix = ".gamut.h5";
+  if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
+    return out.substr(0, out.size() - suffix.size());
+  return out;
+}
+
+void log_step(const char* name, const StepReport& r) {
+  spdlog::info("  {}: {} tried, {} added ({} duplicates, {} outside the space, {} failed)", name, r.tried, r.added,
+               r.duplicates, r.outside, r.failed);
+}
+
+void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
+    for (const GamutCycle& c : history)
+      f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
+        << ',' << c.seconds << '\n';
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  const int rank = mpi_rank(), size = mpi_size();
+  StageApp app("msfab-gamut-sample", "Microstructure gamut sampling, discrete + continuous (thesis 3.2), MPI-parallel");
+  app.add_common_options();
+  app.set_default_config(kDefaultSamplerConfig);
+  bool resume = false;
+  int max_cycles = 0;
+  std::string structures_path, plots_dir;
+  app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config and seed required)");
+  app.cli().add_option("--max-cycles", max_cycles,
+                       "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
+      ->check(CLI::NonNegativeNumber);
+  app.cli().add_option("--structures", structures_path,
+                       "the microstructures artifact (default: <out without .gamut.h5>.microstructures.h5)");
+  app.cli().add_option("--plots", plots_dir, "folder for the PNG plots and history.csv (default: <out stem>.plots)");
+  const int code = app.run(argc, argv, [&](StageContext& ctx) {
+    const std::string& out = ctx.require_out();
+    const auto t_start = std::chrono::steady_clock::now();
+    if (rank != 0) {
+      Progress::set_quiet(true);
+      spdlog::set_level(spdlog::level::warn);
+    }
+
+    // 1. Settings.
+    const SamplerOptions options = read_sampler_options(ctx.config);
+    ctx.config.check_no_unknown_keys();
+    if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
+      throw InputError(out + ": output folder does not exist");
+    if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
+    if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
+    if (rank == 0) std::filesystem::create_directories(plots_dir);
+    const std::string run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
+    const GamutSampler sampler(options, ctx.options.seed);
+    if (rank == 0)
+      spdlog::info("{} gamut, {}^{} voxel cells, population {}, {} cycles; {} rank(s) x {} thread(s)", options.space,
+                   options.resolution, options.kind == MaterialSpaceKind::cubic3d ? 3 : 2, options.population,
+                   options.cycles, size, omp_get_max_threads());
+
+    // 2. Initial population, or the checkpoint.
+    const std::string ckpt = sampler_checkpoint_path(out);
+    SamplerState state;
+    if (resume && std::filesystem::exists(ckpt)) {
+      state = read_sampler_checkpoint(ckpt, run_text);
+      if (rank == 0) spdlog::info("resuming after cycle {} with {} structures", state.cycles_done, state.set.items.size());
+    } else {
+      if (resume && rank == 0) spdlog::warn("--resume: no checkpoint {} yet, starting from the beginning", ckpt);
+      const auto t0 = std::chrono::steady_clock::now();
+      StepReport init;
+      state = sampler.initialize(&init);
+      if (rank == 0) log_step("initial", init);
+      const GamutLevelSet gamut = sampler.level_set(state);
+      state.history.push_back({0, static_cast<int>(state.set.items.size()), init.added, 0, coverage(gamut),
+                               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+      if (rank == 0) {
+        write_sampler_checkpoint(ckpt, run_text, state);
+        if (options.plot_every_cycle)
+          plot_gamut_projection(plots_dir + "/cycle_00.png", state.set, gamut, sampler.space(), "CYCLE 0");
+      }
+    }
+
+    // 3. Cycles.
+    int this_run = 0;
+    for (int cycle = state.cycles_done + 1; cycle <= options.cycles; ++cycle) {
+      if (max_cycles > 0 && this_run == max_cycles) {
+        if (rank == 0)
+          std::printf("msfab-gamut-sample: stopped after cycle %d of %d (%zu structures); continue with --resume\n",
+                      state.cycles_done, options.cycles, state.set.items.size());
+        return;
+      }
+      const auto t0 = std::chrono::steady_clock::now();
+      const StepReport discrete = sampler.discrete_step(state, cycle);
+      const StepReport continuous = sampler.continuous_step(state, sampler.level_set(state), cycle);
+      const GamutLevelSet gamut = sampler.level_set(state);
+      sampler.resample(state, gamut, cycle);
+      state.cycles_done = cycle;
+      state.history.push_back({cycle, static_cast<int>(state.set.items.size()), discrete.added, continuous.added,
+                               coverage(gamut), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+      if (rank == 0) {
+        const GamutCycle& h = state.history.back();
+        spdlog::info("cycle {}/{}: {} structures, coverage {:.4f}, {:.1f} s", cycle, options.cycles, h.samples,
+                     h.coverage, h.seconds);
+        log_step("discrete", discrete);
+        log_step("continuous", continuous);
+        write_sampler_checkpoint(ckpt, run_text, state);
+        if (options.plot_every_cycle) {
+          char name[32];
+          std::snprintf(name, sizeof name, "/cycle_%02d.png", cycle);
+          plot_gamut_projection(plots_dir + name, state.set, gamut, sampler.space(), "CYCLE " + std::to_string(cycle));
+        }
+      }
+      ++this_run;
+    }
+
+    // 4. Artifacts and plots.
+    if (rank == 0) {
+      Gamut g;
+      g.space = options.space;
+      g.property_names = sampler.space().names();
+      g.E_stiff = options.stiff.E;
+      g.decades = options.decades;
+      g.level_set = sampler.level_set(state);
+      g.history = state.history;
+      write_microstructures_artifact(structures_path, state.set, "msfab-gamut-sample", run_text, {}, ctx.options.seed);
+      write_gamut_artifact(out, g, "msfab-gamut-sample", run_text, {structures_path}, ctx.options.seed);
+      plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
+                            options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
+      plot_coverage(plots_dir + "/coverage.png", state.history);
+      write_history_csv(plots_dir + "/history.csv", state.history);
+      std::filesystem::remove(ckpt);
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
+      int by_step[4] = {0, 0, 0, 0};
+      for (const Microstructure& m : state.set.items) ++by_step[static_cast<int>(m.step)];
+      std::printf("msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous) after %d cycles\n",
+                  options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], options.cycles);
+      std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
+      std::printf("  time: %.1f s wall\n", wall);
+      std::printf("  artifacts: %s, %s\n  plots: %s\n", out.c_str(), structures_path.c_str(), plots_dir.c_str());
+    }
+  });
+  MPI_Finalize();
+  return code;
+}

@@ -1,0 +1,232 @@
+#include "sampler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_set>
+
+#include "core/errors.hpp"
+#include "fan_out.hpp"
+#include "gamut/continuous_refinement.hpp"
+#include "gamut/particle_scoring.hpp"
+#include "gamut/structure_evolution.hpp"
+#include "homog/periodic_homogenization.hpp"
+#include "material/linear_isotropic.hpp"
+
+namespace msfab {
+namespace {
+
+std::uint64_t splitmix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// One independent stream per (seed, cycle, item, purpose): results do not
+// depend on which rank or thread draws them.
+std::uint64_t stream(std::uint64_t seed, int cycle, std::int64_t item, int purpose) {
+  return splitmix(splitmix(splitmix(seed) ^ static_cast<std::uint64_t>(cycle)) ^
+                  (static_cast<std::uint64_t>(item) << 8 | static_cast<std::uint64_t>(purpose)));
+}
+
+std::uint64_t hash_ids(const std::vector<int>& ids) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (int v : ids) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ULL;
+  return h;
+}
+
+constexpr int kPlane[3] = {0, 1, 5};
+constexpr int kHeader = 2 + 36;  // ok, rho, C
+
+}  // namespace
+
+GamutSampler::GamutSampler(const SamplerOptions& options, std::uint64_t seed)
+    : o_(options), seed_(seed), space_(options.kind, options.stiff.E, options.decades) {
+  palette_ = {nullptr, std::make_shared<LinearIsotropic>(o_.stiff.E, o_.stiff.nu)};
+  if (!o_.soft_is_void) palette_.push_back(std::make_shared<LinearIsotropic>(o_.soft.E, o_.soft.nu));
+}
+
+int GamutSampler::voxels_per_side_z() const { return o_.kind == MaterialSpaceKind::cubic3d ? o_.resolution : 1; }
+
+VoxelGrid GamutSampler::cell_of(const Microstructure& m) const {
+  VoxelGrid c(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution);
+  c.ids = m.ids;
+  return c;
+}
+
+bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho) const {
+  m.C = C;
+  if (o_.kind == MaterialSpaceKind::cubic3d) {
+    m.properties = space_.properties(C, rho);
+  } else {
+    Mat3 C2;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) C2(a, b) = C(kPlane[a], kPlane[b]);
+    m.properties = space_.properties_2d(C2, rho);
+  }
+  m.unit = space_.normalize(m.properties);
+  for (int a = 0; a < m.unit.size(); ++a)
+    if (!(m.unit[a] >= 0 && m.unit[a] <= 1)) return false;
+  return true;
+}
+
+StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
+                                        const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const {
+  StepReport report;
+  report.tried = static_cast<int>(cells.size());
+  HomogenizationOptions ho;
+  ho.void_stiffness = o_.void_stiffness;
+  const std::vector<double> records = fan_out(report.tried, kHeader, [&](int i, double* r) {
+    if (cells[i].count_solid() == 0) return;
+    const HomogenizationResult h = homogenize(cells[i], palette_, ho);
+    r[0] = 1;
+    r[1] = h.volume_fraction.size() > 1 ? h.volume_fraction[1] : 0.0;
+    for (int k = 0; k < 36; ++k) r[2 + k] = h.C(k / 6, k % 6);
+  });
+  std::unordered_set<std::uint64_t> known;
+  for (const Microstructure& m : state.set.items) known.insert(hash_ids(m.ids));
+  for (int i = 0; i < report.tried; ++i) {
+    const double* r = &records[static_cast<std::size_t>(i) * kHeader];
+    if (r[0] != 1) {
+      ++report.failed;
+      continue;
+    }
+    const std::uint64_t h = hash_ids(cells[i].ids);
+    if (known.count(h)) {
+      ++report.duplicates;
+      continue;
+    }
+    Microstructure m;
+    m.ids = cells[i].ids;
+    Mat6 C;
+    for (int k = 0; k < 36; ++k) C(k / 6, k % 6) = r[2 + k];
+    if (!fill_properties(m, C, r[1])) {
+      ++report.outside;
+      continue;
+    }
+    m.cycle = cycle;
+    m.step = step;
+    m.parent = parents[i];
+    known.insert(h);
+    state.set.items.push_back(std::move(m));
+    state.refined.push_back(0);
+    ++report.added;
+  }
+  return report;
+}
+
+SamplerState GamutSampler::initialize(StepReport* report) const {
+  SamplerState state;
+  MicrostructureSet& set = state.set;
+  set.space = o_.space;
+  set.property_names = space_.names();
+  set.E_stiff = o_.stiff.E;
+  set.decades = o_.decades;
+  set.nx = set.ny = o_.resolution;
+  set.nz = voxels_per_side_z();
+  set.stiff = o_.stiff;
+  set.soft = o_.soft;
+  set.soft_is_void = o_.soft_is_void;
+
+  const VoxelGrid solid(set.nx, set.ny, set.nz, 1.0 / o_.resolution, 1);
+  BeamMoveOptions first = o_.move;
+  first.max_beams = o_.initial_beams;
+  std::vector<VoxelGrid> cells = {solid};
+  for (int i = 0; i < o_.population; ++i) cells.push_back(evolve_structure(solid, stream(seed_, 0, i, 1), first));
+  *report = add_structures(state, cells, std::vector<std::int64_t>(cells.size(), -1), 0, SampleStep::initial);
+  if (state.set.items.empty())
+    throw NumericalError("gamut sampler: no initial structure lies inside the material space's box");
+  state.cycles_done = 0;
+  resample(state, level_set(state), 0);
+  return state;
+}
+
+StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
+  std::vector<VoxelGrid> cells;
+  std::vector<std::int64_t> parents;
+  for (std::size_t i = 0; i < state.population.size(); ++i) {
+    const std::int64_t p = state.population[i];
+    cells.push_back(evolve_structure(cell_of(state.set.items[p]), stream(seed_, cycle, static_cast<std::int64_t>(i), 2), o_.move));
+    parents.push_back(p);
+  }
+  return add_structures(state, cells, parents, cycle, SampleStep::discrete);
+}
+
+StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
+  StepReport report;
+  if (o_.continuous_per_cycle == 0) return report;
+  // The unrefined structures nearest the boundary (ties: the older first).
+  std::vector<std::pair<double, std::int64_t>> order;
+  for (std::size_t i = 0; i < state.set.items.size(); ++i)
+    if (!state.refined[i]) order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
+  std::sort(order.begin(), order.end());
+  order.resize(std::min<std::size_t>(order.size(), o_.continuous_per_cycle));
+
+  const int voxels = o_.resolution * o_.resolution * voxels_per_side_z();
+  const int record = 1 + voxels;
+  const int soft_id = o_.soft_is_void ? 0 : 2;
+  const std::vector<double> records = fan_out(static_cast<int>(order.size()), record, [&](int i, double* r) {
+    const Microstructure& start = state.set.items[order[i].second];
+    VecX g = gamut.gradient(start.unit);
+    if (!(g.norm() > 1e-12)) return;
+    VecX q = start.unit + o_.continuous_step * g / g.norm();
+    for (int a = 0; a < q.size(); ++a) q[a] = std::clamp(q[a], 0.005, 0.995);
+    const VecX raw = space_.denormalize(q);
+    RefinementTarget target;
+    if (o_.kind == MaterialSpaceKind::cubic3d) target.G = space_.tensor_3d(raw).inverse();
+    else target.G = space_.tensor_2d(raw).inverse();
+    target.rho = raw[raw.size() - 1];
+    const ContinuousResult c = refine_structure(cell_of(start), 1, soft_id, palette_[1],
+                                                o_.soft_is_void ? nullptr : palette_[2], target, o_.continuous);
+    r[0] = 1;
+    for (int v = 0; v < voxels; ++v) r[1 + v] = c.structure.ids[v];
+  });
+  std::vector<VoxelGrid> cells;
+  std::vector<std::int64_t> parents;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    state.refined[order[i].second] = 1;
+    const double* r = &records[i * record];
+    if (r[0] != 1) {
+      ++report.failed;
+      continue;
+    }
+    VoxelGrid c(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution);
+    for (int v = 0; v < voxels; ++v) c.ids[v] = static_cast<int>(r[1 + v]);
+    cells.push_back(std::move(c));
+    parents.push_back(order[i].second);
+  }
+  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous);
+  report.tried = static_cast<int>(order.size());
+  report.added = added.added;
+  report.duplicates = added.duplicates;
+  report.outside = added.outside;
+  report.failed += added.failed;
+  return report;
+}
+
+GamutLevelSet GamutSampler::level_set(const SamplerState& state) const {
+  std::vector<VecX> points;
+  points.reserve(state.set.items.size());
+  for (const Microstructure& m : state.set.items) points.push_back(m.unit);
+  return GamutLevelSet::from_points(points, o_.level_set);
+}
+
+void GamutSampler::resample(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
+  const std::size_t n = state.set.items.size();
+  std::vector<VecX> units;
+  for (const Microstructure& m : state.set.items) units.push_back(m.unit);
+  std::vector<double> weights(n);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < static_cast<std::int64_t>(n); ++i) {
+    const double D = sample_density(units[i], units, o_.density_radius);
+    weights[i] = particle_score(gamut.value(units[i]), D, o_.boundary_depth);
+  }
+  double total = 0;
+  for (double w : weights) total += w;
+  if (!(total > 0)) std::fill(weights.begin(), weights.end(), 1.0);  // nothing near the boundary: uniform
+  const double u0 = double(stream(seed_, cycle, 0, 3) >> 11) * 0x1.0p-53;
+  const std::vector<int> picks = systematic_resample(weights, o_.population, u0);
+  state.population.assign(picks.begin(), picks.end());
+}
+
+}  // namespace msfab

@@ -1,0 +1,60 @@
+#pragma once
+// The gamut sampler's steps (thesis §3.2), over a state that every MPI rank
+// holds identically: the structures found so far, the particle population
+// and the per-cycle history.
+#include <cstdint>
+#include <vector>
+
+#include "gamut/gamut_artifact.hpp"
+#include "gamut/material_space.hpp"
+#include "gamut/microstructure_set.hpp"
+#include "sampler_options.hpp"
+
+namespace msfab {
+
+struct SamplerState {
+  MicrostructureSet set;
+  std::vector<std::int64_t> population;  // indices into set.items
+  std::vector<std::uint8_t> refined;     // per structure: already a continuous start
+  std::vector<GamutCycle> history;
+  int cycles_done = -1;                  // -1: not initialized; 0: initial population only
+};
+
+struct StepReport {
+  int tried = 0, added = 0;
+  int duplicates = 0, outside = 0, failed = 0;  // rejected: already in the set, outside the space's box, no result
+};
+
+class GamutSampler {
+ public:
+  GamutSampler(const SamplerOptions& options, std::uint64_t seed);
+
+  // Cycle 0: the solid cell and `population` structures cut from it by
+  // random beams, homogenized; the population resampled from them.
+  SamplerState initialize(StepReport* report) const;
+  // §3.2.1: every particle evolved by random beams; new structures added.
+  StepReport discrete_step(SamplerState& state, int cycle) const;
+  // §3.2.2: up to continuous_per_cycle unrefined structures nearest the
+  // boundary pushed along the level set's normal by MMA.
+  StepReport continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const;
+  // §3.2.3 on the current structures.
+  GamutLevelSet level_set(const SamplerState& state) const;
+  // Eq. 3.1-3.2 scores of every structure, then systematic resampling.
+  void resample(SamplerState& state, const GamutLevelSet& gamut, int cycle) const;
+
+  const MaterialSpace& space() const { return space_; }
+
+ private:
+  SamplerOptions o_;
+  std::uint64_t seed_;
+  MaterialSpace space_;
+  std::vector<MaterialPtr> palette_;  // [0] void, [1] stiff, [2] soft (if any)
+  int voxels_per_side_z() const;
+  VoxelGrid cell_of(const Microstructure& m) const;
+  // Homogenizes `cells` across ranks; appends the new, valid, unique ones.
+  StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
+                            const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const;
+  bool fill_properties(Microstructure& m, const Mat6& C, double rho) const;
+};
+
+}  // namespace msfab

@@ -1,0 +1,115 @@
+#include "sampler_options.hpp"
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+const char* const kDefaultSamplerConfig = R"(# A small 2D cubic gamut: two materials 100x apart (docs/gamut.md).
+space: cubic2d            # cubic3d | cubic2d | orthotropic2d
+resolution: 16            # voxels per cell side (2D cells are n x n x 1)
+materials:
+  stiff: {E: 1.0e6, nu: 0.3}
+  soft:  {E: 1.0e4, nu: 0.45}   # leave out for stiff material and void
+population: 24
+cycles: 6
+initial_beams: 8
+beams: {max: 3, min_radius: 0.5, max_radius: 2.0}
+continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3}
+level_set: {cells: 16, margin: 0.1, smoothing_steps: 2}
+density_radius: 0.1
+boundary_depth: 0.1
+decades: 4
+void_stiffness: 1.0e-6
+plot_every_cycle: true
+)";
+
+namespace {
+BaseMaterial read_base(const Config& m) {
+  BaseMaterial b;
+  b.E = m.require_positive<double>("E", "Young's modulus");
+  b.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
+  m.check_no_unknown_keys();
+  return b;
+}
+}  // namespace
+
+SamplerOptions read_sampler_options(const Config& config) {
+  SamplerOptions o;
+  if (config.has("space")) o.space = config.one_of("space", {"cubic3d", "cubic2d", "orthotropic2d"});
+  o.kind = MaterialSpace::parse_kind(o.space);
+  o.resolution = config.get_or<int>("resolution", o.resolution);
+  if (o.resolution < 4 || o.resolution > 128) config.fail("resolution", "must be in 4..128");
+  const Config mats = config.child("materials");
+  o.stiff = read_base(mats.child("stiff"));
+  o.soft_is_void = !mats.has("soft");
+  if (!o.soft_is_void) {
+    o.soft = read_base(mats.child("soft"));
+    if (!(o.soft.E < o.stiff.E)) mats.fail("soft", "E must be below the stiff material's");
+  }
+  mats.check_no_unknown_keys();
+  o.decades = config.get_or<double>("decades", o.decades);
+  if (!(o.decades > 0 && o.decades <= 12)) config.fail("decades", "must be in (0, 12]");
+  o.void_stiffness = config.get_or<double>("void_stiffness", o.void_stiffness);
+  if (!(o.void_stiffness > 0 && o.void_stiffness < 1e-2)) config.fail("void_stiffness", "must be in (0, 0.01)");
+
+  o.population = config.get_or<int>("population", o.population);
+  if (o.population < 2) config.fail("population", "must be >= 2");
+  o.cycles = config.get_or<int>("cycles", o.cycles);
+  if (o.cycles < 0) config.fail("cycles", "must be >= 0");
+  o.initial_beams = config.get_or<int>("initial_beams", o.initial_beams);
+  if (o.initial_beams < 1) config.fail("initial_beams", "must be >= 1");
+  if (config.has("beams")) {
+    const Config b = config.child("beams");
+    o.move.max_beams = b.get_or<int>("max", o.move.max_beams);
+    if (o.move.max_beams < 1) b.fail("max", "must be >= 1");
+    o.move.min_radius = b.get_or<double>("min_radius", o.move.min_radius);
+    o.move.max_radius = b.get_or<double>("max_radius", o.move.max_radius);
+    if (!(o.move.min_radius > 0) || !(o.move.max_radius >= o.move.min_radius))
+      b.fail("max_radius", "need 0 < min_radius <= max_radius");
+    b.check_no_unknown_keys();
+  }
+  o.move.materials = 1;
+  o.move.cut_id = o.soft_is_void ? 0 : 2;
+  o.move.symmetry = o.kind == MaterialSpaceKind::orthotropic2d ? CellSymmetry::orthotropic : CellSymmetry::cubic;
+
+  if (config.has("continuous")) {
+    const Config c = config.child("continuous");
+    o.continuous_per_cycle = c.get_or<int>("per_cycle", o.continuous_per_cycle);
+    if (o.continuous_per_cycle < 0) c.fail("per_cycle", "must be >= 0");
+    o.continuous_step = c.get_or<double>("step", o.continuous_step);
+    if (!(o.continuous_step > 0 && o.continuous_step <= 1)) c.fail("step", "must be in (0, 1]");
+    ContinuousOptions& k = o.continuous;
+    k.max_iterations = c.get_or<int>("max_iterations", k.max_iterations);
+    if (k.max_iterations < 1) c.fail("max_iterations", "must be >= 1");
+    k.penalty = c.get_or<double>("penalty", k.penalty);
+    if (!(k.penalty >= 1)) c.fail("penalty", "must be >= 1");
+    k.filter_radius = c.get_or<double>("filter_radius", k.filter_radius);
+    if (!(k.filter_radius >= 0)) c.fail("filter_radius", "must be >= 0");
+    k.density_weight = c.get_or<double>("density_weight", k.density_weight);
+    if (!(k.density_weight >= 0)) c.fail("density_weight", "must be >= 0");
+    k.start_offset = c.get_or<double>("start_offset", k.start_offset);
+    if (!(k.start_offset >= 0 && k.start_offset < 0.5)) c.fail("start_offset", "must be in [0, 0.5)");
+    c.check_no_unknown_keys();
+  }
+  o.continuous.void_stiffness = o.void_stiffness;
+  o.continuous.symmetry = o.move.symmetry;
+
+  if (config.has("level_set")) {
+    const Config l = config.child("level_set");
+    o.level_set.cells = l.get_or<int>("cells", o.level_set.cells);
+    if (o.level_set.cells < 4 || o.level_set.cells > 64) l.fail("cells", "must be in 4..64");
+    o.level_set.margin = l.get_or<double>("margin", o.level_set.margin);
+    if (!(o.level_set.margin >= 0 && o.level_set.margin <= 0.5)) l.fail("margin", "must be in [0, 0.5]");
+    o.level_set.smoothing_steps = l.get_or<int>("smoothing_steps", o.level_set.smoothing_steps);
+    if (o.level_set.smoothing_steps < 0) l.fail("smoothing_steps", "must be >= 0");
+    l.check_no_unknown_keys();
+  }
+  o.density_radius = config.get_or<double>("density_radius", o.density_radius);
+  if (!(o.density_radius > 0 && o.density_radius <= 1)) config.fail("density_radius", "must be in (0, 1]");
+  o.boundary_depth = config.get_or<double>("boundary_depth", o.boundary_depth);
+  if (!(o.boundary_depth > 0 && o.boundary_depth <= 1)) config.fail("boundary_depth", "must be in (0, 1]");
+  o.plot_every_cycle = config.get_or<bool>("plot_every_cycle", o.plot_every_cycle);
+  return o;
+}
+
+}  // namespace msfab

@@ -1,0 +1,46 @@
+#pragma once
+// The gamut sampler's configuration (docs/gamut.md lists every key).
+#include <cstdint>
+#include <string>
+
+#include "gamut/continuous_refinement.hpp"
+#include "gamut/level_set.hpp"
+#include "gamut/material_space.hpp"
+#include "gamut/microstructure_set.hpp"
+#include "gamut/structure_evolution.hpp"
+#include "io/config.hpp"
+
+namespace msfab {
+
+struct SamplerOptions {
+  std::string space = "cubic2d";
+  MaterialSpaceKind kind = MaterialSpaceKind::cubic2d;
+  int resolution = 16;           // voxels per side; a 2D space uses n x n x 1
+  BaseMaterial stiff{1e6, 0.3}, soft{1e4, 0.45};
+  bool soft_is_void = false;
+  double decades = 4;            // log range of the moduli below the stiff E
+  double void_stiffness = 1e-6;
+
+  int population = 24;           // particles
+  int cycles = 6;                // discrete + continuous cycles after the initial population
+  int initial_beams = 8;         // beams cut from the solid cell for the initial population
+  BeamMoveOptions move;          // the discrete step's move
+
+  int continuous_per_cycle = 4;  // boundary structures refined per cycle (0: discrete only)
+  double continuous_step = 0.1;  // |q - p| in the unit cube
+  ContinuousOptions continuous;
+
+  LevelSetOptions level_set{16, 0.1, 0.0, 2};
+  double density_radius = 0.1;   // h of Eq. 3.2 (a tenth of the lattice's extent)
+  double boundary_depth = 0.1;   // depth of the boundary weight in Eq. 3.1
+
+  bool plot_every_cycle = true;
+};
+
+// InputError naming the key on anything out of range.
+SamplerOptions read_sampler_options(const Config& config);
+
+// The built-in defaults: a small 2D cubic gamut of a stiff and a soft material.
+extern const char* const kDefaultSamplerConfig;
+
+}  // namespace msfab

@@ -1,0 +1,52 @@
+#!/bin/bash
+# msfab-gamut-sample on a tiny 2D gamut: artifacts and plots are written;
+# the result is identical for 1 and 3 MPI ranks, for 1 and 2 threads, and
+# after a stop and --resume; bad settings exit 2 naming the key.
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+SAMPLE="$BIN/msfab-gamut-sample"
+TINY="$SRC/configs/gamut/tiny2d.yaml"
+same_run() {  # same_run STEM_A STEM_B
+  local d
+  for d in /voxels /properties /unit_properties /C /cycle /step /parent; do
+    h5diff -q "$1.microstructures.h5" "$2.microstructures.h5" "$d" "$d" || { echo "differs: $d"; return 1; }
+  done
+  for d in /level_set/phi /history/coverage /history/samples; do
+    h5diff -q "$1.gamut.h5" "$2.gamut.h5" "$d" "$d" || { echo "differs: $d"; return 1; }
+  done
+}
+
+expect_exit 0 "after 3 cycles" -- "$SAMPLE" --config "$TINY" --seed 7 --out "$WORK/one.gamut.h5"
+check "gamut schema" -- bash -c "h5dump -a /schema '$WORK/one.gamut.h5' | grep -q msfab.gamut"
+check "microstructures schema" -- bash -c "h5dump -a /schema '$WORK/one.microstructures.h5' | grep -q msfab.microstructures"
+check "level set is 4-D, 12 cells per axis" -- bash -c "h5dump -H -d /level_set/phi '$WORK/one.gamut.h5' | grep -q '( 12, 12, 12, 12 )'"
+check "voxels packed at two bits per voxel (3 ids): 16 bytes per 8 x 8 cell" -- bash -c "h5dump -H -d /voxels '$WORK/one.microstructures.h5' | grep -q ', 16 )'"
+check "history has cycles 0..3" -- bash -c "h5dump -d /history/cycle '$WORK/one.gamut.h5' | grep -q '0, 1, 2, 3'"
+check "plots written" -- bash -c "for f in gamut coverage cycle_00 cycle_03; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
+check "history.csv written" -- bash -c "[ \$(wc -l < '$WORK/one.plots/history.csv') = 5 ]"
+check "no checkpoint left" -- test ! -e "$WORK/one.gamut.h5.checkpoint.h5"
+
+check "three ranks" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$SAMPLE" --config "$TINY" --seed 7 \
+  --out "$WORK/three.gamut.h5" --quiet
+check "1 and 3 ranks give the same gamut and structures" -- same_run "$WORK/one" "$WORK/three"
+check "one thread" -- "$SAMPLE" --config "$TINY" --seed 7 --threads 1 --out "$WORK/t1.gamut.h5" --quiet
+check "1 and 2 threads give the same gamut and structures" -- same_run "$WORK/one" "$WORK/t1"
+check "another seed" -- "$SAMPLE" --config "$TINY" --seed 8 --out "$WORK/s8.gamut.h5" --quiet
+check "another seed gives other structures" -- bash -c "[ \"\$(h5dump -d /voxels '$WORK/one.microstructures.h5' | md5sum)\" != \"\$(h5dump -d /voxels '$WORK/s8.microstructures.h5' | md5sum)\" ]"
+
+# Stop after one cycle (a batch job's time limit), then resume.
+expect_exit 0 "stopped after cycle 1 of 3" -- "$SAMPLE" --config "$TINY" --seed 7 --out "$WORK/part.gamut.h5" --max-cycles 1
+check "checkpoint kept" -- test -e "$WORK/part.gamut.h5.checkpoint.h5"
+check "no artifact before the end" -- test ! -e "$WORK/part.gamut.h5"
+expect_exit 2 "different configuration or seed" -- "$SAMPLE" --config "$TINY" --seed 9 --out "$WORK/part.gamut.h5" --resume
+expect_exit 0 "resuming after cycle 1" -- "$SAMPLE" --config "$TINY" --seed 7 --out "$WORK/part.gamut.h5" --resume
+check "resumed run gives the same gamut and structures" -- same_run "$WORK/one" "$WORK/part"
+
+# Bad settings.
+expect_exit 2 "population.*must be >= 2" -- "$SAMPLE" --config "$TINY" --set population=1 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "space" -- "$SAMPLE" --config "$TINY" --set space=cubic4d --out "$WORK/bad.gamut.h5"
+expect_exit 2 "materials.soft.*E must be below" -- "$SAMPLE" --config "$TINY" --set materials.soft.E=2e6 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "continuous.step" -- "$SAMPLE" --config "$TINY" --set continuous.step=0 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "unknown|not a known" -- "$SAMPLE" --config "$TINY" --set cylces=3 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "output folder does not exist" -- "$SAMPLE" --config "$TINY" --out "$WORK/missing/x.gamut.h5"
+finish
