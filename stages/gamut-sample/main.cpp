@@ -22,6 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -158,7 +159,10 @@ int main(int argc, char** argv) {
       ++this_run;
     }
 
-    // 4. Artifacts and plots.
+    // 4. Artifacts and plots (void variants, a collective step, first).
+    StepReport void_report;
+    SamplerState voids;
+    if (options.void_variants) voids = sampler.void_variants(state, &void_report);
     if (rank == 0) {
       Gamut g;
       g.space = options.space;
@@ -172,6 +176,22 @@ int main(int argc, char** argv) {
       plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
                             options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
       plot_coverage(plots_dir + "/coverage.png", state.history);
+      if (options.void_variants) {
+        log_step("void variants", void_report);
+        if (voids.set.items.empty()) throw NumericalError("void variants: no structure survives removing the soft material");
+        Gamut vg = g;
+        vg.level_set = sampler.level_set(voids);
+        vg.history.clear();
+        const std::string vstem = stem_of(out) + ".void";
+        write_microstructures_artifact(vstem + ".microstructures.h5", voids.set, "msfab-gamut-sample", run_text,
+                                       {structures_path}, ctx.options.seed);
+        write_gamut_artifact(vstem + ".gamut.h5", vg, "msfab-gamut-sample", run_text,
+                             {vstem + ".microstructures.h5"}, ctx.options.seed);
+        plot_gamut_projection(plots_dir + "/void_variants.png", voids.set, vg.level_set, sampler.space(),
+                              "VOID VARIANTS, " + std::to_string(voids.set.items.size()) + " STRUCTURES");
+        std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",
+                    voids.set.items.size(), state.set.items.size(), vstem.c_str());
+      }
       write_history_csv(plots_dir + "/history.csv", state.history);
       std::filesystem::remove(ckpt);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
@@ -180,6 +200,12 @@ int main(int argc, char** argv) {
       std::printf("msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous) after %d cycles\n",
                   options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], options.cycles);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
+      const std::vector<std::string> names = sampler.space().names();
+      for (std::size_t a = 0; a < names.size(); ++a) {
+        double lo = HUGE_VAL, hi = -HUGE_VAL;
+        for (const Microstructure& m : state.set.items) lo = std::min(lo, m.properties[a]), hi = std::max(hi, m.properties[a]);
+        std::printf("  range %s: [%.6g, %.6g]\n", names[a].c_str(), lo, hi);
+      }
       std::printf("  time: %.1f s wall\n", wall);
       std::printf("  artifacts: %s, %s\n  plots: %s\n", out.c_str(), structures_path.c_str(), plots_dir.c_str());
     }

@@ -9,6 +9,7 @@
 #include "gamut/continuous_refinement.hpp"
 #include "gamut/particle_scoring.hpp"
 #include "gamut/structure_evolution.hpp"
+#include "gamut/structure_ops.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 
@@ -44,6 +45,7 @@ GamutSampler::GamutSampler(const SamplerOptions& options, std::uint64_t seed)
     : o_(options), seed_(seed), space_(options.kind, options.stiff.E, options.decades) {
   palette_ = {nullptr, std::make_shared<LinearIsotropic>(o_.stiff.E, o_.stiff.nu)};
   if (!o_.soft_is_void) palette_.push_back(std::make_shared<LinearIsotropic>(o_.soft.E, o_.soft.nu));
+  void_palette_ = {nullptr, palette_[1]};
 }
 
 int GamutSampler::voxels_per_side_z() const { return o_.kind == MaterialSpaceKind::cubic3d ? o_.resolution : 1; }
@@ -72,13 +74,19 @@ bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho)
 
 StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
                                         const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const {
+  return add_structures(state, cells, parents, cycle, step, palette_);
+}
+
+StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
+                                        const std::vector<std::int64_t>& parents, int cycle, SampleStep step,
+                                        const std::vector<MaterialPtr>& palette) const {
   StepReport report;
   report.tried = static_cast<int>(cells.size());
   HomogenizationOptions ho;
   ho.void_stiffness = o_.void_stiffness;
   const std::vector<double> records = fan_out(report.tried, kHeader, [&](int i, double* r) {
     if (cells[i].count_solid() == 0) return;
-    const HomogenizationResult h = homogenize(cells[i], palette_, ho);
+    const HomogenizationResult h = homogenize(cells[i], palette, ho);
     r[0] = 1;
     r[1] = h.volume_fraction.size() > 1 ? h.volume_fraction[1] : 0.0;
     for (int k = 0; k < 36; ++k) r[2 + k] = h.C(k / 6, k % 6);
@@ -144,6 +152,18 @@ SamplerState GamutSampler::initialize(StepReport* report) const {
 StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
   std::vector<VoxelGrid> cells;
   std::vector<std::int64_t> parents;
+  if (o_.random_baseline) {
+    const VoxelGrid solid(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution, 1);
+    BeamMoveOptions first = o_.move;
+    first.max_beams = o_.initial_beams;
+    // The sampler's budget: one homogenization per particle and up to
+    // max_iterations per continuous refinement.
+    const int budget = o_.population + o_.continuous_per_cycle * o_.continuous.max_iterations;
+    for (int i = 0; i < budget; ++i)
+      cells.push_back(evolve_structure(solid, stream(seed_, cycle, i, 1), first));
+    parents.assign(cells.size(), -1);
+    return add_structures(state, cells, parents, cycle, SampleStep::discrete);
+  }
   for (std::size_t i = 0; i < state.population.size(); ++i) {
     const std::int64_t p = state.population[i];
     cells.push_back(evolve_structure(cell_of(state.set.items[p]), stream(seed_, cycle, static_cast<std::int64_t>(i), 2), o_.move));
@@ -154,7 +174,7 @@ StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
 
 StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
   StepReport report;
-  if (o_.continuous_per_cycle == 0) return report;
+  if (o_.continuous_per_cycle == 0 || o_.random_baseline) return report;
   // The unrefined structures nearest the boundary (ties: the older first).
   std::vector<std::pair<double, std::int64_t>> order;
   for (std::size_t i = 0; i < state.set.items.size(); ++i)
@@ -202,6 +222,27 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   report.outside = added.outside;
   report.failed += added.failed;
   return report;
+}
+
+SamplerState GamutSampler::void_variants(const SamplerState& state, StepReport* report) const {
+  SamplerState out;
+  out.set = state.set;
+  out.set.items.clear();
+  out.set.soft_is_void = true;
+  out.set.soft = BaseMaterial{};
+  out.cycles_done = state.cycles_done;
+  std::vector<VoxelGrid> cells;
+  std::vector<std::int64_t> parents;
+  for (std::size_t i = 0; i < state.set.items.size(); ++i) {
+    VoxelGrid c = cell_of(state.set.items[i]);
+    for (int& id : c.ids)
+      if (id == 2) id = 0;
+    clean_structure(c);
+    cells.push_back(std::move(c));
+    parents.push_back(static_cast<std::int64_t>(i));
+  }
+  *report = add_structures(out, cells, parents, state.cycles_done, SampleStep::void_variant, void_palette_);
+  return out;
 }
 
 GamutLevelSet GamutSampler::level_set(const SamplerState& state) const {

@@ -37,6 +37,10 @@ class GamutSampler {
   // §3.2.2: up to continuous_per_cycle unrefined structures nearest the
   // boundary pushed along the level set's normal by MMA.
   StepReport continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const;
+  // §3.6.1: every structure with its soft material replaced by void,
+  // cleaned (floating pieces dropped, 3D cavities filled) and homogenized
+  // again; structures left empty, outside the space or repeated are dropped.
+  SamplerState void_variants(const SamplerState& state, StepReport* report) const;
   // §3.2.3 on the current structures.
   GamutLevelSet level_set(const SamplerState& state) const;
   // Eq. 3.1-3.2 scores of every structure, then systematic resampling.
@@ -49,11 +53,15 @@ class GamutSampler {
   std::uint64_t seed_;
   MaterialSpace space_;
   std::vector<MaterialPtr> palette_;  // [0] void, [1] stiff, [2] soft (if any)
+  std::vector<MaterialPtr> void_palette_;  // [0] void, [1] stiff
   int voxels_per_side_z() const;
   VoxelGrid cell_of(const Microstructure& m) const;
   // Homogenizes `cells` across ranks; appends the new, valid, unique ones.
   StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
                             const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const;
+  StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
+                            const std::vector<std::int64_t>& parents, int cycle, SampleStep step,
+                            const std::vector<MaterialPtr>& palette) const;
   bool fill_properties(Microstructure& m, const Mat6& C, double rho) const;
 };
 

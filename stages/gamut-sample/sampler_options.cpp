@@ -21,6 +21,8 @@ boundary_depth: 0.1
 decades: 4
 void_stiffness: 1.0e-6
 plot_every_cycle: true
+mode: sampler             # sampler | random (the benchmark's baseline)
+void_variants: false      # also write the structures with the soft material removed (thesis 3.6.1)
 )";
 
 namespace {
@@ -109,6 +111,9 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.boundary_depth = config.get_or<double>("boundary_depth", o.boundary_depth);
   if (!(o.boundary_depth > 0 && o.boundary_depth <= 1)) config.fail("boundary_depth", "must be in (0, 1]");
   o.plot_every_cycle = config.get_or<bool>("plot_every_cycle", o.plot_every_cycle);
+  o.void_variants = config.get_or<bool>("void_variants", o.void_variants);
+  if (o.void_variants && o.soft_is_void) config.fail("void_variants", "needs a soft material to remove (materials.soft)");
+  if (config.has("mode")) o.random_baseline = config.one_of("mode", {"sampler", "random"}) == "random";
   return o;
 }
 

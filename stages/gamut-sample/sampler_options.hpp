@@ -35,6 +35,14 @@ struct SamplerOptions {
   double boundary_depth = 0.1;   // depth of the boundary weight in Eq. 3.1
 
   bool plot_every_cycle = true;
+  // §3.6.1: after sampling, the soft material of every structure replaced
+  // by void, cleaned and homogenized again (a second pair of artifacts).
+  bool void_variants = false;
+  // The baseline of the benchmark: every cycle draws population +
+  // continuous_per_cycle * max_iterations fresh random-beam structures from
+  // the solid cell (the initial distribution): at least the sampler's
+  // number of homogenizations, no evolution, scoring or continuous step.
+  bool random_baseline = false;
 };
 
 // InputError naming the key on anything out of range.

@@ -42,6 +42,19 @@ expect_exit 2 "different configuration or seed" -- "$SAMPLE" --config "$TINY" --
 expect_exit 0 "resuming after cycle 1" -- "$SAMPLE" --config "$TINY" --seed 7 --out "$WORK/part.gamut.h5" --resume
 check "resumed run gives the same gamut and structures" -- same_run "$WORK/one" "$WORK/part"
 
+# Void variants (thesis 3.6.1): the soft material removed, on 1 and 3 ranks.
+expect_exit 0 "void variants: [0-9]+ of [0-9]+ structures" -- "$SAMPLE" --config "$TINY" --seed 7 --set void_variants=true \
+  --out "$WORK/v.gamut.h5"
+check "void variants are marked step 3 and one material" -- bash -c "h5dump -d /step '$WORK/v.void.microstructures.h5' | grep -A1 'DATA {' | grep -vq '[0-24-9],' && \
+  h5dump -a /soft_is_void '$WORK/v.void.microstructures.h5' | grep -q '(0): 1'"
+check "void variants keep no soft voxels (one bit per voxel)" -- bash -c "h5dump -H -d /voxels '$WORK/v.void.microstructures.h5' | grep -q ', 8 )'"
+check "three ranks with void variants" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$SAMPLE" --config "$TINY" --seed 7 \
+  --set void_variants=true --out "$WORK/v3.gamut.h5" --quiet
+check "void variants: 1 and 3 ranks agree" -- bash -c "h5diff -q '$WORK/v.void.microstructures.h5' '$WORK/v3.void.microstructures.h5' /properties /properties && \
+  h5diff -q '$WORK/v.void.gamut.h5' '$WORK/v3.void.gamut.h5' /level_set/phi /level_set/phi"
+expect_exit 2 "void_variants.*needs a soft material" -- "$SAMPLE" --config "$TINY" --set void_variants=true \
+  --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' --out "$WORK/bad.gamut.h5"
+
 # Bad settings.
 expect_exit 2 "population.*must be >= 2" -- "$SAMPLE" --config "$TINY" --set population=1 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "space" -- "$SAMPLE" --config "$TINY" --set space=cubic4d --out "$WORK/bad.gamut.h5"

@@ -1,0 +1,24 @@
+# Microstructure gamuts (thesis §3.2): sampling runs and the coverage benchmark.
+#
+#   make -f Makefile.pipeline gamut-2d       2D cubic gamut, stiff + soft (configs/gamut/cubic2d.yaml), a minute
+#   make -f Makefile.pipeline gamut-ortho    2D orthotropic gamut, minutes
+#   make -f Makefile.pipeline gamut-3d       3D cubic gamut, one material + void, 16^3 cells; hours on 2 cores, use RANKS
+#   make -f Makefile.pipeline gamut-bench    sampler vs random sampling, docs/BENCHMARKS.md section
+#
+# Each run writes out/gamut/<name>.gamut.h5, <name>.microstructures.h5 and
+# <name>.plots/ (per-cycle PNGs, coverage.png, history.csv). RANKS=<n> runs
+# on n MPI ranks; an interrupted run resumes from its checkpoint when the
+# target is made again. SEED=<n> picks the random streams.
+SEED ?= 1
+
+$(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume
+
+.PHONY: gamut-2d gamut-ortho gamut-3d gamut-bench
+gamut-2d: build $(OUT)/gamut/cubic2d.gamut.h5
+gamut-ortho: build $(OUT)/gamut/orthotropic2d.gamut.h5
+gamut-3d: build $(OUT)/gamut/cubic3d_void.gamut.h5
+
+gamut-bench: build
+	bash tools/bench_gamut.sh $(BIN) $(OUT)/bench/gamut docs/BENCHMARKS.md
