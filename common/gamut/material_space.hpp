@@ -29,6 +29,7 @@ class MaterialSpace {
   static MaterialSpaceKind parse_kind(const std::string& name);
 
   MaterialSpaceKind kind() const { return kind_; }
+  double E_stiff() const { return E_stiff_; }  // the modulus that normalizes to 1
   int dimension() const;
   std::vector<std::string> names() const;
 

@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
       Gamut g;
       g.space = options.space;
       g.property_names = sampler.space().names();
-      g.E_stiff = options.stiff.E;
+      g.E_stiff = sampler.space().E_stiff();
       g.decades = options.decades;
       g.level_set = sampler.level_set(state);
       g.history = state.history;

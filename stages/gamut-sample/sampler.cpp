@@ -41,8 +41,15 @@ constexpr int kHeader = 2 + 36;  // ok, rho, C
 
 }  // namespace
 
+// The modulus that normalizes to 1: the stiff material's own, which in 2D
+// is its plane-strain modulus E / (1 - nu^2); the solid stiff cell then
+// sits on the top face of the unit cube instead of outside it.
+static double modulus_scale(const SamplerOptions& o) {
+  return o.kind == MaterialSpaceKind::cubic3d ? o.stiff.E : o.stiff.E / (1 - o.stiff.nu * o.stiff.nu);
+}
+
 GamutSampler::GamutSampler(const SamplerOptions& options, std::uint64_t seed)
-    : o_(options), seed_(seed), space_(options.kind, options.stiff.E, options.decades) {
+    : o_(options), seed_(seed), space_(options.kind, modulus_scale(options), options.decades) {
   palette_ = {nullptr, std::make_shared<LinearIsotropic>(o_.stiff.E, o_.stiff.nu)};
   if (!o_.soft_is_void) palette_.push_back(std::make_shared<LinearIsotropic>(o_.soft.E, o_.soft.nu));
   void_palette_ = {nullptr, palette_[1]};
@@ -67,8 +74,10 @@ bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho)
     m.properties = space_.properties_2d(C2, rho);
   }
   m.unit = space_.normalize(m.properties);
-  for (int a = 0; a < m.unit.size(); ++a)
-    if (!(m.unit[a] >= 0 && m.unit[a] <= 1)) return false;
+  for (int a = 0; a < m.unit.size(); ++a) {
+    if (!(m.unit[a] >= -1e-9 && m.unit[a] <= 1 + 1e-9)) return false;
+    m.unit[a] = std::clamp(m.unit[a], 0.0, 1.0);  // round-off at the box's faces (the solid cell)
+  }
   return true;
 }
 
@@ -128,7 +137,7 @@ SamplerState GamutSampler::initialize(StepReport* report) const {
   MicrostructureSet& set = state.set;
   set.space = o_.space;
   set.property_names = space_.names();
-  set.E_stiff = o_.stiff.E;
+  set.E_stiff = modulus_scale(o_);
   set.decades = o_.decades;
   set.nx = set.ny = o_.resolution;
   set.nz = voxels_per_side_z();
