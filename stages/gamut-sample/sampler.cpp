@@ -57,6 +57,19 @@ GamutSampler::GamutSampler(const SamplerOptions& options, std::uint64_t seed)
 
 int GamutSampler::voxels_per_side_z() const { return o_.kind == MaterialSpaceKind::cubic3d ? o_.resolution : 1; }
 
+VoxelGrid GamutSampler::solid_cell() const {
+  return VoxelGrid(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution, 1);
+}
+
+std::vector<VoxelGrid> GamutSampler::random_cuts(int cycle, int count) const {
+  const VoxelGrid solid = solid_cell();
+  BeamMoveOptions move = o_.move;
+  move.max_beams = o_.initial_beams;
+  std::vector<VoxelGrid> cells;
+  for (int i = 0; i < count; ++i) cells.push_back(evolve_structure(solid, stream(seed_, cycle, i, 1), move));
+  return cells;
+}
+
 VoxelGrid GamutSampler::cell_of(const Microstructure& m) const {
   VoxelGrid c(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution);
   c.ids = m.ids;
@@ -79,11 +92,6 @@ bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho)
     m.unit[a] = std::clamp(m.unit[a], 0.0, 1.0);  // round-off at the box's faces (the solid cell)
   }
   return true;
-}
-
-StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
-                                        const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const {
-  return add_structures(state, cells, parents, cycle, step, palette_);
 }
 
 StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
@@ -145,12 +153,9 @@ SamplerState GamutSampler::initialize(StepReport* report) const {
   set.soft = o_.soft;
   set.soft_is_void = o_.soft_is_void;
 
-  const VoxelGrid solid(set.nx, set.ny, set.nz, 1.0 / o_.resolution, 1);
-  BeamMoveOptions first = o_.move;
-  first.max_beams = o_.initial_beams;
-  std::vector<VoxelGrid> cells = {solid};
-  for (int i = 0; i < o_.population; ++i) cells.push_back(evolve_structure(solid, stream(seed_, 0, i, 1), first));
-  *report = add_structures(state, cells, std::vector<std::int64_t>(cells.size(), -1), 0, SampleStep::initial);
+  std::vector<VoxelGrid> cells = {solid_cell()};
+  for (VoxelGrid& c : random_cuts(0, o_.population)) cells.push_back(std::move(c));
+  *report = add_structures(state, cells, std::vector<std::int64_t>(cells.size(), -1), 0, SampleStep::initial, palette_);
   if (state.set.items.empty())
     throw NumericalError("gamut sampler: no initial structure lies inside the material space's box");
   state.cycles_done = 0;
@@ -162,23 +167,18 @@ StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
   std::vector<VoxelGrid> cells;
   std::vector<std::int64_t> parents;
   if (o_.random_baseline) {
-    const VoxelGrid solid(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution, 1);
-    BeamMoveOptions first = o_.move;
-    first.max_beams = o_.initial_beams;
     // The sampler's budget: one homogenization per particle and up to
     // max_iterations per continuous refinement.
-    const int budget = o_.population + o_.continuous_per_cycle * o_.continuous.max_iterations;
-    for (int i = 0; i < budget; ++i)
-      cells.push_back(evolve_structure(solid, stream(seed_, cycle, i, 1), first));
+    cells = random_cuts(cycle, o_.population + o_.continuous_per_cycle * o_.continuous.max_iterations);
     parents.assign(cells.size(), -1);
-    return add_structures(state, cells, parents, cycle, SampleStep::discrete);
+    return add_structures(state, cells, parents, cycle, SampleStep::discrete, palette_);
   }
   for (std::size_t i = 0; i < state.population.size(); ++i) {
     const std::int64_t p = state.population[i];
     cells.push_back(evolve_structure(cell_of(state.set.items[p]), stream(seed_, cycle, static_cast<std::int64_t>(i), 2), o_.move));
     parents.push_back(p);
   }
-  return add_structures(state, cells, parents, cycle, SampleStep::discrete);
+  return add_structures(state, cells, parents, cycle, SampleStep::discrete, palette_);
 }
 
 StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
@@ -224,7 +224,7 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
     cells.push_back(std::move(c));
     parents.push_back(order[i].second);
   }
-  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous);
+  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous, palette_);
   report.tried = static_cast<int>(order.size());
   report.added = added.added;
   report.duplicates = added.duplicates;

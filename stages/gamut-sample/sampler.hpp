@@ -56,9 +56,11 @@ class GamutSampler {
   std::vector<MaterialPtr> void_palette_;  // [0] void, [1] stiff
   int voxels_per_side_z() const;
   VoxelGrid cell_of(const Microstructure& m) const;
-  // Homogenizes `cells` across ranks; appends the new, valid, unique ones.
-  StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
-                            const std::vector<std::int64_t>& parents, int cycle, SampleStep step) const;
+  VoxelGrid solid_cell() const;
+  // `count` structures cut from the solid cell by up to initial_beams beams
+  // (the initial distribution, and the random baseline's draws).
+  std::vector<VoxelGrid> random_cuts(int cycle, int count) const;
+  // Homogenizes `cells` (ids into `palette`) across ranks; appends the new, valid, unique ones.
   StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
                             const std::vector<std::int64_t>& parents, int cycle, SampleStep step,
                             const std::vector<MaterialPtr>& palette) const;
