@@ -121,9 +121,12 @@ double ContinuousCellProblem::objective(const std::vector<double>& x, std::vecto
   const std::vector<double> xt = filtered(x);
   const double p = options_.penalty;
   const Mat24 dK = K_stiff_ - K_soft_;
-  const HomogenizationResult r = homogenize_elements(nx_, ny_, nz_, h_, [&](std::int64_t v) -> Mat24 {
-    return K_soft_ + std::pow(xt[v], p) * dK;
-  });
+  VoxelStiffnessField field;
+  field.nx = nx_, field.ny = ny_, field.nz = nz_, field.h = h_;
+  field.basis = {K_soft_, dK};
+  field.weights.resize(2 * xt.size());
+  for (std::size_t v = 0; v < xt.size(); ++v) field.weights[2 * v] = 1.0, field.weights[2 * v + 1] = std::pow(xt[v], p);
+  const HomogenizationResult r = homogenize_elements(field);
   const bool plane = nz_ == 1;
   const int m = plane ? 3 : 6;
   MatX C(m, m);

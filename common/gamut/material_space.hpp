@@ -37,6 +37,9 @@ class MaterialSpace {
   // block in 2D) and its stiff-material fraction.
   VecX properties(const Mat6& C, double rho) const;
   VecX properties_2d(const Mat3& C, double rho) const;
+  // Either of the above for the full 3D tensor of a homogenized cell: a 2D
+  // space reads the in-plane block (xx, yy, xy) of a plane-strain cell.
+  VecX cell_properties(const Mat6& C, double rho) const;
   // The tensor with given raw properties (the inverse of the above, used by
   // the topology optimizer): 6 x 6 cubic, or 3 x 3 plane strain.
   Mat6 tensor_3d(const VecX& raw) const;

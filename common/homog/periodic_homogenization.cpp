@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "fem/hex_element.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/periodic_grid_multigrid.hpp"
 
 namespace msfab {
 namespace {
@@ -61,19 +62,23 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   }
   if (fraction[0] >= 1.0) throw InputError("homogenization: the cell is all void");
 
-  // Element stiffness per palette id (at rest); void: a fraction of the stiffest.
+  // Element stiffness per palette id (at rest); void: a fraction of the
+  // stiffest. One basis matrix per id, weights one-hot.
   const hex8::NodeMatrix X = voxel_corners(cell.voxel_size);
   const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
-  std::vector<Mat24> Ke(palette.size(), Mat24::Zero());
+  VoxelStiffnessField field;
+  field.nx = nx, field.ny = ny, field.nz = nz, field.h = cell.voxel_size;
+  field.basis.assign(palette.size(), Mat24::Zero());
   int stiffest = -1;
   for (std::size_t id = 1; id < palette.size(); ++id) {
     if (!palette[id] || fraction[id] == 0) continue;
-    hex_evaluate(geo, QuadratureMaterials{{palette[id]}}, X, nullptr, &Ke[id]);
+    hex_evaluate(geo, QuadratureMaterials{{palette[id]}}, X, nullptr, &field.basis[id]);
     if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus()) stiffest = static_cast<int>(id);
   }
-  Ke[0] = options.void_stiffness * Ke[stiffest];
-  HomogenizationResult out = homogenize_elements(nx, ny, nz, cell.voxel_size,
-                                                 [&](std::int64_t v) -> Mat24 { return Ke[cell.ids[v]]; });
+  field.basis[0] = options.void_stiffness * field.basis[stiffest];
+  field.weights.assign(cell.size() * palette.size(), 0.0);
+  for (std::size_t v = 0; v < cell.size(); ++v) field.weights[v * palette.size() + cell.ids[v]] = 1.0;
+  HomogenizationResult out = homogenize_elements(field, options);
   out.volume_fraction = fraction;
   out.pieces = count_periodic_pieces(cell);
   return out;
@@ -103,19 +108,60 @@ Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationRes
   return U;
 }
 
-HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const ElementStiffness& element_stiffness) {
-  const auto t0 = std::chrono::steady_clock::now();
-  if (nx < 1 || ny < 1 || nz < 1 || !(h > 0)) throw InputError("homogenization: the cell has no voxels");
-  const std::int64_t cells = std::int64_t(nx) * ny * nz;
-  HomogenizationResult out;
-  // Element matrices are asked for when needed, never stored per voxel
-  // (64^3 voxels would take 1.2 GB).
+std::string homogenization_solver(int nx, int ny, int nz, const std::string& option) {
+  if (option == "direct") return option;
+  if (option == "multigrid") {
+    if (!PeriodicGridMultigrid::supports(nx, ny, nz))
+      throw InputError("homogenization: solver multigrid needs every cell dimension even and at least 4, got " +
+                       std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz));
+    return option;
+  }
+  if (option == "auto")
+    return PeriodicGridMultigrid::supports(nx, ny, nz) && std::int64_t(nx) * ny * nz >= kAutoMultigridVoxels
+               ? "multigrid"
+               : "direct";
+  throw InputError("homogenization: unknown solver '" + option + "' (choose auto, direct or multigrid)");
+}
 
-  // Periodic lattice: node (i, j, k) mod n; element (i, j, k) has node a at
-  // (i, j, k) + (a>>2&1, a>>1&1, a&1). Node 0 is pinned (translation).
-  const std::int64_t N = cells;
+namespace {
+
+// -K u^m gathered per node (3 rows per node, one column per unit strain):
+// each node sums the loads of its 8 elements, so the result does not depend
+// on the thread count.
+Eigen::MatrixXd strain_loads(const VoxelStiffnessField& field) {
+  const int nx = field.nx, ny = field.ny, nz = field.nz;
+  const hex8::NodeMatrix X = voxel_corners(field.h);
+  // Affine corner displacements of a voxel for each unit strain (the same
+  // for every voxel up to a rigid translation, which K_e ignores).
+  Eigen::Matrix<double, 24, 6> UA;
+  for (int m = 0; m < 6; ++m) {
+    Vec6 e = Vec6::Zero();
+    e[m] = 1;
+    const Mat3 eps = strain_tensor(e);
+    for (int a = 0; a < 8; ++a) UA.col(m).segment<3>(3 * a) = eps * X.row(a).transpose();
+  }
+  std::vector<Eigen::Matrix<double, 24, 6>> basis_loads(field.basis.size());
+  for (std::size_t b = 0; b < field.basis.size(); ++b) basis_loads[b] = -(field.basis[b] * UA);
+  const std::int64_t nodes = field.voxels();
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(3 * nodes, 6);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t p = 0; p < nodes; ++p) {
+    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny), k = static_cast<int>(p / (std::int64_t(nx) * ny));
+    for (int a = 0; a < 8; ++a) {  // p is corner a of element (i, j, k) - offset(a)
+      const std::int64_t e = wrap(i - (a >> 2 & 1), nx) + nx * (wrap(j - (a >> 1 & 1), ny) + std::int64_t(ny) * wrap(k - (a & 1), nz));
+      for (int b = 0; b < field.basis_size(); ++b)
+        if (const double w = field.weight(e, b); w != 0.0) B.middleRows<3>(3 * p) += w * basis_loads[b].middleRows<3>(3 * a);
+    }
+  }
+  return B;
+}
+
+// The direct solver: K assembled with node 0 pinned (it removes the
+// translations), factorized once, six solves.
+void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, HomogenizationResult& out) {
+  const int nx = field.nx, ny = field.ny, nz = field.nz;
+  const std::int64_t N = field.voxels();
   auto node = [&](int i, int j, int k) -> std::int64_t { return wrap(i, nx) + nx * (wrap(j, ny) + std::int64_t(ny) * wrap(k, nz)); };
-  auto element = [&](int i, int j, int k) -> std::int64_t { return node(i, j, k); };
   out.unknowns = 3 * N - 3;
   // Assemble node by node (each column gathers its 8 elements): deterministic for any thread count.
   std::vector<std::vector<Eigen::Triplet<double>>> per_node(N);
@@ -126,7 +172,7 @@ HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const
     if (p == 0) continue;
     for (int a = 0; a < 8; ++a) {  // p is node a of element e = (i, j, k) - offset(a)
       const int ei = i - (a >> 2 & 1), ej = j - (a >> 1 & 1), ek = k - (a & 1);
-      const Mat24 K = element_stiffness(element(ei, ej, ek));
+      const Mat24 K = field.element(node(ei, ej, ek));
       for (int b = 0; b < 8; ++b) {
         const std::int64_t q = node(ei + (b >> 2 & 1), ej + (b >> 1 & 1), ek + (b & 1));
         if (q == 0) continue;
@@ -141,17 +187,6 @@ HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const
   SpMat A(out.unknowns, out.unknowns);
   A.setFromTriplets(all.begin(), all.end());
   std::vector<Eigen::Triplet<double>>().swap(all);
-
-  // Affine corner displacements of a voxel for each unit strain (the same
-  // for every voxel up to a rigid translation, which K_e ignores).
-  const hex8::NodeMatrix X = voxel_corners(h);
-  std::array<Vec24, 6> ua;
-  for (int m = 0; m < 6; ++m) {
-    Vec6 e = Vec6::Zero();
-    e[m] = 1;
-    const Mat3 eps = strain_tensor(e);
-    for (int a = 0; a < 8; ++a) ua[m].segment<3>(3 * a) = eps * X.row(a).transpose();
-  }
   // One BLAS thread: a multithreaded supernodal factorization rounds
   // differently per thread count, and C^H must not depend on it.
   LinearSolverOptions solver_options;
@@ -159,30 +194,54 @@ HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const
   CholmodSolver solver(solver_options);
   solver.analyze(A);
   if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
-  Eigen::Matrix<double, 24, 6> UA;
-  for (int m = 0; m < 6; ++m) UA.col(m) = ua[m];
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(out.unknowns, 6);
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const Eigen::Matrix<double, 24, 6> F = -(element_stiffness(element(i, j, k)) * UA);
-        for (int a = 0; a < 8; ++a) {
-          const std::int64_t q = node(i + (a >> 2 & 1), j + (a >> 1 & 1), k + (a & 1));
-          if (q != 0) B.middleRows<3>(3 * q - 3) += F.middleRows<3>(3 * a);
-        }
-      }
   for (int m = 0; m < 6; ++m) {
-    const VecX x = solver.solve(B.col(m));
+    const VecX x = solver.solve(loads.col(m).tail(3 * N - 3));
     out.fluctuation[m] = VecX::Zero(3 * N);
     out.fluctuation[m].tail(3 * N - 3) = x;
   }
+}
+
+void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, const HomogenizationOptions& options,
+                     HomogenizationResult& out) {
+  PeriodicMultigridOptions mg;
+  mg.tolerance = options.multigrid_tolerance;
+  mg.threads = options.threads;
+  PeriodicGridMultigrid solver(field, mg);
+  out.unknowns = 3 * field.voxels();
+  for (int m = 0; m < 6; ++m) {
+    VecX x = solver.solve(loads.col(m));
+    // The same gauge as the direct solver: zero at node 0.
+    const Vec3 shift = x.head<3>();
+    for (std::int64_t p = 0; p < field.voxels(); ++p) x.segment<3>(3 * p) -= shift;
+    out.fluctuation[m] = std::move(x);
+    out.iterations += solver.stats().iterations;
+  }
+}
+
+}  // namespace
+
+HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const HomogenizationOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  validate_field(field, "homogenization");
+  if (!(options.multigrid_tolerance > 0) || options.multigrid_tolerance >= 1)
+    throw InputError("homogenization: multigrid_tolerance must lie in (0, 1)");
+  const int nx = field.nx, ny = field.ny, nz = field.nz;
+  const double h = field.h;
+  const std::int64_t cells = field.voxels();
+  HomogenizationResult out;
+  out.solver = homogenization_solver(nx, ny, nz, options.solver);
+  const Eigen::MatrixXd loads = strain_loads(field);
+  if (out.solver == "direct")
+    solve_direct(field, loads, out);
+  else
+    solve_multigrid(field, loads, options, out);
   // C^H from the element energies of the total fields, summed per element
   // first and then in element order (deterministic).
   std::vector<Mat6> contribution(cells);
 #pragma omp parallel for schedule(static)
   for (std::int64_t v = 0; v < cells; ++v) {
     const Eigen::Matrix<double, 24, 6> U = total_element_displacements(out, nx, ny, nz, h, v);
-    contribution[v] = U.transpose() * element_stiffness(v) * U;
+    contribution[v] = U.transpose() * field.element(v) * U;
   }
   for (const Mat6& c : contribution) out.C += c;
   out.C /= double(cells) * h * h * h;

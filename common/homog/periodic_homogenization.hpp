@@ -9,10 +9,11 @@
 // is linearized at F = I. docs/homogenization.md.
 #include <array>
 #include <cstdint>
-#include <functional>
+#include <string>
 #include <vector>
 
 #include "fem/voxel_grid.hpp"
+#include "fem/voxel_stiffness_field.hpp"
 #include "fem/hex8.hpp"
 #include "homog/elastic_tensor.hpp"
 
@@ -23,14 +24,30 @@ struct HomogenizationOptions {
   // stiffness ("ersatz material"), so a cell with void is never singular;
   // its bias on C^H is of this relative order.
   double void_stiffness = 1e-6;
+  // Cell solver: "direct" (sparse Cholesky with one node pinned), "multigrid"
+  // (matrix-free multigrid-preconditioned CG, solve/periodic_grid_multigrid.hpp;
+  // every dimension even and at least 4), or "auto": multigrid for grids it
+  // supports from kAutoMultigridVoxels voxels on, direct below.
+  std::string solver = "auto";
+  // Multigrid: relative residual at which CG stops. C^H is an energy, so its
+  // error is of the order of the square of this (docs/homogenization.md).
+  double multigrid_tolerance = 1e-8;
+  // Multigrid: OpenMP threads (0: the OpenMP default).
+  int threads = 0;
 };
+
+// "auto" switches to multigrid at this many voxels (24^3: both solvers take
+// about the same time there; docs/BENCHMARKS.md).
+inline constexpr std::int64_t kAutoMultigridVoxels = 24 * 24 * 24;
 
 struct HomogenizationResult {
   Mat6 C = Mat6::Zero();          // C^H, Voigt (elastic_tensor.hpp)
   Mat6 G = Mat6::Zero();          // harmonic displacements: strains under unit stresses, (C^H)^-1
   std::vector<double> volume_fraction;  // per palette id, [0] = void
   int pieces = 0;                 // connected solid pieces (voxels sharing a node, periodically)
-  std::int64_t unknowns = 0;      // 3 per lattice node, less the 3 pinned ones
+  std::int64_t unknowns = 0;      // 3 per lattice node (direct: less the 3 pinned ones)
+  std::string solver;             // "direct" or "multigrid"
+  int iterations = 0;             // multigrid: CG iterations over the six strain cases
   // Per Voigt strain: the periodic fluctuation at the nx*ny*nz lattice
   // nodes (3 per node, x fastest), zero at node 0.
   std::array<VecX, 6> fluctuation;
@@ -44,14 +61,16 @@ struct HomogenizationResult {
 HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
                                 const HomogenizationOptions& options = {});
 
-// The cell problem for any per-voxel element stiffness (voxel v = i + nx
-// (j + ny k), element matrices of the 8-node hexahedron with corners
-// voxel_corners(h)): the core of homogenize(), and of the continuous
-// sampling step, whose voxels mix two materials. The stiffness must be
-// positive definite up to rigid motions. volume_fraction and pieces are
-// left empty.
-using ElementStiffness = std::function<Mat24(std::int64_t voxel)>;
-HomogenizationResult homogenize_elements(int nx, int ny, int nz, double h, const ElementStiffness& element_stiffness);
+// The cell problem for any per-voxel element stiffness (element matrices of
+// the 8-node hexahedron with corners voxel_corners(h)): the core of
+// homogenize(), and of the continuous sampling step, whose voxels mix two
+// materials. The stiffness must be positive definite up to rigid motions.
+// volume_fraction and pieces are left empty. InputError for an invalid field
+// or solver option (also "multigrid" on a grid it cannot coarsen).
+HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const HomogenizationOptions& options = {});
+
+// The solver homogenize_elements() uses for this grid and option.
+std::string homogenization_solver(int nx, int ny, int nz, const std::string& option);
 
 // Corner positions of one voxel of size h (corner a at (a>>2&1, a>>1&1, a&1) h).
 hex8::NodeMatrix voxel_corners(double h);

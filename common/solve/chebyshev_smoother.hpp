@@ -35,21 +35,13 @@ class ChebyshevSmoother {
   int degree() const { return degree_; }
 
  private:
-  // z = D^-1 r for node i.
-  void apply_block_inverse(int i, const double r[3], double* z) const {
-    const double* m = inverse_.data() + 9 * std::size_t(i);
-    z[0] = m[0] * r[0] + m[1] * r[1] + m[2] * r[2];
-    z[1] = m[3] * r[0] + m[4] * r[1] + m[5] * r[2];
-    z[2] = m[6] * r[0] + m[7] * r[1] + m[8] * r[2];
-  }
   void row_product(int i, const double* x, double out[3]) const {
     block_row_product(*pattern_, values_.data(), i, x, out);
   }
-  double estimate_max_eigenvalue() const;
-
   const BlockMatrix* pattern_ = nullptr;
   std::vector<float> values_;    // A in single precision, laid out like A.values
-  std::vector<double> inverse_;  // inverse diagonal blocks, 9 per node, row-major
+  std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major
+  std::vector<double> inverse_;   // their inverses
   double max_eigenvalue_ = 0.0;
   int degree_ = 2;
   int threads_ = 0;

@@ -36,7 +36,6 @@ std::uint64_t hash_ids(const std::vector<int>& ids) {
   return h;
 }
 
-constexpr int kPlane[3] = {0, 1, 5};
 constexpr int kHeader = 2 + 36;  // ok, rho, C
 
 }  // namespace
@@ -78,14 +77,7 @@ VoxelGrid GamutSampler::cell_of(const Microstructure& m) const {
 
 bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho) const {
   m.C = C;
-  if (o_.kind == MaterialSpaceKind::cubic3d) {
-    m.properties = space_.properties(C, rho);
-  } else {
-    Mat3 C2;
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) C2(a, b) = C(kPlane[a], kPlane[b]);
-    m.properties = space_.properties_2d(C2, rho);
-  }
+  m.properties = space_.cell_properties(C, rho);
   m.unit = space_.normalize(m.properties);
   for (int a = 0; a < m.unit.size(); ++a) {
     if (!(m.unit[a] >= -1e-9 && m.unit[a] <= 1 + 1e-9)) return false;

@@ -20,6 +20,8 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
   f.write_attribute("/", "pieces", r.pieces);
   f.write_attribute("/", "unknowns", static_cast<std::int64_t>(r.unknowns));
   f.write_attribute("/", "seconds", r.seconds);
+  f.write_attribute("/", "solver", r.solver);
+  f.write_attribute("/", "cg_iterations", r.iterations);
   std::vector<std::int32_t> ids32(in.cell.ids.begin(), in.cell.ids.end());
   f.write_vector("/cell/ids", ids32);
   f.write_vector("/cell/size", std::vector<int>{in.cell.nx, in.cell.ny, in.cell.nz});

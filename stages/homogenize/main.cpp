@@ -8,12 +8,17 @@
 //   4. C^H by the energy form, G = (C^H)^-1, volume fractions, and for a
 //      cubic tensor E, nu, G and the shear-modulus ratio G'
 //   5. write `msfab.homogenized`
+//
+// Batch mode (--structures X.microstructures.h5): steps 2-4 for every
+// structure of a gamut's set, optionally refined, written as a new
+// `msfab.microstructures` artifact with the properties recomputed.
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 
+#include "batch_homogenization.hpp"
 #include "cell_input.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
@@ -35,24 +40,85 @@ layout:
   - {box: {min: [0.333, 0, 0.333], max: [0.667, 1, 0.667]}, id: 1}
   - {box: {min: [0.333, 0.333, 0], max: [0.667, 0.667, 1]}, id: 1}
 void_stiffness: 1.0e-6
+solver: auto
 )";
+
+// Batch mode: materials and cells come from the structures artifact.
+constexpr const char* kBatchDefaults = R"(
+void_stiffness: 1.0e-6
+solver: auto
+refine: 1
+)";
+
+HomogenizationOptions read_solver_options(const Config& config) {
+  HomogenizationOptions options;
+  options.void_stiffness = config.get_or<double>("void_stiffness", options.void_stiffness);
+  if (!(options.void_stiffness > 0 && options.void_stiffness < 1e-2)) config.fail("void_stiffness", "must be in (0, 0.01)");
+  if (config.has("solver")) options.solver = config.one_of("solver", {"auto", "direct", "multigrid"});
+  options.multigrid_tolerance = config.get_or<double>("multigrid_tolerance", options.multigrid_tolerance);
+  if (!(options.multigrid_tolerance > 0 && options.multigrid_tolerance < 1))
+    config.fail("multigrid_tolerance", "must be in (0, 1)");
+  return options;
+}
+
+void require_out_folder(const std::string& out) {
+  if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
+    throw InputError(out + ": output folder does not exist");
+}
+
+void run_batch(StageContext& ctx, const std::string& structures) {
+  const std::string& out = ctx.require_out();
+  BatchOptions options;
+  options.homogenization = read_solver_options(ctx.config);
+  options.homogenization.threads = ctx.options.threads;
+  options.threads = ctx.options.threads;
+  options.refine = ctx.config.get_or<int>("refine", 1);
+  if (options.refine < 1 || options.refine > 16) ctx.config.fail("refine", "must be 1..16");
+  for (const char* key : {"materials", "cell", "layout"})
+    if (ctx.config.has(key))
+      ctx.config.fail(key, "batch mode (--structures) takes materials and cells from the structures artifact; drop it");
+  ctx.config.check_no_unknown_keys();
+  require_out_folder(out);
+  MicrostructureSet set = read_microstructures_artifact(structures);
+  if (set.items.empty()) throw InputError(structures + ": the set holds no structures");
+  spdlog::info("{}: {} structures, {} x {} x {} voxels, space {}, refine {}", structures, set.items.size(), set.nx,
+               set.ny, set.nz, set.space, options.refine);
+  const BatchReport report = homogenize_set(set, options);
+  write_microstructures_artifact(out, set, "msfab-homogenize", ctx.config.resolved_text(), {structures},
+                                 ctx.options.seed);
+  std::printf("msfab-homogenize: %d structures of %d x %d x %d voxels (%s), %.3f s (%.2f structures/s)\n",
+              report.structures, set.nx, set.ny, set.nz, report.solver.c_str(), report.seconds,
+              report.structures / report.seconds);
+  if (report.solver == "multigrid")
+    std::printf("  multigrid: %.1f CG iterations per structure (6 strain cases)\n",
+                double(report.iterations) / report.structures);
+  std::printf("  change of C^H against the input: median %.3e, max %.3e (relative Frobenius)\n",
+              report.median_relative_change, report.max_relative_change);
+  if (report.outside > 0)
+    spdlog::warn("{} structures now lie outside the material space's box (unit coordinates clamped)", report.outside);
+  std::printf("  artifact: %s\n", out.c_str());
+}
 }
 
 int main(int argc, char** argv) {
   StageApp app("msfab-homogenize", "Periodic homogenization of a voxel cell: C^H, G, cubic moduli (thesis 3.2)");
   app.add_common_options();
-  app.set_default_config(kDefaults);
+  std::string structures;
+  app.cli().add_option("--structures", structures,
+                       "batch mode: homogenize every structure of this msfab.microstructures artifact");
+  // The defaults depend on the mode, and are needed before parsing.
+  bool batch = false;
+  for (int i = 1; i < argc; ++i) batch = batch || std::string(argv[i]).rfind("--structures", 0) == 0;
+  app.set_default_config(batch ? kBatchDefaults : kDefaults);
   return app.run(argc, argv, [&](StageContext& ctx) {
+    if (!structures.empty()) return run_batch(ctx, structures);
     const std::string& out = ctx.require_out();
     // 1. Materials and cell.
     const CellInput in = read_cell_input(ctx.config);
-    HomogenizationOptions options;
-    options.void_stiffness = ctx.config.get_or<double>("void_stiffness", options.void_stiffness);
-    if (!(options.void_stiffness > 0 && options.void_stiffness < 1e-2))
-      ctx.config.fail("void_stiffness", "must be in (0, 0.01)");
+    HomogenizationOptions options = read_solver_options(ctx.config);
+    options.threads = ctx.options.threads;
     ctx.config.check_no_unknown_keys();
-    if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
-      throw InputError(out + ": output folder does not exist");
+    require_out_folder(out);
     spdlog::info("cell {} x {} x {}, {} materials", in.cell.nx, in.cell.ny, in.cell.nz, in.palette.size());
 
     // 2-4. Pieces, cell problems, tensors.
@@ -67,8 +133,9 @@ int main(int argc, char** argv) {
     // 5. Artifact.
     write_homogenized(out, in, r, plane ? &*plane : nullptr, ctx.config.resolved_text(), ctx.command_line,
                       ctx.options.seed);
-    std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns, %.3f s\n", in.cell.nx, in.cell.ny, in.cell.nz,
-                static_cast<long long>(r.unknowns), r.seconds);
+    std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns, %s solver, %.3f s\n", in.cell.nx, in.cell.ny,
+                in.cell.nz, static_cast<long long>(r.unknowns), r.solver.c_str(), r.seconds);
+    if (r.solver == "multigrid") std::printf("  multigrid: %d CG iterations over the 6 strain cases\n", r.iterations);
     std::printf("  solid fraction %.4f, pieces %d\n", 1.0 - r.volume_fraction[0], r.pieces);
     const double dev = cubic_deviation(r.C);
     if (plane) {

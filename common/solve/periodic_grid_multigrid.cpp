@@ -1,0 +1,474 @@
+#include "solve/periodic_grid_multigrid.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/errors.hpp"
+#include "solve/block_matrix.hpp"
+#include "solve/chebyshev_kernels.hpp"
+#include "solve/chebyshev_smoother.hpp"
+#include "solve/conjugate_gradient.hpp"
+#include "solve/sparse_ops.hpp"
+
+namespace msfab {
+namespace {
+
+// Coarse levels are small: smoothing them harder and visiting them twice (a
+// W-cycle below the finest level) costs little and keeps the high-contrast
+// coarse operators from slowing CG down.
+constexpr int kCoarseDegreeFactor = 2;
+constexpr int kCoarseCorrections = 2;
+
+int wrap(int i, int n) { return ((i % n) + n) % n; }
+
+// Corner a of a voxel sits at (a>>2&1, a>>1&1, a&1) (fem/voxel_stiffness_field.hpp).
+constexpr int corner_x(int a) { return a >> 2 & 1; }
+constexpr int corner_y(int a) { return a >> 1 & 1; }
+constexpr int corner_z(int a) { return a & 1; }
+// Lattice offset (dx, dy, dz) in {-1, 0, 1}^3 as 0..26.
+constexpr int offset_code(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
+// Offset of corner b relative to corner a.
+constexpr int corner_code(int a, int b) {
+  return offset_code(corner_x(b) - corner_x(a), corner_y(b) - corner_y(a), corner_z(b) - corner_z(a));
+}
+
+std::string dims_text(const std::array<int, 3>& n) {
+  return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// x -= its mean, per displacement component.
+void project_zero_mean(VecX& x, int threads) {
+  const Eigen::Index nodes = x.size() / 3;
+  if (nodes == 0) return;
+  const Vec3 sum = chunked_reduce(nodes, threads, [&](Eigen::Index begin, Eigen::Index end) {
+    Vec3 s = Vec3::Zero();
+    for (Eigen::Index i = begin; i < end; ++i) s += x.segment<3>(3 * i);
+    return s;
+  });
+  const Vec3 mean = sum / double(nodes);
+  chunked_for(nodes, threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index i = begin; i < end; ++i) x.segment<3>(3 * i) -= mean;
+  });
+}
+
+}  // namespace
+
+struct PeriodicGridMultigrid::Level {
+  std::array<int, 3> n{0, 0, 0};  // nodes = elements per axis
+  int scale = 1;                  // voxels per element edge
+  bool coarsest = false;
+  BlockMatrix matrix;             // assembled operator (levels between the finest and the coarsest)
+  std::vector<int> slot;          // 27 per node: slot of the block at each lattice offset
+  ChebyshevSmoother smoother;
+  std::vector<Mat24> galerkin;    // Q[pos * basis + b] while the level is built
+  VecX rhs, solution, residual;   // cycle workspace
+
+  int nodes() const { return n[0] * n[1] * n[2]; }
+  int node(int i, int j, int k) const { return wrap(i, n[0]) + n[0] * (wrap(j, n[1]) + n[1] * wrap(k, n[2])); }
+  std::array<int, 3> coords(int p) const { return {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])}; }
+};
+
+bool PeriodicGridMultigrid::supports(int nx, int ny, int nz) {
+  for (int n : {nx, ny, nz})
+    if (n < 4 || n % 2 != 0) return false;
+  return true;
+}
+
+PeriodicGridMultigrid::~PeriodicGridMultigrid() = default;
+
+PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const PeriodicMultigridOptions& options)
+    : field_(std::move(field)), options_(options) {
+  const auto start = std::chrono::steady_clock::now();
+  validate_field(field_, "periodic multigrid");
+  if (!(options_.tolerance > 0) || options_.tolerance >= 1)
+    throw InputError("periodic multigrid: tolerance must lie in (0, 1)");
+  if (options_.max_iterations < 1) throw InputError("periodic multigrid: max_iterations must be >= 1");
+  if (options_.smoother_degree < 1 || options_.smoother_degree > 10)
+    throw InputError("periodic multigrid: smoother_degree must lie in 1..10");
+  if (options_.coarsest_nodes < 8) throw InputError("periodic multigrid: coarsest_nodes must be >= 8");
+  if (!supports(field_.nx, field_.ny, field_.nz))
+    throw InputError("periodic multigrid: a " + dims_text({field_.nx, field_.ny, field_.nz}) +
+                     " grid cannot be coarsened (every dimension must be even and at least 4)");
+
+  // The hierarchy: always one coarsening, then more while the level is large and can be halved.
+  auto level0 = std::make_unique<Level>();
+  level0->n = {field_.nx, field_.ny, field_.nz};
+  levels_.push_back(std::move(level0));
+  for (;;) {
+    const Level& last = *levels_.back();
+    if (levels_.size() > 1 && (last.nodes() <= options_.coarsest_nodes || !supports(last.n[0], last.n[1], last.n[2])))
+      break;
+    auto next = std::make_unique<Level>();
+    next->n = {last.n[0] / 2, last.n[1] / 2, last.n[2] / 2};
+    next->scale = 2 * last.scale;
+    levels_.push_back(std::move(next));
+  }
+  levels_.back()->coarsest = true;
+
+  // Finest level: corner rows of the basis, diagonal blocks, Chebyshev bounds.
+  const int B = field_.basis_size();
+  corner_rows_.resize(8 * std::size_t(B));
+  for (int b = 0; b < B; ++b)
+    for (int a = 0; a < 8; ++a) corner_rows_[8 * b + a] = field_.basis[b].middleRows<3>(3 * a);
+  const Level& fine = *levels_.front();
+  const int nodes = fine.nodes();
+  fine_diagonal_.assign(9 * std::size_t(nodes), 0.0);
+  chunked_for(nodes, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index p = begin; p < end; ++p) {
+      const auto c = fine.coords(static_cast<int>(p));
+      Mat3 D = Mat3::Zero();
+      for (int a = 0; a < 8; ++a) {
+        const int e = fine.node(c[0] - corner_x(a), c[1] - corner_y(a), c[2] - corner_z(a));
+        for (int b = 0; b < B; ++b)
+          if (const double w = field_.weight(e, b); w != 0.0) D += w * field_.basis[b].block<3, 3>(3 * a, 3 * a);
+      }
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(fine_diagonal_.data() + 9 * p) = D;
+    }
+  });
+  if (chebyshev::invert_diagonal_blocks(nodes, fine_diagonal_.data(), fine_inverse_, options_.threads) != 0)
+    throw NumericalError("periodic multigrid: a node's diagonal stiffness block is not positive definite");
+  fine_max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
+      nodes, fine_diagonal_.data(), fine_inverse_.data(),
+      [this](int i, const double* x, double out[3]) { fine_row_product(i, x, out); }, options_.threads);
+  if (!(fine_max_eigenvalue_ > 0) || !std::isfinite(fine_max_eigenvalue_))
+    throw NumericalError("periodic multigrid: no usable eigenvalue bound for the smoother");
+
+  for (std::size_t l = 1; l < levels_.size(); ++l) build_level(l);
+  stats_.analyze_seconds = seconds_since(start);
+  stats_.positive_definite = true;
+}
+
+void PeriodicGridMultigrid::build_level(std::size_t l) {
+  Level& level = *levels_[l];
+  const int B = field_.basis_size();
+  const int s = level.scale;
+  // Q[pos][b] = P_pos^T K_b P_pos for every voxel position pos inside a coarse element.
+  level.galerkin.assign(std::size_t(s) * s * s * B, Mat24::Zero());
+#pragma omp parallel for schedule(static) num_threads(resolve_thread_count(options_.threads))
+  for (int pos = 0; pos < s * s * s; ++pos) {
+    const int pi = pos % s, pj = (pos / s) % s, pk = pos / (s * s);
+    Mat24 P = Mat24::Zero();
+    for (int c = 0; c < 8; ++c) {
+      const double xi[3] = {double(pi + corner_x(c)) / s, double(pj + corner_y(c)) / s, double(pk + corner_z(c)) / s};
+      for (int A = 0; A < 8; ++A) {
+        const double phi = (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) *
+                           (corner_z(A) ? xi[2] : 1 - xi[2]);
+        for (int d = 0; d < 3; ++d) P(3 * c + d, 3 * A + d) = phi;
+      }
+    }
+    for (int b = 0; b < B; ++b) level.galerkin[std::size_t(pos) * B + b] = P.transpose() * field_.basis[b] * P;
+  }
+
+  const int nodes = level.nodes();
+  if (level.coarsest) {
+    // Small: assemble by triplets (duplicates add, which also handles a
+    // dimension of 2, where a node is its own neighbour on both sides).
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(std::size_t(nodes) * 576);
+    for (int e = 0; e < nodes; ++e) {
+      const Mat24 K = coarse_element(l, e);
+      const auto c = level.coords(e);
+      int corner_node[8];
+      for (int a = 0; a < 8; ++a) corner_node[a] = level.node(c[0] + corner_x(a), c[1] + corner_y(a), c[2] + corner_z(a));
+      for (int a = 0; a < 8; ++a)
+        for (int b = 0; b < 8; ++b)
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q)
+              triplets.emplace_back(3 * corner_node[a] + r, 3 * corner_node[b] + q, K(3 * a + r, 3 * b + q));
+    }
+    const int N = 3 * nodes;
+    coarsest_full_.resize(N, N);
+    coarsest_full_.setFromTriplets(triplets.begin(), triplets.end());
+    const SpMat pinned = coarsest_full_.block(3, 3, N - 3, N - 3);
+    coarse_solver_.compute(pinned);
+    std::vector<Mat24>().swap(level.galerkin);
+    if (coarse_solver_.info() != Eigen::Success)
+      throw NumericalError("periodic multigrid: the coarsest operator (" + dims_text(level.n) +
+                           ") is not positive definite; the cell's solid may not be connected");
+    return;
+  }
+
+  // Block pattern: the 27 lattice neighbours of each node, in ascending order.
+  BlockMatrix& M = level.matrix;
+  M.rows = nodes;
+  M.row_start.resize(std::size_t(nodes) + 1);
+  M.column.resize(27 * std::size_t(nodes));
+  M.diagonal.resize(nodes);
+  level.slot.resize(27 * std::size_t(nodes));
+  for (int p = 0; p < nodes; ++p) {
+    M.row_start[p] = 27 * p;
+    const auto c = level.coords(p);
+    std::array<std::pair<int, int>, 27> neighbours;  // (node, code)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          neighbours[offset_code(dx, dy, dz)] = {level.node(c[0] + dx, c[1] + dy, c[2] + dz), offset_code(dx, dy, dz)};
+    std::sort(neighbours.begin(), neighbours.end());
+    for (int t = 0; t < 27; ++t) {
+      M.column[27 * std::size_t(p) + t] = neighbours[t].first;
+      level.slot[27 * std::size_t(p) + neighbours[t].second] = 27 * p + t;
+    }
+    M.diagonal[p] = level.slot[27 * std::size_t(p) + offset_code(0, 0, 0)];
+  }
+  M.row_start[nodes] = 27 * nodes;
+  M.values.assign(9 * std::size_t(M.num_blocks()), 0.0);
+  // Scatter element matrices colour by colour: elements of one parity share
+  // no node (dimensions are even), so a colour adds without conflicts and
+  // the order of additions is fixed.
+  const int half = nodes / 8;
+  for (int colour = 0; colour < 8; ++colour) {
+#pragma omp parallel for schedule(static) num_threads(resolve_thread_count(options_.threads))
+    for (int t = 0; t < half; ++t) {
+      const int hx = level.n[0] / 2, hy = level.n[1] / 2;
+      const int i = 2 * (t % hx) + corner_x(colour), j = 2 * ((t / hx) % hy) + corner_y(colour),
+                k = 2 * (t / (hx * hy)) + corner_z(colour);
+      const int e = level.node(i, j, k);
+      const Mat24 K = coarse_element(l, e);
+      for (int a = 0; a < 8; ++a) {
+        const int row = level.node(i + corner_x(a), j + corner_y(a), k + corner_z(a));
+        for (int b = 0; b < 8; ++b) {
+          double* block = M.values.data() + 9 * std::size_t(level.slot[27 * std::size_t(row) + corner_code(a, b)]);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) block[3 * r + q] += K(3 * a + r, 3 * b + q);
+        }
+      }
+    }
+  }
+  std::vector<Mat24>().swap(level.galerkin);
+  if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads))
+    throw NumericalError("periodic multigrid: a diagonal block of level " + std::to_string(l) + " (" +
+                         dims_text(level.n) + ") is not positive definite");
+}
+
+Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element) const {
+  const Level& level = *levels_[l];
+  const int s = level.scale, B = field_.basis_size();
+  const auto c = level.coords(static_cast<int>(element));
+  Mat24 K = Mat24::Zero();
+  for (int pk = 0; pk < s; ++pk)
+    for (int pj = 0; pj < s; ++pj)
+      for (int pi = 0; pi < s; ++pi) {
+        const std::int64_t v = (s * c[0] + pi) + std::int64_t(field_.nx) * ((s * c[1] + pj) + std::int64_t(field_.ny) * (s * c[2] + pk));
+        const std::size_t pos = std::size_t(pi + s * (pj + s * pk));
+        for (int b = 0; b < B; ++b)
+          if (const double w = field_.weight(v, b); w != 0.0) K.noalias() += w * level.galerkin[pos * B + b];
+      }
+  return K;
+}
+
+void PeriodicGridMultigrid::fine_row_product(int node, const double* x, double out[3]) const {
+  const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
+  const int i = node % nx, j = (node / nx) % ny, k = node / (nx * ny);
+  const int xs[3] = {i == 0 ? nx - 1 : i - 1, i, i + 1 == nx ? 0 : i + 1};
+  const int ys[3] = {j == 0 ? ny - 1 : j - 1, j, j + 1 == ny ? 0 : j + 1};
+  const int zs[3] = {k == 0 ? nz - 1 : k - 1, k, k + 1 == nz ? 0 : k + 1};
+  int neighbour[27];
+  for (int dz = 0; dz < 3; ++dz)
+    for (int dy = 0; dy < 3; ++dy)
+      for (int dx = 0; dx < 3; ++dx) neighbour[dx + 3 * dy + 9 * dz] = xs[dx] + nx * (ys[dy] + ny * zs[dz]);
+  const int B = field_.basis_size();
+  Vec3 y = Vec3::Zero();
+  Eigen::Matrix<double, 24, 1> xe;
+  for (int a = 0; a < 8; ++a) {
+    // This node is corner a of the element whose corner 0 is at offset -corner(a).
+    const int e = neighbour[offset_code(-corner_x(a), -corner_y(a), -corner_z(a))];
+    bool gathered = false;
+    for (int b = 0; b < B; ++b) {
+      const double w = field_.weight(e, b);
+      if (w == 0.0) continue;
+      if (!gathered) {
+        for (int c = 0; c < 8; ++c) {
+          const double* xc = x + 3 * std::size_t(neighbour[corner_code(a, c)]);
+          xe[3 * c] = xc[0];
+          xe[3 * c + 1] = xc[1];
+          xe[3 * c + 2] = xc[2];
+        }
+        gathered = true;
+      }
+      y.noalias() += w * (corner_rows_[8 * b + a] * xe);
+    }
+  }
+  out[0] = y[0];
+  out[1] = y[1];
+  out[2] = y[2];
+}
+
+void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
+  const int nodes = levels_.front()->nodes();
+  y.resize(3 * Eigen::Index(nodes));
+  parallel_row_ranges(nodes, resolve_thread_count(options_.threads), [&](int begin, int end) {
+    for (int p = begin; p < end; ++p) fine_row_product(p, x.data(), y.data() + 3 * std::size_t(p));
+  });
+}
+
+void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
+  Level& level = *levels_[index];
+  const int threads = options_.threads;
+  if (level.coarsest) {
+    VecX r = rhs;
+    project_zero_mean(r, threads);
+    const Eigen::Index N = r.size();
+    solution.resize(N);
+    solution.head<3>().setZero();
+    solution.tail(N - 3) = coarse_solver_.solve(r.tail(N - 3));
+    project_zero_mean(solution, threads);
+    return;
+  }
+  const auto fine_product = [this](int i, const double* x, double out[3]) { fine_row_product(i, x, out); };
+  auto smooth = [&](bool zero_start) {
+    if (index == 0)
+      chebyshev::smooth(level.nodes(), fine_inverse_.data(), fine_max_eigenvalue_, options_.smoother_degree,
+                        fine_product, rhs, solution, zero_start, step_, next_, threads);
+    else
+      level.smoother.smooth(rhs, solution, zero_start);
+  };
+  Level& coarse = *levels_[index + 1];
+  const int team = resolve_thread_count(threads);
+  smooth(true);
+  const int corrections = index == 0 ? 1 : kCoarseCorrections;
+  for (int c = 0; c < corrections; ++c) {
+    if (index == 0)
+      chebyshev::residual(level.nodes(), fine_product, rhs, solution, level.residual, threads);
+    else
+      level.smoother.residual(rhs, solution, level.residual);
+    // Restriction P^T r: each coarse node gathers the fine nodes within one
+    // fine spacing of its point, weight 1 or 1/2 per axis.
+    coarse.rhs.resize(3 * Eigen::Index(coarse.nodes()));
+    parallel_row_ranges(coarse.nodes(), team, [&](int begin, int end) {
+      for (int P = begin; P < end; ++P) {
+        const auto C = coarse.coords(P);
+        Vec3 sum = Vec3::Zero();
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const double w = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
+              sum += w * level.residual.segment<3>(3 * level.node(2 * C[0] + dx, 2 * C[1] + dy, 2 * C[2] + dz));
+            }
+        coarse.rhs.segment<3>(3 * P) = sum;
+      }
+    });
+    cycle(index + 1, coarse.rhs, coarse.solution);
+    // Prolongation x += P x_c: a fine node interpolates the coarse nodes of
+    // its enclosing coarse cell (1, 2, 4 or 8 of them).
+    parallel_row_ranges(level.nodes(), team, [&](int begin, int end) {
+      for (int p = begin; p < end; ++p) {
+        const auto f = level.coords(p);
+        Vec3 sum = Vec3::Zero();
+        const int ox = f[0] % 2, oy = f[1] % 2, oz = f[2] % 2;
+        const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
+        for (int cz = 0; cz <= oz; ++cz)
+          for (int cy = 0; cy <= oy; ++cy)
+            for (int cx = 0; cx <= ox; ++cx)
+              sum += coarse.solution.segment<3>(3 * coarse.node(f[0] / 2 + cx, f[1] / 2 + cy, f[2] / 2 + cz));
+        solution.segment<3>(3 * p) += w * sum;
+      }
+    });
+  }
+  smooth(false);
+}
+
+VecX PeriodicGridMultigrid::apply_preconditioner(const VecX& r) {
+  VecX z;
+  cycle(0, r, z);
+  project_zero_mean(z, options_.threads);
+  return z;
+}
+
+VecX PeriodicGridMultigrid::solve(const VecX& b) {
+  const Eigen::Index n = 3 * Eigen::Index(levels_.front()->nodes());
+  if (b.size() != n)
+    throw std::invalid_argument("PeriodicGridMultigrid::solve: right-hand side has " + std::to_string(b.size()) +
+                                " entries, the grid has " + std::to_string(n) + " unknowns");
+  const int threads = options_.threads;
+  VecX consistent = b;
+  project_zero_mean(consistent, threads);
+  CgOperator op;
+  op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
+  op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
+    const int nodes = levels_.front()->nodes();
+    y.resize(3 * Eigen::Index(nodes));
+    return chunked_reduce(nodes, threads, [&](Eigen::Index begin, Eigen::Index end) {
+      double sum = 0.0;
+      for (Eigen::Index p = begin; p < end; ++p) {
+        fine_row_product(static_cast<int>(p), x.data(), y.data() + 3 * p);
+        sum += x.segment<3>(3 * p).dot(y.segment<3>(3 * p));
+      }
+      return sum;
+    });
+  };
+  CgPreconditioner preconditioner;
+  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
+    cycle(0, r, z);
+    project_zero_mean(z, threads);
+    return parallel_dot(r, z, threads);
+  };
+  preconditioner.check_definite = true;
+  CgSettings settings;
+  settings.tolerance = options_.tolerance;
+  settings.max_iterations = options_.max_iterations;
+  settings.threads = threads;
+  settings.label = "periodic multigrid CG";
+  settings.curvature_label = "periodic multigrid CG";
+  settings.curvature_message_has_residual = true;
+  VecX x = conjugate_gradient(op, preconditioner, consistent, settings, stats_);
+  project_zero_mean(x, threads);
+  return x;
+}
+
+std::array<int, 3> PeriodicGridMultigrid::level_dims(int level) const { return levels_.at(level)->n; }
+
+SpMat PeriodicGridMultigrid::level_operator(int l) const {
+  const Level& level = *levels_.at(l);
+  if (level.coarsest) return coarsest_full_;
+  if (l > 0) {
+    SpMat S = sparse_pattern(level.matrix);
+    copy_to_sparse(level.matrix, S);
+    return S;
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int e = 0; e < level.nodes(); ++e) {
+    const Mat24 K = field_.element(e);
+    const auto c = level.coords(e);
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const int p = level.node(c[0] + corner_x(a), c[1] + corner_y(a), c[2] + corner_z(a));
+        const int q = level.node(c[0] + corner_x(b), c[1] + corner_y(b), c[2] + corner_z(b));
+        for (int r = 0; r < 3; ++r)
+          for (int t = 0; t < 3; ++t) triplets.emplace_back(3 * p + r, 3 * q + t, K(3 * a + r, 3 * b + t));
+      }
+  }
+  SpMat S(3 * level.nodes(), 3 * level.nodes());
+  S.setFromTriplets(triplets.begin(), triplets.end());
+  return S;
+}
+
+SpMat PeriodicGridMultigrid::prolongation(int l) const {
+  const Level& fine = *levels_.at(l);
+  if (fine.coarsest)
+    throw std::invalid_argument("PeriodicGridMultigrid::prolongation: level " + std::to_string(l) + " is the coarsest");
+  const Level& coarse = *levels_.at(l + 1);
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int p = 0; p < fine.nodes(); ++p) {
+    const auto f = fine.coords(p);
+    const int ox = f[0] % 2, oy = f[1] % 2, oz = f[2] % 2;
+    const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
+    for (int cz = 0; cz <= oz; ++cz)
+      for (int cy = 0; cy <= oy; ++cy)
+        for (int cx = 0; cx <= ox; ++cx) {
+          const int P = coarse.node(f[0] / 2 + cx, f[1] / 2 + cy, f[2] / 2 + cz);
+          for (int d = 0; d < 3; ++d) triplets.emplace_back(3 * p + d, 3 * P + d, w);
+        }
+  }
+  SpMat S(3 * fine.nodes(), 3 * coarse.nodes());
+  S.setFromTriplets(triplets.begin(), triplets.end());
+  return S;
+}
+
+}  // namespace msfab
