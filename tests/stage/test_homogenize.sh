@@ -1,6 +1,7 @@
 #!/bin/bash
 # msfab-homogenize: the default cubic frame, a voxel file, thread-count
-# independence, and bad input (exit 2 naming the problem).
+# independence, the multigrid solver, batch mode over a microstructures
+# artifact, and bad input (exit 2 naming the problem).
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 H="$BIN/msfab-homogenize"
@@ -25,6 +26,41 @@ expect_exit 0 "cubic: E 1e\+06, nu 0\.300000" -- "$H" --config "$WORK/file.yaml"
 sed 's/solid.txt/flat.txt/' "$WORK/file.yaml" > "$WORK/flat.yaml"
 expect_exit 0 "2D plane strain: Ex 1\.0989e\+06" -- "$H" --config "$WORK/flat.yaml" --out "$WORK/flat.h5"
 check "2D tensor written" -- bash -c "h5dump -H -d /C2 '$WORK/flat.h5' | grep -q '( 3, 3 )'"
+
+# The multigrid solver on the default frame at 24^3 agrees with the direct one.
+expect_exit 0 "multigrid: [0-9]+ CG iterations" -- "$H" --set cell.size='[24, 24, 24]' --set solver=multigrid --out "$WORK/mg.h5"
+check "direct at 24^3" -- "$H" --set cell.size='[24, 24, 24]' --set solver=direct --out "$WORK/direct.h5" --quiet
+check "multigrid and direct tensors agree to 1e-2 Pa (C ~ 1e5 Pa)" -- h5diff -q --delta=1e-2 "$WORK/mg.h5" "$WORK/direct.h5" /C /C
+expect_exit 2 "solver multigrid needs every cell dimension even" -- "$H" --set cell.size='[12, 12, 9]' --set solver=multigrid --out "$WORK/bad.h5"
+
+# Batch mode: a small 3D set from the sampler, homogenized again.
+cat > "$WORK/set.yaml" <<'Y'
+space: cubic3d
+resolution: 8
+materials:
+  stiff: {E: 1.0e6, nu: 0.3}
+population: 6
+cycles: 1
+initial_beams: 2
+beams: {max: 1, min_radius: 0.5, max_radius: 1.2}
+continuous: {per_cycle: 0}
+level_set: {cells: 6}
+Y
+check "a small 3D set" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 3 --out "$WORK/set.gamut.h5" --quiet
+expect_exit 0 "change of C\^H against the input: median 0\.000e\+00, max 0\.000e\+00" -- \
+  "$H" --structures "$WORK/set.microstructures.h5" --out "$WORK/same.microstructures.h5"
+check "same solver, same tensors and properties" -- bash -c "h5diff -q '$WORK/set.microstructures.h5' '$WORK/same.microstructures.h5' /C /C &&
+  h5diff -q '$WORK/set.microstructures.h5' '$WORK/same.microstructures.h5' /properties /properties"
+expect_exit 0 "structures of 16 x 16 x 16 voxels \(multigrid\)" -- "$H" --structures "$WORK/set.microstructures.h5" \
+  --set refine=2 --set solver=multigrid --threads 1 --out "$WORK/fine1.microstructures.h5"
+check "refined cells are stored (16^3 voxels, one bit each)" -- bash -c "h5dump -H -d /voxels '$WORK/fine1.microstructures.h5' | grep -q ', 512 )'"
+check "refined set, threads inside each solve" -- "$H" --structures "$WORK/set.microstructures.h5" \
+  --set refine=2 --set solver=multigrid --threads 8 --out "$WORK/fine8.microstructures.h5" --quiet
+check "1 and 8 threads give the same refined set" -- h5diff -q "$WORK/fine1.microstructures.h5" "$WORK/fine8.microstructures.h5" /C /C
+expect_exit 2 "batch mode .* drop it" -- "$H" --structures "$WORK/set.microstructures.h5" --set 'materials=[]' --out "$WORK/bad.h5"
+expect_exit 2 "refine.*must be 1..16" -- "$H" --structures "$WORK/set.microstructures.h5" --set refine=0 --out "$WORK/bad.h5"
+expect_exit 2 "missing.h5" -- "$H" --structures "$WORK/missing.h5" --out "$WORK/bad.h5"
+expect_exit 2 "msfab.microstructures" -- "$H" --structures "$WORK/frame.h5" --out "$WORK/bad.h5"
 
 # Bad input.
 { echo "2 2 2"; echo "1 1 1 1 1 1 1"; } > "$WORK/short.txt"
