@@ -206,6 +206,7 @@ void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& lo
   PeriodicMultigridOptions mg;
   mg.tolerance = options.multigrid_tolerance;
   mg.threads = options.threads;
+  mg.smoother_degree = options.multigrid_smoother_degree;
   PeriodicGridMultigrid solver(field, mg);
   out.unknowns = 3 * field.voxels();
   for (int m = 0; m < 6; ++m) {

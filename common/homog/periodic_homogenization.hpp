@@ -30,15 +30,19 @@ struct HomogenizationOptions {
   // supports from kAutoMultigridVoxels voxels on, direct below.
   std::string solver = "auto";
   // Multigrid: relative residual at which CG stops. C^H is an energy, so its
-  // error is of the order of the square of this (docs/homogenization.md).
-  double multigrid_tolerance = 1e-8;
+  // error falls much faster than the residual: at 1e-6 it was below 1e-10
+  // relative on random, inclusion and void-frame cells (docs/BENCHMARKS.md).
+  double multigrid_tolerance = 1e-6;
+  // Multigrid: Chebyshev smoother degree on the finest level (a tuning knob).
+  int multigrid_smoother_degree = 2;
   // Multigrid: OpenMP threads (0: the OpenMP default).
   int threads = 0;
 };
 
-// "auto" switches to multigrid at this many voxels (24^3: both solvers take
-// about the same time there; docs/BENCHMARKS.md).
-inline constexpr std::int64_t kAutoMultigridVoxels = 24 * 24 * 24;
+// "auto" switches to multigrid at this many voxels: from 12^3 on it is 2.4x
+// faster than the direct solver or more, on one thread and on two; at 8^3
+// the two are within 1.5x (docs/BENCHMARKS.md).
+inline constexpr std::int64_t kAutoMultigridVoxels = 12 * 12 * 12;
 
 struct HomogenizationResult {
   Mat6 C = Mat6::Zero();          // C^H, Voigt (elastic_tensor.hpp)

@@ -42,6 +42,7 @@ struct Config::Document {
 namespace {
 
 std::string join(const std::string& prefix, const std::string& key) {
+  if (key.empty()) return prefix;  // "" names the node itself
   return prefix.empty() ? key : prefix + "." + key;
 }
 
@@ -465,6 +466,7 @@ std::optional<YAML::Node> Config::lookup(const std::string& key, bool consume) c
   YAML::Node cur;
   cur.reset(node_);
   std::string path = path_;
+  if (key.empty()) return cur;  // the node itself (fail("", ...) on a list item)
   auto parts = split_dots(key);
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (parts[i].empty()) throw std::logic_error("Config: empty segment in key '" + key + "'");

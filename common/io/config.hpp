@@ -88,7 +88,7 @@ class Config {
   double require_finite(const std::string& key, const std::string& what = {}) const;
   std::string one_of(const std::string& key, const std::vector<std::string>& choices) const;
   // Throws InputError "<source>: <path> = <value>: <problem>" for checks the
-  // helpers above do not cover.
+  // helpers above do not cover. key "" names this node itself (a list item).
   [[noreturn]] void fail(const std::string& key, const std::string& problem) const;
 
   // Every key anywhere under this mapping that no accessor asked for ->

@@ -141,9 +141,14 @@ void residual(int rows, RowProduct&& row_product, const VecX& b, const VecX& x, 
 // `degree` steps of the Chebyshev iteration for A x = b (Saad, Iterative
 // Methods for Sparse Linear Systems, Alg. 12.1) on the interval set by
 // max_eigenvalue, starting from x or from zero. step and next are workspace.
-template <class RowProduct>
+//
+// before_pass(x) runs before every pass that calls row_product on x: an
+// operator that is cheaper applied whole (element by element) computes A x
+// there and row_product reads it back.
+template <class RowProduct, class BeforePass>
 void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
-            const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next, int threads) {
+            BeforePass&& before_pass, const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next,
+            int threads) {
   const double upper = kSafety * max_eigenvalue;
   const double lower = upper / kSmoothingRange;
   const double theta = 0.5 * (upper + lower);
@@ -165,6 +170,7 @@ void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, 
       }
     });
   } else {
+    before_pass(x);
     parallel_row_ranges(rows, team, [&](int begin, int end) {
       for (int i = begin; i < end; ++i) {
         double r[3];
@@ -181,6 +187,7 @@ void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, 
     const double rho_next = 1.0 / (2.0 * sigma - rho);
     const double keep = rho_next * rho;
     const double gain = 2.0 * rho_next / delta;
+    before_pass(x);
     parallel_row_ranges(rows, team, [&](int begin, int end) {
       for (int i = begin; i < end; ++i) {
         double r[3], z[3];
@@ -197,6 +204,18 @@ void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, 
     x.swap(next);
     rho = rho_next;
   }
+}
+
+}  // namespace msfab::chebyshev
+
+namespace msfab::chebyshev {
+
+// smooth() for an operator applied row by row.
+template <class RowProduct>
+void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
+            const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next, int threads) {
+  smooth(rows, inverse, max_eigenvalue, degree, row_product, [](const VecX&) {}, b, x, zero_start, step, next,
+         threads);
 }
 
 }  // namespace msfab::chebyshev

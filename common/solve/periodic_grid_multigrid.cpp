@@ -300,13 +300,44 @@ void PeriodicGridMultigrid::fine_row_product(int node, const double* x, double o
   out[2] = y[2];
 }
 
-void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
-  const int nodes = levels_.front()->nodes();
-  y.resize(3 * Eigen::Index(nodes));
-  parallel_row_ranges(nodes, resolve_thread_count(options_.threads), [&](int begin, int end) {
-    for (int p = begin; p < end; ++p) fine_row_product(p, x.data(), y.data() + 3 * std::size_t(p));
-  });
+void PeriodicGridMultigrid::fine_apply(const VecX& x, VecX& y) const {
+  const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
+  const Eigen::Index n = 3 * Eigen::Index(nx) * ny * nz;
+  const int hx = nx / 2, hy = ny / 2, half = hx * hy * (nz / 2);
+  const int B = field_.basis_size();
+  y.resize(n);
+  const int team = resolve_thread_count(options_.threads);
+#pragma omp parallel num_threads(team) if (n > 3 * 4096)
+  {
+#pragma omp for schedule(static)
+    for (Eigen::Index k = 0; k < n; ++k) y[k] = 0.0;
+    for (int colour = 0; colour < 8; ++colour) {
+#pragma omp for schedule(static)
+      for (int t = 0; t < half; ++t) {
+        const int i = 2 * (t % hx) + corner_x(colour), j = 2 * ((t / hx) % hy) + corner_y(colour),
+                  k = 2 * (t / (hx * hy)) + corner_z(colour);
+        const int xs[2] = {i, i + 1 == nx ? 0 : i + 1}, ys[2] = {j, j + 1 == ny ? 0 : j + 1},
+                  zs[2] = {k, k + 1 == nz ? 0 : k + 1};
+        int corner[8];
+        for (int a = 0; a < 8; ++a) corner[a] = xs[corner_x(a)] + nx * (ys[corner_y(a)] + ny * zs[corner_z(a)]);
+        Eigen::Matrix<double, 24, 1> xe, ye = Eigen::Matrix<double, 24, 1>::Zero();
+        for (int a = 0; a < 8; ++a) xe.segment<3>(3 * a) = x.segment<3>(3 * Eigen::Index(corner[a]));
+        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
+        for (int b = 0; b < B; ++b) {
+          const double w = field_.weight(e, b);
+          if (w == 0.0) continue;
+          // Column by column: fixed-size 24-vectors that vectorize, where
+          // a 24 x 24 product would go through Eigen's general kernel.
+          const Mat24& K = field_.basis[b];
+          for (int c = 0; c < 24; ++c) ye += (w * xe[c]) * K.col(c);
+        }
+        for (int a = 0; a < 8; ++a) y.segment<3>(3 * Eigen::Index(corner[a])) += ye.segment<3>(3 * a);
+      }
+    }
+  }
 }
+
+void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const { fine_apply(x, y); }
 
 void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
   Level& level = *levels_[index];
@@ -321,11 +352,16 @@ void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solu
     project_zero_mean(solution, threads);
     return;
   }
-  const auto fine_product = [this](int i, const double* x, double out[3]) { fine_row_product(i, x, out); };
+  // Finest level: K x is applied whole before each smoothing pass and read back by rows.
+  const auto fine_product = [this](int i, const double*, double out[3]) {
+    const double* y = fine_product_.data() + 3 * std::size_t(i);
+    out[0] = y[0], out[1] = y[1], out[2] = y[2];
+  };
+  const auto apply_fine = [this](const VecX& x) { fine_apply(x, fine_product_); };
   auto smooth = [&](bool zero_start) {
     if (index == 0)
       chebyshev::smooth(level.nodes(), fine_inverse_.data(), fine_max_eigenvalue_, options_.smoother_degree,
-                        fine_product, rhs, solution, zero_start, step_, next_, threads);
+                        fine_product, apply_fine, rhs, solution, zero_start, step_, next_, threads);
     else
       level.smoother.smooth(rhs, solution, zero_start);
   };
@@ -334,8 +370,10 @@ void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solu
   smooth(true);
   const int corrections = index == 0 ? 1 : kCoarseCorrections;
   for (int c = 0; c < corrections; ++c) {
-    if (index == 0)
+    if (index == 0) {
+      apply_fine(solution);
       chebyshev::residual(level.nodes(), fine_product, rhs, solution, level.residual, threads);
+    }
     else
       level.smoother.residual(rhs, solution, level.residual);
     // Restriction P^T r: each coarse node gathers the fine nodes within one
@@ -392,16 +430,8 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
   CgOperator op;
   op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
   op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
-    const int nodes = levels_.front()->nodes();
-    y.resize(3 * Eigen::Index(nodes));
-    return chunked_reduce(nodes, threads, [&](Eigen::Index begin, Eigen::Index end) {
-      double sum = 0.0;
-      for (Eigen::Index p = begin; p < end; ++p) {
-        fine_row_product(static_cast<int>(p), x.data(), y.data() + 3 * p);
-        sum += x.segment<3>(3 * p).dot(y.segment<3>(3 * p));
-      }
-      return sum;
-    });
+    fine_apply(x, y);
+    return parallel_dot(x, y, threads);
   };
   CgPreconditioner preconditioner;
   preconditioner.apply = [this, threads](const VecX& r, VecX& z) {

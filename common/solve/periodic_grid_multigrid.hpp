@@ -3,10 +3,12 @@
 // stiffness matrix of a voxel grid: the cell problem of homogenization at 32^3,
 // 64^3 and beyond, where a sparse factorization runs out of time and memory.
 //
-// Finest level: matrix-free. K x is gathered node by node from the eight
-// elements around each node, with K_v = sum_b w_vb K_b (VoxelStiffnessField),
-// so memory is the weights plus a few vectors (and 18 numbers per node for
-// the smoother's diagonal blocks and their inverses).
+// Finest level: matrix-free. K x is a sum of element products K_v x_v,
+// K_v = sum_b w_vb K_b (VoxelStiffnessField), computed colour by colour
+// (voxels of one coordinate parity share no node) so that additions never
+// conflict and always come in the same order. Memory is the weights plus a
+// few vectors (and 18 numbers per node for the smoother's diagonal blocks
+// and their inverses).
 // Coarse levels: every other lattice point per axis, trilinear prolongation
 // P, Galerkin operators P^T K P. Trilinear interpolation of nested grids
 // composes, so the Galerkin operator of level l is itself an element sum,
@@ -81,7 +83,10 @@ class PeriodicGridMultigrid {
   struct Level;
   void build_level(std::size_t l);
   void cycle(std::size_t level, const VecX& rhs, VecX& solution);
+  // Node row of K x on the finest level (the smoother's eigenvalue estimate).
   void fine_row_product(int node, const double* x, double out[3]) const;
+  // y = K x on the finest level, element by element in 8 colours.
+  void fine_apply(const VecX& x, VecX& y) const;
   // K_E of element `element` of level l (l >= 1).
   Mat24 coarse_element(std::size_t l, std::int64_t element) const;
 
@@ -93,7 +98,7 @@ class PeriodicGridMultigrid {
   std::vector<Eigen::Matrix<double, 3, 24, Eigen::RowMajor>> corner_rows_;  // [b * 8 + a]
   std::vector<double> fine_diagonal_, fine_inverse_;
   double fine_max_eigenvalue_ = 0.0;
-  VecX step_, next_;
+  VecX step_, next_, fine_product_;
   // Coarsest level: full operator (for checks) and its factorization with node 0 pinned.
   SpMat coarsest_full_;
   Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> coarse_solver_;

@@ -308,3 +308,19 @@ TEST(Config, RelativePathsAreTakenFromTheConfigFilesFolder) {
 
 }  // namespace
 }  // namespace msfab
+
+namespace msfab {
+namespace {
+TEST(Config, FailOnTheNodeItselfNamesItsPath) {
+  const Config c = Config::from_string("layout:\n  - {sphere: 1}\n", "cfg");
+  const std::vector<Config> items = c.children("layout");
+  try {
+    items.at(0).fail("", "a layout item needs one of: fill, box");
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("layout[0]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("needs one of"), std::string::npos) << e.what();
+  }
+}
+}  // namespace
+}  // namespace msfab

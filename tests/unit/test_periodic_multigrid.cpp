@@ -182,7 +182,9 @@ TEST(PeriodicMultigrid, BadGridsAndOptionsAreInputErrors) {
   h.solver = "lu";
   EXPECT_THROW(homogenize(VoxelGrid(8, 8, 8, 1e-3, 1), palette(), h), InputError);
   EXPECT_EQ(homogenization_solver(32, 32, 32, "auto"), "multigrid");
-  EXPECT_EQ(homogenization_solver(16, 16, 16, "auto"), "direct");
+  EXPECT_EQ(homogenization_solver(16, 16, 16, "auto"), "multigrid");
+  EXPECT_EQ(homogenization_solver(10, 10, 10, "auto"), "direct");
+  EXPECT_EQ(homogenization_solver(64, 64, 1, "auto"), "direct");
   EXPECT_EQ(homogenization_solver(30, 30, 30, "auto"), "multigrid");
   EXPECT_EQ(homogenization_solver(33, 32, 32, "auto"), "direct");
 }
