@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
 #include <iostream>
 
 #include "cli/logging.hpp"
@@ -44,6 +45,12 @@ CLI::Validator integer_validator(bool positive) {
 const std::string& StageContext::require_out() const {
   if (options.out.empty()) throw InputError("missing --out PATH (where to write the result)");
   return options.out;
+}
+
+void StageContext::check_out_folder() const {
+  const std::string& out = require_out();
+  if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
+    throw InputError(out + ": output folder does not exist");
 }
 
 StageApp::StageApp(std::string name, std::string description) : name_(std::move(name)), cli_(description, name_) {

@@ -46,6 +46,10 @@ struct StageContext {
 
   // The --out path; InputError when it was not given.
   const std::string& require_out() const;
+  // InputError ("<out>: output folder does not exist") unless the folder
+  // --out writes into exists; stages call it after validating their config,
+  // before any long work.
+  void check_out_folder() const;
 };
 
 class StageApp {

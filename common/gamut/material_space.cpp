@@ -1,5 +1,6 @@
 #include "gamut/material_space.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -36,6 +37,15 @@ VecX MaterialSpace::properties(const Mat6& C, double rho) const {
   VecX p(4);
   p << m.E, m.nu, m.G, rho;
   return p;
+}
+
+bool MaterialSpace::clamp_to_box(VecX& unit) {
+  bool inside = true;
+  for (Eigen::Index a = 0; a < unit.size(); ++a) {
+    if (!(unit[a] >= -1e-9 && unit[a] <= 1 + 1e-9)) inside = false;
+    unit[a] = std::clamp(unit[a], 0.0, 1.0);
+  }
+  return inside;
 }
 
 VecX MaterialSpace::cell_properties(const Mat6& C, double rho) const {

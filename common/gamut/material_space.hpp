@@ -49,6 +49,9 @@ class MaterialSpace {
   // mean the property lies outside the space's box.
   VecX normalize(const VecX& raw) const;
   VecX denormalize(const VecX& unit) const;
+  // Clamps unit coordinates into [0, 1]; false if one lay outside by more
+  // than round-off (1e-9: the solid cell sits exactly on the box's faces).
+  static bool clamp_to_box(VecX& unit);
 
  private:
   MaterialSpaceKind kind_;

@@ -65,10 +65,10 @@ inline int invert_diagonal_blocks(int rows, const double* diagonal, std::vector<
 }
 
 // Largest eigenvalue of D^-1 A by Lanczos in the D inner product (D^-1 A is
-// self-adjoint there).
-template <class RowProduct>
+// self-adjoint there). before_pass(v) runs before each product, as in smooth().
+template <class RowProduct, class BeforePass>
 double estimate_max_eigenvalue(int rows, const double* diagonal, const double* inverse,
-                               RowProduct&& row_product, int threads) {
+                               RowProduct&& row_product, BeforePass&& before_pass, int threads) {
   const Eigen::Index n = 3 * Eigen::Index(rows);
   auto d_norm_part = [&](const VecX& u, Eigen::Index begin, Eigen::Index end) {
     double sum = 0.0;
@@ -91,6 +91,7 @@ double estimate_max_eigenvalue(int rows, const double* diagonal, const double* i
   double beta = 0.0;
   for (int step = 0; step < kLanczosSteps; ++step) {
     // w = D^-1 A v and alpha = v . A v in one pass.
+    before_pass(v);
     const double alpha = chunked_reduce(rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
       double sum = 0.0;
       for (Eigen::Index i = begin; i < end; ++i) {
@@ -204,18 +205,6 @@ void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, 
     x.swap(next);
     rho = rho_next;
   }
-}
-
-}  // namespace msfab::chebyshev
-
-namespace msfab::chebyshev {
-
-// smooth() for an operator applied row by row.
-template <class RowProduct>
-void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
-            const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next, int threads) {
-  smooth(rows, inverse, max_eigenvalue, degree, row_product, [](const VecX&) {}, b, x, zero_start, step, next,
-         threads);
 }
 
 }  // namespace msfab::chebyshev

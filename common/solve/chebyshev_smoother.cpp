@@ -23,7 +23,7 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads) {
   if (chebyshev::invert_diagonal_blocks(A.rows, diagonal_.data(), inverse_, threads) != 0) return false;
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
       A.rows, diagonal_.data(), inverse_.data(),
-      [&](int i, const double* x, double out[3]) { row_product(i, x, out); }, threads);
+      [&](int i, const double* x, double out[3]) { row_product(i, x, out); }, [](const VecX&) {}, threads);
   return std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0;
 }
 
@@ -34,8 +34,8 @@ void ChebyshevSmoother::residual(const VecX& b, const VecX& x, VecX& r) const {
 
 void ChebyshevSmoother::smooth(const VecX& b, VecX& x, bool zero_start) {
   chebyshev::smooth(pattern_->rows, inverse_.data(), max_eigenvalue_, degree_,
-                    [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, b, x, zero_start,
-                    step_, next_, threads_);
+                    [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, [](const VecX&) {}, b, x,
+                    zero_start, step_, next_, threads_);
 }
 
 }  // namespace msfab

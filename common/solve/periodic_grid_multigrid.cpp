@@ -67,7 +67,6 @@ struct PeriodicGridMultigrid::Level {
   BlockMatrix matrix;             // assembled operator (levels between the finest and the coarsest)
   std::vector<int> slot;          // 27 per node: slot of the block at each lattice offset
   ChebyshevSmoother smoother;
-  std::vector<Mat24> galerkin;    // Q[pos * basis + b] while the level is built
   VecX rhs, solution, residual;   // cycle workspace
 
   int nodes() const { return n[0] * n[1] * n[2]; }
@@ -112,11 +111,8 @@ PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const Pe
   }
   levels_.back()->coarsest = true;
 
-  // Finest level: corner rows of the basis, diagonal blocks, Chebyshev bounds.
+  // Finest level: diagonal blocks, Chebyshev bound.
   const int B = field_.basis_size();
-  corner_rows_.resize(8 * std::size_t(B));
-  for (int b = 0; b < B; ++b)
-    for (int a = 0; a < 8; ++a) corner_rows_[8 * b + a] = field_.basis[b].middleRows<3>(3 * a);
   const Level& fine = *levels_.front();
   const int nodes = fine.nodes();
   fine_diagonal_.assign(9 * std::size_t(nodes), 0.0);
@@ -135,8 +131,8 @@ PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const Pe
   if (chebyshev::invert_diagonal_blocks(nodes, fine_diagonal_.data(), fine_inverse_, options_.threads) != 0)
     throw NumericalError("periodic multigrid: a node's diagonal stiffness block is not positive definite");
   fine_max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      nodes, fine_diagonal_.data(), fine_inverse_.data(),
-      [this](int i, const double* x, double out[3]) { fine_row_product(i, x, out); }, options_.threads);
+      nodes, fine_diagonal_.data(), fine_inverse_.data(), fine_rows(), [this](const VecX& x) { fine_apply(x, fine_product_); },
+      options_.threads);
   if (!(fine_max_eigenvalue_ > 0) || !std::isfinite(fine_max_eigenvalue_))
     throw NumericalError("periodic multigrid: no usable eigenvalue bound for the smoother");
 
@@ -150,7 +146,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
   const int B = field_.basis_size();
   const int s = level.scale;
   // Q[pos][b] = P_pos^T K_b P_pos for every voxel position pos inside a coarse element.
-  level.galerkin.assign(std::size_t(s) * s * s * B, Mat24::Zero());
+  std::vector<Mat24> galerkin(std::size_t(s) * s * s * B);
 #pragma omp parallel for schedule(static) num_threads(resolve_thread_count(options_.threads))
   for (int pos = 0; pos < s * s * s; ++pos) {
     const int pi = pos % s, pj = (pos / s) % s, pk = pos / (s * s);
@@ -163,7 +159,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
         for (int d = 0; d < 3; ++d) P(3 * c + d, 3 * A + d) = phi;
       }
     }
-    for (int b = 0; b < B; ++b) level.galerkin[std::size_t(pos) * B + b] = P.transpose() * field_.basis[b] * P;
+    for (int b = 0; b < B; ++b) galerkin[std::size_t(pos) * B + b] = P.transpose() * field_.basis[b] * P;
   }
 
   const int nodes = level.nodes();
@@ -173,7 +169,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(std::size_t(nodes) * 576);
     for (int e = 0; e < nodes; ++e) {
-      const Mat24 K = coarse_element(l, e);
+      const Mat24 K = coarse_element(l, e, galerkin);
       const auto c = level.coords(e);
       int corner_node[8];
       for (int a = 0; a < 8; ++a) corner_node[a] = level.node(c[0] + corner_x(a), c[1] + corner_y(a), c[2] + corner_z(a));
@@ -188,7 +184,6 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
     coarsest_full_.setFromTriplets(triplets.begin(), triplets.end());
     const SpMat pinned = coarsest_full_.block(3, 3, N - 3, N - 3);
     coarse_solver_.compute(pinned);
-    std::vector<Mat24>().swap(level.galerkin);
     if (coarse_solver_.info() != Eigen::Success)
       throw NumericalError("periodic multigrid: the coarsest operator (" + dims_text(level.n) +
                            ") is not positive definite; the cell's solid may not be connected");
@@ -230,7 +225,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
       const int i = 2 * (t % hx) + corner_x(colour), j = 2 * ((t / hx) % hy) + corner_y(colour),
                 k = 2 * (t / (hx * hy)) + corner_z(colour);
       const int e = level.node(i, j, k);
-      const Mat24 K = coarse_element(l, e);
+      const Mat24 K = coarse_element(l, e, galerkin);
       for (int a = 0; a < 8; ++a) {
         const int row = level.node(i + corner_x(a), j + corner_y(a), k + corner_z(a));
         for (int b = 0; b < 8; ++b) {
@@ -241,13 +236,13 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
       }
     }
   }
-  std::vector<Mat24>().swap(level.galerkin);
   if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads))
     throw NumericalError("periodic multigrid: a diagonal block of level " + std::to_string(l) + " (" +
                          dims_text(level.n) + ") is not positive definite");
 }
 
-Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element) const {
+Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element,
+                                            const std::vector<Mat24>& galerkin) const {
   const Level& level = *levels_[l];
   const int s = level.scale, B = field_.basis_size();
   const auto c = level.coords(static_cast<int>(element));
@@ -258,46 +253,9 @@ Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element)
         const std::int64_t v = (s * c[0] + pi) + std::int64_t(field_.nx) * ((s * c[1] + pj) + std::int64_t(field_.ny) * (s * c[2] + pk));
         const std::size_t pos = std::size_t(pi + s * (pj + s * pk));
         for (int b = 0; b < B; ++b)
-          if (const double w = field_.weight(v, b); w != 0.0) K.noalias() += w * level.galerkin[pos * B + b];
+          if (const double w = field_.weight(v, b); w != 0.0) K.noalias() += w * galerkin[pos * B + b];
       }
   return K;
-}
-
-void PeriodicGridMultigrid::fine_row_product(int node, const double* x, double out[3]) const {
-  const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
-  const int i = node % nx, j = (node / nx) % ny, k = node / (nx * ny);
-  const int xs[3] = {i == 0 ? nx - 1 : i - 1, i, i + 1 == nx ? 0 : i + 1};
-  const int ys[3] = {j == 0 ? ny - 1 : j - 1, j, j + 1 == ny ? 0 : j + 1};
-  const int zs[3] = {k == 0 ? nz - 1 : k - 1, k, k + 1 == nz ? 0 : k + 1};
-  int neighbour[27];
-  for (int dz = 0; dz < 3; ++dz)
-    for (int dy = 0; dy < 3; ++dy)
-      for (int dx = 0; dx < 3; ++dx) neighbour[dx + 3 * dy + 9 * dz] = xs[dx] + nx * (ys[dy] + ny * zs[dz]);
-  const int B = field_.basis_size();
-  Vec3 y = Vec3::Zero();
-  Eigen::Matrix<double, 24, 1> xe;
-  for (int a = 0; a < 8; ++a) {
-    // This node is corner a of the element whose corner 0 is at offset -corner(a).
-    const int e = neighbour[offset_code(-corner_x(a), -corner_y(a), -corner_z(a))];
-    bool gathered = false;
-    for (int b = 0; b < B; ++b) {
-      const double w = field_.weight(e, b);
-      if (w == 0.0) continue;
-      if (!gathered) {
-        for (int c = 0; c < 8; ++c) {
-          const double* xc = x + 3 * std::size_t(neighbour[corner_code(a, c)]);
-          xe[3 * c] = xc[0];
-          xe[3 * c + 1] = xc[1];
-          xe[3 * c + 2] = xc[2];
-        }
-        gathered = true;
-      }
-      y.noalias() += w * (corner_rows_[8 * b + a] * xe);
-    }
-  }
-  out[0] = y[0];
-  out[1] = y[1];
-  out[2] = y[2];
 }
 
 void PeriodicGridMultigrid::fine_apply(const VecX& x, VecX& y) const {
@@ -353,10 +311,7 @@ void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solu
     return;
   }
   // Finest level: K x is applied whole before each smoothing pass and read back by rows.
-  const auto fine_product = [this](int i, const double*, double out[3]) {
-    const double* y = fine_product_.data() + 3 * std::size_t(i);
-    out[0] = y[0], out[1] = y[1], out[2] = y[2];
-  };
+  const auto fine_product = fine_rows();
   const auto apply_fine = [this](const VecX& x) { fine_apply(x, fine_product_); };
   auto smooth = [&](bool zero_start) {
     if (index == 0)

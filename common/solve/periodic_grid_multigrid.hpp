@@ -83,19 +83,26 @@ class PeriodicGridMultigrid {
   struct Level;
   void build_level(std::size_t l);
   void cycle(std::size_t level, const VecX& rhs, VecX& solution);
-  // Node row of K x on the finest level (the smoother's eigenvalue estimate).
-  void fine_row_product(int node, const double* x, double out[3]) const;
   // y = K x on the finest level, element by element in 8 colours.
   void fine_apply(const VecX& x, VecX& y) const;
-  // K_E of element `element` of level l (l >= 1).
-  Mat24 coarse_element(std::size_t l, std::int64_t element) const;
+  // The row-wise view the Chebyshev kernels take: node row i of the product
+  // last computed into fine_product_ (their before_pass hook computes it).
+  auto fine_rows() const {
+    return [this](int i, const double*, double out[3]) {
+      const double* y = fine_product_.data() + 3 * std::size_t(i);
+      out[0] = y[0], out[1] = y[1], out[2] = y[2];
+    };
+  }
+  // K_E of element `element` of level l (l >= 1) from the level's Galerkin
+  // tables galerkin[pos * basis + b] = P_pos^T K_b P_pos.
+  Mat24 coarse_element(std::size_t l, std::int64_t element, const std::vector<Mat24>& galerkin) const;
 
   VoxelStiffnessField field_;
   PeriodicMultigridOptions options_;
   LinearSolveStats stats_;
   std::vector<std::unique_ptr<Level>> levels_;
-  // Finest level: rows 3a..3a+2 of each basis matrix (row-major), diagonal blocks, smoother.
-  std::vector<Eigen::Matrix<double, 3, 24, Eigen::RowMajor>> corner_rows_;  // [b * 8 + a]
+  // Finest level: diagonal blocks and their inverses, smoother bound,
+  // workspace (fine_product_ holds K x for the row-wise smoothing kernels).
   std::vector<double> fine_diagonal_, fine_inverse_;
   double fine_max_eigenvalue_ = 0.0;
   VecX step_, next_, fine_product_;

@@ -92,8 +92,7 @@ int main(int argc, char** argv) {
     // 1. Palette (or the level-1 database) and options.
     const BuildOptions options = read_build_options(ctx.config);
     ctx.config.check_no_unknown_keys();
-    if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
-      throw InputError(out + ": output folder does not exist");
+    ctx.check_out_folder();
 
     // 2. What to fit.
     const bool level2 = !options.base_database.empty();

@@ -41,8 +41,7 @@ int main(int argc, char** argv) {
     const double strain = ctx.config.require_range<double>("strain", 0.0, 0.5, Bounds::Open, "deformation strain");
     const auto seed = ctx.config.get_or<std::uint64_t>("seed", 3);
     ctx.config.check_no_unknown_keys();
-    if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
-      throw InputError(out + ": output folder does not exist");
+    ctx.check_out_folder();
 
     const CoarseDatabase full = read_coarse_db(input);
     if (full.compressed()) throw InputError(input + ": the database is already compressed");

@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
@@ -92,8 +93,7 @@ int main(int argc, char** argv) {
     // 1. Settings.
     const SamplerOptions options = read_sampler_options(ctx.config);
     ctx.config.check_no_unknown_keys();
-    if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
-      throw InputError(out + ": output folder does not exist");
+    ctx.check_out_folder();
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
     if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
     if (rank == 0) std::filesystem::create_directories(plots_dir);
@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
     // 2. Initial population, or the checkpoint.
     const std::string ckpt = sampler_checkpoint_path(out);
     SamplerState state;
+    std::optional<GamutLevelSet> gamut;  // of the current set (none yet after resuming)
     if (resume && std::filesystem::exists(ckpt)) {
       state = read_sampler_checkpoint(ckpt, run_text);
       if (rank == 0) spdlog::info("resuming after cycle {} with {} structures", state.cycles_done, state.set.items.size());
@@ -116,13 +117,13 @@ int main(int argc, char** argv) {
       StepReport init;
       state = sampler.initialize(&init);
       if (rank == 0) log_step("initial", init);
-      const GamutLevelSet gamut = sampler.level_set(state);
-      state.history.push_back({0, static_cast<int>(state.set.items.size()), init.added, 0, coverage(gamut),
+      gamut = sampler.level_set(state);
+      state.history.push_back({0, static_cast<int>(state.set.items.size()), init.added, 0, coverage(*gamut),
                                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
       if (rank == 0) {
         write_sampler_checkpoint(ckpt, run_text, state);
         if (options.plot_every_cycle)
-          plot_gamut_projection(plots_dir + "/cycle_00.png", state.set, gamut, sampler.space(), "CYCLE 0");
+          plot_gamut_projection(plots_dir + "/cycle_00.png", state.set, *gamut, sampler.space(), "CYCLE 0");
       }
     }
 
@@ -138,11 +139,11 @@ int main(int argc, char** argv) {
       const auto t0 = std::chrono::steady_clock::now();
       const StepReport discrete = sampler.discrete_step(state, cycle);
       const StepReport continuous = sampler.continuous_step(state, sampler.level_set(state), cycle);
-      const GamutLevelSet gamut = sampler.level_set(state);
-      sampler.resample(state, gamut, cycle);
+      gamut = sampler.level_set(state);
+      sampler.resample(state, *gamut, cycle);
       state.cycles_done = cycle;
       state.history.push_back({cycle, static_cast<int>(state.set.items.size()), discrete.added, continuous.added,
-                               coverage(gamut), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+                               coverage(*gamut), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
       if (rank == 0) {
         const GamutCycle& h = state.history.back();
         spdlog::info("cycle {}/{}: {} structures, coverage {:.4f}, {:.1f} s", cycle, options.cycles, h.samples,
@@ -153,7 +154,7 @@ int main(int argc, char** argv) {
         if (options.plot_every_cycle) {
           char name[32];
           std::snprintf(name, sizeof name, "/cycle_%02d.png", cycle);
-          plot_gamut_projection(plots_dir + name, state.set, gamut, sampler.space(), "CYCLE " + std::to_string(cycle));
+          plot_gamut_projection(plots_dir + name, state.set, *gamut, sampler.space(), "CYCLE " + std::to_string(cycle));
         }
       }
       ++this_run;
@@ -169,7 +170,7 @@ int main(int argc, char** argv) {
       g.property_names = sampler.space().names();
       g.E_stiff = sampler.space().E_stiff();
       g.decades = options.decades;
-      g.level_set = sampler.level_set(state);
+      g.level_set = gamut ? *gamut : sampler.level_set(state);  // resampling leaves the set as it was
       g.history = state.history;
       write_microstructures_artifact(structures_path, state.set, "msfab-gamut-sample", run_text, {}, ctx.options.seed);
       write_gamut_artifact(out, g, "msfab-gamut-sample", run_text, {structures_path}, ctx.options.seed);

@@ -69,21 +69,19 @@ std::vector<VoxelGrid> GamutSampler::random_cuts(int cycle, int count) const {
   return cells;
 }
 
-VoxelGrid GamutSampler::cell_of(const Microstructure& m) const {
+VoxelGrid GamutSampler::cell_with(std::vector<int> ids) const {
   VoxelGrid c(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution);
-  c.ids = m.ids;
+  c.ids = std::move(ids);
   return c;
 }
+
+VoxelGrid GamutSampler::cell_of(const Microstructure& m) const { return cell_with(m.ids); }
 
 bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho) const {
   m.C = C;
   m.properties = space_.cell_properties(C, rho);
   m.unit = space_.normalize(m.properties);
-  for (int a = 0; a < m.unit.size(); ++a) {
-    if (!(m.unit[a] >= -1e-9 && m.unit[a] <= 1 + 1e-9)) return false;
-    m.unit[a] = std::clamp(m.unit[a], 0.0, 1.0);  // round-off at the box's faces (the solid cell)
-  }
-  return true;
+  return MaterialSpace::clamp_to_box(m.unit);
 }
 
 StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
@@ -211,9 +209,9 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
       ++report.failed;
       continue;
     }
-    VoxelGrid c(o_.resolution, o_.resolution, voxels_per_side_z(), 1.0 / o_.resolution);
-    for (int v = 0; v < voxels; ++v) c.ids[v] = static_cast<int>(r[1 + v]);
-    cells.push_back(std::move(c));
+    std::vector<int> ids(voxels);
+    for (int v = 0; v < voxels; ++v) ids[v] = static_cast<int>(r[1 + v]);
+    cells.push_back(cell_with(std::move(ids)));
     parents.push_back(order[i].second);
   }
   const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous, palette_);

@@ -55,6 +55,8 @@ class GamutSampler {
   std::vector<MaterialPtr> palette_;  // [0] void, [1] stiff, [2] soft (if any)
   std::vector<MaterialPtr> void_palette_;  // [0] void, [1] stiff
   int voxels_per_side_z() const;
+  // A cell of the sampler's resolution with these ids, or with a structure's.
+  VoxelGrid cell_with(std::vector<int> ids) const;
   VoxelGrid cell_of(const Microstructure& m) const;
   VoxelGrid solid_cell() const;
   // `count` structures cut from the solid cell by up to initial_beams beams

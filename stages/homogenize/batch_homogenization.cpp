@@ -58,10 +58,7 @@ BatchReport homogenize_set(MicrostructureSet& set, const BatchOptions& options) 
     m.C = h.C;
     m.properties = space.cell_properties(h.C, rho);
     m.unit = space.normalize(m.properties);
-    for (int a = 0; a < m.unit.size(); ++a) {
-      if (!(m.unit[a] >= -1e-9 && m.unit[a] <= 1 + 1e-9)) outside[s] = 1;
-      m.unit[a] = std::clamp(m.unit[a], 0.0, 1.0);
-    }
+    outside[s] = !MaterialSpace::clamp_to_box(m.unit);
     progress.tick();
   }
   progress.done();

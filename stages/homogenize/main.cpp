@@ -15,7 +15,6 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <optional>
 
 #include "batch_homogenization.hpp"
@@ -61,11 +60,6 @@ HomogenizationOptions read_solver_options(const Config& config) {
   return options;
 }
 
-void require_out_folder(const std::string& out) {
-  if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
-    throw InputError(out + ": output folder does not exist");
-}
-
 void run_batch(StageContext& ctx, const std::string& structures) {
   const std::string& out = ctx.require_out();
   BatchOptions options;
@@ -78,7 +72,7 @@ void run_batch(StageContext& ctx, const std::string& structures) {
     if (ctx.config.has(key))
       ctx.config.fail(key, "batch mode (--structures) takes materials and cells from the structures artifact; drop it");
   ctx.config.check_no_unknown_keys();
-  require_out_folder(out);
+  ctx.check_out_folder();
   MicrostructureSet set = read_microstructures_artifact(structures);
   if (set.items.empty()) throw InputError(structures + ": the set holds no structures");
   spdlog::info("{}: {} structures, {} x {} x {} voxels, space {}, refine {}", structures, set.items.size(), set.nx,
@@ -118,7 +112,7 @@ int main(int argc, char** argv) {
     HomogenizationOptions options = read_solver_options(ctx.config);
     options.threads = ctx.options.threads;
     ctx.config.check_no_unknown_keys();
-    require_out_folder(out);
+    ctx.check_out_folder();
     spdlog::info("cell {} x {} x {}, {} materials", in.cell.nx, in.cell.ny, in.cell.nz, in.palette.size());
 
     // 2-4. Pieces, cell problems, tensors.
