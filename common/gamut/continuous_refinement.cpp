@@ -7,21 +7,10 @@
 #include <map>
 
 #include "core/errors.hpp"
-#include "fem/hex_element.hpp"
 #include "homog/periodic_homogenization.hpp"
 
 namespace msfab {
 namespace {
-
-constexpr int kPlane[3] = {0, 1, 5};  // in-plane Voigt rows of a 2D cell
-
-Mat24 rest_stiffness(const MaterialPtr& material, double h) {
-  const hex8::NodeMatrix X = voxel_corners(h);
-  const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
-  Mat24 K = Mat24::Zero();
-  hex_evaluate(geo, QuadratureMaterials{{material}}, X, nullptr, &K);
-  return K;
-}
 
 int periodic_gap(int a, int b, int n) {
   const int d = std::abs(a - b);
@@ -51,8 +40,8 @@ ContinuousCellProblem::ContinuousCellProblem(int nx, int ny, int nz, double h, M
   if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() > 0))
     throw InputError("continuous step: the target G is not positive definite");
   W_ = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().cwiseSqrt().asDiagonal() * eig.eigenvectors().transpose();
-  K_stiff_ = rest_stiffness(stiff, h);
-  K_soft_ = soft ? rest_stiffness(soft, h) : Mat24(options.void_stiffness * K_stiff_);
+  K_stiff_ = voxel_stiffness(stiff, h);
+  K_soft_ = soft ? voxel_stiffness(soft, h) : Mat24(options.void_stiffness * K_stiff_);
 
   // Orbits of the cell symmetry: one design variable each.
   VoxelGrid probe(nx, ny, nz, h);
@@ -131,7 +120,7 @@ double ContinuousCellProblem::objective(const std::vector<double>& x, std::vecto
   const int m = plane ? 3 : 6;
   MatX C(m, m);
   for (int a = 0; a < m; ++a)
-    for (int b = 0; b < m; ++b) C(a, b) = plane ? r.C(kPlane[a], kPlane[b]) : r.C(a, b);
+    for (int b = 0; b < m; ++b) C(a, b) = plane ? r.C(kPlaneVoigt[a], kPlaneVoigt[b]) : r.C(a, b);
   const MatX G = C.inverse();
   const MatX E = W_ * (G - target_.G) * W_;
   double rho = 0;
@@ -144,7 +133,7 @@ double ContinuousCellProblem::objective(const std::vector<double>& x, std::vecto
   const MatX dfdC_small = -2.0 * G * (W_ * E * W_) * G;
   Mat6 dfdC = Mat6::Zero();
   for (int a = 0; a < m; ++a)
-    for (int b = 0; b < m; ++b) (plane ? dfdC(kPlane[a], kPlane[b]) : dfdC(a, b)) = dfdC_small(a, b);
+    for (int b = 0; b < m; ++b) (plane ? dfdC(kPlaneVoigt[a], kPlaneVoigt[b]) : dfdC(a, b)) = dfdC_small(a, b);
   const double volume = double(xt.size()) * h_ * h_ * h_;
   const double drho = 2.0 * options_.density_weight * (rho - target_.rho) / xt.size();
   std::vector<double> df_dxt(xt.size());

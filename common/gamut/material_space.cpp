@@ -50,11 +50,7 @@ bool MaterialSpace::clamp_to_box(VecX& unit) {
 
 VecX MaterialSpace::cell_properties(const Mat6& C, double rho) const {
   if (kind_ == MaterialSpaceKind::cubic3d) return properties(C, rho);
-  constexpr int plane[3] = {0, 1, 5};  // in-plane Voigt rows of a 2D cell
-  Mat3 C2;
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) C2(a, b) = C(plane[a], plane[b]);
-  return properties_2d(C2, rho);
+  return properties_2d(plane_block(C), rho);
 }
 
 VecX MaterialSpace::properties_2d(const Mat3& C, double rho) const {

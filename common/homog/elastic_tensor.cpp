@@ -10,6 +10,13 @@ Mat3 strain_tensor(const Vec6& e) {
   return s;
 }
 
+Mat3 plane_block(const Mat6& C) {
+  Mat3 P;
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) P(a, b) = C(kPlaneVoigt[a], kPlaneVoigt[b]);
+  return P;
+}
+
 Mat6 isotropic_tensor(double E, double nu) {
   const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
   Mat6 C = Mat6::Zero();

@@ -15,6 +15,11 @@ Mat3 strain_tensor(const Vec6& voigt);
 // Isotropic tensor from Young's modulus and Poisson's ratio.
 Mat6 isotropic_tensor(double E, double nu);
 
+// Voigt rows of the in-plane components (xx, yy, xy) of a 2D
+// (plane-strain) cell, and that 3 x 3 block of a 6 x 6 tensor.
+inline constexpr int kPlaneVoigt[3] = {0, 1, 5};
+Mat3 plane_block(const Mat6& C);
+
 // Moduli of a tensor with cubic symmetry (axes along x, y, z): C11, C12,
 // C44 averaged over their three copies, and the engineering constants
 // E = (C11 - C12)(C11 + 2 C12) / (C11 + C12), nu = C12 / (C11 + C12),

@@ -64,15 +64,13 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
 
   // Element stiffness per palette id (at rest); void: a fraction of the
   // stiffest. One basis matrix per id, weights one-hot.
-  const hex8::NodeMatrix X = voxel_corners(cell.voxel_size);
-  const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
   VoxelStiffnessField field;
   field.nx = nx, field.ny = ny, field.nz = nz, field.h = cell.voxel_size;
   field.basis.assign(palette.size(), Mat24::Zero());
   int stiffest = -1;
   for (std::size_t id = 1; id < palette.size(); ++id) {
     if (!palette[id] || fraction[id] == 0) continue;
-    hex_evaluate(geo, QuadratureMaterials{{palette[id]}}, X, nullptr, &field.basis[id]);
+    field.basis[id] = voxel_stiffness(palette[id], cell.voxel_size);
     if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus()) stiffest = static_cast<int>(id);
   }
   field.basis[0] = options.void_stiffness * field.basis[stiffest];
@@ -82,6 +80,14 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   out.volume_fraction = fraction;
   out.pieces = count_periodic_pieces(cell);
   return out;
+}
+
+Mat24 voxel_stiffness(const MaterialPtr& material, double h) {
+  const hex8::NodeMatrix X = voxel_corners(h);
+  const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
+  Mat24 K = Mat24::Zero();
+  hex_evaluate(geo, QuadratureMaterials{{material}}, X, nullptr, &K);
+  return K;
 }
 
 hex8::NodeMatrix voxel_corners(double h) {
@@ -259,9 +265,7 @@ PlaneStrainResult homogenize_plane_strain(const VoxelGrid& cell, const std::vect
                      std::to_string(cell.nz));
   PlaneStrainResult r;
   r.full = homogenize(cell, palette, options);
-  const int in_plane[3] = {0, 1, 5};
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) r.C(a, b) = r.full.C(in_plane[a], in_plane[b]);
+  r.C = plane_block(r.full.C);
   r.G = r.C.inverse();
   return r;
 }

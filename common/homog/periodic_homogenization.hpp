@@ -79,6 +79,10 @@ std::string homogenization_solver(int nx, int ny, int nz, const std::string& opt
 // Corner positions of one voxel of size h (corner a at (a>>2&1, a>>1&1, a&1) h).
 hex8::NodeMatrix voxel_corners(double h);
 
+// The element stiffness of a voxel of size h at rest (the material's
+// Hessian at F = I, 2 x 2 x 2 Gauss points), corners as voxel_corners(h).
+Mat24 voxel_stiffness(const MaterialPtr& material, double h);
+
 // Columns m = 0..5: the total displacement (affine eps^m x plus the
 // periodic fluctuation) at the 8 corners of `voxel`. Then
 // C^H_mn = sum_v U_v^T K_v U_v / |Y|, and because the fluctuations are

@@ -131,7 +131,7 @@ PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const Pe
   if (chebyshev::invert_diagonal_blocks(nodes, fine_diagonal_.data(), fine_inverse_, options_.threads) != 0)
     throw NumericalError("periodic multigrid: a node's diagonal stiffness block is not positive definite");
   fine_max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      nodes, fine_diagonal_.data(), fine_inverse_.data(), fine_rows(), [this](const VecX& x) { fine_apply(x, fine_product_); },
+      nodes, fine_diagonal_.data(), fine_inverse_.data(), fine_rows(), [this](const VecX& x) { multiply(x, fine_product_); },
       options_.threads);
   if (!(fine_max_eigenvalue_ > 0) || !std::isfinite(fine_max_eigenvalue_))
     throw NumericalError("periodic multigrid: no usable eigenvalue bound for the smoother");
@@ -258,7 +258,7 @@ Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element,
   return K;
 }
 
-void PeriodicGridMultigrid::fine_apply(const VecX& x, VecX& y) const {
+void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
   const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
   const Eigen::Index n = 3 * Eigen::Index(nx) * ny * nz;
   const int hx = nx / 2, hy = ny / 2, half = hx * hy * (nz / 2);
@@ -295,7 +295,6 @@ void PeriodicGridMultigrid::fine_apply(const VecX& x, VecX& y) const {
   }
 }
 
-void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const { fine_apply(x, y); }
 
 void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
   Level& level = *levels_[index];
@@ -312,7 +311,7 @@ void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solu
   }
   // Finest level: K x is applied whole before each smoothing pass and read back by rows.
   const auto fine_product = fine_rows();
-  const auto apply_fine = [this](const VecX& x) { fine_apply(x, fine_product_); };
+  const auto apply_fine = [this](const VecX& x) { multiply(x, fine_product_); };
   auto smooth = [&](bool zero_start) {
     if (index == 0)
       chebyshev::smooth(level.nodes(), fine_inverse_.data(), fine_max_eigenvalue_, options_.smoother_degree,
@@ -385,7 +384,7 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
   CgOperator op;
   op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
   op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
-    fine_apply(x, y);
+    multiply(x, y);
     return parallel_dot(x, y, threads);
   };
   CgPreconditioner preconditioner;

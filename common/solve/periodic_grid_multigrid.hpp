@@ -66,7 +66,7 @@ class PeriodicGridMultigrid {
   VecX solve(const VecX& b);
   const LinearSolveStats& stats() const { return stats_; }
 
-  // y = K x (finest level, matrix-free).
+  // y = K x (finest level, matrix-free, element by element in 8 colours).
   void multiply(const VecX& x, VecX& y) const;
   // One cycle z = M^-1 r (r and z of zero mean).
   VecX apply_preconditioner(const VecX& r);
@@ -83,8 +83,6 @@ class PeriodicGridMultigrid {
   struct Level;
   void build_level(std::size_t l);
   void cycle(std::size_t level, const VecX& rhs, VecX& solution);
-  // y = K x on the finest level, element by element in 8 colours.
-  void fine_apply(const VecX& x, VecX& y) const;
   // The row-wise view the Chebyshev kernels take: node row i of the product
   // last computed into fine_product_ (their before_pass hook computes it).
   auto fine_rows() const {

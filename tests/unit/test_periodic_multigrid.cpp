@@ -10,8 +10,6 @@
 #include <random>
 
 #include "core/errors.hpp"
-#include "fem/hex8.hpp"
-#include "fem/hex_element.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 #include "solve/periodic_grid_multigrid.hpp"
@@ -20,11 +18,7 @@ namespace msfab {
 namespace {
 
 Mat24 rest_stiffness(double E, double nu, double h) {
-  const hex8::NodeMatrix X = voxel_corners(h);
-  const hex8::ElementGeometry geo = hex8::element_geometry(X, hex8::gauss_rule(2));
-  Mat24 K = Mat24::Zero();
-  hex_evaluate(geo, QuadratureMaterials{{std::make_shared<LinearIsotropic>(E, nu)}}, X, nullptr, &K);
-  return K;
+  return voxel_stiffness(std::make_shared<LinearIsotropic>(E, nu), h);
 }
 
 // Two materials mixed per voxel with random weights (a SIMP-like field).
