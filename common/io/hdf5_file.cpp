@@ -1,10 +1,12 @@
 #include "io/hdf5_file.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <utility>
 
 #include "core/errors.hpp"
 
@@ -412,6 +414,86 @@ void H5File::read_raw(const std::string& path, H5Dtype dtype, void* data, std::s
     throw InputError(path_ + ": reading dataset '" + path + "' failed (file corrupt? " +
                      hdf5_error_detail() + ")");
   }
+}
+
+// ---------------------------------------------------------------------------
+// Datasets written and read piece by piece
+
+void H5File::create_chunked_raw(const std::string& path, H5Dtype dtype, const std::vector<hsize_t>& shape,
+                                const std::vector<hsize_t>& chunk, int gzip_level) {
+  require_open();
+  if (exists(path)) throw std::runtime_error(path_ + ": '" + path + "' already exists");
+  if (shape.empty() || chunk.size() != shape.size())
+    throw std::logic_error(path_ + ": chunked dataset '" + path + "' needs a chunk shape of rank " +
+                           std::to_string(shape.size()) + " >= 1");
+  for (hsize_t c : chunk)
+    if (c == 0) throw std::logic_error(path_ + ": chunked dataset '" + path + "': chunk extents must be >= 1");
+  H5Id space(H5Screate_simple(int(shape.size()), shape.data(), nullptr), H5Sclose);
+  if (!space.valid()) throw std::runtime_error(path_ + ": bad shape " + shape_text(shape) + " for '" + path + "'");
+  H5Id create(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  H5Pset_chunk(create.get(), int(chunk.size()), chunk.data());
+  if (gzip_level > 0) {
+    if (!gzip_available()) throw std::runtime_error("this HDF5 library has no gzip filter");
+    H5Pset_shuffle(create.get());
+    H5Pset_deflate(create.get(), unsigned(std::min(gzip_level, 9)));
+  }
+  H5Id lcpl = link_creation_with_parents();
+  H5Id dataset(H5Dcreate2(file_.get(), path.c_str(), file_type_of(dtype), space.get(), lcpl.get(), create.get(),
+                          H5P_DEFAULT),
+               H5Dclose);
+  if (!dataset.valid())
+    throw std::runtime_error(path_ + ": cannot create dataset '" + path + "' (" + hdf5_error_detail() + ")");
+  if (dataset.close() < 0)
+    throw std::runtime_error(path_ + ": closing dataset '" + path + "' failed (" + hdf5_error_detail() + ")");
+}
+
+namespace {
+// Selects offset/count in the dataset's file space (std::out_of_range naming
+// the dataset when the block does not fit). Returns the file space and a
+// matching memory space.
+std::pair<H5Id, H5Id> select_slab(const std::string& file, const std::string& path, hid_t dataset,
+                                  const std::vector<hsize_t>& offset, const std::vector<hsize_t>& count) {
+  H5Id space(H5Dget_space(dataset), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  std::vector<hsize_t> shape(std::size_t(std::max(rank, 0)), 0);
+  if (rank > 0) H5Sget_simple_extent_dims(space.get(), shape.data(), nullptr);
+  bool fits = offset.size() == shape.size() && count.size() == shape.size() && rank > 0;
+  for (std::size_t d = 0; fits && d < shape.size(); ++d) fits = offset[d] + count[d] <= shape[d];
+  if (!fits)
+    throw std::out_of_range(file + ": dataset '" + path + "' of shape " + shape_text(shape) +
+                            " has no block at offset " + shape_text(offset) + " of " + shape_text(count));
+  H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, offset.data(), nullptr, count.data(), nullptr);
+  H5Id memory(H5Screate_simple(int(count.size()), count.data(), nullptr), H5Sclose);
+  return {std::move(space), std::move(memory)};
+}
+}  // namespace
+
+void H5File::write_slab_raw(const std::string& path, H5Dtype dtype, const void* data,
+                            const std::vector<hsize_t>& offset, const std::vector<hsize_t>& count) {
+  require_open();
+  if (!is_dataset(path)) throw std::runtime_error(path_ + ": dataset '" + path + "' not found");
+  H5Id dataset(H5Dopen2(file_.get(), path.c_str(), H5P_DEFAULT), H5Dclose);
+  auto [space, memory] = select_slab(path_, path, dataset.get(), offset, count);
+  if (element_count(count) > 0 &&
+      H5Dwrite(dataset.get(), memory_type_of(dtype), memory.get(), space.get(), H5P_DEFAULT, data) < 0)
+    throw std::runtime_error(path_ + ": writing a block of dataset '" + path + "' failed (" + hdf5_error_detail() +
+                             ")");
+}
+
+void H5File::read_slab_raw(const std::string& path, H5Dtype dtype, void* data, const std::vector<hsize_t>& offset,
+                           const std::vector<hsize_t>& count) const {
+  require_open();
+  if (!is_dataset(path)) throw InputError(path_ + ": dataset '" + path + "' not found");
+  H5Id dataset(H5Dopen2(file_.get(), path.c_str(), H5P_DEFAULT), H5Dclose);
+  H5Id stored_type(H5Dget_type(dataset.get()), H5Tclose);
+  if (!converts_losslessly(stored_type.get(), dtype))
+    throw InputError(path_ + ": dataset '" + path + "' holds " + describe_type(stored_type.get()) +
+                     ", cannot read it as " + dtype_name(dtype));
+  auto [space, memory] = select_slab(path_, path, dataset.get(), offset, count);
+  if (element_count(count) > 0 &&
+      H5Dread(dataset.get(), memory_type_of(dtype), memory.get(), space.get(), H5P_DEFAULT, data) < 0)
+    throw InputError(path_ + ": reading a block of dataset '" + path + "' failed (file corrupt? " +
+                     hdf5_error_detail() + ")");
 }
 
 // ---------------------------------------------------------------------------

@@ -137,6 +137,36 @@ class H5File {
               {hsize_t(copy.rows()), hsize_t(copy.cols())}, options);
   }
 
+  // --- datasets written piece by piece (larger than memory) -------------
+  // create_chunked_dataset makes a dataset of `shape` stored in chunks of
+  // `chunk` (same rank, every entry >= 1; gzip_level 0..9 adds shuffle +
+  // gzip) and writes no data: elements never written read as 0. write_slab
+  // then fills the block of `count` elements per dimension starting at
+  // `offset` from `data` (C order, count[0] * count[1] * ... values), so a
+  // writer needs only one block in memory at a time. read_slab reads such a
+  // block back (any dataset; same lossless conversions as read_dataset). A
+  // block outside the dataset's shape throws std::out_of_range.
+  //
+  //   f.create_chunked_dataset<std::uint8_t>("/voxels", {layers, bytes}, {8, bytes}, 4);
+  //   for (layer...) f.write_slab("/voxels", row.data(), {layer, 0}, {1, bytes});
+  template <class T>
+  void create_chunked_dataset(const std::string& path, const std::vector<hsize_t>& shape,
+                              const std::vector<hsize_t>& chunk, int gzip_level = 0) {
+    create_chunked_raw(path, H5DtypeOf<T>::value, shape, chunk, gzip_level);
+  }
+  template <class T>
+  void write_slab(const std::string& path, const T* data, const std::vector<hsize_t>& offset,
+                  const std::vector<hsize_t>& count) {
+    write_slab_raw(path, H5DtypeOf<T>::value, data, offset, count);
+  }
+  template <class T>
+  std::vector<T> read_slab(const std::string& path, const std::vector<hsize_t>& offset,
+                           const std::vector<hsize_t>& count) const {
+    std::vector<T> values(element_count(count));
+    read_slab_raw(path, H5DtypeOf<T>::value, values.data(), offset, count);
+    return values;
+  }
+
   // --- reading datasets --------------------------------------------------
   // A dataset is read as T when that is lossless: integers into a wide
   // enough integer type, floats (and integers up to 32 bit) into double.
@@ -214,6 +244,12 @@ class H5File {
   void write_raw(const std::string& path, H5Dtype dtype, const void* data,
                  const std::vector<hsize_t>& shape, const H5WriteOptions& options);
   void read_raw(const std::string& path, H5Dtype dtype, void* data, std::size_t count) const;
+  void create_chunked_raw(const std::string& path, H5Dtype dtype, const std::vector<hsize_t>& shape,
+                          const std::vector<hsize_t>& chunk, int gzip_level);
+  void write_slab_raw(const std::string& path, H5Dtype dtype, const void* data,
+                      const std::vector<hsize_t>& offset, const std::vector<hsize_t>& count);
+  void read_slab_raw(const std::string& path, H5Dtype dtype, void* data, const std::vector<hsize_t>& offset,
+                     const std::vector<hsize_t>& count) const;
   void write_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,
                            const void* data, std::size_t count, bool scalar);
   void read_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,

@@ -1,0 +1,145 @@
+#include "mapping/mapper.hpp"
+
+#include <algorithm>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+namespace {
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ",") + n;
+  return s;
+}
+
+}  // namespace
+
+void check_mapping_inputs(const Design& design, const std::string& design_path, const MicrostructureSet& set,
+                          const std::string& structures_path) {
+  if (!is_gamut_space(design.space))
+    throw InputError(design_path + ": design space '" + design.space +
+                     "' is not a gamut space (cubic3d, cubic2d, orthotropic2d); only designs optimized in a "
+                     "microstructure gamut can be mapped to microstructures");
+  if (set.items.empty()) throw InputError(structures_path + ": the microstructure set holds no structures");
+  if (design.space != set.space)
+    throw InputError(structures_path + ": microstructure space '" + set.space + "' differs from the design's '" +
+                     design.space + "' (" + design_path + ")");
+  if (design.property_names != set.property_names)
+    throw InputError(structures_path + ": property names '" + joined(set.property_names) +
+                     "' differ from the design's '" + joined(design.property_names) + "' (" + design_path + ")");
+  const bool flat_set = set.nz == 1;
+  if (design.dimension == 2 && !flat_set)
+    throw InputError(structures_path + ": 3D structures (" + std::to_string(set.nx) + " x " + std::to_string(set.ny) +
+                     " x " + std::to_string(set.nz) + " voxels) for the 2D design " + design_path);
+  if (design.dimension == 3 && flat_set)
+    throw InputError(structures_path + ": 2D structures (" + std::to_string(set.nx) + " x " + std::to_string(set.ny) +
+                     " voxels) for the 3D design " + design_path);
+  if (design.cells() < 1) throw InputError(design_path + ": the design has no cells");
+  const Eigen::Index d = Eigen::Index(design.property_names.size());
+  if (design.unit.cols() != d || design.unit.rows() != design.cells())
+    throw InputError(design_path + ": /cells/unit must be cells x properties");
+  if (std::int64_t(design.roles.size()) != design.cells())
+    throw InputError(design_path + ": /cells/role must have one entry per cell");
+  if (!design.unit.allFinite()) throw InputError(design_path + ": /cells/unit holds non-finite values");
+  for (std::size_t i = 0; i < set.items.size(); ++i)
+    if (set.items[i].unit.size() != d || !set.items[i].unit.allFinite())
+      throw InputError(structures_path + ": structure " + std::to_string(i) + " has no finite unit properties");
+}
+
+CellCandidates design_candidates(const Design& design, const MicrostructureSet& set,
+                                 const CandidateOptions& options) {
+  MatX points(Eigen::Index(set.items.size()), design.unit.cols());
+  for (std::size_t i = 0; i < set.items.size(); ++i) points.row(Eigen::Index(i)) = set.items[i].unit.transpose();
+  std::vector<bool> wanted(std::size_t(design.cells()));
+  for (std::size_t c = 0; c < wanted.size(); ++c) wanted[c] = design.roles[c] == CellRole::design;
+  return find_candidates(design.unit, wanted, points, options);
+}
+
+MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
+                                 bool half_shift) {
+  const int variants = half_shift ? 2 : 1;
+  FaceTable table(set.nx, set.ny, set.nz, design.dimension);
+  const int empty = table.add_uniform(0);
+  const int solid = table.add_uniform(1);
+  // Faces only of the structures some cell may take: entry of structure s,
+  // variant v is first_entry[s] + v.
+  std::vector<int> first_entry(set.items.size(), -1);
+  for (std::int32_t s : candidates.structure) first_entry[std::size_t(s)] = 0;
+  for (std::size_t s = 0; s < set.items.size(); ++s) {
+    if (first_entry[s] < 0) continue;
+    first_entry[s] = table.add(set.items[s].ids);
+    if (half_shift) table.add(half_shifted(set.items[s].ids, set.nx, set.ny, set.nz));
+  }
+  const std::int64_t cells = design.cells();
+  std::vector<std::int64_t> offsets(std::size_t(cells) + 1, 0);
+  for (std::int64_t c = 0; c < cells; ++c)
+    offsets[c + 1] = offsets[c] + (design.roles[c] == CellRole::design ? candidates.count(c) * variants : 1);
+  std::vector<std::int32_t> options(std::size_t(offsets.back()));
+  for (std::int64_t c = 0; c < cells; ++c) {
+    std::int64_t o = offsets[c];
+    if (design.roles[c] != CellRole::design) {
+      options[o] = design.roles[c] == CellRole::empty ? empty : solid;
+      continue;
+    }
+    for (std::int64_t j = candidates.offsets[c]; j < candidates.offsets[c + 1]; ++j)
+      for (int v = 0; v < variants; ++v) options[o++] = first_entry[candidates.structure[j]] + v;
+  }
+  CellGrid grid{design.dimension, design.nx, design.ny, design.nz};
+  return MismatchProblem(grid, std::move(table), std::move(offsets), std::move(options));
+}
+
+MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
+                           const MismatchProblem& problem, const DescentReport& report,
+                           const MapperOptions& options) {
+  const int variants = options.half_shift ? 2 : 1;
+  MappedDesign m;
+  m.space = design.space;
+  m.property_names = design.property_names;
+  m.dimension = design.dimension;
+  m.nx = design.nx, m.ny = design.ny, m.nz = design.nz;
+  m.cell_size = design.cell_size;
+  m.vx = set.nx, m.vy = set.ny, m.vz = set.nz;
+  m.roles = design.roles;
+  const std::size_t n = std::size_t(design.cells());
+  m.structure.assign(n, -1);
+  m.shift.assign(n, 0);
+  m.distance.assign(n, 0.0);
+  m.candidates.assign(n, 0);
+  m.mismatch.resize(n);
+  for (std::size_t c = 0; c < n; ++c) {
+    m.mismatch[c] = problem.energy(std::int64_t(c));
+    if (design.roles[c] != CellRole::design) continue;
+    const int o = problem.choice()[c];
+    const std::int64_t j = candidates.offsets[c] + o / variants;
+    m.structure[c] = candidates.structure[std::size_t(j)];
+    m.shift[c] = static_cast<std::uint8_t>(o % variants);
+    m.distance[c] = candidates.distance[std::size_t(j)];
+    m.candidates[c] = std::int32_t(candidates.count(std::int64_t(c)));
+  }
+  m.history = report.history;
+  m.history_cell = report.changed;
+  m.k = options.candidates.k;
+  m.radius = options.candidates.radius;
+  m.half_shift = options.half_shift;
+  m.max_distance = options.max_distance;
+  m.evaluations = report.evaluations;
+  m.seconds = report.seconds;
+  return m;
+}
+
+DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped,
+                                    double max_distance) {
+  DistanceSummary s;
+  for (std::int64_t c = 0; c < mapped.cells(); ++c) {
+    if (mapped.roles[std::size_t(c)] != CellRole::design) continue;
+    ++s.design_cells;
+    const double nearest = candidates.nearest_distance(c);
+    if (nearest > max_distance) ++s.far_cells;
+    s.max_nearest = std::max(s.max_nearest, nearest);
+    s.max_chosen = std::max(s.max_chosen, mapped.distance[std::size_t(c)]);
+  }
+  return s;
+}
+
+}  // namespace msfab

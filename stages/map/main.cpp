@@ -1,0 +1,179 @@
+// msfab-map: replace every cell of an optimized design by a microstructure
+// whose properties match the cell's, choosing among near matches so that
+// neighbouring cells line up at their shared faces (thesis §3.5).
+//
+//   1. candidates: per design cell the k nearest structures to its target
+//      in the normalized material space (and all within `radius`), each also
+//      translated by half a cell (same properties, another boundary)
+//   2. mismatch energy I = sum_i I_i, I_i the boundary voxels of cell i whose
+//      id differs from the voxel across the face (forced empty cells void,
+//      forced solid cells id 1)
+//   3. a random candidate per cell (hash of seed and cell), then greedy
+//      descent: the cell with the largest I_i takes the candidate lowering I
+//      most, or leaves the list; changed cells' neighbours re-enter it; until
+//      no single change lowers I
+//   4. write `msfab.mapped`; on request the voxel model as a bit-packed
+//      voxel file, per-material STL surfaces and PNG slices, layer by layer
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+
+#include "cli/stage_app.hpp"
+#include "core/errors.hpp"
+#include "mapping/mapper.hpp"
+#include "mapping/voxel_model.hpp"
+
+using namespace msfab;
+
+namespace {
+
+constexpr const char* kDefaults = R"(
+candidates: 16          # nearest structures per cell
+half_shift: true        # also offer every candidate translated by half a cell
+max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
+export:
+  voxels: false         # <stem>.voxels.h5, bit-packed, written layer by layer
+  stl: false            # <stem>.material<id>.stl per material
+  png: false            # <stem>.slices/z00000.png ... one per voxel layer
+  stl_max_voxels: 16777216
+)";
+
+struct ExportOptions {
+  bool voxels = false, stl = false, png = false;
+  std::int64_t stl_max_voxels = 0;
+};
+
+struct Settings {
+  MapperOptions mapper;
+  ExportOptions exports;
+};
+
+Settings read_settings(const Config& config) {
+  Settings s;
+  s.mapper.candidates.k = config.get_or<int>("candidates", 16);
+  if (s.mapper.candidates.k < 1 || s.mapper.candidates.k > 4096) config.fail("candidates", "must be 1..4096");
+  if (config.has("radius")) s.mapper.candidates.radius = config.require_positive("radius", "candidate radius");
+  s.mapper.half_shift = config.get_or<bool>("half_shift", true);
+  s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
+  if (!(s.mapper.max_distance > 0)) config.fail("max_distance", "must be > 0");
+  s.exports.voxels = config.get_or<bool>("export.voxels", false);
+  s.exports.stl = config.get_or<bool>("export.stl", false);
+  s.exports.png = config.get_or<bool>("export.png", false);
+  s.exports.stl_max_voxels = config.get_or<std::int64_t>("export.stl_max_voxels", 16777216);
+  if (s.exports.stl_max_voxels < 1) config.fail("export.stl_max_voxels", "must be >= 1");
+  return s;
+}
+
+// "run/part.mapped.h5" -> "run/part"; otherwise drop ".h5".
+std::string stem_of(const std::string& out) {
+  for (const std::string suffix : {".mapped.h5", ".h5"})
+    if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return out.substr(0, out.size() - suffix.size());
+  return out;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  StageApp app("msfab-map", "Map a design's cells to microstructures with matching boundaries (thesis 3.5)");
+  app.add_common_options();
+  app.set_default_config(kDefaults);
+  std::string design_path, structures_path;
+  app.cli().add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
+      ->type_name("FILE")
+      ->required();
+  app.cli().add_option("--structures", structures_path, "msfab.microstructures artifact of the same space")
+      ->type_name("FILE")
+      ->required();
+  return app.run(argc, argv, [&](StageContext& ctx) {
+    const Settings settings = read_settings(ctx.config);
+    ctx.config.check_no_unknown_keys();
+    const std::string out = ctx.require_out();
+    ctx.check_out_folder();
+    const std::string stem = stem_of(out);
+
+    const MicrostructureSet set = read_microstructures_artifact(structures_path);
+    const Design design = read_design_artifact(design_path);
+    check_mapping_inputs(design, design_path, set, structures_path);
+    const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz;
+    if (settings.exports.stl && model_voxels > settings.exports.stl_max_voxels)
+      ctx.config.fail("export.stl", "the model has " + std::to_string(model_voxels) +
+                                        " voxels, more than export.stl_max_voxels = " +
+                                        std::to_string(settings.exports.stl_max_voxels) +
+                                        "; raise the limit, or export voxels or png slices instead");
+    spdlog::info("{}: {} x {} x {} cells ({}), {}: {} structures of {} x {} x {} voxels", design_path, design.nx,
+                 design.ny, design.nz, design.space, structures_path, set.items.size(), set.nx, set.ny, set.nz);
+    const auto start = std::chrono::steady_clock::now();
+
+    // 1. Candidates (and their half-shifted variants).
+    const CellCandidates candidates = design_candidates(design, set, settings.mapper.candidates);
+    // 2. Boundary faces and the mismatch energy of every cell.
+    MismatchProblem problem = mismatch_problem(design, set, candidates, settings.mapper.half_shift);
+    // 3. Random start, then greedy descent on the priority list.
+    problem.randomize(ctx.options.seed);
+    spdlog::info("initial mismatch {}", problem.total());
+    const DescentReport descent = problem.descend();
+    spdlog::info("final mismatch {} after {} moves ({} cells evaluated)", descent.final, descent.moves,
+                 descent.evaluations);
+    // 4. The mapping artifact.
+    const MappedDesign mapped = mapped_design(design, set, candidates, problem, descent, settings.mapper);
+    const double mapping_seconds = seconds_since(start);
+    write_mapped_artifact(out, mapped, "msfab-map", ctx.config.resolved_text(), {design_path, structures_path},
+                          ctx.options.seed);
+
+    const DistanceSummary distances = summarize_distances(candidates, mapped, settings.mapper.max_distance);
+    if (distances.far_cells > 0)
+      spdlog::warn("{} of {} design cells have no structure within max_distance {} of their target (farthest "
+                   "nearest candidate {:.4g}); the set does not cover those properties",
+                   distances.far_cells, distances.design_cells, settings.mapper.max_distance, distances.max_nearest);
+
+    std::int64_t min_cand = 0, max_cand = 0, sum_cand = 0;
+    for (std::int64_t c = 0; c < candidates.cells(); ++c) {
+      if (design.roles[std::size_t(c)] != CellRole::design) continue;
+      const std::int64_t n = candidates.count(c);
+      min_cand = sum_cand == 0 ? n : std::min(min_cand, n);
+      max_cand = std::max(max_cand, n), sum_cand += n;
+    }
+    const double mean_cand = distances.design_cells ? double(sum_cand) / double(distances.design_cells) : 0.0;
+    std::printf("msfab-map: %lld cells (%d x %d x %d, %lld to map), %.3f s\n", static_cast<long long>(design.cells()),
+                design.nx, design.ny, design.nz, static_cast<long long>(distances.design_cells), mapping_seconds);
+    std::printf("  candidates per cell: %.1f (min %lld, max %lld)%s\n", mean_cand, static_cast<long long>(min_cand),
+                static_cast<long long>(max_cand), settings.mapper.half_shift ? ", each with its half-shifted exemplar" : "");
+    const double drop = descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;
+    std::printf("  mismatch: initial %lld, final %lld (-%.1f%%), %lld moves, %lld evaluations, descent %.3f s\n",
+                static_cast<long long>(descent.initial), static_cast<long long>(descent.final), drop,
+                static_cast<long long>(descent.moves), static_cast<long long>(descent.evaluations), descent.seconds);
+    std::printf("  distance to target: max %.4g (nearest candidate: max %.4g; %lld cells beyond max_distance %g)\n",
+                distances.max_chosen, distances.max_nearest, static_cast<long long>(distances.far_cells),
+                settings.mapper.max_distance);
+    std::printf("  artifact: %s\n", out.c_str());
+
+    // Exports of the voxel model, each streamed layer by layer.
+    if (!settings.exports.voxels && !settings.exports.stl && !settings.exports.png) return;
+    const VoxelModel model(mapped, set);
+    const auto export_start = std::chrono::steady_clock::now();
+    if (settings.exports.voxels) {
+      const std::string path = stem + ".voxels.h5";
+      write_voxels_artifact(path, model, "msfab-map", ctx.config.resolved_text(), {design_path, structures_path},
+                            ctx.options.seed);
+      std::printf("  voxels: %s (%lld x %lld x %lld)\n", path.c_str(), static_cast<long long>(model.nx()),
+                  static_cast<long long>(model.ny()), static_cast<long long>(model.nz()));
+    }
+    if (settings.exports.stl) {
+      const StlExport stl = write_material_stls(stem, model);
+      for (std::size_t i = 0; i < stl.paths.size(); ++i)
+        std::printf("  stl: %s (%lld triangles)\n", stl.paths[i].c_str(), static_cast<long long>(stl.triangles[i]));
+    }
+    if (settings.exports.png) {
+      const std::int64_t n = write_png_slices(stem + ".slices", model);
+      std::printf("  png: %s.slices/ (%lld layers)\n", stem.c_str(), static_cast<long long>(n));
+    }
+    std::printf("  exports: %.3f s\n", seconds_since(export_start));
+  });
+}
