@@ -1,5 +1,7 @@
 #include "gamut/level_set.hpp"
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -286,6 +288,49 @@ VecX GamutLevelSet::gradient(const VecX& p) const {
   const double out = outside.norm();
   if (out > 0) g += outside / out;
   return g;
+}
+
+double GamutLevelSet::smooth_value(const VecX& p, VecX* gradient) const {
+  if (p.size() != dim_) throw std::invalid_argument("GamutLevelSet::smooth_value: wrong dimension");
+  // Per axis: the nearest node i, the offset u in [-1/2, 1/2], and the
+  // quadratic B-spline weights of nodes i - 1, i, i + 1 and their slopes.
+  std::vector<std::array<int, 3>> index(dim_);
+  std::vector<std::array<double, 3>> w(dim_), dw(dim_);
+  VecX outside = VecX::Zero(dim_);
+  for (int a = 0; a < dim_; ++a) {
+    double t = (p[a] - lo_) / h_ - 0.5;
+    if (t < 0) outside[a] = t * h_, t = 0;
+    if (t > cells_ - 1) outside[a] = (t - (cells_ - 1)) * h_, t = cells_ - 1;
+    const int i = int(std::lround(t));
+    const double u = t - i;
+    w[a] = {0.5 * (0.5 - u) * (0.5 - u), 0.75 - u * u, 0.5 * (0.5 + u) * (0.5 + u)};
+    const double slope = outside[a] != 0 ? 0.0 : 1.0 / h_;
+    dw[a] = {-(0.5 - u) * slope, -2 * u * slope, (0.5 + u) * slope};
+    for (int k = 0; k < 3; ++k) index[a][k] = std::clamp(i + k - 1, 0, cells_ - 1);
+  }
+  double v = 0;
+  VecX g = VecX::Zero(dim_);
+  std::vector<int> corner(dim_), digit(dim_, 0);
+  int terms = 1;
+  for (int a = 0; a < dim_; ++a) terms *= 3;
+  for (int t = 0; t < terms; ++t) {
+    int rest = t;
+    for (int a = 0; a < dim_; ++a) digit[a] = rest % 3, rest /= 3, corner[a] = index[a][digit[a]];
+    const double phi = node(corner);
+    double weight = 1;
+    for (int a = 0; a < dim_; ++a) weight *= w[a][digit[a]];
+    v += weight * phi;
+    if (!gradient) continue;
+    for (int a = 0; a < dim_; ++a) {
+      double wa = dw[a][digit[a]];
+      for (int b = 0; b < dim_; ++b)
+        if (b != a) wa *= w[b][digit[b]];
+      g[a] += wa * phi;
+    }
+  }
+  const double out = outside.norm();
+  if (gradient) *gradient = out > 0 ? VecX(g + outside / out) : g;
+  return v + out;
 }
 
 }  // namespace msfab

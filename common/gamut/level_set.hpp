@@ -51,6 +51,13 @@ class GamutLevelSet {
   double value(const VecX& p) const;
   // Gradient of that interpolant (inside the node range).
   VecX gradient(const VecX& p) const;
+  // A C1 alternative for optimizers: the tensor-product quadratic B-spline
+  // with the node values as coefficients (3^d nodes per query), and its
+  // exact gradient. It reproduces linear functions, so a signed distance
+  // keeps its slope; unlike value() its gradient has no jumps across grid
+  // faces, which Newton-type optimizers need to settle on the boundary.
+  // Beyond the node range: like value().
+  double smooth_value(const VecX& p, VecX* gradient = nullptr) const;
 
  private:
   int dim_ = 0, cells_ = 0;

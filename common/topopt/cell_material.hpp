@@ -1,0 +1,80 @@
+#pragma once
+// How a cell's material parameters become its stiffness, and which
+// parameters are achievable (thesis §3.4, §3.6.2, Fig. 3-16).
+//
+// The optimizer works on parameters normalized to [0, 1] (the unit cube of
+// gamut/material_space.hpp: moduli on a log scale, Poisson's ratios
+// linearly, rho as is), so every space has the same box bounds and the
+// gamut level set is queried directly. Each model gives the cell's Voigt
+// stiffness C(p) (3 x 3 in 2D: in-plane constants, a plate of unit
+// thickness; 6 x 6 in 3D), its derivatives dC/dp_k, the stiff-material
+// fraction rho that counts as mass, and an optional constraint Phi(p) <= 0.
+//
+//   space          parameters          stiffness                    constraint
+//   cubic3d/2d     E, nu, G, rho       cubic compliance             gamut level set
+//   orthotropic2d  Ex, Ey, nu_xy, G, rho orthotropic compliance     gamut level set
+//   isotropic2d/3d E, nu, rho          G = E / (2 (1 + nu))         the cubic gamut at that G
+//   analytic2d/3d  E, rho              isotropic, nu fixed          E / E0 - rho^3 <= 0 (§3.6.2)
+//   simp2d/3d      rho                 E = Emin + rho^p (E0 - Emin) none (a volume constraint instead)
+//
+// Every C is the inverse of a compliance S that is linear in a few raw
+// properties, so dC/dp_k = -C (dS/dp_k) C exactly.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "gamut/level_set.hpp"
+
+namespace msfab {
+
+class CellMaterialModel {
+ public:
+  virtual ~CellMaterialModel() = default;
+  virtual std::string space() const = 0;
+  virtual std::vector<std::string> names() const = 0;
+  int parameters() const { return static_cast<int>(names().size()); }
+  virtual int dimension() const = 0;
+  // Voigt stiffness at unit parameters p; with dC, also dC/dp_k for every k.
+  void tensor(const VecX& p, MatX& C, std::vector<MatX>* dC = nullptr) const;
+  // Raw parameters (moduli in Pa) of unit parameters.
+  virtual VecX raw(const VecX& p) const = 0;
+  // Index of rho (the mass fraction) among the parameters.
+  int density_index() const { return parameters() - 1; }
+  // Phi(p) <= 0 marks achievable parameters; models without a constraint
+  // return false from has_constraint().
+  virtual bool has_constraint() const { return false; }
+  virtual double constraint(const VecX& p, VecX* gradient) const;
+  // A point to start from: inside the constraint where there is one.
+  virtual VecX initial_point(double rho) const = 0;
+
+ protected:
+  // S(p) and dS/dp_k (m x m each).
+  virtual void compliance(const VecX& p, MatX& S, std::vector<MatX>& dS) const = 0;
+};
+
+struct CellMaterialSettings {
+  std::string space;           // see the table above
+  double E_stiff = 1.0;        // E0: the stiffest base material, normalizes moduli
+  double decades = 4.0;        // log-scale span of the moduli
+  double nu = 0.3;             // analytic and simp: the fixed Poisson's ratio
+  double penalty = 3.0;        // simp: p
+  double E_min_ratio = 1e-9;   // simp: Emin / E0
+  const GamutLevelSet* level_set = nullptr;  // gamut spaces and isotropic: the (cubic) gamut
+};
+
+// InputError for an unknown space, a missing level set where one is
+// needed, or a level set of the wrong dimension.
+std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSettings& settings);
+
+// The spaces make_cell_material_model accepts.
+std::vector<std::string> cell_material_spaces();
+
+// The gamut space whose artifact a design space needs ("" for none):
+// isotropic2d -> cubic2d, isotropic3d -> cubic3d, a gamut space -> itself.
+std::string required_gamut_space(const std::string& space);
+
+// Isotropic Voigt stiffness (in-plane constants in 2D) of a solid cell.
+MatX isotropic_voigt(int dimension, double E, double nu);
+
+}  // namespace msfab

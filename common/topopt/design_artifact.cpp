@@ -1,0 +1,113 @@
+#include "topopt/design_artifact.hpp"
+
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "io/artifact.hpp"
+
+namespace msfab {
+
+bool is_gamut_space(const std::string& space) {
+  return space == "cubic3d" || space == "cubic2d" || space == "orthotropic2d";
+}
+
+namespace {
+void check_sizes(const Design& d, const std::string& where) {
+  auto fail = [&](const std::string& what) { throw InputError(where + ": " + what); };
+  if (d.dimension != 2 && d.dimension != 3) fail("dimension must be 2 or 3");
+  if (d.nx < 1 || d.ny < 1 || d.nz < 1 || (d.dimension == 2 && d.nz != 1)) fail("bad grid size");
+  const Eigen::Index n = d.cells(), p = Eigen::Index(d.property_names.size());
+  if (d.unit.rows() != n || d.unit.cols() != p) fail("/cells/unit must be cells x properties");
+  if (d.raw.rows() != n || d.raw.cols() != p) fail("/cells/raw must be cells x properties");
+  if (Eigen::Index(d.roles.size()) != n) fail("/cells/role must have one entry per cell");
+  if (d.phi.size() != n) fail("/cells/phi must have one entry per cell");
+  if (d.displacement.size() != 0 && (d.displacement.rows() != d.nodes() || d.displacement.cols() != d.dimension))
+    fail("/nodes/displacement must be nodes x dimension");
+  if (!d.unit.allFinite() || !d.raw.allFinite()) fail("non-finite cell parameters");
+}
+}  // namespace
+
+void write_design_artifact(const std::string& path, const Design& d, const std::string& executable,
+                           const std::string& config_text, const std::vector<std::string>& inputs,
+                           std::uint64_t seed) {
+  check_sizes(d, path);
+  ArtifactWriter out(path, kDesignSchema, kDesignSchemaVersion, executable, config_text, inputs, seed);
+  H5File& f = out.file();
+  f.write_attribute("/", "space", d.space);
+  std::string names;
+  for (const auto& name : d.property_names) names += (names.empty() ? "" : ",") + name;
+  f.write_attribute("/", "property_names", names);
+  f.write_attribute("/", "E_stiff", d.E_stiff);
+  f.write_attribute("/", "decades", d.decades);
+  f.write_attribute("/", "dimension", static_cast<std::int32_t>(d.dimension));
+  f.write_attribute("/", "grid", std::vector<std::int32_t>{d.nx, d.ny, d.nz});
+  f.write_attribute("/", "cell_size", d.cell_size);
+  f.write_matrix("/cells/unit", d.unit);
+  f.write_attribute("/cells/unit", "meaning", "material parameters normalized to the space's unit cube");
+  f.write_matrix("/cells/raw", d.raw);
+  f.write_attribute("/cells/raw", "units", "moduli in Pa, Poisson's ratios and rho dimensionless");
+  std::vector<std::uint8_t> roles(d.roles.size());
+  for (std::size_t i = 0; i < roles.size(); ++i) roles[i] = static_cast<std::uint8_t>(d.roles[i]);
+  f.write_vector("/cells/role", roles);
+  f.write_attribute("/cells/role", "meaning", "0 design, 1 forced empty, 2 forced solid");
+  f.write_vector("/cells/phi", d.phi);
+  f.write_attribute("/cells/phi", "meaning", "gamut constraint value at the end, <= 0 inside");
+  if (d.displacement.size() > 0) {
+    f.write_matrix("/nodes/displacement", d.displacement);
+    f.write_attribute("/nodes/displacement", "units", "m");
+  }
+  std::vector<std::int32_t> iteration;
+  std::vector<double> objective, elastic, violation, seconds;
+  for (const auto& h : d.history) {
+    iteration.push_back(h.iteration), objective.push_back(h.objective), elastic.push_back(h.elastic);
+    violation.push_back(h.max_violation), seconds.push_back(h.seconds);
+  }
+  if (!iteration.empty()) {
+    f.write_vector("/history/iteration", iteration);
+    f.write_vector("/history/objective", objective);
+    f.write_vector("/history/elastic", elastic);
+    f.write_vector("/history/max_violation", violation);
+    f.write_vector("/history/seconds", seconds);
+  }
+  out.commit();
+}
+
+Design read_design_artifact(const std::string& path) {
+  const ArtifactReader in(path, kDesignSchema, kDesignSchemaVersion);
+  const H5File& f = in.file();
+  Design d;
+  d.space = f.read_string_attribute("/", "space");
+  std::stringstream names(f.read_string_attribute("/", "property_names"));
+  for (std::string name; std::getline(names, name, ',');) d.property_names.push_back(name);
+  d.E_stiff = f.read_attribute<double>("/", "E_stiff");
+  d.decades = f.read_attribute<double>("/", "decades");
+  d.dimension = f.read_attribute<std::int32_t>("/", "dimension");
+  const auto grid = f.read_attribute_vector<std::int32_t>("/", "grid");
+  if (grid.size() != 3) throw InputError(path + ": attribute grid must have 3 entries");
+  d.nx = grid[0], d.ny = grid[1], d.nz = grid[2];
+  d.cell_size = f.read_attribute<double>("/", "cell_size");
+  d.unit = f.read_matrix<double>("/cells/unit");
+  d.raw = f.read_matrix<double>("/cells/raw");
+  const auto roles = f.read_vector<std::uint8_t>("/cells/role");
+  for (std::uint8_t r : roles) {
+    if (r > 2) throw InputError(path + ": /cells/role holds " + std::to_string(r) + " (expected 0, 1 or 2)");
+    d.roles.push_back(static_cast<CellRole>(r));
+  }
+  const auto phi = f.read_vector<double>("/cells/phi");
+  d.phi = Eigen::Map<const VecX>(phi.data(), Eigen::Index(phi.size()));
+  if (f.exists("/nodes/displacement")) d.displacement = f.read_matrix<double>("/nodes/displacement");
+  if (f.exists("/history/iteration")) {
+    const auto it = f.read_vector<std::int32_t>("/history/iteration");
+    const auto obj = f.read_vector<double>("/history/objective");
+    const auto el = f.read_vector<double>("/history/elastic");
+    const auto vi = f.read_vector<double>("/history/max_violation");
+    const auto se = f.read_vector<double>("/history/seconds");
+    if (obj.size() != it.size() || el.size() != it.size() || vi.size() != it.size() || se.size() != it.size())
+      throw InputError(path + ": /history datasets differ in length");
+    for (std::size_t i = 0; i < it.size(); ++i) d.history.push_back({it[i], obj[i], el[i], vi[i], se[i]});
+  }
+  check_sizes(d, path);
+  return d;
+}
+
+}  // namespace msfab

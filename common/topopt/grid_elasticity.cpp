@@ -1,0 +1,197 @@
+#include "topopt/grid_elasticity.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
+                               const LinearSolverOptions& options)
+    : grid_(grid), fixed_(std::move(fixed)), options_(options) {
+  if (std::int64_t(fixed_.size()) != grid_.unknowns())
+    throw std::invalid_argument("GridElasticity: one fixed flag per unknown");
+  if (grid_.unknowns() > std::int64_t(1) << 30) throw InputError("grid: more than 2^30 unknowns");
+  solver_name_ = solver;
+  if (solver == "auto") solver_name_ = grid_.dimension() == 3 && grid_.unknowns() > 300000 ? "pcg-mg" : "cholmod";
+  if (solver_name_ == "pcg-mg") {
+    if (grid_.dimension() != 3) throw InputError("solver pcg-mg needs a 3D grid; use cholmod in 2D");
+    auto nodes = std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(grid_.nodes(), 3);
+    for (std::int64_t n = 0; n < grid_.nodes(); ++n) nodes->row(n) = grid_.node_position(n).transpose();
+    options_.node_positions = nodes;
+  }
+  solver_ = make_linear_solver(solver_name_, options_);
+  // Cells of one parity colour share no node.
+  colours_.assign(grid_.dimension() == 3 ? 8 : 4, {});
+  for (std::int64_t c = 0; c < grid_.cells(); ++c) {
+    const auto [i, j, k] = grid_.cell_coords(c);
+    colours_[(i & 1) + 2 * (j & 1) + 4 * (k & 1)].push_back(c);
+  }
+  build_pattern();
+}
+
+GridElasticity::~GridElasticity() = default;
+
+void GridElasticity::build_pattern() {
+  const int ne = grid_.element_unknowns();
+  const std::int64_t n = grid_.unknowns();
+  std::vector<Eigen::Triplet<double, int>> triplets;
+  triplets.reserve(std::size_t(grid_.cells()) * ne * ne / 2 + fixed_.size());
+  std::vector<std::int64_t> dofs(ne);
+  for (std::int64_t c = 0; c < grid_.cells(); ++c) {
+    grid_.cell_unknowns(c, dofs.data());
+    for (int a = 0; a < ne; ++a)
+      for (int b = 0; b < ne; ++b)
+        if (!fixed_[dofs[a]] && !fixed_[dofs[b]]) triplets.emplace_back(int(dofs[a]), int(dofs[b]), 0.0);
+  }
+  for (std::int64_t d = 0; d < n; ++d)
+    if (fixed_[d]) triplets.emplace_back(int(d), int(d), 0.0);
+  K_.resize(n, n);
+  K_.setFromTriplets(triplets.begin(), triplets.end());
+  K_.makeCompressed();
+  auto slot_of = [&](std::int64_t row, std::int64_t col) {
+    const int* begin = K_.innerIndexPtr() + K_.outerIndexPtr()[col];
+    const int* end = K_.innerIndexPtr() + K_.outerIndexPtr()[col + 1];
+    const int* it = std::lower_bound(begin, end, int(row));
+    return int(it - K_.innerIndexPtr());
+  };
+  slot_.assign(std::size_t(grid_.cells()) * ne * ne, -1);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t c = 0; c < grid_.cells(); ++c) {
+    std::int64_t local[24];
+    grid_.cell_unknowns(c, local);
+    int* out = &slot_[std::size_t(c) * ne * ne];
+    for (int a = 0; a < ne; ++a)
+      for (int b = 0; b < ne; ++b)
+        if (!fixed_[local[a]] && !fixed_[local[b]]) out[a * ne + b] = slot_of(local[b], local[a]);
+  }
+  fixed_slot_.clear();
+  for (std::int64_t d = 0; d < n; ++d)
+    if (fixed_[d]) fixed_slot_.push_back(slot_of(d, d));
+}
+
+void GridElasticity::set_stiffness(const MatX& pairs) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (pairs.rows() != grid_.cells() || pairs.cols() != grid_.voigt_pairs())
+    throw std::invalid_argument("GridElasticity::set_stiffness: cells x voigt_pairs");
+  pairs_ = pairs;
+  const int ne = grid_.element_unknowns(), m = grid_.voigt();
+  const std::vector<MatX>& basis = grid_.element_basis();
+  double* values = K_.valuePtr();
+  std::fill(values, values + K_.nonZeros(), 0.0);
+  for (const auto& colour : colours_) {
+#pragma omp parallel for schedule(static)
+    for (std::size_t idx = 0; idx < colour.size(); ++idx) {
+      const std::int64_t c = colour[idx];
+      MatX Ke = MatX::Zero(ne, ne);
+      for (int s = 0; s < m; ++s)
+        for (int t = s; t < m; ++t) {
+          const int q = CellGrid::pair_index(s, t, m);
+          if (pairs(c, q) != 0) Ke += pairs(c, q) * basis[q];
+        }
+      const int* slots = &slot_[std::size_t(c) * ne * ne];
+      for (int b = 0; b < ne; ++b)
+        for (int a = 0; a < ne; ++a)
+          if (slots[a * ne + b] >= 0) values[slots[a * ne + b]] += Ke(a, b);
+    }
+  }
+  // Fixed rows: a scaled identity, so an iterative solver sees a matrix of
+  // uniform scale.
+  double diag = 0;
+  long free = 0;
+  for (int col = 0; col < K_.outerSize(); ++col) {
+    if (fixed_[col]) continue;
+    diag += K_.coeff(col, col);
+    ++free;
+  }
+  if (free == 0) throw InputError("every unknown of the grid is fixed: nothing to solve");
+  fixed_scale_ = diag / free;
+  for (int s : fixed_slot_) values[s] = fixed_scale_;
+  stats_.assemble_seconds += seconds_since(t0);
+  const auto t1 = std::chrono::steady_clock::now();
+  if (!analyzed_) {
+    solver_->analyze(K_);
+    analyzed_ = true;
+  }
+  if (!solver_->factorize(K_))
+    throw NumericalError("the stiffness matrix is not positive definite: some part of the design is not held by a "
+                         "support, or a cell's stiffness is not positive definite");
+  ++stats_.factorizations;
+  stats_.factorize_seconds += seconds_since(t1);
+}
+
+VecX GridElasticity::run_solve(const VecX& rhs) {
+  const auto t0 = std::chrono::steady_clock::now();
+  VecX x = solver_->solve(rhs);
+  ++stats_.solves;
+  stats_.iterations += solver_->stats().iterations;
+  stats_.solve_seconds += seconds_since(t0);
+  return x;
+}
+
+VecX GridElasticity::solve(const VecX& force, const VecX& prescribed) {
+  const std::int64_t n = grid_.unknowns();
+  VecX rhs = force;
+  for (std::int64_t d = 0; d < n; ++d)
+    if (fixed_[d]) rhs[d] = 0;
+  if (prescribed.size() == n) {
+    // Move the prescribed values to the right-hand side: rhs_f -= K_fp u_p.
+    const int ne = grid_.element_unknowns();
+    std::int64_t dofs[24];
+    Eigen::VectorXd ue(ne);
+    for (std::int64_t c = 0; c < grid_.cells(); ++c) {
+      grid_.cell_unknowns(c, dofs);
+      bool any = false;
+      for (int a = 0; a < ne; ++a) {
+        ue[a] = fixed_[dofs[a]] ? prescribed[dofs[a]] : 0.0;
+        any = any || ue[a] != 0;
+      }
+      if (!any) continue;
+      MatX C = MatX::Zero(grid_.voigt(), grid_.voigt());
+      for (int s = 0; s < grid_.voigt(); ++s)
+        for (int t = s; t < grid_.voigt(); ++t) C(s, t) = C(t, s) = pairs_(c, CellGrid::pair_index(s, t, grid_.voigt()));
+      const VecX r = grid_.element_stiffness(C) * ue;
+      for (int a = 0; a < ne; ++a)
+        if (!fixed_[dofs[a]]) rhs[dofs[a]] -= r[a];
+    }
+    for (std::int64_t d = 0; d < n; ++d)
+      if (fixed_[d]) rhs[d] = fixed_scale_ * prescribed[d];
+  }
+  return run_solve(rhs);
+}
+
+VecX GridElasticity::solve_adjoint(const VecX& rhs) {
+  VecX b = rhs;
+  for (std::int64_t d = 0; d < grid_.unknowns(); ++d)
+    if (fixed_[d]) b[d] = 0;
+  return run_solve(b);
+}
+
+MatX GridElasticity::pair_products(const VecX& a, const VecX& b) const {
+  const int ne = grid_.element_unknowns(), pairs = grid_.voigt_pairs();
+  const std::vector<MatX>& basis = grid_.element_basis();
+  MatX out(grid_.cells(), pairs);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t c = 0; c < grid_.cells(); ++c) {
+    std::int64_t dofs[24];
+    grid_.cell_unknowns(c, dofs);
+    VecX ae(ne), be(ne);
+    for (int i = 0; i < ne; ++i) ae[i] = a[dofs[i]], be[i] = b[dofs[i]];
+    for (int q = 0; q < pairs; ++q) out(c, q) = ae.dot(basis[q] * be);
+  }
+  return out;
+}
+
+double GridElasticity::energy(const VecX& u) const {
+  const MatX products = pair_products(u, u);
+  return 0.5 * (products.cwiseProduct(pairs_)).sum();
+}
+
+}  // namespace msfab

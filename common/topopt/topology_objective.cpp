@@ -1,0 +1,172 @@
+#include "topopt/topology_objective.hpp"
+
+#include "core/errors.hpp"
+
+namespace msfab {
+
+namespace {
+void upper_triangle(const MatX& C, int m, double* out) {
+  for (int s = 0; s < m; ++s)
+    for (int t = s; t < m; ++t) out[CellGrid::pair_index(s, t, m)] = C(s, t);
+}
+}  // namespace
+
+TopologyObjective::TopologyObjective(TopologySetup setup, const CellMaterialModel& model)
+    : setup_(std::move(setup)), model_(model) {
+  const CellGrid& g = setup_.grid;
+  const std::int64_t n = g.unknowns();
+  if (model.dimension() != g.dimension())
+    throw InputError("material space " + model.space() + " is " + std::to_string(model.dimension()) +
+                     "D but the grid is " + std::to_string(g.dimension()) + "D");
+  if (std::int64_t(setup_.roles.size()) != g.cells() || std::int64_t(setup_.fixed.size()) != n)
+    throw std::invalid_argument("TopologyObjective: roles per cell and fixed flags per unknown");
+  if (setup_.loads.empty()) throw InputError("no load case: the objective needs at least one");
+  for (const LoadCase& l : setup_.loads) {
+    if (l.force.size() != n) throw std::invalid_argument("TopologyObjective: force per unknown");
+    if (l.objective == ElasticObjective::compliance && l.prescribed.size() == n) {
+      for (std::int64_t d = 0; d < n; ++d)
+        if (setup_.fixed[d] && l.prescribed[d] != 0)
+          throw InputError("load case '" + l.name +
+                           "': minimum compliance needs force loads; with a prescribed displacement u^T K u grows "
+                           "with stiffness (use a target-deformation objective)");
+    }
+    if (l.objective == ElasticObjective::target && (l.target.size() != n || l.target_weight.size() != n))
+      throw std::invalid_argument("TopologyObjective: target and weights per unknown");
+  }
+  for (std::int64_t c = 0; c < g.cells(); ++c)
+    if (setup_.roles[c] == CellRole::design) design_cells_.push_back(c);
+  if (design_cells_.empty()) throw InputError("the design domain has no design cell");
+  filter_ = CellFilter(g, design_cells_, setup_.filter_radius);
+  fem_ = std::make_unique<GridElasticity>(g, setup_.fixed, setup_.solver, setup_.solver_options);
+}
+
+double TopologyObjective::mass(const MatX& q) const {
+  const MatX p = physical(q);
+  const int rho = model_.density_index();
+  double total = p.col(rho).sum();
+  for (CellRole r : setup_.roles) total += r == CellRole::solid ? 1.0 : 0.0;
+  return total * setup_.grid.cell_volume();
+}
+
+ObjectiveValue TopologyObjective::evaluate(const MatX& q, MatX* gradient) {
+  const int d = model_.parameters();
+  const Eigen::Index rows = Eigen::Index(design_cells_.size());
+  if (q.rows() != rows || q.cols() != d) throw std::invalid_argument("TopologyObjective::evaluate: q shape");
+  // A gradient asked for at the point of the last evaluation (Ipopt's
+  // eval_f then eval_grad_f) reuses its solves.
+  if (!(has_state_ && q == last_q_)) compute_state(q);
+  if (gradient) *gradient = gradient_from_state();
+  return value_;
+}
+
+void TopologyObjective::compute_state(const MatX& q) {
+  const CellGrid& g = setup_.grid;
+  const int m = g.voigt(), npairs = g.voigt_pairs();
+  const Eigen::Index rows = Eigen::Index(design_cells_.size());
+  has_state_ = false;
+  last_q_ = q;
+  p_ = physical(q);
+  const MatX& p = p_;
+
+  // Cell stiffnesses.
+  MatX pairs(g.cells(), npairs);
+  Eigen::Matrix<double, 1, Eigen::Dynamic> solid(npairs), empty(npairs);
+  upper_triangle(setup_.solid_C, m, solid.data());
+  upper_triangle(setup_.empty_C, m, empty.data());
+  for (std::int64_t c = 0; c < g.cells(); ++c)
+    if (setup_.roles[c] != CellRole::design) pairs.row(c) = setup_.roles[c] == CellRole::solid ? solid : empty;
+  bool finite = true;
+#pragma omp parallel for schedule(static) reduction(&& : finite)
+  for (Eigen::Index r = 0; r < rows; ++r) {
+    MatX C;
+    model_.tensor(p.row(r).transpose(), C);
+    finite = finite && C.allFinite();
+    Eigen::Matrix<double, 1, Eigen::Dynamic> row(npairs);
+    upper_triangle(C, m, row.data());
+    pairs.row(design_cells_[r]) = row;
+  }
+  if (!finite) throw NumericalError("a cell's stiffness is not finite (parameters at a singular point of the space)");
+  fem_->set_stiffness(pairs);
+
+
+
+  // Elasticity terms.
+  ObjectiveValue value;
+  u_.clear();
+  for (const LoadCase& l : setup_.loads) {
+    const VecX u = fem_->solve(l.force, l.prescribed);
+    double J = 0;
+    if (l.objective == ElasticObjective::compliance) {
+      J = u.dot(l.force);  // = u^T K u at equilibrium with zero prescribed values
+    } else {
+      J = (l.target_weight.array() * (u - l.target).array().square()).sum();
+    }
+    value.per_load.push_back(J);
+    value.elastic += l.weight * J;
+    u_.push_back(u);
+  }
+
+  // Mass terms (Eq. 3.7 and the local targets).
+  const int rho = model_.density_index();
+  const double V = g.cell_volume();
+  const MassTerms& mt = setup_.mass;
+  if (mt.total_weight > 0) {
+    const double excess = mass(q) - mt.total_target;
+    value.mass += mt.total_weight * excess * excess;
+  }
+  if (mt.local_weight > 0) {
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      const double diff = p(r, rho) - mt.local_target[design_cells_[r]];
+      value.mass += mt.local_weight * diff * diff * V;
+    }
+  }
+  value.total = value.elastic + value.mass;
+  value_ = value;
+  has_state_ = true;
+}
+
+MatX TopologyObjective::gradient_from_state() {
+  const CellGrid& g = setup_.grid;
+  const int m = g.voigt(), npairs = g.voigt_pairs(), d = model_.parameters();
+  const Eigen::Index rows = Eigen::Index(design_cells_.size());
+  const MatX& p = p_;
+  // dS/dC per cell and pair by the adjoint method.
+  MatX dS_dC = MatX::Zero(g.cells(), npairs);
+  for (std::size_t i = 0; i < setup_.loads.size(); ++i) {
+    const LoadCase& l = setup_.loads[i];
+    const VecX& u = u_[i];
+    if (l.objective == ElasticObjective::compliance) {
+      // Adjoint lambda = 2u: dJ/dC = u^T B u - 2 u^T B u.
+      dS_dC -= l.weight * fem_->pair_products(u, u);
+    } else {
+      const VecX lambda = fem_->solve_adjoint(2 * l.target_weight.cwiseProduct(u - l.target));
+      dS_dC -= l.weight * fem_->pair_products(lambda, u);
+    }
+  }
+  const int rho = model_.density_index();
+  const double V = g.cell_volume();
+  const MassTerms& mt = setup_.mass;
+  MatX grad_p = MatX::Zero(rows, d);
+  if (mt.total_weight > 0) grad_p.col(rho).array() += 2 * mt.total_weight * (mass(last_q_) - mt.total_target) * V;
+  if (mt.local_weight > 0)
+    for (Eigen::Index r = 0; r < rows; ++r)
+      grad_p(r, rho) += 2 * mt.local_weight * (p(r, rho) - mt.local_target[design_cells_[r]]) * V;
+  {
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index r = 0; r < rows; ++r) {
+      MatX C;
+      std::vector<MatX> dC;
+      model_.tensor(p.row(r).transpose(), C, &dC);
+      const std::int64_t c = design_cells_[r];
+      for (int k = 0; k < d; ++k) {
+        double s = 0;
+        for (int a = 0; a < m; ++a)
+          for (int b = a; b < m; ++b) s += dC[k](a, b) * dS_dC(c, CellGrid::pair_index(a, b, m));
+        grad_p(r, k) += s;
+      }
+    }
+  }
+  return filter_.apply_transpose(grad_p);
+}
+
+}  // namespace msfab
