@@ -4,6 +4,7 @@
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "io/xdmf.hpp"
 
 namespace msfab {
 
@@ -25,6 +26,41 @@ void check_sizes(const Design& d, const std::string& where) {
     fail("/nodes/displacement must be nodes x dimension");
   if (!d.unit.allFinite() || !d.raw.allFinite()) fail("non-finite cell parameters");
 }
+// Hexahedra for ParaView: a 2D design becomes a slab one cell thick.
+void write_mesh(H5File& f, const Design& d) {
+  const int nz = d.dimension == 3 ? d.nz : 1;
+  const std::int64_t px = d.nx + 1, py = d.ny + 1, pz = nz + 1;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> nodes(px * py * pz, 3), u(px * py * pz, 3);
+  u.setZero();
+  for (std::int64_t k = 0; k < pz; ++k)
+    for (std::int64_t j = 0; j < py; ++j)
+      for (std::int64_t i = 0; i < px; ++i) {
+        const std::int64_t n = i + px * (j + py * k);
+        nodes.row(n) << i * d.cell_size, j * d.cell_size, k * d.cell_size;
+        if (d.displacement.size() == 0) continue;
+        // 2D: both layers carry the in-plane displacement of their node.
+        const std::int64_t src = d.dimension == 3 ? n : i + px * j;
+        for (int a = 0; a < d.dimension; ++a) u(n, a) = d.displacement(src, a);
+      }
+  Eigen::Matrix<std::int32_t, Eigen::Dynamic, 8, Eigen::RowMajor> hexes(d.cells(), 8);
+  for (std::int64_t k = 0; k < nz; ++k)
+    for (std::int64_t j = 0; j < d.ny; ++j)
+      for (std::int64_t i = 0; i < d.nx; ++i) {
+        const std::int64_t c = i + std::int64_t(d.nx) * (j + std::int64_t(d.ny) * k);
+        for (int a = 0; a < 8; ++a) {
+          const int v = kToolkitNodeAtVtkCorner[a];  // toolkit corner (v>>2, v>>1 & 1, v & 1)
+          hexes(c, a) = std::int32_t((i + (v >> 2 & 1)) + px * ((j + (v >> 1 & 1)) + py * (k + (v & 1))));
+        }
+      }
+  f.write_matrix("/mesh/nodes", nodes);
+  f.write_matrix("/mesh/hexes_vtk", hexes);
+  if (d.displacement.size() > 0) f.write_matrix("/mesh/displacement", u);
+  VecX rho = d.unit.col(d.unit.cols() - 1);
+  for (std::int64_t c = 0; c < d.cells(); ++c)
+    if (d.roles[c] != CellRole::design) rho[c] = d.roles[c] == CellRole::solid ? 1.0 : 0.0;
+  f.write_vector("/mesh/rho", rho);
+}
+
 }  // namespace
 
 void write_design_artifact(const std::string& path, const Design& d, const std::string& executable,
@@ -69,7 +105,23 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
     f.write_vector("/history/max_violation", violation);
     f.write_vector("/history/seconds", seconds);
   }
+  write_mesh(f, d);
   out.commit();
+  // The ParaView sidecar.
+  std::string xmf = path;
+  const auto dot = xmf.rfind(".h5");
+  xmf = (dot != std::string::npos && dot + 3 == xmf.size()) ? xmf.substr(0, dot) + ".xmf" : xmf + ".xmf";
+  const auto slash = path.rfind('/');
+  XdmfHexMesh xm;
+  xm.h5_file = slash == std::string::npos ? path : path.substr(slash + 1);
+  xm.nodes_dataset = "/mesh/nodes";
+  xm.connectivity_dataset = "/mesh/hexes_vtk";
+  xm.n_nodes = std::size_t(d.dimension == 3 ? d.nodes() : 2 * d.nodes());
+  xm.n_elems = std::size_t(d.cells());
+  std::vector<XdmfField> node_fields;
+  if (d.displacement.size() > 0) node_fields.push_back({"displacement", "/mesh/displacement", 3, H5Dtype::kFloat64});
+  write_hex_mesh_xdmf(xmf, xm, node_fields,
+                      {{"rho", "/mesh/rho", 1, H5Dtype::kFloat64}, {"phi", "/cells/phi", 1, H5Dtype::kFloat64}});
 }
 
 Design read_design_artifact(const std::string& path) {

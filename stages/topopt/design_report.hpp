@@ -1,0 +1,17 @@
+#pragma once
+// What msfab-topopt writes: the `msfab.design` content of an optimization
+// result, and its convergence plot.
+#include <string>
+
+#include "topopt/design_artifact.hpp"
+#include "topopt/topology_optimizers.hpp"
+
+namespace msfab {
+
+Design make_design(TopologyObjective& objective, const OptimizationResult& result, double E_stiff, double decades);
+// "<stem>.convergence.png" next to the artifact: elastic objective and
+// constraint violation against the iteration. Returns its path.
+std::string write_convergence_plot(const std::string& artifact, const OptimizationResult& result,
+                                   const std::string& space);
+
+}  // namespace msfab

@@ -1,0 +1,129 @@
+// msfab-topopt: two-scale topology optimization inside a material gamut
+// (thesis §3.4, Eq. 3.5-3.9), with the SIMP baselines of §3.6.2.
+//
+//   1. read the scene: grid, design domain, supports, load cases, mass terms
+//   2. the material space: a gamut level set (cubic3d, cubic2d,
+//      orthotropic2d; isotropic inside a cubic gamut), the analytic gamut
+//      E <= rho^3 E0, or SIMP E = rho^p E0
+//   3. the start: uniform rho inside the space, or a coarser design
+//      (coarse-to-fine continuation, §3.6.3)
+//   4. minimize S(p, u) s.t. K(p) u = f (adjoint) and Phi(p_i) <= 0 per cell,
+//      with Ipopt (limited-memory Hessian); SIMP by optimality criteria
+//   5. write `msfab.design` with its ParaView sidecar and a convergence plot
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+
+#include "cli/stage_app.hpp"
+#include "core/errors.hpp"
+#include "design_start.hpp"
+#include "design_report.hpp"
+#include "gamut/gamut_artifact.hpp"
+#include "topopt/topology_optimizers.hpp"
+#include "topopt/topopt_scene.hpp"
+
+using namespace msfab;
+
+namespace {
+// A 2D cantilever (Fig. 3-16's loading): left side clamped, a downward load
+// spread over the right half of the bottom side; SIMP p = 3 needs no gamut.
+constexpr const char* kDefaults = R"(
+grid: {size: [48, 24], cell_size: 1.0}
+space: simp2d
+material: {E: 1.0, nu: 0.3, penalty: 3}
+supports: [{box: {min: [0, 0], max: [0, 24]}}]
+loads:
+  - {name: bottom, objective: compliance,
+     forces: [{box: {min: [24, 0], max: [48, 0]}, force: [0, -1], distribute: total}]}
+mass: {volume_fraction: 0.5}
+filter: {radius: 1.5}
+optimizer: {name: auto, max_iterations: 500}
+initial: {rho: 0.5}
+)";
+}  // namespace
+
+int main(int argc, char** argv) {
+  StageApp app("msfab-topopt", "Two-scale topology optimization in a material gamut (thesis 3.4)");
+  app.add_common_options();
+  app.set_default_config(kDefaults);
+  return app.run(argc, argv, [&](StageContext& ctx) {
+    const std::string& out = ctx.require_out();
+    Config& config = ctx.config;
+
+    // 2. The material space (its gamut first: it sets E0 and the normalization).
+    Gamut gamut;
+    std::vector<std::string> inputs;
+    const std::string space = config.one_of("space", cell_material_spaces());
+    const std::string needs = required_gamut_space(space);
+    if (!needs.empty()) {
+      if (!config.has("gamut")) config.fail("gamut", "is missing: space " + space + " needs a gamut artifact");
+      const std::string path = config.get_path("gamut");
+      gamut = read_gamut_artifact(path);
+      if (gamut.space != needs)
+        config.fail("gamut", path + " is a " + gamut.space + " gamut; space " + space + " needs a " + needs + " gamut");
+      inputs.push_back(path);
+    } else if (config.has("gamut")) {
+      config.fail("gamut", "space " + space + " takes no gamut");
+    }
+
+    // 1. The scene.
+    const TopoptScene scene = read_topopt_scene(config, gamut.E_stiff, gamut.decades);
+    CellMaterialSettings ms{scene.space, scene.E0, scene.decades, scene.nu, scene.penalty, scene.E_min_ratio,
+                            needs.empty() ? nullptr : &gamut.level_set};
+    const auto model = make_cell_material_model(ms);
+
+    OptimizerSettings os;
+    const std::string optimizer = config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc"}) : "auto";
+    os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
+    if (os.max_iterations < 1) config.fail("optimizer.max_iterations", "must be >= 1");
+    os.tolerance = config.get_or<double>("optimizer.tolerance", os.tolerance);
+    if (!(os.tolerance > 0 && os.tolerance < 1)) config.fail("optimizer.tolerance", "must be in (0, 1)");
+    os.constraint_tolerance = config.get_or<double>("optimizer.constraint_tolerance", os.constraint_tolerance);
+    if (!(os.constraint_tolerance > 0)) config.fail("optimizer.constraint_tolerance", "must be > 0");
+    const bool use_oc = optimizer == "oc" || (optimizer == "auto" && model->parameters() == 1);
+    if (use_oc && model->parameters() != 1) config.fail("optimizer.name", "oc needs a one-parameter space (simp2d, simp3d)");
+    const CellGrid& grid = scene.setup.grid;
+    os.mass_limit = scene.volume_fraction > 0;
+    os.mass_budget = scene.volume_fraction * grid.cell_volume() * double(grid.cells());
+    if (use_oc && !os.mass_limit) config.fail("mass.volume_fraction", "the oc optimizer needs a volume fraction");
+
+    // 3. The start.
+    const DesignStart start = read_design_start(config, *model, grid, scene.setup.roles);
+    if (!start.path.empty()) inputs.push_back(start.path);
+    config.check_no_unknown_keys();
+    ctx.check_out_folder();
+
+    TopologySetup setup = scene.setup;
+    setup.solver_options.threads = ctx.options.threads;
+    TopologyObjective objective(setup, *model);
+    const MatX q0 = start.rows(objective.design_cells());
+    spdlog::info("{}D grid {} x {} x {} ({} design cells, {} unknowns), space {} ({} parameters), {} load case(s), "
+                 "solver {}, optimizer {}",
+                 grid.dimension(), grid.nx(), grid.ny(), grid.nz(), objective.design_cells().size(),
+                 grid.unknowns(), space, model->parameters(), setup.loads.size(),
+                 objective.elasticity().solver_name(), use_oc ? "oc" : "ipopt");
+
+    // 4. Optimize.
+    os.log_every = 10;
+    const OptimizationResult r = use_oc ? optimize_oc(objective, q0, os) : optimize_in_gamut(objective, q0, os);
+
+    // 5. Report and artifact.
+    const Design design = make_design(objective, r, gamut.E_stiff > 0 ? gamut.E_stiff : scene.E0, scene.decades);
+    write_design_artifact(out, design, "msfab-topopt", config.resolved_text(), inputs, ctx.options.seed);
+    const std::string plot = write_convergence_plot(out, r, space);
+    const GridSolveStats& st = objective.elasticity().stats();
+    std::printf("msfab-topopt: %s after %d iterations (%d objective evaluations), %.2f s\n", r.status.c_str(),
+                r.iterations, r.evaluations, r.seconds);
+    std::printf("  objective %.6e (elastic %.6e, mass terms %.3e)\n", r.value.total, r.value.elastic, r.value.mass);
+    for (std::size_t l = 0; l < setup.loads.size(); ++l)
+      std::printf("  load case %s: %s %.6e\n", setup.loads[l].name.c_str(),
+                  setup.loads[l].objective == ElasticObjective::compliance ? "compliance" : "target error",
+                  r.value.per_load[l]);
+    std::printf("  mass fraction %.4f, max constraint %.3e\n",
+                objective.mass(r.q) / (grid.cell_volume() * double(grid.cells())), r.max_violation);
+    std::printf("  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve\n", st.factorizations,
+                st.solves, objective.elasticity().solver_name().c_str(),
+                (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) / std::max(1, st.factorizations));
+    std::printf("  artifact: %s (plot %s)\n", out.c_str(), plot.c_str());
+  });
+}

@@ -1,0 +1,60 @@
+#!/bin/bash
+# msfab-topopt: the SIMP cantilever on built-in defaults, a cubic2d design
+# inside a sampled gamut mapped to microstructures by msfab-map, the
+# coarse-to-fine continuation, and bad input (exit 2, clear message).
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+T="$BIN/msfab-topopt"
+
+# 1. Built-in defaults on a smaller grid.
+out=$("$T" --set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' \
+  --set 'loads=[{objective: compliance, forces: [{box: {min: [12, 0], max: [24, 0]}, force: [0, -1], distribute: total}]}]' \
+  --out "$WORK/simp.design.h5" --quiet 2>&1)
+check "simp cantilever converges" -- grep -q "converged" <<<"$out"
+check "design artifact, sidecar and plot" -- test -s "$WORK/simp.design.h5" -a -s "$WORK/simp.design.xmf" -a -s "$WORK/simp.convergence.png"
+check "mass fraction at the budget" -- grep -Eq "mass fraction 0\.(49[89]|500)" <<<"$out"
+
+# 2. A tiny cubic2d gamut, a design inside it, and its mapping.
+cat > "$WORK/set.yaml" <<'Y'
+space: cubic2d
+resolution: 8
+materials:
+  stiff: {E: 1.0e6, nu: 0.3}
+population: 8
+cycles: 1
+initial_beams: 3
+beams: {max: 2, min_radius: 0.5, max_radius: 1.5}
+continuous: {per_cycle: 0}
+level_set: {cells: 8}
+Y
+check "a tiny 2D gamut" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 3 --out "$WORK/set.gamut.h5" --quiet
+cat > "$WORK/cubic.yaml" <<Y
+grid: {size: [12, 6]}
+space: cubic2d
+gamut: $WORK/set.gamut.h5
+supports: [{box: {min: [0, 0], max: [0, 6]}}]
+loads: [{objective: compliance, forces: [{node: [12, 0], force: [0, -1]}]}]
+mass: {volume_fraction: 0.5}
+optimizer: {max_iterations: 300}
+Y
+out=$("$T" --config "$WORK/cubic.yaml" --out "$WORK/cubic.design.h5" --quiet 2>&1)
+check "cubic2d design written" -- test -s "$WORK/cubic.design.h5"
+check "cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-0[4-9]|0\.000)" <<<"$out"
+check "the design maps to microstructures" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
+  --structures "$WORK/set.microstructures.h5" --out "$WORK/cubic.mapped.h5" --quiet
+check "coarse-to-fine continuation" -- "$T" --config "$WORK/cubic.yaml" --set 'grid.size=[24,12]' \
+  --set "initial.design=$WORK/cubic.design.h5" --set 'loads=[{objective: compliance, forces: [{node: [24, 0], force: [0, -1]}]}]' \
+  --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' --set optimizer.max_iterations=20 --out "$WORK/fine.design.h5" --quiet
+
+# 3. Bad input.
+D=(--out "$WORK/bad.design.h5")
+expect_exit 2 "supports.*fixes no unknown" -- "$T" --set 'supports=[]' "${D[@]}"
+expect_exit 2 "load on void" -- "$T" --set 'domain=[{box: {min: [40, 0], max: [48, 24]}, role: empty}]' "${D[@]}"
+expect_exit 2 "no such node" -- "$T" --set 'loads=[{objective: target, forces: [{node: [48, 0], force: [0, -1]}], targets: [{node: [60, 0], displacement: [0, -1]}]}]' "${D[@]}"
+expect_exit 2 "is a cubic2d gamut; space cubic3d needs a cubic3d gamut" -- "$T" --config "$WORK/cubic.yaml" \
+  --set space=cubic3d --set 'grid.size=[4,2,2]' "${D[@]}"
+expect_exit 2 "space simp2d takes no gamut" -- "$T" --config "$WORK/cubic.yaml" --set space=simp2d "${D[@]}"
+expect_exit 2 "none.h5: no such file" -- "$T" --config "$WORK/cubic.yaml" --set gamut=$WORK/none.h5 "${D[@]}"
+expect_exit 2 "unknown key 'fitler'" -- "$T" --set fitler.radius=2 "${D[@]}"
+check "nothing written on bad input" -- test ! -e "$WORK/bad.design.h5"
+finish
