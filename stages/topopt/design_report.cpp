@@ -53,7 +53,9 @@ std::string write_convergence_plot(const std::string& artifact, const Optimizati
   const double hi = *std::max_element(elastic.begin(), elastic.end());
   ChartAxes axes;
   axes.x0 = 0, axes.x1 = std::max(1.0, it.back());
-  axes.y0 = lo - 0.05 * (hi - lo + 1e-30), axes.y1 = hi + 0.05 * (hi - lo + 1e-30);
+  // A flat history (one iteration) still needs a visible range.
+  const double pad = hi - lo > 1e-9 * std::abs(hi) ? 0.05 * (hi - lo) : 0.05 * std::abs(hi) + 1e-30;
+  axes.y0 = lo - pad, axes.y1 = hi + pad;
   axes.x_label = "iteration";
   axes.y_label = "elastic objective";
   axes.title = "msfab-topopt convergence (" + space + ")";

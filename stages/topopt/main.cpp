@@ -121,9 +121,13 @@ int main(int argc, char** argv) {
                   r.value.per_load[l]);
     std::printf("  mass fraction %.4f, max constraint %.3e\n",
                 objective.mass(r.q) / (grid.cell_volume() * double(grid.cells())), r.max_violation);
-    std::printf("  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve\n", st.factorizations,
-                st.solves, objective.elasticity().solver_name().c_str(),
-                (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) / std::max(1, st.factorizations));
+    const double per = 1.0 / std::max(1, st.factorizations);
+    std::printf("  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve (assembly %.3f, "
+                "factorization %.3f, solves %.3f)\n",
+                st.factorizations, st.solves, objective.elasticity().solver_name().c_str(),
+                (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) * per, st.assemble_seconds * per,
+                st.factorize_seconds * per, st.solve_seconds * per);
+    if (st.iterations > 0) std::printf("  CG iterations per solve: %.1f\n", double(st.iterations) / st.solves);
     std::printf("  artifact: %s (plot %s)\n", out.c_str(), plot.c_str());
   });
 }
