@@ -1,6 +1,5 @@
 #include "gamut/gamut_artifact.hpp"
 
-#include <sstream>
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
@@ -32,9 +31,7 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
   ArtifactWriter out(path, kGamutSchema, kGamutSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "space", g.space);
-  std::string names;
-  for (const auto& name : g.property_names) names += (names.empty() ? "" : ",") + name;
-  f.write_attribute("/", "property_names", names);
+  f.write_attribute("/", "property_names", format_name_list(g.property_names));
   f.write_attribute("/", "E_stiff", g.E_stiff);
   f.write_attribute("/", "decades", g.decades);
   const GamutLevelSet& ls = g.level_set;
@@ -70,8 +67,7 @@ Gamut read_gamut_artifact(const std::string& path) {
   const H5File& f = in.file();
   Gamut g;
   g.space = f.read_string_attribute("/", "space");
-  std::stringstream names(f.read_string_attribute("/", "property_names"));
-  for (std::string name; std::getline(names, name, ',');) g.property_names.push_back(name);
+  g.property_names = parse_name_list(f.read_string_attribute("/", "property_names"));
   g.E_stiff = f.read_attribute<double>("/", "E_stiff");
   g.decades = f.read_attribute<double>("/", "decades");
   const int d = f.read_attribute<std::int32_t>("/level_set", "dimension");

@@ -15,6 +15,20 @@
 #include "io/sha256.hpp"
 
 namespace msfab {
+
+std::string format_name_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ",") + name;
+  return out;
+}
+
+std::vector<std::string> parse_name_list(const std::string& text) {
+  std::vector<std::string> names;
+  std::stringstream in(text);
+  for (std::string name; std::getline(in, name, ',');) names.push_back(name);
+  return names;
+}
+
 namespace {
 
 namespace fs = std::filesystem;

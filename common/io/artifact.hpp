@@ -26,6 +26,10 @@ std::string utc_timestamp_now();
 std::string format_inputs(const std::vector<ArtifactInput>& inputs);
 std::vector<ArtifactInput> parse_inputs(const std::string& text);
 
+// Attributes holding a list of names ("E,nu,G,rho").
+std::string format_name_list(const std::vector<std::string>& names);
+std::vector<std::string> parse_name_list(const std::string& text);
+
 // Writes "<path>.tmp"; commit() flushes, closes and renames it over <path>.
 // Destroyed without commit() (an exception, an early return), it deletes
 // the tmp file and leaves whatever was at <path> untouched.

@@ -7,6 +7,17 @@
 #include <sstream>
 
 namespace msfab {
+
+std::string xdmf_sidecar_path(const std::string& h5_path) {
+  const auto dot = h5_path.rfind(".h5");
+  return (dot != std::string::npos && dot + 3 == h5_path.size()) ? h5_path.substr(0, dot) + ".xmf" : h5_path + ".xmf";
+}
+
+std::string file_name_of(const std::string& path) {
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
 namespace {
 
 std::string xml_escape(const std::string& text) {

@@ -32,6 +32,11 @@ typename Derived::PlainObject hex_connectivity_to_vtk_order(const Eigen::MatrixB
   return vtk;
 }
 
+// The sidecar of an artifact: "x.h5" -> "x.xmf" (any other name gets
+// ".xmf" appended), and the artifact's file name as the sidecar refers to it.
+std::string xdmf_sidecar_path(const std::string& h5_path);
+std::string file_name_of(const std::string& path);
+
 // A field on nodes or cells. The dataset has shape (n) for a scalar or
 // (n, components) otherwise.
 struct XdmfField {

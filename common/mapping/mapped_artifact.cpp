@@ -1,6 +1,5 @@
 #include "mapping/mapped_artifact.hpp"
 
-#include <sstream>
 #include <stdexcept>
 
 #include "core/errors.hpp"
@@ -41,9 +40,7 @@ void write_mapped_artifact(const std::string& path, const MappedDesign& m, const
   ArtifactWriter out(path, kMappedSchema, kMappedSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "space", m.space);
-  std::string names;
-  for (const auto& name : m.property_names) names += (names.empty() ? "" : ",") + name;
-  f.write_attribute("/", "property_names", names);
+  f.write_attribute("/", "property_names", format_name_list(m.property_names));
   f.write_attribute("/", "dimension", static_cast<std::int32_t>(m.dimension));
   f.write_attribute("/", "grid", std::vector<std::int32_t>{m.nx, m.ny, m.nz});
   f.write_attribute("/", "cell_size", m.cell_size);
@@ -90,8 +87,7 @@ MappedDesign read_mapped_artifact(const std::string& path) {
   const H5File& f = in.file();
   MappedDesign m;
   m.space = f.read_string_attribute("/", "space");
-  std::stringstream names(f.read_string_attribute("/", "property_names"));
-  for (std::string name; std::getline(names, name, ',');) m.property_names.push_back(name);
+  m.property_names = parse_name_list(f.read_string_attribute("/", "property_names"));
   m.dimension = f.read_attribute<std::int32_t>("/", "dimension");
   const auto grid = f.read_attribute_vector<std::int32_t>("/", "grid");
   const auto voxels = f.read_attribute_vector<std::int32_t>("/", "cell_voxels");

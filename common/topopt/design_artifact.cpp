@@ -1,6 +1,5 @@
 #include "topopt/design_artifact.hpp"
 
-#include <sstream>
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
@@ -70,9 +69,7 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
   ArtifactWriter out(path, kDesignSchema, kDesignSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "space", d.space);
-  std::string names;
-  for (const auto& name : d.property_names) names += (names.empty() ? "" : ",") + name;
-  f.write_attribute("/", "property_names", names);
+  f.write_attribute("/", "property_names", format_name_list(d.property_names));
   f.write_attribute("/", "E_stiff", d.E_stiff);
   f.write_attribute("/", "decades", d.decades);
   f.write_attribute("/", "dimension", static_cast<std::int32_t>(d.dimension));
@@ -108,12 +105,9 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
   write_mesh(f, d);
   out.commit();
   // The ParaView sidecar.
-  std::string xmf = path;
-  const auto dot = xmf.rfind(".h5");
-  xmf = (dot != std::string::npos && dot + 3 == xmf.size()) ? xmf.substr(0, dot) + ".xmf" : xmf + ".xmf";
-  const auto slash = path.rfind('/');
+  const std::string xmf = xdmf_sidecar_path(path);
   XdmfHexMesh xm;
-  xm.h5_file = slash == std::string::npos ? path : path.substr(slash + 1);
+  xm.h5_file = file_name_of(path);
   xm.nodes_dataset = "/mesh/nodes";
   xm.connectivity_dataset = "/mesh/hexes_vtk";
   xm.n_nodes = std::size_t(d.dimension == 3 ? d.nodes() : 2 * d.nodes());
@@ -129,8 +123,7 @@ Design read_design_artifact(const std::string& path) {
   const H5File& f = in.file();
   Design d;
   d.space = f.read_string_attribute("/", "space");
-  std::stringstream names(f.read_string_attribute("/", "property_names"));
-  for (std::string name; std::getline(names, name, ',');) d.property_names.push_back(name);
+  d.property_names = parse_name_list(f.read_string_attribute("/", "property_names"));
   d.E_stiff = f.read_attribute<double>("/", "E_stiff");
   d.decades = f.read_attribute<double>("/", "decades");
   d.dimension = f.read_attribute<std::int32_t>("/", "dimension");

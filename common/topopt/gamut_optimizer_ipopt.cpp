@@ -39,7 +39,6 @@ class GamutProblem : public Ipopt::TNLP {
       const MatX ones = MatX::Ones(rows_, 1);
       mass_gradient_ = obj_.filter().apply_transpose(ones).col(0) * (V / volume_);
     }
-    MatX g;
     const ObjectiveValue v0 = obj_.evaluate(q0_, nullptr);
     scale_ = std::abs(v0.total) > 0 ? 1.0 / std::abs(v0.total) : 1.0;
   }

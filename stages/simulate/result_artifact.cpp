@@ -91,12 +91,9 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
   }
   writer.commit();
 
-  std::string xmf = path;
-  const auto dot = xmf.rfind(".h5");
-  xmf = (dot != std::string::npos && dot + 3 == xmf.size()) ? xmf.substr(0, dot) + ".xmf" : xmf + ".xmf";
-  const auto slash = path.rfind('/');
+  const std::string xmf = xdmf_sidecar_path(path);
   XdmfHexMesh xm;
-  xm.h5_file = slash == std::string::npos ? path : path.substr(slash + 1);
+  xm.h5_file = file_name_of(path);
   xm.nodes_dataset = "/mesh/nodes";
   xm.connectivity_dataset = "/mesh/elements_vtk";
   xm.n_nodes = mesh.num_nodes();

@@ -12,8 +12,7 @@ MatX DesignStart::rows(const std::vector<std::int64_t>& design_cells) const {
   return q;
 }
 
-DesignStart read_design_start(const Config& config, const CellMaterialModel& model, const CellGrid& grid,
-                              const std::vector<CellRole>&) {
+DesignStart read_design_start(const Config& config, const CellMaterialModel& model, const CellGrid& grid) {
   DesignStart start;
   start.per_cell.resize(grid.cells(), model.parameters());
   if (config.has("initial.design")) {

@@ -21,7 +21,6 @@ struct DesignStart {
   MatX rows(const std::vector<std::int64_t>& design_cells) const;
 };
 
-DesignStart read_design_start(const Config& config, const CellMaterialModel& model, const CellGrid& grid,
-                              const std::vector<CellRole>& roles);
+DesignStart read_design_start(const Config& config, const CellMaterialModel& model, const CellGrid& grid);
 
 }  // namespace msfab

@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
     if (use_oc && !os.mass_limit) config.fail("mass.volume_fraction", "the oc optimizer needs a volume fraction");
 
     // 3. The start.
-    const DesignStart start = read_design_start(config, *model, grid, scene.setup.roles);
+    const DesignStart start = read_design_start(config, *model, grid);
     if (!start.path.empty()) inputs.push_back(start.path);
     config.check_no_unknown_keys();
     ctx.check_out_folder();
