@@ -4,6 +4,7 @@
 #include <chrono>
 
 #include "core/errors.hpp"
+#include "solve/dirichlet_grid_multigrid.hpp"
 
 namespace msfab {
 
@@ -13,6 +14,51 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 }  // namespace
 
+VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs) {
+  if (grid.dimension() != 3) throw std::invalid_argument("stiffness_field: a 3D grid");
+  if (pairs.rows() != grid.cells() || pairs.cols() != grid.voigt_pairs())
+    throw std::invalid_argument("stiffness_field: cells x voigt_pairs");
+  struct Group {
+    Eigen::Index reference;  // the column the group's weights are
+    Eigen::Index peak_row;   // where |reference| is largest
+    std::vector<std::pair<int, double>> members;  // (pair, factor on the reference)
+  };
+  std::vector<Group> groups;
+  for (int q = 0; q < pairs.cols(); ++q) {
+    Eigen::Index peak_row = 0;
+    const double peak = pairs.col(q).cwiseAbs().maxCoeff(&peak_row);
+    if (peak == 0.0) continue;
+    bool placed = false;
+    for (Group& g : groups) {
+      const double ratio = pairs(g.peak_row, q) / pairs(g.peak_row, g.reference);
+      if ((pairs.col(q) - ratio * pairs.col(g.reference)).cwiseAbs().maxCoeff() <= 1e-13 * peak) {
+        g.members.emplace_back(q, ratio);
+        placed = true;
+        break;
+      }
+    }
+    if (!placed) groups.push_back({q, peak_row, {{q, 1.0}}});
+  }
+  VoxelStiffnessField field;
+  field.nx = grid.nx(), field.ny = grid.ny(), field.nz = grid.nz();
+  field.h = grid.h();
+  const std::vector<MatX>& basis = grid.element_basis();
+  for (const Group& g : groups) {
+    Mat24 K = Mat24::Zero();
+    for (const auto& [q, factor] : g.members) K += factor * basis[q];
+    field.basis.push_back(K);
+  }
+  if (groups.empty()) {  // every cell without stiffness: keep the shapes valid
+    field.basis.push_back(Mat24::Zero());
+    groups.push_back({0, 0, {}});
+  }
+  const std::size_t G = groups.size();
+  field.weights.resize(std::size_t(grid.cells()) * G);
+  for (std::size_t g = 0; g < G; ++g)
+    for (Eigen::Index c = 0; c < pairs.rows(); ++c) field.weights[std::size_t(c) * G + g] = pairs(c, groups[g].reference);
+  return field;
+}
+
 GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
                                const LinearSolverOptions& options)
     : grid_(grid), fixed_(std::move(fixed)), options_(options) {
@@ -20,7 +66,26 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
     throw std::invalid_argument("GridElasticity: one fixed flag per unknown");
   if (grid_.unknowns() > std::int64_t(1) << 30) throw InputError("grid: more than 2^30 unknowns");
   solver_name_ = solver;
-  if (solver == "auto") solver_name_ = grid_.dimension() == 3 && grid_.unknowns() > 300000 ? "pcg-mg" : "cholmod";
+  if (solver == "auto") {
+    solver_name_ = "cholmod";
+    if (grid_.dimension() == 3 && grid_.unknowns() > 300000)
+      solver_name_ = DirichletGridMultigrid::supports(grid_.nx(), grid_.ny(), grid_.nz()) ? "matrix-free" : "pcg-mg";
+  }
+  if (solver_name_ == "matrix-free") {
+    if (grid_.dimension() != 3) throw InputError("solver matrix-free needs a 3D grid; use cholmod in 2D");
+    if (!DirichletGridMultigrid::supports(grid_.nx(), grid_.ny(), grid_.nz()))
+      throw InputError("solver matrix-free needs even grid dimensions, not " + std::to_string(grid_.nx()) + " x " +
+                       std::to_string(grid_.ny()) + " x " + std::to_string(grid_.nz()) + "; use pcg-mg");
+    validate_linear_solver_options(options_);
+    DirichletMultigridOptions mg;
+    mg.tolerance = options_.pcg_tolerance;
+    mg.max_iterations = options_.pcg_max_iterations;
+    mg.smoother_degree = options_.mg_smoother_degree;
+    mg.coarse_unknowns = options_.mg_coarse_unknowns;
+    mg.threads = options_.threads;
+    matrix_free_ = std::make_unique<DirichletGridMultigrid>(grid_.nx(), grid_.ny(), grid_.nz(), fixed_, mg);
+    return;
+  }
   if (solver_name_ == "pcg-mg") {
     if (grid_.dimension() != 3) throw InputError("solver pcg-mg needs a 3D grid; use cholmod in 2D");
     auto nodes = std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(grid_.nodes(), 3);
@@ -82,6 +147,13 @@ void GridElasticity::set_stiffness(const MatX& pairs) {
   if (pairs.rows() != grid_.cells() || pairs.cols() != grid_.voigt_pairs())
     throw std::invalid_argument("GridElasticity::set_stiffness: cells x voigt_pairs");
   pairs_ = pairs;
+  if (matrix_free_) {
+    matrix_free_->set_field(stiffness_field(grid_, pairs_));
+    fixed_scale_ = matrix_free_->fixed_scale();
+    ++stats_.factorizations;
+    stats_.factorize_seconds += seconds_since(t0);
+    return;
+  }
   const int ne = grid_.element_unknowns(), m = grid_.voigt();
   const std::vector<MatX>& basis = grid_.element_basis();
   double* values = K_.valuePtr();
@@ -129,9 +201,9 @@ void GridElasticity::set_stiffness(const MatX& pairs) {
 
 VecX GridElasticity::run_solve(const VecX& rhs) {
   const auto t0 = std::chrono::steady_clock::now();
-  VecX x = solver_->solve(rhs);
+  VecX x = matrix_free_ ? matrix_free_->solve(rhs) : solver_->solve(rhs);
   ++stats_.solves;
-  stats_.iterations += solver_->stats().iterations;
+  stats_.iterations += matrix_free_ ? matrix_free_->stats().iterations : solver_->stats().iterations;
   stats_.solve_seconds += seconds_since(t0);
   return x;
 }

@@ -9,12 +9,18 @@
 // `dimension` unknowns per lattice node and pcg-mg applies on 3D grids.
 // Assembly runs over cells in 2^d parity colours (cells of one colour
 // share no node), so it is parallel and bitwise deterministic.
+//
+// Solver "matrix-free" (3D grids with even dimensions) never assembles K:
+// DirichletGridMultigrid applies it cell by cell from the per-cell
+// stiffness, so memory stays at a few vectors per unknown (the grids of
+// Table 3.2, up to millions of cells).
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/types.hpp"
+#include "fem/voxel_stiffness_field.hpp"
 #include "solve/linear_solver.hpp"
 #include "topopt/cell_grid.hpp"
 
@@ -27,10 +33,21 @@ struct GridSolveStats {
   double assemble_seconds = 0, factorize_seconds = 0, solve_seconds = 0;
 };
 
+class DirichletGridMultigrid;
+
+// The element stiffnesses of a 3D grid as a VoxelStiffnessField with as few
+// base matrices as the pairs allow: pair columns that are proportional over
+// all cells (to 1e-13 relative) share one base matrix, all-zero columns
+// drop out. SIMP (C = scale x C0) needs one, a cubic material three
+// (C11, C12, C44); a product then costs that many 24 x 24 products per cell.
+VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs);
+
 class GridElasticity {
  public:
   // `fixed`: one flag per unknown. solver: "cholmod" | "pcg-mg" (3D only) |
-  // "auto" (cholmod up to 300k unknowns in 3D, always in 2D).
+  // "matrix-free" (3D, even dimensions) | "auto" (cholmod in 2D and up to
+  // 300k unknowns in 3D; above that matrix-free where the dimensions allow,
+  // else pcg-mg).
   GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
                  const LinearSolverOptions& options);
   ~GridElasticity();
@@ -61,7 +78,8 @@ class GridElasticity {
   std::vector<char> fixed_;
   std::string solver_name_;
   LinearSolverOptions options_;
-  std::unique_ptr<LinearSolver> solver_;
+  std::unique_ptr<LinearSolver> solver_;                 // assembled solvers
+  std::unique_ptr<DirichletGridMultigrid> matrix_free_;  // or this
   SpMat K_;
   std::vector<int> slot_;       // cells x ne x ne: value index of each element entry, -1 if dropped
   std::vector<int> fixed_slot_; // diagonal value index of each fixed unknown

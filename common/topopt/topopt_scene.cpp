@@ -245,7 +245,7 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
   }
   s.filter_radius = config.get_or<double>("filter.radius", 0.0);
   if (!(s.filter_radius >= 0)) config.fail("filter.radius", "must be >= 0");
-  s.solver = config.has("solver") ? config.one_of("solver", {"auto", "cholmod", "pcg-mg"}) : "auto";
+  s.solver = config.has("solver") ? config.one_of("solver", {"auto", "cholmod", "pcg-mg", "matrix-free"}) : "auto";
   return scene;
 }
 

@@ -1,0 +1,497 @@
+#include "solve/dirichlet_grid_multigrid.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "core/errors.hpp"
+#include "solve/chebyshev_kernels.hpp"
+#include "solve/conjugate_gradient.hpp"
+#include "solve/multigrid_solver.hpp"
+#include "solve/sparse_ops.hpp"
+
+namespace msfab {
+namespace {
+
+// Corner a of a hexahedron sits at (a>>2&1, a>>1&1, a&1) (fem/voxel_stiffness_field.hpp).
+constexpr int corner_x(int a) { return a >> 2 & 1; }
+constexpr int corner_y(int a) { return a >> 1 & 1; }
+constexpr int corner_z(int a) { return a & 1; }
+// Lattice offset (dx, dy, dz) in {-1, 0, 1}^3 as 0..26.
+constexpr int offset_code(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
+constexpr int corner_code(int a, int b) {
+  return offset_code(corner_x(b) - corner_x(a), corner_y(b) - corner_y(a), corner_z(b) - corner_z(a));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string dims_text(const int n[3]) {
+  return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
+}
+
+// P_pos: the trilinear interpolation from a coarse element's corners to the
+// corners of its fine element at position pos = pi + 2 (pj + 2 pk).
+Mat24 interpolation(int pos) {
+  const int p[3] = {pos & 1, pos >> 1 & 1, pos >> 2 & 1};
+  Mat24 P = Mat24::Zero();
+  for (int c = 0; c < 8; ++c) {
+    const double xi[3] = {0.5 * (p[0] + corner_x(c)), 0.5 * (p[1] + corner_y(c)), 0.5 * (p[2] + corner_z(c))};
+    for (int A = 0; A < 8; ++A) {
+      const double phi = (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) *
+                         (corner_z(A) ? xi[2] : 1 - xi[2]);
+      for (int d = 0; d < 3; ++d) P(3 * c + d, 3 * A + d) = phi;
+    }
+  }
+  return P;
+}
+
+}  // namespace
+
+bool DirichletGridMultigrid::supports(int nx, int ny, int nz) {
+  for (int n : {nx, ny, nz})
+    if (n < 2 || n % 2 != 0) return false;
+  return true;
+}
+
+DirichletGridMultigrid::~DirichletGridMultigrid() = default;
+
+DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vector<char> fixed,
+                                               const DirichletMultigridOptions& options)
+    : fixed_(std::move(fixed)), options_(options) {
+  fine_.n[0] = nx, fine_.n[1] = ny, fine_.n[2] = nz;
+  if (!supports(nx, ny, nz))
+    throw InputError("matrix-free multigrid: a " + dims_text(fine_.n) +
+                     " grid cannot be coarsened (every dimension must be even)");
+  if (!(options_.tolerance > 0) || options_.tolerance >= 1)
+    throw InputError("matrix-free multigrid: tolerance must lie in (0, 1)");
+  if (options_.max_iterations < 1) throw InputError("matrix-free multigrid: max_iterations must be >= 1");
+  if (options_.smoother_degree < 1 || options_.smoother_degree > 10)
+    throw InputError("matrix-free multigrid: smoother_degree must lie in 1..10");
+  const std::int64_t nodes = fine_.nodes();
+  if (nodes > (std::int64_t(1) << 31) / 3)
+    throw InputError("matrix-free multigrid: more than 2^31 unknowns");
+  if (std::int64_t(fixed_.size()) != 3 * nodes)
+    throw std::invalid_argument("DirichletGridMultigrid: one fixed flag per unknown");
+  coarse_.n[0] = nx / 2, coarse_.n[1] = ny / 2, coarse_.n[2] = nz / 2;
+
+  node_mask_.assign(std::size_t(nodes), 0);
+  for (std::int64_t d = 0; d < 3 * nodes; ++d)
+    if (fixed_[std::size_t(d)]) {
+      node_mask_[std::size_t(d / 3)] |= std::uint8_t(1u << (d % 3));
+      fixed_list_.push_back(d);
+    }
+
+  // A coarse unknown is reached when some free fine unknown of the same
+  // component lies within one fine spacing of its point.
+  const std::int64_t coarse_nodes = coarse_.nodes();
+  coarse_reached_.assign(3 * std::size_t(coarse_nodes), 0);
+  for (int K = 0; K <= coarse_.n[2]; ++K)
+    for (int J = 0; J <= coarse_.n[1]; ++J)
+      for (int I = 0; I <= coarse_.n[0]; ++I) {
+        const std::int64_t C = coarse_.node(I, J, K);
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int i = 2 * I + dx, j = 2 * J + dy, k = 2 * K + dz;
+              if (i < 0 || j < 0 || k < 0 || i > nx || j > ny || k > nz) continue;
+              const std::uint8_t m = node_mask_[std::size_t(fine_.node(i, j, k))];
+              for (int d = 0; d < 3; ++d)
+                if (!(m >> d & 1)) coarse_reached_[std::size_t(3 * C + d)] = 1;
+            }
+      }
+  build_coarse_pattern();
+}
+
+void DirichletGridMultigrid::build_coarse_pattern() {
+  const int N[3] = {coarse_.n[0] + 1, coarse_.n[1] + 1, coarse_.n[2] + 1};
+  const std::int64_t nodes = coarse_.nodes();
+  BlockMatrix& M = coarse_blocks_;
+  M.rows = static_cast<int>(nodes);
+  M.row_start.assign(std::size_t(nodes) + 1, 0);
+  M.column.clear();
+  M.diagonal.assign(std::size_t(nodes), 0);
+  coarse_slot_.assign(27 * std::size_t(nodes), -1);
+  for (int k = 0; k < N[2]; ++k)
+    for (int j = 0; j < N[1]; ++j)
+      for (int i = 0; i < N[0]; ++i) {
+        const std::int64_t p = coarse_.node(i, j, k);
+        M.row_start[std::size_t(p)] = static_cast<int>(M.column.size());
+        // z, y, x outermost to innermost: node indices come out ascending.
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              if (i + dx < 0 || j + dy < 0 || k + dz < 0 || i + dx >= N[0] || j + dy >= N[1] || k + dz >= N[2])
+                continue;
+              coarse_slot_[27 * std::size_t(p) + offset_code(dx, dy, dz)] = static_cast<int>(M.column.size());
+              M.column.push_back(static_cast<int>(coarse_.node(i + dx, j + dy, k + dz)));
+            }
+        M.diagonal[std::size_t(p)] = coarse_slot_[27 * std::size_t(p) + offset_code(0, 0, 0)];
+      }
+  M.row_start[std::size_t(nodes)] = static_cast<int>(M.column.size());
+  M.values.assign(9 * M.column.size(), 0.0);
+}
+
+void DirichletGridMultigrid::set_field(VoxelStiffnessField field) {
+  const auto start = std::chrono::steady_clock::now();
+  validate_field(field, "matrix-free multigrid");
+  if (field.nx != fine_.n[0] || field.ny != fine_.n[1] || field.nz != fine_.n[2])
+    throw InputError("matrix-free multigrid: a field of " + std::to_string(field.nx) + " x " +
+                     std::to_string(field.ny) + " x " + std::to_string(field.nz) + " elements for a " +
+                     dims_text(fine_.n) + " grid");
+  if (std::int64_t(fixed_list_.size()) == 3 * fine_.nodes())
+    throw InputError("every unknown of the grid is fixed: nothing to solve");
+  field_ = std::move(field);
+  has_field_ = false;
+  build_fine_smoother();
+  assemble_coarse();
+  has_field_ = true;
+  stats_.analyze_seconds = seconds_since(start);
+  stats_.factorize_seconds = stats_.analyze_seconds;
+  stats_.positive_definite = true;
+}
+
+void DirichletGridMultigrid::build_fine_smoother() {
+  const int B = field_.basis_size();
+  const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
+  const std::int64_t nodes = fine_.nodes();
+  diagonal_.assign(9 * std::size_t(nodes), 0.0);
+  // Unmasked diagonal blocks, and (sum, count) of the free unknowns' diagonal entries.
+  const Eigen::Vector2d sum = chunked_reduce(nodes, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    Eigen::Vector2d s = Eigen::Vector2d::Zero();
+    for (Eigen::Index p = begin; p < end; ++p) {
+      const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
+                k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
+      Mat3 D = Mat3::Zero();
+      for (int a = 0; a < 8; ++a) {
+        const int ei = i - corner_x(a), ej = j - corner_y(a), ek = k - corner_z(a);
+        if (ei < 0 || ej < 0 || ek < 0 || ei >= nx || ej >= ny || ek >= nz) continue;
+        const std::int64_t e = ei + std::int64_t(nx) * (ej + std::int64_t(ny) * ek);
+        for (int b = 0; b < B; ++b)
+          if (const double w = field_.weight(e, b); w != 0.0) D += w * field_.basis[b].block<3, 3>(3 * a, 3 * a);
+      }
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal_.data() + 9 * p) = D;
+      for (int d = 0; d < 3; ++d)
+        if (!(node_mask_[std::size_t(p)] >> d & 1)) s += Eigen::Vector2d(D(d, d), 1.0);
+    }
+    return s;
+  });
+  fixed_scale_ = sum[0] / sum[1];
+  if (!(fixed_scale_ > 0) || !std::isfinite(fixed_scale_))
+    throw NumericalError("matrix-free multigrid: the free unknowns have no positive stiffness");
+  for (std::int64_t d : fixed_list_) {
+    double* m = diagonal_.data() + 9 * std::size_t(d / 3);
+    const int c = static_cast<int>(d % 3);
+    for (int t = 0; t < 3; ++t) m[3 * c + t] = m[3 * t + c] = 0.0;
+    m[4 * c] = fixed_scale_;
+  }
+  const int bad = chebyshev::invert_diagonal_blocks(static_cast<int>(nodes), diagonal_.data(), inverse_, options_.threads);
+  if (bad != 0)
+    throw NumericalError("matrix-free multigrid: " + std::to_string(bad) +
+                         " nodes have a diagonal stiffness block that is not positive definite (nodes that only "
+                         "cells without stiffness touch)");
+  max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
+      static_cast<int>(nodes), diagonal_.data(), inverse_.data(),
+      [this](int i, const double*, double out[3]) {
+        const double* y = product_.data() + 3 * std::size_t(i);
+        out[0] = y[0], out[1] = y[1], out[2] = y[2];
+      },
+      [this](const VecX& x) { multiply(x, product_); }, options_.threads);
+  if (!(max_eigenvalue_ > 0) || !std::isfinite(max_eigenvalue_))
+    throw NumericalError("matrix-free multigrid: no usable eigenvalue bound for the smoother");
+}
+
+void DirichletGridMultigrid::assemble_coarse() {
+  const int B = field_.basis_size();
+  std::vector<Mat24> P(8), galerkin(8 * std::size_t(B));
+  for (int pos = 0; pos < 8; ++pos) {
+    P[pos] = interpolation(pos);
+    for (int b = 0; b < B; ++b) galerkin[std::size_t(pos) * B + b] = P[pos].transpose() * field_.basis[b] * P[pos];
+  }
+  BlockMatrix& M = coarse_blocks_;
+  std::fill(M.values.begin(), M.values.end(), 0.0);
+  const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
+  const int team = resolve_thread_count(options_.threads);
+  // Coarse elements of one parity colour share no coarse node.
+  for (int colour = 0; colour < 8; ++colour) {
+    const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
+    const int hx = (NX - ci + 1) / 2, hy = (NY - cj + 1) / 2, hz = (NZ - ck + 1) / 2;
+    const std::int64_t count = std::int64_t(hx) * hy * hz;
+#pragma omp parallel for schedule(static) num_threads(team)
+    for (std::int64_t t = 0; t < count; ++t) {
+      const int I = ci + 2 * static_cast<int>(t % hx), J = cj + 2 * static_cast<int>((t / hx) % hy),
+                K = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+      Mat24 KE = Mat24::Zero();
+      for (int pos = 0; pos < 8; ++pos) {
+        const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
+        const std::int64_t e = i + std::int64_t(fine_.n[0]) * (j + std::int64_t(fine_.n[1]) * k);
+        std::uint8_t masked = 0;
+        for (int a = 0; a < 8; ++a)
+          masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+        if (!masked) {
+          for (int b = 0; b < B; ++b)
+            if (const double w = field_.weight(e, b); w != 0.0) KE.noalias() += w * galerkin[std::size_t(pos) * B + b];
+          continue;
+        }
+        Mat24 Ke = field_.element(e);
+        for (int a = 0; a < 8; ++a) {
+          const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+          for (int d = 0; d < 3; ++d)
+            if (m >> d & 1) {
+              Ke.row(3 * a + d).setZero();
+              Ke.col(3 * a + d).setZero();
+            }
+        }
+        KE.noalias() += P[pos].transpose() * Ke * P[pos];
+      }
+      for (int a = 0; a < 8; ++a) {
+        const std::int64_t row = coarse_.node(I + corner_x(a), J + corner_y(a), K + corner_z(a));
+        for (int b = 0; b < 8; ++b) {
+          double* block = M.values.data() + 9 * std::size_t(coarse_slot_[27 * std::size_t(row) + corner_code(a, b)]);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) block[3 * r + q] += KE(3 * a + r, 3 * b + q);
+        }
+      }
+    }
+  }
+  // Coarse unknowns no free fine unknown interpolates have empty rows and
+  // columns: a diagonal of the level's scale keeps the operator definite.
+  double diagonal_sum = 0.0;
+  std::int64_t reached = 0;
+  for (std::size_t u = 0; u < coarse_reached_.size(); ++u)
+    if (coarse_reached_[u]) {
+      diagonal_sum += M.values[9 * std::size_t(M.diagonal[u / 3]) + 4 * (u % 3)];
+      ++reached;
+    }
+  const double scale = reached > 0 ? diagonal_sum / double(reached) : 1.0;
+  for (std::size_t u = 0; u < coarse_reached_.size(); ++u)
+    if (!coarse_reached_[u]) M.values[9 * std::size_t(M.diagonal[u / 3]) + 4 * (u % 3)] = scale;
+
+  if (!coarse_analyzed_) {
+    coarse_matrix_ = sparse_pattern(M);
+    copy_to_sparse(M, coarse_matrix_);
+    LinearSolverOptions options;
+    options.threads = options_.threads;
+    options.mg_coarse_unknowns = options_.coarse_unknowns;
+    options.mg_smoother_degree = options_.smoother_degree;
+    auto positions =
+        std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(coarse_.nodes(), 3);
+    for (int k = 0; k <= NZ; ++k)
+      for (int j = 0; j <= NY; ++j)
+        for (int i = 0; i <= NX; ++i) positions->row(coarse_.node(i, j, k)) << i, j, k;
+    options.node_positions = positions;
+    coarse_solver_ = std::make_unique<MultigridSolver>(options);
+    coarse_solver_->analyze(coarse_matrix_);
+    coarse_analyzed_ = true;
+  } else {
+    copy_to_sparse(M, coarse_matrix_);
+  }
+  if (!coarse_solver_->factorize(coarse_matrix_))
+    throw NumericalError("matrix-free multigrid: the coarse operator (" + dims_text(coarse_.n) +
+                         " elements) is not positive definite: part of the body is not held by a support");
+}
+
+void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
+  const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
+  const Eigen::Index n = 3 * Eigen::Index(fine_.nodes());
+  const int B = field_.basis_size();
+  y.resize(n);
+  const int team = resolve_thread_count(options_.threads);
+#pragma omp parallel num_threads(team) if (n > 3 * 4096)
+  {
+#pragma omp for schedule(static)
+    for (Eigen::Index k = 0; k < n; ++k) y[k] = 0.0;
+    // Elements of one parity colour share no node: no conflicting additions,
+    // and every entry sums its elements in the same order.
+    for (int colour = 0; colour < 8; ++colour) {
+      const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
+      const int hx = (nx - ci + 1) / 2, hy = (ny - cj + 1) / 2, hz = (nz - ck + 1) / 2;
+      const std::int64_t count = std::int64_t(hx) * hy * hz;
+#pragma omp for schedule(static)
+      for (std::int64_t t = 0; t < count; ++t) {
+        const int i = ci + 2 * static_cast<int>(t % hx), j = cj + 2 * static_cast<int>((t / hx) % hy),
+                  k = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+        std::int64_t corner[8];
+        Vec24 xe, ye = Vec24::Zero();
+        for (int a = 0; a < 8; ++a) {
+          corner[a] = fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a));
+          xe.segment<3>(3 * a) = x.segment<3>(3 * corner[a]);
+          if (const std::uint8_t m = node_mask_[std::size_t(corner[a])]; m != 0)
+            for (int d = 0; d < 3; ++d)
+              if (m >> d & 1) xe[3 * a + d] = 0.0;
+        }
+        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
+        for (int b = 0; b < B; ++b) {
+          const double w = field_.weight(e, b);
+          if (w == 0.0) continue;
+          // Column by column: fixed-size 24-vectors that vectorize.
+          const Mat24& K = field_.basis[b];
+          for (int c = 0; c < 24; ++c) ye += (w * xe[c]) * K.col(c);
+        }
+        for (int a = 0; a < 8; ++a) y.segment<3>(3 * corner[a]) += ye.segment<3>(3 * a);
+      }
+    }
+    // Fixed rows: s x_d (what the element sums put there is discarded).
+    const std::int64_t fixed_count = static_cast<std::int64_t>(fixed_list_.size());
+#pragma omp for schedule(static)
+    for (std::int64_t t = 0; t < fixed_count; ++t) {
+      const std::int64_t d = fixed_list_[std::size_t(t)];
+      y[d] = fixed_scale_ * x[d];
+    }
+  }
+}
+
+void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) const {
+  const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
+  const int NX = coarse_.n[0], NY = coarse_.n[1];
+  const std::int64_t nodes = coarse_.nodes();
+  coarse.resize(3 * nodes);
+  parallel_row_ranges(static_cast<int>(nodes), resolve_thread_count(options_.threads), [&](int begin, int end) {
+    for (int P = begin; P < end; ++P) {
+      const int I = P % (NX + 1), J = (P / (NX + 1)) % (NY + 1), K = P / ((NX + 1) * (NY + 1));
+      double sum[3] = {0, 0, 0};
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int i = 2 * I + dx, j = 2 * J + dy, k = 2 * K + dz;
+            if (i < 0 || j < 0 || k < 0 || i > nx || j > ny || k > nz) continue;
+            const double w = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
+            const std::int64_t f = fine_.node(i, j, k);
+            const std::uint8_t m = node_mask_[std::size_t(f)];
+            for (int d = 0; d < 3; ++d)
+              if (!(m >> d & 1)) sum[d] += w * fine[3 * f + d];
+          }
+      for (int d = 0; d < 3; ++d) coarse[3 * std::int64_t(P) + d] = sum[d];
+    }
+  });
+}
+
+void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) const {
+  const int nx = fine_.n[0], ny = fine_.n[1];
+  const std::int64_t nodes = fine_.nodes();
+  parallel_row_ranges(static_cast<int>(nodes), resolve_thread_count(options_.threads), [&](int begin, int end) {
+    for (int p = begin; p < end; ++p) {
+      const std::uint8_t m = node_mask_[std::size_t(p)];
+      if (m == 7) continue;
+      const int i = p % (nx + 1), j = (p / (nx + 1)) % (ny + 1), k = p / ((nx + 1) * (ny + 1));
+      const int ox = i % 2, oy = j % 2, oz = k % 2;
+      const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
+      double sum[3] = {0, 0, 0};
+      for (int cz = 0; cz <= oz; ++cz)
+        for (int cy = 0; cy <= oy; ++cy)
+          for (int cx = 0; cx <= ox; ++cx) {
+            const std::int64_t C = coarse_.node(i / 2 + cx, j / 2 + cy, k / 2 + cz);
+            for (int d = 0; d < 3; ++d) sum[d] += coarse[3 * C + d];
+          }
+      for (int d = 0; d < 3; ++d)
+        if (!(m >> d & 1)) fine[3 * std::int64_t(p) + d] += w * sum[d];
+    }
+  });
+}
+
+void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
+  const int rows = static_cast<int>(fine_.nodes());
+  const int threads = options_.threads;
+  const auto row_product = [this](int i, const double*, double out[3]) {
+    const double* y = product_.data() + 3 * std::size_t(i);
+    out[0] = y[0], out[1] = y[1], out[2] = y[2];
+  };
+  const auto apply = [this](const VecX& x) { multiply(x, product_); };
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
+                    true, step_, next_, threads);
+  apply(z);
+  chebyshev::residual(rows, row_product, r, z, residual_, threads);
+  restrict_residual(residual_, coarse_rhs_);
+  coarse_solution_ = coarse_solver_->apply_preconditioner(coarse_rhs_);
+  add_prolongation(coarse_solution_, z);
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
+                    false, step_, next_, threads);
+}
+
+VecX DirichletGridMultigrid::apply_preconditioner(const VecX& r) {
+  if (!has_field_) throw std::logic_error("DirichletGridMultigrid: no field set");
+  VecX z;
+  cycle(r, z);
+  return z;
+}
+
+VecX DirichletGridMultigrid::solve(const VecX& b) {
+  if (!has_field_) throw std::logic_error("DirichletGridMultigrid::solve: no field set");
+  const Eigen::Index n = 3 * Eigen::Index(fine_.nodes());
+  if (b.size() != n)
+    throw std::invalid_argument("DirichletGridMultigrid::solve: right-hand side has " + std::to_string(b.size()) +
+                                " entries, the grid has " + std::to_string(n) + " unknowns");
+  const int threads = options_.threads;
+  CgOperator op;
+  op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
+  op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
+    multiply(x, y);
+    return parallel_dot(x, y, threads);
+  };
+  CgPreconditioner preconditioner;
+  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
+    cycle(r, z);
+    return parallel_dot(r, z, threads);
+  };
+  preconditioner.check_definite = true;
+  CgSettings settings;
+  settings.tolerance = options_.tolerance;
+  settings.max_iterations = options_.max_iterations;
+  settings.threads = threads;
+  settings.label = "matrix-free multigrid CG";
+  settings.curvature_label = "matrix-free multigrid CG";
+  settings.curvature_message_has_residual = true;
+  return conjugate_gradient(op, preconditioner, b, settings, stats_);
+}
+
+int DirichletGridMultigrid::num_levels() const {
+  return 1 + (coarse_solver_ ? coarse_solver_->num_levels() : 0);
+}
+
+SpMat DirichletGridMultigrid::fine_operator() const {
+  const int nx = fine_.n[0], ny = fine_.n[1];
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::int64_t e = 0; e < field_.voxels(); ++e) {
+    const int i = static_cast<int>(e % nx), j = static_cast<int>((e / nx) % ny), k = static_cast<int>(e / (std::int64_t(nx) * ny));
+    const Mat24 K = field_.element(e);
+    std::int64_t dof[24];
+    for (int a = 0; a < 8; ++a)
+      for (int d = 0; d < 3; ++d) dof[3 * a + d] = 3 * fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)) + d;
+    for (int r = 0; r < 24; ++r)
+      for (int c = 0; c < 24; ++c)
+        if (!is_fixed(dof[r]) && !is_fixed(dof[c])) triplets.emplace_back(int(dof[r]), int(dof[c]), K(r, c));
+  }
+  for (std::int64_t d : fixed_list_) triplets.emplace_back(int(d), int(d), fixed_scale_);
+  const int n = static_cast<int>(3 * fine_.nodes());
+  SpMat A(n, n);
+  A.setFromTriplets(triplets.begin(), triplets.end());
+  return A;
+}
+
+SpMat DirichletGridMultigrid::coarse_operator() const { return coarse_matrix_; }
+
+SpMat DirichletGridMultigrid::prolongation() const {
+  const int nx = fine_.n[0], ny = fine_.n[1];
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::int64_t p = 0; p < fine_.nodes(); ++p) {
+    const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
+              k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
+    const int ox = i % 2, oy = j % 2, oz = k % 2;
+    const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
+    for (int cz = 0; cz <= oz; ++cz)
+      for (int cy = 0; cy <= oy; ++cy)
+        for (int cx = 0; cx <= ox; ++cx) {
+          const std::int64_t C = coarse_.node(i / 2 + cx, j / 2 + cy, k / 2 + cz);
+          for (int d = 0; d < 3; ++d)
+            if (!is_fixed(3 * p + d)) triplets.emplace_back(int(3 * p + d), int(3 * C + d), w);
+        }
+  }
+  SpMat P(int(3 * fine_.nodes()), int(3 * coarse_.nodes()));
+  P.setFromTriplets(triplets.begin(), triplets.end());
+  return P;
+}
+
+}  // namespace msfab

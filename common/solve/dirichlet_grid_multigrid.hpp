@@ -1,0 +1,124 @@
+#pragma once
+// Conjugate gradients preconditioned by geometric multigrid for the
+// stiffness matrix of a box of nx x ny x nz hexahedra with Dirichlet
+// unknowns, applied without assembling it: the FEM solve of 3D topology
+// optimization on grids of millions of cells (thesis §3.4, Table 3.2).
+// It is the non-periodic sibling of PeriodicGridMultigrid (homogenization)
+// and shares its element form, smoothing kernels and CG loop.
+//
+// The operator is A = D K D + s (I - D): K = sum_e K_e with
+// K_e = sum_b w_eb K_b (a VoxelStiffnessField), D the 0/1 diagonal of free
+// unknowns, s the mean diagonal of the free unknowns (fixed_scale()). A
+// fixed unknown's row is s x_d, so b_d = s u_d prescribes u_d. Memory:
+// the weights, a dozen vectors and 18 numbers per node (the smoother's
+// diagonal blocks and their inverses) on the grid itself; nothing per
+// matrix entry.
+//
+// Levels: the grid, matrix-free (products element by element in 8 parity
+// colours: bitwise deterministic for any thread count); level 1 (every
+// other node per axis) assembled as the Galerkin product P^T A P with P
+// trilinear and its rows of fixed unknowns zeroed. Trilinear interpolation
+// turns the Galerkin product into a sum over the fine elements,
+//   K_E = sum_{e in E} P_pos(e)^T D_e K_e D_e P_pos(e),
+// so level 1 is built from the weights in one pass (tables P^T K_b P for
+// elements without fixed unknowns). Below level 1 the assembled multigrid
+// of pcg-mg takes over (MultigridSolver, one cycle per coarse correction).
+// The cycle (Chebyshev / block-Jacobi smoothing before and after one
+// coarse correction) is a fixed SPD operator, so plain CG applies.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "fem/voxel_stiffness_field.hpp"
+#include "solve/block_matrix.hpp"
+#include "solve/linear_solver.hpp"
+
+namespace msfab {
+
+class MultigridSolver;
+
+struct DirichletMultigridOptions {
+  double tolerance = 1e-8;   // stop when ||b - A x|| <= tolerance ||b||
+  int max_iterations = 2000;
+  int smoother_degree = 2;   // Chebyshev degree on the grid (matrix products per smoothing)
+  int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
+  int threads = 0;           // 0: the OpenMP default
+};
+
+class DirichletGridMultigrid {
+ public:
+  // Node (i, j, k) = i + (nx+1) (j + (ny+1) k), 3 unknowns per node;
+  // `fixed`: one flag per unknown. InputError for an invalid option, a
+  // grid supports() refuses, or a mask of the wrong size.
+  DirichletGridMultigrid(int nx, int ny, int nz, std::vector<char> fixed,
+                         const DirichletMultigridOptions& options = {});
+  ~DirichletGridMultigrid();
+  DirichletGridMultigrid(const DirichletGridMultigrid&) = delete;
+  DirichletGridMultigrid& operator=(const DirichletGridMultigrid&) = delete;
+
+  // Every dimension even and at least 2 (level 1 takes every other node).
+  static bool supports(int nx, int ny, int nz);
+
+  // New element stiffnesses (field dimensions must match): rebuilds the
+  // smoother and the coarse operators. InputError for a mismatched or
+  // invalid field, or one where every unknown is fixed; NumericalError if
+  // a diagonal block or a coarse operator is not positive definite (part
+  // of the body not held by a support).
+  void set_field(VoxelStiffnessField field);
+
+  double fixed_scale() const { return fixed_scale_; }
+  // x with A x = b. Throws NumericalError if CG does not converge.
+  VecX solve(const VecX& b);
+  // y = A x, matrix-free.
+  void multiply(const VecX& x, VecX& y) const;
+  // One cycle z = M^-1 r.
+  VecX apply_preconditioner(const VecX& r);
+  const LinearSolveStats& stats() const { return stats_; }
+
+  // Inspection (small grids): A assembled, level 1 and the masked P.
+  SpMat fine_operator() const;
+  SpMat coarse_operator() const;
+  SpMat prolongation() const;
+  // Levels in all: the grid, level 1 and the assembled hierarchy's further levels.
+  int num_levels() const;
+
+ private:
+  struct Grid {
+    int n[3]{0, 0, 0};  // elements per axis; nodes n + 1
+    std::int64_t nodes() const { return std::int64_t(n[0] + 1) * (n[1] + 1) * (n[2] + 1); }
+    std::int64_t node(int i, int j, int k) const { return i + std::int64_t(n[0] + 1) * (j + std::int64_t(n[1] + 1) * k); }
+  };
+  void build_fine_smoother();
+  void build_coarse_pattern();
+  void assemble_coarse();
+  void cycle(const VecX& r, VecX& z);
+  void restrict_residual(const VecX& fine, VecX& coarse) const;
+  void add_prolongation(const VecX& coarse, VecX& fine) const;
+  bool is_fixed(std::int64_t unknown) const { return fixed_[std::size_t(unknown)] != 0; }
+
+  Grid fine_, coarse_;
+  std::vector<char> fixed_;
+  std::vector<std::uint8_t> node_mask_;    // per fine node: bit d set if component d is fixed
+  std::vector<std::int64_t> fixed_list_;   // the fixed unknowns, ascending
+  std::vector<char> coarse_reached_;       // per coarse unknown: some free fine unknown interpolates it
+  DirichletMultigridOptions options_;
+  VoxelStiffnessField field_;
+  bool has_field_ = false;
+  double fixed_scale_ = 1.0;
+  LinearSolveStats stats_;
+
+  // Grid level: diagonal blocks of A and their inverses, Chebyshev bound, workspace.
+  std::vector<double> diagonal_, inverse_;
+  double max_eigenvalue_ = 0.0;
+  VecX product_, step_, next_, residual_, coarse_rhs_, coarse_solution_;
+
+  // Level 1: block pattern (27 lattice neighbours, -1 outside the grid),
+  // its compressed-column copy and the assembled multigrid below it.
+  std::vector<int> coarse_slot_;  // 27 per coarse node, by lattice offset code
+  BlockMatrix coarse_blocks_;
+  SpMat coarse_matrix_;
+  std::unique_ptr<MultigridSolver> coarse_solver_;
+  bool coarse_analyzed_ = false;
+};
+
+}  // namespace msfab
