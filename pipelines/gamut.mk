@@ -2,6 +2,7 @@
 #
 #   make -f Makefile.pipeline gamut-2d       2D cubic gamut, stiff + soft (configs/gamut/cubic2d.yaml), a minute
 #   make -f Makefile.pipeline gamut-ortho    2D orthotropic gamut, minutes
+#   make -f Makefile.pipeline gamut-2d-void  2D cubic and orthotropic gamuts of one material + void (Fig. 3-16), minutes
 #   make -f Makefile.pipeline gamut-3d       3D cubic gamut, one material + void, 16^3 cells; hours on 2 cores, use RANKS
 #   make -f Makefile.pipeline gamut-bench    sampler vs random sampling, docs/BENCHMARKS.md section
 #
@@ -15,9 +16,10 @@ $(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume
 
-.PHONY: gamut-2d gamut-ortho gamut-3d gamut-bench
+.PHONY: gamut-2d gamut-ortho gamut-2d-void gamut-3d gamut-bench
 gamut-2d: build $(OUT)/gamut/cubic2d.gamut.h5
 gamut-ortho: build $(OUT)/gamut/orthotropic2d.gamut.h5
+gamut-2d-void: build $(OUT)/gamut/cubic2d_void.gamut.h5 $(OUT)/gamut/orthotropic2d_void.gamut.h5
 gamut-3d: build $(OUT)/gamut/cubic3d_void.gamut.h5
 
 gamut-bench: build

@@ -4,7 +4,9 @@
 #     half of the bottom) in every material space that needs no sampled gamut,
 #     plus cubic2d / orthotropic2d / isotropic2d when gamut artifacts are given:
 #       CUBIC2D=out/gamut/cubic2d.gamut.h5 ORTHO2D=out/gamut/orthotropic2d.gamut.h5 tools/bench_topopt.sh
-#  2. time per FEM solve (assembly + factorization + solve) on 3D grids.
+#  2. time per FEM solve on 3D grids (bench_grid_solver: cholmod, pcg-mg and
+#     matrix-free side by side; LARGEST="nx ny nz" adds a matrix-free row for
+#     a bigger grid) and per optimizer step (STEP_LARGE=1 adds 320x160x80).
 # Usage: tools/bench_topopt.sh [build-dir]
 set -euo pipefail
 BIN=${1:-build}/bin
@@ -37,19 +39,39 @@ row analytic --set space=analytic2d
 [ -n "${CUBIC2D:-}" ] && row isotropic --set space=isotropic2d --set gamut="$CUBIC2D"
 [ -n "${ORTHO2D:-}" ] && row orthotropic --set space=orthotropic2d --set gamut="$ORTHO2D"
 echo
-echo "### Time per FEM solve on 3D grids (SIMP, one OC step)"
+echo "### Time per FEM solve on 3D grids (SIMP cantilever)"
 echo
-echo "| cells | unknowns | solver | seconds per assembly+factorization+solve |"
-echo "|---|---|---|---|"
-for g in "96 24 4" "64 32 8" "128 64 32"; do
+echo "bench_grid_solver: set-up (assembly + factorization, or the multigrid hierarchy) and one solve,"
+echo "CG tolerance 1e-8; f.u is the compliance (equal across solvers to the CG tolerance)."
+echo
+echo "| cells | unknowns | solver | density | set-up s | solve s | CG iterations | peak MB | f.u |"
+echo "|---|---|---|---|---|---|---|---|---|"
+for g in "96 24 4" "64 32 8" "128 64 32" "320 160 80" ${LARGEST:+"$LARGEST"}; do
   set -- $g
-  for solver in cholmod pcg-mg; do
-    [ "$1" = 128 ] && [ "$solver" = cholmod ] && continue
-    out=$("$BIN/msfab-topopt" --set "grid.size=[$1,$2,$3]" --set space=simp3d \
-      --set "supports=[{box: {min: [0, 0, 0], max: [0, $2, $3]}}]" \
-      --set "loads=[{objective: compliance, forces: [{box: {min: [$1, 0, 0], max: [$1, $2, 0]}, force: [0, 0, -1], distribute: total}]}]" \
-      --set solver=$solver --set optimizer.max_iterations=1 --out "$W/g.design.h5" --quiet 2>&1)
-    s=$(grep -oE "[0-9.]+ s per factorization\+solve" <<<"$out" | awk '{print $1}')
-    printf "| %sx%sx%s | %s | %s | %s |\n" "$1" "$2" "$3" $((3 * ($1 + 1) * ($2 + 1) * ($3 + 1))) "$solver" "$s"
+  for solver in cholmod pcg-mg matrix-free; do
+    [ "$1" -ge 128 ] && [ "$solver" = cholmod ] && continue
+    [ "$1" -ge 320 ] && [ "$solver" = pcg-mg ] && continue
+    for field in uniform random; do
+      [ "$1" -gt 320 ] && [ "$field" = random ] && continue
+      "$BIN/bench_grid_solver" "$1" "$2" "$3" "$solver" "$field"
+    done
   done
+done
+echo
+echo "### Time per optimizer step (msfab-topopt, SIMP/OC, solver auto, 3 iterations)"
+echo
+echo "| cells | solver | seconds per OC iteration | FEM seconds per solve | CG iterations per solve | peak MB |"
+echo "|---|---|---|---|---|---|"
+for g in "96 24 4" "64 32 8" "128 64 32" ${STEP_LARGE:+"320 160 80"}; do
+  set -- $g
+  log=$(/usr/bin/time -f "peak %M" "$BIN/msfab-topopt" --set "grid.size=[$1,$2,$3]" --set space=simp3d \
+    --set "supports=[{box: {min: [0, 0, 0], max: [0, $2, $3]}}]" \
+    --set "loads=[{objective: compliance, forces: [{box: {min: [$1, 0, 0], max: [$1, $2, 0]}, force: [0, 0, -1], distribute: total}]}]" \
+    --set optimizer.max_iterations=3 --out "$W/g.design.h5" --quiet 2>&1)
+  total=$(grep -oE "evaluations\), [0-9.]+ s" <<<"$log" | awk '{print $2}')
+  solver=$(grep -oE "solves \([a-z-]+\)" <<<"$log" | tr -d '()' | awk '{print $2}')
+  fem=$(grep -oE "[0-9.]+ s per factorization\+solve" <<<"$log" | awk '{print $1}')
+  cg=$(grep -oE "CG iterations per solve: [0-9.]+" <<<"$log" | awk '{print $5}')
+  peak=$(grep -oE "peak [0-9]+" <<<"$log" | awk '{print int($2 / 1024)}')
+  printf "| %sx%sx%s | %s | %.2f | %s | %s | %s |\n" "$1" "$2" "$3" "$solver" "$(awk -v t="$total" 'BEGIN { print t / 3 }')" "$fem" "${cg:--}" "$peak"
 done

@@ -67,9 +67,14 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
   if (grid_.unknowns() > std::int64_t(1) << 30) throw InputError("grid: more than 2^30 unknowns");
   solver_name_ = solver;
   if (solver == "auto") {
+    // Measured (docs/BENCHMARKS.md): at 58k unknowns the matrix-free solve
+    // takes 0.2 s where CHOLMOD takes 2.5 s, and the gap grows with size.
     solver_name_ = "cholmod";
-    if (grid_.dimension() == 3 && grid_.unknowns() > 300000)
-      solver_name_ = DirichletGridMultigrid::supports(grid_.nx(), grid_.ny(), grid_.nz()) ? "matrix-free" : "pcg-mg";
+    if (grid_.dimension() == 3 && grid_.unknowns() > 30000 &&
+        DirichletGridMultigrid::supports(grid_.nx(), grid_.ny(), grid_.nz()))
+      solver_name_ = "matrix-free";
+    else if (grid_.dimension() == 3 && grid_.unknowns() > 300000)
+      solver_name_ = "pcg-mg";
   }
   if (solver_name_ == "matrix-free") {
     if (grid_.dimension() != 3) throw InputError("solver matrix-free needs a 3D grid; use cholmod in 2D");

@@ -45,9 +45,9 @@ VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs);
 class GridElasticity {
  public:
   // `fixed`: one flag per unknown. solver: "cholmod" | "pcg-mg" (3D only) |
-  // "matrix-free" (3D, even dimensions) | "auto" (cholmod in 2D and up to
-  // 300k unknowns in 3D; above that matrix-free where the dimensions allow,
-  // else pcg-mg).
+  // "matrix-free" (3D, even dimensions) | "auto" (cholmod in 2D; in 3D
+  // matrix-free above 30k unknowns where the dimensions are even, pcg-mg
+  // above 300k where they are not, else cholmod).
   GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
                  const LinearSolverOptions& options);
   ~GridElasticity();

@@ -55,7 +55,7 @@ OptimizationResult optimize_oc(TopologyObjective& objective, const MatX& q0, con
       spdlog::info("oc iteration {:4d}: compliance {:.6e}  change {:.3f}  ({:.1f} s)", it - 1, v.elastic, change,
                    h.seconds);
     result.iterations = it;
-    if (change < settings.oc_change_tolerance) {
+    if (change < settings.change_tolerance) {
       result.converged = true;
       break;
     }

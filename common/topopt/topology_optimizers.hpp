@@ -9,6 +9,7 @@
 //  * optimize_oc: the optimality-criteria update of the classic SIMP codes
 //    (bisection on the volume multiplier, move limit, damping 1/2), for
 //    single-parameter spaces with a volume budget: the baseline.
+//  * optimize_mma (topopt/simp_mma.hpp): NLopt's MMA on the same problem.
 #include <string>
 #include <vector>
 
@@ -23,7 +24,10 @@ struct OptimizerSettings {
   int lbfgs_memory = 8;
   bool mass_limit = false;           // add the constraint sum rho_i V_i <= mass_budget
   double mass_budget = 0;
-  double oc_move = 0.2, oc_change_tolerance = 0.01;  // OC only
+  double oc_move = 0.2;              // OC only
+  // OC and MMA: stop when no design variable changes by this much in an
+  // iteration (0: never; run max_iterations).
+  double change_tolerance = 0.01;
   int log_every = 10;                // progress line every this many iterations (0: none)
 };
 

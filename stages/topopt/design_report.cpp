@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "io/chart.hpp"
+#include "io/png_image.hpp"
 
 namespace msfab {
 
@@ -41,11 +43,20 @@ Design make_design(TopologyObjective& objective, const OptimizationResult& r, do
   return d;
 }
 
-std::string write_convergence_plot(const std::string& artifact, const OptimizationResult& r, const std::string& space) {
+namespace {
+
+// "out/x.design.h5" -> "out/x".
+std::string artifact_stem(const std::string& artifact) {
   std::string stem = artifact;
   if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
   if (stem.size() > 7 && stem.compare(stem.size() - 7, 7, ".design") == 0) stem.resize(stem.size() - 7);
-  const std::string path = stem + ".convergence.png";
+  return stem;
+}
+
+}  // namespace
+
+std::string write_convergence_plot(const std::string& artifact, const OptimizationResult& r, const std::string& space) {
+  const std::string path = artifact_stem(artifact) + ".convergence.png";
   std::vector<double> it, elastic;
   for (const auto& h : r.history) it.push_back(h.iteration), elastic.push_back(h.elastic);
   if (it.empty()) it = {0}, elastic = {r.value.elastic};
@@ -63,6 +74,56 @@ std::string write_convergence_plot(const std::string& artifact, const Optimizati
   chart.polyline(it, elastic, {30, 90, 200});
   chart.points(it, elastic, {30, 90, 200}, 1.5);
   chart.write(path);
+  return path;
+}
+
+}  // namespace msfab
+
+namespace msfab {
+
+std::string write_density_picture(const std::string& artifact, const Design& d) {
+  const std::string path = artifact_stem(artifact) + ".density.png";
+  const int rho = static_cast<int>(d.raw.cols()) - 1;  // density is the last parameter of every space
+  const auto colour = [&](std::int64_t c, double density) -> Rgb {
+    if (d.roles[std::size_t(c)] == CellRole::solid) return {30, 60, 160};
+    if (d.roles[std::size_t(c)] == CellRole::empty) return {250, 225, 225};
+    const auto grey = static_cast<std::uint8_t>(std::lround(255.0 * (1.0 - std::clamp(density, 0.0, 1.0))));
+    return {grey, grey, grey};
+  };
+  const auto cell = [&](int i, int j, int k) { return i + std::int64_t(d.nx) * (j + std::int64_t(d.ny) * k); };
+  // Views: (columns, rows, cell at (column, row from the bottom), depth).
+  struct View {
+    int width, height, depth;
+    int axis;  // 0: top view (depth along z), 1: front view (depth along y)
+  };
+  std::vector<View> views;
+  if (d.dimension == 2) views.push_back({d.nx, d.ny, 1, 0});
+  else views = {{d.nx, d.ny, d.nz, 0}, {d.nx, d.nz, d.ny, 1}};
+  int total_height = 0;
+  for (const View& v : views) total_height = std::max(total_height, v.height);
+  const int total_width = std::accumulate(views.begin(), views.end(), 0, [](int s, const View& v) { return s + v.width; });
+  const int scale = std::clamp(1200 / std::max(1, total_width), 1, 12), gap = views.size() > 1 ? 16 : 0;
+  PngImage image(total_width * scale + gap * int(views.size() - 1), total_height * scale);
+  int left = 0;
+  for (const View& v : views) {
+    for (int row = 0; row < v.height; ++row)
+      for (int col = 0; col < v.width; ++col) {
+        // The densest cell along the viewing direction decides the pixel.
+        std::int64_t best = -1;
+        double best_density = -1;
+        for (int t = 0; t < v.depth; ++t) {
+          const std::int64_t c = v.axis == 0 ? cell(col, row, t) : cell(col, t, row);
+          const double density = d.roles[std::size_t(c)] == CellRole::empty ? -0.5 : d.raw(c, rho);
+          if (density > best_density) best = c, best_density = density;
+        }
+        const Rgb rgb = colour(best, best_density);
+        for (int y = 0; y < scale; ++y)
+          for (int x = 0; x < scale; ++x)
+            image.set(left + col * scale + x, (total_height - 1 - row) * scale + y, rgb);
+      }
+    left += v.width * scale + gap;
+  }
+  image.write_png(path);
   return path;
 }
 

@@ -14,4 +14,10 @@ Design make_design(TopologyObjective& objective, const OptimizationResult& resul
 std::string write_convergence_plot(const std::string& artifact, const OptimizationResult& result,
                                    const std::string& space);
 
+// "<stem>.density.png": the cells' density, black = solid, white = void
+// (forced-solid cells blue, forced-empty cells pale red). A 2D design is
+// drawn as is (y up); a 3D design as two views side by side, the largest
+// density along z (top) and along y (front). Returns its path.
+std::string write_density_picture(const std::string& artifact, const Design& design);
+
 }  // namespace msfab

@@ -8,8 +8,8 @@
 //   3. the start: uniform rho inside the space, or a coarser design
 //      (coarse-to-fine continuation, §3.6.3)
 //   4. minimize S(p, u) s.t. K(p) u = f (adjoint) and Phi(p_i) <= 0 per cell,
-//      with Ipopt (limited-memory Hessian); SIMP by optimality criteria
-//   5. write `msfab.design` with its ParaView sidecar and a convergence plot
+//      with Ipopt (limited-memory Hessian); SIMP by optimality criteria or MMA
+//   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
 #include <spdlog/spdlog.h>
 
 #include <cstdio>
@@ -19,6 +19,7 @@
 #include "design_start.hpp"
 #include "design_report.hpp"
 #include "gamut/gamut_artifact.hpp"
+#include "topopt/simp_mma.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
 
@@ -73,19 +74,28 @@ int main(int argc, char** argv) {
     const auto model = make_cell_material_model(ms);
 
     OptimizerSettings os;
-    const std::string optimizer = config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc"}) : "auto";
+    const std::string optimizer =
+        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma"}) : "auto";
     os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
     if (os.max_iterations < 1) config.fail("optimizer.max_iterations", "must be >= 1");
     os.tolerance = config.get_or<double>("optimizer.tolerance", os.tolerance);
     if (!(os.tolerance > 0 && os.tolerance < 1)) config.fail("optimizer.tolerance", "must be in (0, 1)");
     os.constraint_tolerance = config.get_or<double>("optimizer.constraint_tolerance", os.constraint_tolerance);
     if (!(os.constraint_tolerance > 0)) config.fail("optimizer.constraint_tolerance", "must be > 0");
+    os.change_tolerance = config.get_or<double>("optimizer.change_tolerance", os.change_tolerance);
+    if (!(os.change_tolerance >= 0 && os.change_tolerance < 1))
+      config.fail("optimizer.change_tolerance", "must be in [0, 1) (0: run max_iterations)");
     const bool use_oc = optimizer == "oc" || (optimizer == "auto" && model->parameters() == 1);
-    if (use_oc && model->parameters() != 1) config.fail("optimizer.name", "oc needs a one-parameter space (simp2d, simp3d)");
+    const bool use_mma = optimizer == "mma";
+    const std::string chosen = use_oc ? "oc" : use_mma ? "mma" : "ipopt";
+    if ((use_oc || use_mma) && model->parameters() != 1)
+      config.fail("optimizer.name", chosen + " is for the simp spaces (simp2d, simp3d); space " + space + " has " +
+                                        std::to_string(model->parameters()) + " parameters per cell (use ipopt)");
     const CellGrid& grid = scene.setup.grid;
     os.mass_limit = scene.volume_fraction > 0;
     os.mass_budget = scene.volume_fraction * grid.cell_volume() * double(grid.cells());
-    if (use_oc && !os.mass_limit) config.fail("mass.volume_fraction", "the oc optimizer needs a volume fraction");
+    if ((use_oc || use_mma) && !os.mass_limit)
+      config.fail("mass.volume_fraction", "the " + chosen + " optimizer needs a volume fraction > 0");
 
     // 3. The start.
     const DesignStart start = read_design_start(config, *model, grid);
@@ -101,16 +111,19 @@ int main(int argc, char** argv) {
                  "solver {}, optimizer {}",
                  grid.dimension(), grid.nx(), grid.ny(), grid.nz(), objective.design_cells().size(),
                  grid.unknowns(), space, model->parameters(), setup.loads.size(),
-                 objective.elasticity().solver_name(), use_oc ? "oc" : "ipopt");
+                 objective.elasticity().solver_name(), chosen);
 
     // 4. Optimize.
     os.log_every = 10;
-    const OptimizationResult r = use_oc ? optimize_oc(objective, q0, os) : optimize_in_gamut(objective, q0, os);
+    const OptimizationResult r = use_oc    ? optimize_oc(objective, q0, os)
+                                 : use_mma ? optimize_mma(objective, q0, os)
+                                           : optimize_in_gamut(objective, q0, os);
 
     // 5. Report and artifact.
     const Design design = make_design(objective, r, gamut.E_stiff > 0 ? gamut.E_stiff : scene.E0, scene.decades);
     write_design_artifact(out, design, "msfab-topopt", config.resolved_text(), inputs, ctx.options.seed);
     const std::string plot = write_convergence_plot(out, r, space);
+    const std::string picture = write_density_picture(out, design);
     const GridSolveStats& st = objective.elasticity().stats();
     std::printf("msfab-topopt: %s after %d iterations (%d objective evaluations), %.2f s\n", r.status.c_str(),
                 r.iterations, r.evaluations, r.seconds);
@@ -128,6 +141,6 @@ int main(int argc, char** argv) {
                 (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) * per, st.assemble_seconds * per,
                 st.factorize_seconds * per, st.solve_seconds * per);
     if (st.iterations > 0) std::printf("  CG iterations per solve: %.1f\n", double(st.iterations) / st.solves);
-    std::printf("  artifact: %s (plot %s)\n", out.c_str(), plot.c_str());
+    std::printf("  artifact: %s (plot %s, picture %s)\n", out.c_str(), plot.c_str(), picture.c_str());
   });
 }

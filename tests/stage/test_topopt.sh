@@ -13,6 +13,11 @@ out=$("$T" --set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [
 check "simp cantilever converges" -- grep -q "converged" <<<"$out"
 check "design artifact, sidecar and plot" -- test -s "$WORK/simp.design.h5" -a -s "$WORK/simp.design.xmf" -a -s "$WORK/simp.convergence.png"
 check "mass fraction at the budget" -- grep -Eq "mass fraction 0\.(49[89]|500)" <<<"$out"
+out=$("$T" --set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' \
+  --set 'loads=[{objective: compliance, forces: [{box: {min: [12, 0], max: [24, 0]}, force: [0, -1], distribute: total}]}]' \
+  --set optimizer.name=mma --set optimizer.max_iterations=30 --set optimizer.change_tolerance=0 --out "$WORK/mma.design.h5" --quiet 2>&1)
+check "simp cantilever with mma" -- grep -q "after 30 iterations (31 objective evaluations)" <<<"$out"
+check "mma: mass fraction within the budget" -- grep -Eq "mass fraction 0\.(4[89][0-9]|500)" <<<"$out"
 
 # 2. A tiny cubic2d gamut, a design inside it, and its mapping.
 cat > "$WORK/set.yaml" <<'Y'
@@ -55,6 +60,8 @@ expect_exit 2 "is a cubic2d gamut; space cubic3d needs a cubic3d gamut" -- "$T" 
   --set space=cubic3d --set 'grid.size=[4,2,2]' "${D[@]}"
 expect_exit 2 "space simp2d takes no gamut" -- "$T" --config "$WORK/cubic.yaml" --set space=simp2d "${D[@]}"
 expect_exit 2 "none.h5: no such file" -- "$T" --config "$WORK/cubic.yaml" --set gamut=$WORK/none.h5 "${D[@]}"
+expect_exit 2 "mma is for the simp spaces" -- "$T" --set space=analytic2d --set optimizer.name=mma "${D[@]}"
+expect_exit 2 "optimizer.change_tolerance.*must be in" -- "$T" --set optimizer.change_tolerance=-1 "${D[@]}"
 expect_exit 2 "unknown key 'fitler'" -- "$T" --set fitler.radius=2 "${D[@]}"
 check "nothing written on bad input" -- test ! -e "$WORK/bad.design.h5"
 finish

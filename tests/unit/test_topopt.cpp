@@ -10,6 +10,7 @@
 #include "io/config.hpp"
 #include "topopt/cell_grid.hpp"
 #include "topopt/cell_material.hpp"
+#include "topopt/simp_mma.hpp"
 #include "topopt/topology_objective.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
@@ -311,6 +312,58 @@ TEST(TopoptSimp, MbbBeamReproducesThe88LineCode) {
   EXPECT_NEAR(c15, 218.80, 0.02 * 218.80) << "rmin 1.5 after " << it << " iterations";
   const double c24 = run_mbb(2.4, &it);
   EXPECT_NEAR(c24, 233.71, 0.02 * 233.71) << "rmin 2.4 after " << it << " iterations";
+}
+
+// MMA (NLopt LD_MMA) on the same beam: a compliance within a few percent of
+// OC's, the volume budget met, and a history of MMA's iterates (trial
+// points it rejects leave it unchanged) that only goes down once the first
+// large steps are taken and ends at the result.
+TEST(TopoptSimp, MmaMatchesOcOnTheMbbBeam) {
+  int it = 0;
+  const double c_oc = run_mbb(2.4, &it);
+  TopoptScene sc = mbb(2.4);
+  CellMaterialSettings ms{"simp2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
+  const auto model = make_cell_material_model(ms);
+  TopologyObjective obj(sc.setup, *model);
+  OptimizerSettings os;
+  os.max_iterations = 300;
+  os.log_every = 0;
+  os.mass_limit = true;
+  os.mass_budget = 0.5 * 60 * 20;
+  const OptimizationResult r = optimize_mma(obj, MatX::Constant(1200, 1, 0.5), os);
+  // 233.50 against OC's 233.71. (At radius 1.5 MMA settles in another
+  // local optimum, 3.7% below OC's: docs/BENCHMARKS.md.)
+  EXPECT_NEAR(r.value.elastic, c_oc, 0.02 * c_oc) << r.status << " after " << r.iterations << " iterations";
+  EXPECT_TRUE(r.converged) << r.status;
+  EXPECT_LE(r.max_violation, 1e-6);
+  ASSERT_EQ(int(r.history.size()), r.evaluations);
+  ASSERT_GT(r.history.size(), 10u);
+  for (std::size_t k = 5; k < r.history.size(); ++k)
+    EXPECT_LE(r.history[k].objective, r.history[k - 1].objective * (1 + 1e-3)) << "iteration " << k;
+  EXPECT_EQ(r.history.back().objective, r.value.total);
+  EXPECT_EQ(r.history.front().iteration, 0);
+  EXPECT_LT(r.history[40].objective, 1.05 * r.value.total);  // most of the way after 40 iterations
+}
+
+TEST(TopoptSimp, MmaRefusesNonSimpSpacesAndMissingBudgets) {
+  TopoptScene sc = mbb(1.5);
+  CellMaterialSettings simp{"simp2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
+  const auto model = make_cell_material_model(simp);
+  TopologyObjective obj(sc.setup, *model);
+  OptimizerSettings os;
+  os.max_iterations = 2;
+  os.log_every = 0;
+  EXPECT_THROW(optimize_mma(obj, MatX::Constant(1200, 1, 0.5), os), InputError);  // no budget
+  os.mass_limit = true;
+  os.mass_budget = 600;
+  CellMaterialSettings analytic{"analytic2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
+  const auto two = make_cell_material_model(analytic);
+  TopologyObjective obj2(sc.setup, *two);
+  EXPECT_THROW(optimize_mma(obj2, MatX::Constant(1200, 2, 0.5), os), InputError);  // E and rho per cell
+  const OptimizationResult r = optimize_mma(obj, MatX::Constant(1200, 1, 0.5), os);
+  EXPECT_EQ(r.iterations, 2);
+  EXPECT_EQ(r.history.size(), 3u);
+  EXPECT_EQ(r.status, "iteration limit reached");
 }
 
 // ---------------------------------------------------------------- gamut problem
