@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "io/chart.hpp"
 #include "io/png_image.hpp"
@@ -98,30 +97,31 @@ std::string write_density_picture(const std::string& artifact, const Design& d) 
   };
   std::vector<View> views;
   if (d.dimension == 2) views.push_back({d.nx, d.ny, 1, 0});
-  else views = {{d.nx, d.ny, d.nz, 0}, {d.nx, d.nz, d.ny, 1}};
+  else views = {{d.nx, d.nz, d.ny, 1}, {d.nx, d.ny, d.nz, 0}};  // front above top
   int total_height = 0;
-  for (const View& v : views) total_height = std::max(total_height, v.height);
-  const int total_width = std::accumulate(views.begin(), views.end(), 0, [](int s, const View& v) { return s + v.width; });
-  const int scale = std::clamp(1200 / std::max(1, total_width), 1, 12), gap = views.size() > 1 ? 16 : 0;
-  PngImage image(total_width * scale + gap * int(views.size() - 1), total_height * scale);
-  int left = 0;
+  for (const View& v : views) total_height += v.height;
+  const int scale = std::clamp(1200 / std::max(1, d.nx), 1, 12), gap = views.size() > 1 ? 16 : 0;
+  PngImage image(d.nx * scale, total_height * scale + gap * int(views.size() - 1));
+  int top = 0;
   for (const View& v : views) {
     for (int row = 0; row < v.height; ++row)
       for (int col = 0; col < v.width; ++col) {
-        // The densest cell along the viewing direction decides the pixel.
+        // The densest design cell along the viewing direction decides the
+        // pixel; forced-solid cells only where no design cell is seen
+        // through them (a bridge deck would hide the structure below).
         std::int64_t best = -1;
-        double best_density = -1;
+        double best_density = -1, best_rank = -2;
         for (int t = 0; t < v.depth; ++t) {
           const std::int64_t c = v.axis == 0 ? cell(col, row, t) : cell(col, t, row);
-          const double density = d.roles[std::size_t(c)] == CellRole::empty ? -0.5 : d.raw(c, rho);
-          if (density > best_density) best = c, best_density = density;
+          const CellRole role = d.roles[std::size_t(c)];
+          const double rank = role == CellRole::empty ? -1.0 : role == CellRole::solid ? -0.5 : d.raw(c, rho);
+          if (rank > best_rank) best = c, best_rank = rank, best_density = d.raw(c, rho);
         }
         const Rgb rgb = colour(best, best_density);
         for (int y = 0; y < scale; ++y)
-          for (int x = 0; x < scale; ++x)
-            image.set(left + col * scale + x, (total_height - 1 - row) * scale + y, rgb);
+          for (int x = 0; x < scale; ++x) image.set(col * scale + x, top + (v.height - 1 - row) * scale + y, rgb);
       }
-    left += v.width * scale + gap;
+    top += v.height * scale + gap;
   }
   image.write_png(path);
   return path;

@@ -16,8 +16,9 @@ std::string write_convergence_plot(const std::string& artifact, const Optimizati
 
 // "<stem>.density.png": the cells' density, black = solid, white = void
 // (forced-solid cells blue, forced-empty cells pale red). A 2D design is
-// drawn as is (y up); a 3D design as two views side by side, the largest
-// density along z (top) and along y (front). Returns its path.
+// drawn as is (y up); a 3D design as two views, one above the other: the
+// largest density along y (front, z up) and along z (top, y up).
+// Returns its path.
 std::string write_density_picture(const std::string& artifact, const Design& design);
 
 }  // namespace msfab
