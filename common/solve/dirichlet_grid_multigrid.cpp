@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "solve/chebyshev_kernels.hpp"
+#include "solve/hex_lattice.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/multigrid_solver.hpp"
 #include "solve/sparse_ops.hpp"
@@ -15,15 +16,7 @@
 namespace msfab {
 namespace {
 
-// Corner a of a hexahedron sits at (a>>2&1, a>>1&1, a&1) (fem/voxel_stiffness_field.hpp).
-constexpr int corner_x(int a) { return a >> 2 & 1; }
-constexpr int corner_y(int a) { return a >> 1 & 1; }
-constexpr int corner_z(int a) { return a & 1; }
-// Lattice offset (dx, dy, dz) in {-1, 0, 1}^3 as 0..26.
-constexpr int offset_code(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
-constexpr int corner_code(int a, int b) {
-  return offset_code(corner_x(b) - corner_x(a), corner_y(b) - corner_y(a), corner_z(b) - corner_z(a));
-}
+using namespace hex_lattice;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_kernels.hpp"
+#include "solve/hex_lattice.hpp"
 #include "solve/chebyshev_smoother.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/sparse_ops.hpp"
@@ -24,16 +25,7 @@ constexpr int kCoarseCorrections = 2;
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-// Corner a of a voxel sits at (a>>2&1, a>>1&1, a&1) (fem/voxel_stiffness_field.hpp).
-constexpr int corner_x(int a) { return a >> 2 & 1; }
-constexpr int corner_y(int a) { return a >> 1 & 1; }
-constexpr int corner_z(int a) { return a & 1; }
-// Lattice offset (dx, dy, dz) in {-1, 0, 1}^3 as 0..26.
-constexpr int offset_code(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
-// Offset of corner b relative to corner a.
-constexpr int corner_code(int a, int b) {
-  return offset_code(corner_x(b) - corner_x(a), corner_y(b) - corner_y(a), corner_z(b) - corner_z(a));
-}
+using namespace hex_lattice;
 
 std::string dims_text(const std::array<int, 3>& n) {
   return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
