@@ -1,31 +1,44 @@
 # Two-scale topology optimization and its full-resolution check (thesis
 # §3.4–3.6, Table 3.1): gamut -> design -> mapping -> homogenized against
-# voxel simulation.
+# voxel simulation, for three scenes in one 3D cubic gamut of one material
+# and void at 16^3 voxels per cell (configs/gamut/cubic3d_bar.yaml, minutes):
 #
-#   make -f Makefile.pipeline topopt-bar-check   the 8x2x2 bar of Table 3.1: 16^3 gamut (minutes), design,
-#                                                mapping, check on 128x32x32 voxels (docs/verify_map.md)
+#   make -f Makefile.pipeline topopt-bar-check       the 8x2x2 bar of Table 3.1 (128x32x32 voxels)
+#   make -f Makefile.pipeline topopt-gripper-check   the gripper as a 32x16x2 plate (512x256x32 voxels)
+#   make -f Makefile.pipeline topopt-bridge-check    a 24x6x4 bridge (384x96x64 voxels)
+#   make -f Makefile.pipeline topopt-checks          all three
 #
-# Writes out/topopt/bar.{design,mapped}.h5 and three checks, one summary
-# line each: bar.verify.h5 (the thesis's comparison: one hexahedron per
-# cell), bar.h4.verify.h5 (the homogenized model with 4^3 hexahedra per cell:
-# the homogenization's own error, without most of the coarse mesh's
-# stiffness) and bar.solid.verify.h5 (every cell solid: the coarse mesh's
-# error alone). SEED (pipelines/gamut.mk) seeds the gamut and the mapping.
+# Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.{design,mapped}.h5
+# (the mapping with its STL surfaces and PNG slice stack for the bar and the
+# gripper, the voxel model for all), and S.verify.h5, the thesis's comparison
+# (one hexahedron per cell). The bar adds bar.h4.verify.h5 (the homogenized
+# model with 4^3 hexahedra per cell: the homogenization's own error, without
+# most of the coarse mesh's stiffness) and bar.solid.verify.h5 (every cell
+# solid: the coarse mesh's error alone). Each check prints one summary line
+# (docs/verify_map.md). SEED (pipelines/gamut.mk) seeds the gamut and the mapping.
 BAR_GAMUT := $(OUT)/gamut/cubic3d_bar
+TWO_SCALE_SCENES := bar gripper3d bridge_cubic
 
 $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 	@test -s $@
 
-$(OUT)/topopt/bar.design.h5: configs/topopt/bar.yaml $(BAR_GAMUT).gamut.h5 $(BIN)/msfab-topopt
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.design.h5): $(OUT)/topopt/%.design.h5: configs/topopt/%.yaml \
+    $(BAR_GAMUT).gamut.h5 $(BIN)/msfab-topopt
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@ --quiet
 
-$(OUT)/topopt/bar.mapped.h5: $(OUT)/topopt/bar.design.h5 $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-map
+# Exports: the voxel model always; STL surfaces and a PNG slice per voxel
+# layer for the smaller models.
+MAP_EXPORTS_bar := --set export.stl=true --set export.png=true
+MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.mapped.h5): $(OUT)/topopt/%.mapped.h5: $(OUT)/topopt/%.design.h5 \
+    $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(BAR_GAMUT).microstructures.h5 --seed $(SEED) \
-	  --threads $(THREADS) --out $@ --quiet
+	  --set export.voxels=true $(MAP_EXPORTS_$*) --threads $(THREADS) --out $@ --quiet
 
-$(OUT)/topopt/bar.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.verify.h5): $(OUT)/topopt/%.verify.h5: $(OUT)/topopt/%.mapped.h5 \
+    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
 	  --structures $(BAR_GAMUT).microstructures.h5 --threads $(THREADS) --out $@
 
 $(OUT)/topopt/bar.h4.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
@@ -36,5 +49,8 @@ $(OUT)/topopt/bar.solid.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
 	  --structures $(BAR_GAMUT).microstructures.h5 --set fill=solid --threads $(THREADS) --out $@
 
-.PHONY: topopt-bar-check
+.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-checks
 topopt-bar-check: build $(OUT)/topopt/bar.verify.h5 $(OUT)/topopt/bar.h4.verify.h5 $(OUT)/topopt/bar.solid.verify.h5
+topopt-gripper-check: build $(OUT)/topopt/gripper3d.verify.h5
+topopt-bridge-check: build $(OUT)/topopt/bridge_cubic.verify.h5
+topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check
