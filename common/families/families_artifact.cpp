@@ -32,6 +32,9 @@ void write_families_artifact(const std::string& path, const FamiliesResult& r, c
   H5File& f = out.file();
   f.write_attribute("/", "resolution", static_cast<std::int32_t>(r.resolution));
   f.write_attribute("/", "E_stiff", r.E_stiff);
+  f.write_attribute("/", "decades", r.decades);
+  f.write_attribute("/", "stiff_E", r.stiff_E);
+  f.write_attribute("/", "stiff_nu", r.stiff_nu);
   f.write_attribute("/", "families", static_cast<std::int32_t>(r.families.size()));
   f.write_vector("/selection", r.selection);
   f.create_group("/embedding");
@@ -85,6 +88,9 @@ FamiliesResult read_families_artifact(const std::string& path) {
   FamiliesResult r;
   r.resolution = f.read_attribute<std::int32_t>("/", "resolution");
   r.E_stiff = f.read_attribute<double>("/", "E_stiff");
+  r.decades = f.read_attribute<double>("/", "decades");
+  r.stiff_E = f.read_attribute<double>("/", "stiff_E");
+  r.stiff_nu = f.read_attribute<double>("/", "stiff_nu");
   const int families = f.read_attribute<std::int32_t>("/", "families");
   r.selection = f.read_vector<std::int64_t>("/selection");
   r.embedding = f.read_matrix<double>("/embedding/coordinates");

@@ -36,7 +36,8 @@ struct FamilyRecord {
 
 struct FamiliesResult {
   int resolution = 0;                       // voxels per cell edge of the input set
-  double E_stiff = 0;
+  double E_stiff = 0, decades = 4;          // the input set's normalization
+  double stiff_E = 0, stiff_nu = 0;         // its stiff base material (generated structures are made of it)
   std::vector<std::int64_t> selection;      // indices of the selected structures
   MatX embedding;                           // selection x dimensions (rows of left-out structures: NaN)
   std::vector<int> labels;                  // per selected structure: its mixture cluster, -1 left out

@@ -70,7 +70,7 @@ double normalize_responsibilities(MatX& logp) {
 
 // One M-step from responsibilities R. A component with (numerically) no
 // points keeps its previous mean and covariance.
-void maximize(const MatX& X, const MatX& R, double opt_reg, double trace_floor, Model& m) {
+void maximize(const MatX& X, const MatX& R, double opt_reg, double trace_floor, double variance_floor, Model& m) {
   const int n = static_cast<int>(X.rows()), d = static_cast<int>(X.cols()), K = static_cast<int>(R.cols());
   for (int k = 0; k < K; ++k) {
     const double nk = R.col(k).sum();
@@ -80,7 +80,7 @@ void maximize(const MatX& X, const MatX& R, double opt_reg, double trace_floor, 
     const MatX centred = X.rowwise() - m.means.row(k);
     MatX S = centred.transpose() * R.col(k).asDiagonal() * centred / nk;
     S = 0.5 * (S + S.transpose());
-    S.diagonal().array() += opt_reg * std::max(S.trace(), trace_floor) / d;
+    S.diagonal().array() += opt_reg * std::max(S.trace(), trace_floor) / d + variance_floor;
     m.covs[k] = S;
   }
   m.weights /= m.weights.sum();
@@ -97,7 +97,7 @@ struct Run {
 };
 
 // k-means++ centres, hard assignment to the nearest, then EM.
-Run run_em(const MatX& X, const GmmOptions& o, int start, double trace_floor) {
+Run run_em(const MatX& X, const GmmOptions& o, int start, double trace_floor, double variance_floor) {
   const int n = static_cast<int>(X.rows()), d = static_cast<int>(X.cols()), K = o.components;
   std::mt19937_64 rng(mix_seed(o.seed, static_cast<std::uint64_t>(start)));
   std::vector<int> centres;
@@ -130,7 +130,7 @@ Run run_em(const MatX& X, const GmmOptions& o, int start, double trace_floor) {
   m.means.resize(K, d);
   for (int k = 0; k < K; ++k) m.means.row(k) = X.row(centres[k]);
   MatX data_cov = covariance_of(X);
-  data_cov.diagonal().array() += o.regularization * std::max(data_cov.trace(), trace_floor) / d;
+  data_cov.diagonal().array() += o.regularization * std::max(data_cov.trace(), trace_floor) / d + variance_floor;
   m.covs.assign(K, data_cov);  // kept by components that get no point below
   MatX R = MatX::Zero(n, K);
   for (int i = 0; i < n; ++i) {
@@ -142,7 +142,7 @@ Run run_em(const MatX& X, const GmmOptions& o, int start, double trace_floor) {
     }
     R(i, best) = 1.0;
   }
-  maximize(X, R, o.regularization, trace_floor, m);
+  maximize(X, R, o.regularization, trace_floor, variance_floor, m);
 
   for (int it = 0;; ++it) {
     if (!log_densities(m, X, R)) return run;
@@ -155,7 +155,7 @@ Run run_em(const MatX& X, const GmmOptions& o, int start, double trace_floor) {
       break;
     }
     if (it == o.max_iterations) break;
-    maximize(X, R, o.regularization, trace_floor, m);
+    maximize(X, R, o.regularization, trace_floor, variance_floor, m);
   }
   run.ok = true;
   run.logL = run.history.back();
@@ -184,15 +184,18 @@ double gmm_bic(double log_likelihood, int components, int dimensions, int points
 GaussianMixture fit_gaussian_mixture(const MatX& points, const GmmOptions& options) {
   require_points(points, options.components);
   if (options.restarts < 1 || options.max_iterations < 1 || !(options.tolerance >= 0) ||
-      !(options.regularization > 0) || !std::isfinite(options.regularization))
-    throw InputError("gaussian mixture: need restarts >= 1, max_iterations >= 1, tolerance >= 0, regularization > 0");
+      !(options.regularization > 0) || !std::isfinite(options.regularization) || !(options.min_variance >= 0))
+    throw InputError(
+        "gaussian mixture: need restarts >= 1, max_iterations >= 1, tolerance >= 0, regularization > 0, "
+        "min_variance >= 0");
   const double data_trace = covariance_of(points).trace();
   if (!(data_trace > 0)) throw InputError("gaussian mixture: all points coincide; there is nothing to cluster");
   const double trace_floor = 1e-6 * data_trace;
+  const double variance_floor = options.min_variance * data_trace / double(points.cols());
 
   std::vector<Run> runs(options.restarts);
 #pragma omp parallel for schedule(dynamic)
-  for (int s = 0; s < options.restarts; ++s) runs[s] = run_em(points, options, s, trace_floor);
+  for (int s = 0; s < options.restarts; ++s) runs[s] = run_em(points, options, s, trace_floor, variance_floor);
   int best = -1;
   for (int s = 0; s < options.restarts; ++s)
     if (runs[s].ok && (best < 0 || runs[s].logL > runs[best].logL)) best = s;

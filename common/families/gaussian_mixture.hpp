@@ -19,6 +19,11 @@ struct GmmOptions {
   // added to its diagonal: relative to the component's own scale, with a
   // floor for a component that has collapsed onto a single point.
   double regularization = 1e-6;
+  // min_variance * trace(data) / d is added to every covariance's diagonal:
+  // the smallest cluster width the mixture resolves. Without it, clusters
+  // collapse onto groups of (nearly) identical points, whose likelihood
+  // grows without bound and wins any BIC comparison. 0: off.
+  double min_variance = 0.0;
   std::uint64_t seed = 1;
 };
 

@@ -162,11 +162,61 @@ double residual_variance(const MatX& D, const MatX& coordinates) {
   return std::max(0.0, 1.0 - cxy * cxy / (vx * vy));
 }
 
-IsomapResult isomap(const MatX& D, const IsomapOptions& options) {
-  const NeighborGraph graph = knn_graph(D, options.neighbors);
-  const int n = static_cast<int>(graph.size());
+int connect_components(NeighborGraph& graph, const MatX& D) {
   const std::vector<int> comp = connected_components(graph);
-  const int ncomp = *std::max_element(comp.begin(), comp.end()) + 1;
+  const int n = static_cast<int>(graph.size());
+  const int ncomp = n ? *std::max_element(comp.begin(), comp.end()) + 1 : 0;
+  if (ncomp <= 1) return 0;
+  // The shortest edge between every pair of components (ties: smallest
+  // indices, from the scan order), then Kruskal over the components.
+  struct Link { double length; int i, j; };
+  std::vector<Link> best(std::size_t(ncomp) * ncomp, {std::numeric_limits<double>::infinity(), -1, -1});
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      const int a = std::min(comp[i], comp[j]), b = std::max(comp[i], comp[j]);
+      if (a == b) continue;
+      Link& l = best[std::size_t(a) * ncomp + b];
+      if (D(i, j) < l.length) l = {D(i, j), i, j};
+    }
+  std::vector<Link> links;
+  for (int a = 0; a < ncomp; ++a)
+    for (int b = a + 1; b < ncomp; ++b) links.push_back(best[std::size_t(a) * ncomp + b]);
+  std::stable_sort(links.begin(), links.end(), [](const Link& x, const Link& y) { return x.length < y.length; });
+  std::vector<int> parent(ncomp);
+  for (int c = 0; c < ncomp; ++c) parent[c] = c;
+  const auto root = [&](int c) {
+    while (parent[c] != c) c = parent[c] = parent[parent[c]];
+    return c;
+  };
+  const auto insert = [&](int from, int to, double length) {
+    std::vector<GraphEdge>& edges = graph[from];
+    const auto at = std::lower_bound(edges.begin(), edges.end(), to,
+                                     [](const GraphEdge& e, int t) { return e.target < t; });
+    edges.insert(at, GraphEdge{to, length});
+  };
+  int added = 0;
+  for (const Link& l : links) {
+    const int a = root(comp[l.i]), b = root(comp[l.j]);
+    if (a == b) continue;
+    parent[a] = b;
+    insert(l.i, l.j, l.length);
+    insert(l.j, l.i, l.length);
+    ++added;
+  }
+  return added;
+}
+
+IsomapResult isomap(const MatX& D, const IsomapOptions& options) {
+  NeighborGraph graph = knn_graph(D, options.neighbors);
+  const int n = static_cast<int>(graph.size());
+  std::vector<int> comp = connected_components(graph);
+  int ncomp = *std::max_element(comp.begin(), comp.end()) + 1;
+  const int components_before = ncomp;
+  if (options.connect && ncomp > 1 && !options.require_connected) {
+    connect_components(graph, D);
+    comp = connected_components(graph);
+    ncomp = 1;
+  }
   std::vector<int> sizes(ncomp, 0);
   for (int c : comp) ++sizes[c];
   if (options.require_connected && ncomp > 1) {
@@ -179,7 +229,7 @@ IsomapResult isomap(const MatX& D, const IsomapOptions& options) {
   // max_element returns the first maximum: the component with the smaller index.
   const int largest = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
   IsomapResult r;
-  r.components = ncomp;
+  r.components = components_before;
   for (int i = 0; i < n; ++i) (comp[i] == largest ? r.kept : r.left_out).push_back(i);
   const int m = static_cast<int>(r.kept.size());
   if (options.dimensions < 1 || options.dimensions + 1 > m)

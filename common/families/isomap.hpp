@@ -52,19 +52,30 @@ MdsResult classical_mds(const MatX& D, int dimensions);
 // undefined: 0 if neither side varies, else 1.
 double residual_variance(const MatX& D, const MatX& coordinates);
 
+// Joins the components of a neighbour graph by the shortest edges of D
+// between them (Kruskal's rule on the components: the overall shortest
+// edge between two not yet joined components first), so a graph of k
+// components gains k - 1 edges. Separate families of structures stay far
+// apart in the embedding, joined only through their closest members.
+// Returns the number of edges added.
+int connect_components(NeighborGraph& graph, const MatX& D);
+
 struct IsomapOptions {
   int neighbors = 8;
   int dimensions = 3;
   // true: a neighbour graph with several components is an InputError;
-  // false: only the largest component is embedded.
+  // false: only the largest component is embedded (unless joined below).
   bool require_connected = false;
+  // true: components are joined (connect_components) before embedding, so
+  // every point is embedded.
+  bool connect = false;
 };
 
 struct IsomapResult {
   MatX coordinates;            // kept.size() x dimensions; row r is point kept[r]
   std::vector<int> kept;       // input indices embedded, ascending
   std::vector<int> left_out;   // input indices outside the largest component
-  int components = 1;          // of the neighbour graph
+  int components = 1;          // of the neighbour graph (before joining)
   VecX eigenvalues;            // descending
   double residual_variance = 0;  // of the embedding against the geodesic distances
   MatX geodesic;               // kept x kept

@@ -17,7 +17,7 @@
 #include <cstdio>
 #include <optional>
 
-#include "batch_homogenization.hpp"
+#include "homog/batch_homogenization.hpp"
 #include "cell_input.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"

@@ -292,6 +292,34 @@ TEST(Isomap, DisconnectedGraphEmbedsTheLargestComponent) {
   EXPECT_TRUE(std::isinf(geodesic_distances(knn_graph(D, 3))(0, 19)));
 }
 
+TEST(Isomap, JoinedComponentsEmbedEveryPointAndStayApart) {
+  std::mt19937_64 rng(11);
+  MatX X(30, 3);
+  // Three groups of 10, far apart along x (0, 100, 300).
+  for (int i = 0; i < 30; ++i)
+    for (int a = 0; a < 3; ++a) X(i, a) = uniform(rng) + (a == 0 ? (i < 10 ? 0.0 : i < 20 ? 100.0 : 300.0) : 0.0);
+  const MatX D = euclidean_distances(X);
+  NeighborGraph graph = knn_graph(D, 3);
+  const std::vector<int> separate = connected_components(graph);
+  ASSERT_EQ(*std::max_element(separate.begin(), separate.end()), 2);
+  EXPECT_EQ(connect_components(graph, D), 2);  // k components gain k - 1 edges
+  const std::vector<int> joined = connected_components(graph);
+  EXPECT_EQ(*std::max_element(joined.begin(), joined.end()), 0);
+  IsomapOptions options{3, 2, false, true};
+  const IsomapResult iso = isomap(D, options);
+  EXPECT_EQ(iso.components, 3);
+  EXPECT_TRUE(iso.left_out.empty());
+  ASSERT_EQ(iso.coordinates.rows(), 30);
+  // The groups keep their order and spacing on the first axis: the joins
+  // are the shortest gaps (about 100 and 200).
+  const auto mean = [&](int g) { return iso.coordinates.col(0).segment(10 * g, 10).mean(); };
+  const double gap1 = std::abs(mean(1) - mean(0)), gap2 = std::abs(mean(2) - mean(1));
+  EXPECT_NEAR(gap1, 100.0, 5.0);
+  EXPECT_NEAR(gap2, 200.0, 5.0);
+  for (int g = 0; g < 3; ++g)
+    for (int i = 0; i < 10; ++i) EXPECT_LT(std::abs(iso.coordinates(10 * g + i, 0) - mean(g)), 5.0);
+}
+
 TEST(Isomap, RejectsBadInput) {
   MatX D = euclidean_distances(MatX::Random(6, 2));
   EXPECT_THROW(knn_graph(D, 6), InputError);

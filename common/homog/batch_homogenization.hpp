@@ -1,8 +1,9 @@
 #pragma once
-// Batch mode of msfab-homogenize: every structure of a `msfab.microstructures`
-// artifact homogenized again, optionally refined (each voxel split into
-// refine^3 voxels, or refine^2 for a 2D cell), with its properties in the
-// set's material space recomputed. Uses: a gamut sampled at 16^3 checked at
+// Batch homogenization (msfab-homogenize --structures, msfab-family-generate):
+// every structure of a `msfab.microstructures` artifact homogenized again,
+// optionally refined (each voxel split into refine^3 voxels, or refine^2
+// for a 2D cell), with its properties in the set's material space
+// recomputed. Uses: a gamut sampled at 16^3 checked at
 // 32^3 or 64^3 (the multigrid solver), or a set re-evaluated after a change
 // of base materials' void stiffness.
 #include <string>

@@ -1,4 +1,4 @@
-#include "batch_homogenization.hpp"
+#include "homog/batch_homogenization.hpp"
 
 #include <omp.h>
 
