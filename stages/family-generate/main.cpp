@@ -56,6 +56,7 @@ struct TemplateRequest {
 // The config's `templates:` list.
 std::vector<TemplateRequest> read_templates(const Config& config) {
   std::vector<TemplateRequest> out;
+  if (!config.has("templates")) return out;
   const std::vector<Config> items = config.children("templates");
   for (std::size_t t = 0; t < items.size(); ++t) {
     const Config& item = items[t];
