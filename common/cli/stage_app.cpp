@@ -9,13 +9,8 @@
 #include "cli/logging.hpp"
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
+#include "core/version.hpp"
 
-#ifndef MSFAB_VERSION
-#define MSFAB_VERSION "unknown"
-#endif
-#ifndef MSFAB_GIT_REVISION
-#define MSFAB_GIT_REVISION "unknown"
-#endif
 
 namespace msfab {
 namespace {
@@ -77,7 +72,7 @@ void StageApp::add_common_options() {
       ->type_name("LEVEL")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   cli_.add_flag("-q,--quiet", options_.quiet, "only warnings and errors; no progress display");
-  cli_.set_version_flag("--version", name_ + " " + MSFAB_VERSION + " (revision " + MSFAB_GIT_REVISION + ")");
+  cli_.set_version_flag("--version", name_ + " " + version() + " (revision " + git_revision() + ")");
 }
 
 void StageApp::set_default_config(std::string yaml_text) { default_config_ = std::move(yaml_text); }
@@ -110,7 +105,7 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
     if (options_.threads > 0) omp_set_num_threads(options_.threads);
 
     StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};
-    spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, MSFAB_VERSION, MSFAB_GIT_REVISION,
+    spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, version(), git_revision(),
                   omp_get_max_threads(), options_.seed);
     spdlog::debug("command line: {}", ctx.command_line);
     body(ctx);

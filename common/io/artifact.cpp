@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "io/sha256.hpp"
 
 namespace msfab {
@@ -62,7 +63,7 @@ std::string versions_text(int min_version, int max_version) {
 }  // namespace
 
 std::string producer_string(const std::string& executable) {
-  return executable + " " + MSFAB_VERSION + " (git " + MSFAB_GIT_REVISION + ")";
+  return executable + " " + version() + " (git " + git_revision() + ")";
 }
 
 std::string utc_timestamp_now() {

@@ -17,7 +17,7 @@ struct ArtifactInput {
   std::string sha256;
 };
 
-// "<executable> <MSFAB_VERSION> (git <MSFAB_GIT_REVISION>)".
+// "<executable> <version> (git <revision>)" (core/version.hpp).
 std::string producer_string(const std::string& executable);
 // Current time as ISO-8601 UTC, e.g. "2024-05-01T12:34:56Z".
 std::string utc_timestamp_now();

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "io/artifact.hpp"
 #include "io/hdf5_file.hpp"
 #include "io/sha256.hpp"
@@ -283,8 +284,7 @@ TEST_F(ArtifactWriterTest, RecordsProvenanceAsRootAttributes) {
   EXPECT_EQ(in.schema_version(), 3);
   EXPECT_EQ(in.config(), config);
   EXPECT_EQ(in.seed(), 123456789012345ull);
-  EXPECT_EQ(in.producer(), std::string("msfab-simulate ") + MSFAB_VERSION + " (git " +
-                               MSFAB_GIT_REVISION + ")");
+  EXPECT_EQ(in.producer(), std::string("msfab-simulate ") + version() + " (git " + git_revision() + ")");
   EXPECT_TRUE(std::regex_match(in.created(), std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)")))
       << in.created();
   const std::vector<ArtifactInput> inputs = in.inputs();
