@@ -43,7 +43,6 @@ solver: auto             # full-resolution model: auto | cholmod | pcg-mg | matr
 homogenized_solver: auto # the design grid
 homogenized_elements: 1  # hexahedra per cell edge in the homogenized model (> 1: without most of the coarse mesh's stiffness)
 tolerance: 1.0e-8        # iterative solvers: relative residual
-void_nodes: fixed        # fixed: voxel nodes that only void touches are held at zero | free
 )";
 
 struct Settings {
@@ -54,7 +53,6 @@ struct Settings {
   std::string solver = "auto", homogenized_solver = "auto";
   int homogenized_elements = 1;
   double tolerance = 1e-8;
-  bool fix_void_nodes = true;
 };
 
 Settings read_settings(const Config& config, const std::string& solver_option) {
@@ -75,7 +73,6 @@ Settings read_settings(const Config& config, const std::string& solver_option) {
   if (s.homogenized_elements < 1 || s.homogenized_elements > 64) config.fail("homogenized_elements", "must be 1..64");
   s.tolerance = config.get_or<double>("tolerance", 1e-8);
   if (!(s.tolerance > 0 && s.tolerance < 1)) config.fail("tolerance", "must be in (0, 1)");
-  s.fix_void_nodes = config.one_of("void_nodes", {"fixed", "free"}) == "fixed";
   return s;
 }
 
@@ -268,20 +265,7 @@ int main(int argc, char** argv) {
     spdlog::info("full-resolution model: {} voxels ({:.1f}% material), {} unknowns", report.voxels,
                  100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
                  fine.unknowns());
-    // Nodes that only void touches carry no material. Left free, they are
-    // held only by the ersatz void (void_ratio x the stiff material), and
-    // their near-zero stiffness slows CG by orders of magnitude on designs
-    // with much void; held at zero, they add springs of that tiny
-    // stiffness to the material nodes next to them, a bias of the order of
-    // void_ratio, like the ersatz void itself.
-    std::vector<char> full_fixed = supports.fixed;
-    if (settings.fix_void_nodes)
-      for (std::int64_t n = 0; n < fine.nodes(); ++n)
-        if (!node_material[std::size_t(n)]) {
-          ++report.void_nodes_fixed;
-          for (int a = 0; a < 3; ++a) full_fixed[std::size_t(3 * n + a)] = 1;
-        }
-    const auto full_model = make_model(fine, full_fixed, settings.solver, "solver", solver_options);
+    const auto full_model = make_model(fine, supports.fixed, settings.solver, "solver", solver_options);
     GridElasticity& full = *full_model;
     {
       MatX pairs = voxel_pairs(voxels, materials);

@@ -28,7 +28,6 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "point_supports", r.point_supports);
   f.write_attribute("/", "moved_point_supports", r.moved_point_supports);
   f.write_attribute("/", "lost_point_supports", r.lost_point_supports);
-  f.write_attribute("/", "void_nodes_fixed", r.void_nodes_fixed);
 
   f.create_group("/timings");
   f.write_attribute("/timings", "model", r.seconds_model);

@@ -36,7 +36,6 @@ struct VerifyReport {
   std::string solver_homogenized, solver_full;  // as resolved by GridElasticity
   std::int64_t unknowns_homogenized = 0, unknowns_full = 0;
   std::int64_t point_supports = 0, moved_point_supports = 0, lost_point_supports = 0;
-  std::int64_t void_nodes_fixed = 0;  // voxel nodes only void touches, held at zero (void_nodes: fixed)
   double seconds_model = 0;  // voxel model, stiffness and the transfer of supports
   double seconds_factorize_homogenized = 0, seconds_factorize_full = 0;  // assembly + factorization (matrix-free: setup)
   double seconds_total = 0;
