@@ -1,0 +1,34 @@
+# Extremal microstructure families (thesis §3.3, Appendix A; docs/families.md).
+#
+#   make -f Makefile.pipeline families-demo    two hand-made families (a lattice and a frame, 30 members
+#                                              each) homogenized and found again; seconds
+#   make -f Makefile.pipeline families-gamut   a random 3D cubic set of ~1500 structures at 16^3 (minutes),
+#                                              families among its nu > 0.3 structures and among its auxetic
+#                                              ones (if any)
+#
+# Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
+# a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
+$(OUT)/families/two.microstructures.h5: configs/families/two_templates.yaml $(BIN)/msfab-family-generate
+	@mkdir -p $(@D)
+	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ --quiet
+
+$(OUT)/families/two.families.h5: $(OUT)/families/two.microstructures.h5 $(BIN)/msfab-families
+	$(BIN)/msfab-families --structures $< --set 'selection.nu=[-1,0.5]' --set min_members=10 \
+	  --seed $(SEED) --threads $(THREADS) --out $@
+
+$(OUT)/families/%.family1.microstructures.h5: $(OUT)/families/%.families.h5 $(BIN)/msfab-family-generate
+	$(BIN)/msfab-family-generate --families $< --family 1 --sweep 5 --threads $(THREADS) --out $@
+
+$(OUT)/families/stiff_nu.families.h5: configs/families/stiff_nu.yaml $(OUT)/gamut/cubic3d_families.gamut.h5 \
+    $(BIN)/msfab-families
+	@mkdir -p $(@D)
+	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_families.microstructures.h5 \
+	  --seed $(SEED) --threads $(THREADS) --out $@
+
+.PHONY: families-demo families-gamut
+families-demo: build $(OUT)/families/two.families.h5 $(OUT)/families/two.family1.microstructures.h5
+families-gamut: build $(OUT)/families/stiff_nu.families.h5
+	@# The auxetic selection of the same set (an input error when it holds none).
+	-$(BIN)/msfab-families --config configs/families/auxetic.yaml \
+	  --structures $(OUT)/gamut/cubic3d_families.microstructures.h5 --seed $(SEED) --threads $(THREADS) \
+	  --out $(OUT)/families/auxetic.families.h5
