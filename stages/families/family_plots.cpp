@@ -64,6 +64,17 @@ void draw_depth_view(PngImage& image, int x0, int y0, int scale, const std::vect
     }
 }
 
+// One layer of a structure: solid black, void white.
+void draw_slice(PngImage& image, int x0, int y0, int scale, const std::vector<int>& ids, int n, int k) {
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const bool solid = ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0;
+      const std::uint8_t g = solid ? 30 : 255;
+      for (int a = 0; a < scale; ++a)
+        for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {g, g, g});
+    }
+}
+
 }  // namespace
 
 std::string plot_folder_for(const std::string& out) {
@@ -100,15 +111,24 @@ void write_family_plots(const std::string& folder, const FamiliesResult& r, cons
           [&](std::size_t i) { return shear_modulus_ratio(prop(i)[0], prop(i)[1], prop(i)[2]); });
 
   // Per family: representative (left) and its fitted template (right), at
-  // the set's resolution, one pixel block per voxel.
-  const int n = set.nx, scale = std::max(1, 256 / n), gap = 16;
+  // the set's resolution, one pixel block per voxel: seen along z with
+  // depth shading (top), and the layers z = n/4 and z = 0 (below), which
+  // cut through the fundamental tetrahedron and the cell face.
+  const int n = set.nx, scale = std::max(1, 192 / n), gap = 12, side = n * scale;
   for (std::size_t f = 0; f < r.families.size(); ++f) {
     const FamilyRecord& fam = r.families[f];
-    PngImage image(2 * n * scale + 3 * gap, n * scale + 2 * gap, {255, 255, 255});
-    draw_depth_view(image, gap, gap, scale, set.items[std::size_t(fam.representative)].ids, n);
-    if (fam.representative_template.size() > 0) {
-      const VoxelGrid t = rasterize_template(template_from_parameters(fam.representative_template, fam.caps), n);
-      draw_depth_view(image, 2 * gap + n * scale, gap, scale, t.ids, n);
+    PngImage image(2 * side + 3 * gap, 3 * side + 4 * gap, {255, 255, 255});
+    const std::vector<int>& rep = set.items[std::size_t(fam.representative)].ids;
+    std::vector<int> tpl;
+    if (fam.representative_template.size() > 0)
+      tpl = rasterize_template(template_from_parameters(fam.representative_template, fam.caps), n).ids;
+    for (int col = 0; col < 2; ++col) {
+      const std::vector<int>& ids = col == 0 ? rep : tpl;
+      if (ids.empty()) continue;
+      const int x0 = gap + col * (side + gap);
+      draw_depth_view(image, x0, gap, scale, ids, n);
+      draw_slice(image, x0, 2 * gap + side, scale, ids, n, n / 4);
+      draw_slice(image, x0, 3 * gap + 2 * side, scale, ids, n, 0);
     }
     image.write_png(folder + "/family" + std::to_string(f + 1) + ".png");
   }
