@@ -13,6 +13,9 @@ namespace {
 constexpr double kShortestBeam = 1e-10;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kParallelWork = 1e6;  // inner-loop evaluations worth a parallel region
+// Six logistic scales out the kernel's tail is below 1e-2.6 of a voxel;
+// the occupancy ignores material 4 pi scales (two voxels unsharpened) away.
+constexpr double kKernelReach = 4 * kPi;
 
 // A beam moved to one of its images: its end, frame and reach.
 struct PlacedBeam {
@@ -42,16 +45,26 @@ double placed_distance(const PlacedBeam& P, const Vec3& p) {
   return dist;
 }
 
+// Past 37 scales exp(-x) is below half an ulp of 1, so the logistic is
+// exactly 1 and exp, where the fit spends much of its time, need not run.
+double logistic(double x) { return x > 37.0 ? 1.0 : 1.0 / (1.0 + std::exp(-x)); }
+
 // A logistic-smoothed interval [-lo, hi] at t: the difference of two
 // logistic distribution functions of the given sharpness (1 / scale).
 double smoothed_interval(double t, double lo, double hi, double sharpness) {
-  const double inside = 1.0 / (1.0 + std::exp(-(hi - t) * sharpness)) + 1.0 / (1.0 + std::exp(-(t + lo) * sharpness)) - 1.0;
+  const double inside = logistic((hi - t) * sharpness) + logistic((t + lo) * sharpness) - 1.0;
   return std::max(inside, 0.0);
 }
 
 double placed_occupancy(const PlacedBeam& P, const Vec3& p, double sharpness) {
   const Vec3 d = p - P.a;
-  const double v = d.dot(P.y), w = d.dot(P.z);
+  // Beyond the kernel's reach across the section the occupancy counts as
+  // none, as it does for images that far away, and exp need not run.
+  const double reach = kKernelReach / sharpness;
+  const double v = d.dot(P.y);
+  if (std::abs(v) > P.r0 + reach) return 0.0;
+  const double w = d.dot(P.z);
+  if (std::abs(w) > P.r1 + reach) return 0.0;
   const double across = smoothed_interval(v, P.r0, P.r0, sharpness) * smoothed_interval(w, P.r1, P.r1, sharpness);
   if (across < 1e-12) return 0.0;
   // A dome reaches sqrt(cap^2 - rho^2) past the end at section radius rho.
@@ -178,13 +191,13 @@ std::vector<double> beam_distance(const Beam& beam, bool caps, const Fundamental
   return dist;
 }
 
-std::vector<double> beam_occupancy(const Beam& beam, bool caps, const FundamentalVoxels& fv) {
+std::vector<double> beam_occupancy(const Beam& beam, bool caps, const FundamentalVoxels& fv, double sharpening) {
   check_beam(beam, "beam_occupancy: ");
+  if (!(sharpening >= 1) || !std::isfinite(sharpening))
+    throw InputError("beam_occupancy: sharpening must be >= 1, got " + std::to_string(sharpening));
   std::vector<double> occ(fv.voxel.size(), 0.0);
-  // Six logistic scales out the kernel's tail is below 1e-2.6 of a voxel;
-  // two voxels is twelve.
-  const std::vector<PlacedBeam> images = images_near_domain(beam, caps, 2.0 / fv.n);
-  const double sharpness = 2 * kPi * fv.n;
+  const double sharpness = 2 * kPi * fv.n * sharpening;
+  const std::vector<PlacedBeam> images = images_near_domain(beam, caps, kKernelReach / sharpness);
   const int count = static_cast<int>(fv.voxel.size());
   const bool parallel = double(count) * images.size() > kParallelWork;
 #pragma omp parallel for schedule(static) if (parallel)
@@ -209,23 +222,31 @@ std::vector<double> periodic_blur(const std::vector<double>& field, int n, doubl
   double total = 0;
   for (int k = -reach; k <= reach; ++k) total += kernel[k + reach] = std::exp(-0.5 * k * k / (width * width));
   for (double& w : kernel) w /= total;
-  // Wrapped neighbour offsets, so the inner loop does no modulo.
-  std::vector<int> wrapped((2 * reach + 1) * n);
-  for (int c = 0; c < n; ++c)
-    for (int k = -reach; k <= reach; ++k) wrapped[c * (2 * reach + 1) + k + reach] = ((c + k) % n + n) % n;
+  // Each line of the cell along the axis is copied with its periodic
+  // continuation on both sides, so the inner loop reads contiguous values
+  // and does no index arithmetic; the sum runs in kernel order as before.
+  const int padded = n + 2 * reach;
+  std::vector<int> wrapped(padded);
+  for (int q = 0; q < padded; ++q) wrapped[q] = ((q - reach) % n + n) % n;
   std::vector<double> a = field, b(field.size());
-  const int stride[3] = {1, n, n * n};
-  const int total_voxels = n * n * n;
-  const bool parallel = double(total_voxels) * kernel.size() > kParallelWork;
+  const int lines = n * n;
+  const bool parallel = double(lines) * n * kernel.size() > kParallelWork;
   for (int axis = 0; axis < 3; ++axis) {
-#pragma omp parallel for schedule(static) if (parallel)
-    for (int v = 0; v < total_voxels; ++v) {
-      const int coord = v / stride[axis] % n;
-      const int base = v - coord * stride[axis];
-      const int* w = &wrapped[coord * (2 * reach + 1)];
-      double s = 0;
-      for (int k = 0; k <= 2 * reach; ++k) s += kernel[k] * a[base + w[k] * stride[axis]];
-      b[v] = s;
+    const int stride = axis == 0 ? 1 : axis == 1 ? n : n * n;
+#pragma omp parallel if (parallel)
+    {
+      std::vector<double> line(padded);
+#pragma omp for schedule(static)
+      for (int l = 0; l < lines; ++l) {
+        // The line's first voxel: lines are indexed by the two other coordinates.
+        const int base = axis == 0 ? l * n : axis == 1 ? l % n + l / n * n * n : l;
+        for (int q = 0; q < padded; ++q) line[q] = a[base + wrapped[q] * stride];
+        for (int c = 0; c < n; ++c) {
+          double sum = 0;
+          for (int k = 0; k <= 2 * reach; ++k) sum += kernel[k] * line[c + k];
+          b[base + c * stride] = sum;
+        }
+      }
     }
     std::swap(a, b);
   }
@@ -241,12 +262,12 @@ VoxelGrid rasterize_template(const BeamTemplate& tpl, int n) {
   return cell;
 }
 
-std::vector<double> rasterize_template_smooth(const BeamTemplate& tpl, int n, double width) {
+std::vector<double> rasterize_template_smooth(const BeamTemplate& tpl, int n, double width, double sharpening) {
   check_template(tpl, n, "rasterize_template_smooth");
   const FundamentalVoxels fv = fundamental_voxels(n);
   std::vector<double> best(fv.voxel.size(), 0.0);
   for (const Beam& b : tpl.beams) {
-    const std::vector<double> occ = beam_occupancy(b, tpl.caps, fv);
+    const std::vector<double> occ = beam_occupancy(b, tpl.caps, fv, sharpening);
     for (std::size_t i = 0; i < best.size(); ++i) best[i] = std::max(best[i], occ[i]);
   }
   std::vector<double> occ(std::size_t(n) * n * n);

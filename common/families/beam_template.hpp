@@ -57,8 +57,12 @@ std::vector<double> beam_distance(const Beam& beam, bool caps, const Fundamental
 // h / (2 pi)), so the occupancy is exactly the product of three smoothed
 // intervals and a beam's material is counted without bias even when it is
 // only a few voxels thick. A dome is smoothed as if the end moved out by
-// the dome's height at the point's section position.
-std::vector<double> beam_occupancy(const Beam& beam, bool caps, const FundamentalVoxels& voxels);
+// the dome's height at the point's section position. `sharpening` (>= 1,
+// else InputError) divides the kernel's scale: the occupancy then tends to
+// whether the voxel's centre lies in the beam, what rasterize_template
+// samples. Material more than 4 pi kernel scales away is not counted.
+std::vector<double> beam_occupancy(const Beam& beam, bool caps, const FundamentalVoxels& voxels,
+                                   double sharpening = 1.0);
 
 // A periodic n^3 field (x fastest) convolved with a Gaussian of standard
 // deviation `width` voxels, truncated at 3 widths and renormalized.
@@ -73,13 +77,14 @@ std::vector<double> periodic_blur(const std::vector<double>& field, int n, doubl
 VoxelGrid rasterize_template(const BeamTemplate& tpl, int n);
 
 // The same as occupancies in [0, 1] (x fastest): the largest
-// beam_occupancy over the beams, then periodic_blur by `width` voxels,
-// the blur the fit applies to the target. Beams are united before the
-// blur, at one voxel's sharpness, so where images meet or beams cross
-// their material counts once; a sigmoid of the signed distance as wide as
-// the blur would instead ignore a thin beam's far face and overstate its
-// material.
-std::vector<double> rasterize_template_smooth(const BeamTemplate& tpl, int n, double width = 1.0);
+// beam_occupancy (at `sharpening`) over the beams, then periodic_blur by
+// `width` voxels, the blur the fit applies to the target. Beams are united
+// before the blur, at one voxel's sharpness or sharper, so where images
+// meet or beams cross their material counts once; a sigmoid of the signed
+// distance as wide as the blur would instead ignore a thin beam's far face
+// and overstate its material.
+std::vector<double> rasterize_template_smooth(const BeamTemplate& tpl, int n, double width = 1.0,
+                                              double sharpening = 1.0);
 
 // InputError, naming `context`, the beam and the field, for an end point
 // that is not finite or a size that is negative or not finite.

@@ -348,10 +348,12 @@ Segment canonical_image(const Segment& s) {
 }
 
 // Distance from p to the nearest image of k under the cube symmetries and
-// lattice translations.
-double distance_to_images(const Vec3& p, const Segment& k) {
+// lattice translations; with `moved_only`, k itself does not count.
+double distance_to_images(const Vec3& p, const Segment& k, bool moved_only = false) {
   double best = std::numeric_limits<double>::infinity();
-  for (const Mat3& S : cell_symmetries()) {
+  const auto& symmetries = cell_symmetries();
+  for (std::size_t s = 0; s < symmetries.size(); ++s) {
+    const Mat3& S = symmetries[s];
     // The symmetries are orthogonal and fix the centre, so the distance to
     // an image of k is the distance from the inverse image of p to k.
     const Vec3 q = apply_cell_symmetry(S.transpose(), p);
@@ -359,23 +361,50 @@ double distance_to_images(const Vec3& p, const Segment& k) {
     const Vec3 base = (q - mid).array().round().matrix();
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          best = std::min(best, point_segment_distance(q - base - Vec3(dx, dy, dz), k.a, k.b));
+        for (int dx = -1; dx <= 1; ++dx) {
+          const Vec3 shift = base + Vec3(dx, dy, dz);
+          if (moved_only && s == 0 && shift.isZero()) continue;  // the identity comes first
+          best = std::min(best, point_segment_distance(q - shift, k.a, k.b));
+        }
   }
   return best;
 }
 
 // Whether every point of s lies within tol of an image of a kept segment,
 // checked at points no more than tol / 2 apart.
-bool covered(const Segment& s, const std::vector<Segment>& kept, double tol) {
+bool covered(const Segment& s, const std::vector<Segment>& kept, double tol, bool moved_only = false) {
   const int pieces = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / (0.5 * std::max(tol, 1e-6)))));
   for (int i = 0; i <= pieces; ++i) {
     const Vec3 p = s.a + (s.b - s.a) * (double(i) / pieces);
     bool near = false;
-    for (const Segment& k : kept) near = near || distance_to_images(p, k) <= tol;
+    for (const Segment& k : kept) near = near || distance_to_images(p, k, moved_only) <= tol;
     if (!near) return false;
   }
   return true;
+}
+
+// Where s crosses a mirror plane of the periodic cubic cell, as fractions
+// of the way from a to b strictly inside (0, 1): the planes x_i = k / 2,
+// x_i - x_j = k and x_i + x_j = k for integers k.
+std::vector<double> mirror_crossings(const Segment& s) {
+  std::vector<double> t;
+  auto crossings = [&](double from, double to, double spacing) {
+    if (std::abs(to - from) < 1e-12) return;  // along the plane
+    const double lo = std::min(from, to), hi = std::max(from, to);
+    for (double k = std::ceil(lo / spacing); k * spacing <= hi; k += 1) {
+      const double f = (k * spacing - from) / (to - from);
+      if (f > 1e-9 && f < 1 - 1e-9) t.push_back(f);
+    }
+  };
+  for (int i = 0; i < 3; ++i) {
+    crossings(s.a[i], s.b[i], 0.5);
+    for (int j = i + 1; j < 3; ++j) {
+      crossings(s.a[i] - s.a[j], s.b[i] - s.b[j], 1.0);
+      crossings(s.a[i] + s.a[j], s.b[i] + s.b[j], 1.0);
+    }
+  }
+  std::sort(t.begin(), t.end());
+  return t;
 }
 
 }  // namespace
@@ -544,6 +573,34 @@ std::vector<Segment> skeleton_segments(const VoxelGrid& cell, const SkeletonOpti
     }
   }
   return out;
+}
+
+Segment cut_at_mirrors(const Segment& segment, double tolerance) {
+  if (!(tolerance >= 0)) throw InputError("cut_at_mirrors: tolerance must be >= 0, got " + std::to_string(tolerance));
+  Segment s = segment;
+  while (true) {
+    const double length = (s.b - s.a).norm();
+    if (!(length > 2 * tolerance)) return s;
+    // A piece shorter than the tolerance would be "covered" by any image
+    // through the cut point, mirrored or not.
+    auto try_cut = [&](double t, Segment& kept) {
+      const Vec3 c = s.a + t * (s.b - s.a);
+      const Segment first{s.a, c}, second{c, s.b};
+      const bool keep_first = t >= 0.5;
+      const Segment& cut = keep_first ? second : first;
+      kept = keep_first ? first : second;
+      return (cut.b - cut.a).norm() >= tolerance && covered(cut, {kept}, tolerance, true);
+    };
+    Segment best = s, kept;
+    for (double t : mirror_crossings(s))
+      if (try_cut(t, kept) && (kept.b - kept.a).norm() < (best.b - best.a).norm()) best = kept;
+    // A centre of inversion or a two-fold axis lies at the midpoint of a
+    // segment it maps onto itself; mirror planes are preferred, as the
+    // exact place of the cut.
+    if (best.a == s.a && best.b == s.b && try_cut(0.5, kept)) best = kept;
+    if (best.a == s.a && best.b == s.b) return s;
+    s = best;
+  }
 }
 
 std::vector<Segment> fundamental_segments(const std::vector<Segment>& segments, double merge_tolerance) {

@@ -99,4 +99,14 @@ std::vector<Segment> skeleton_segments(const VoxelGrid& cell, const SkeletonOpti
 // cap that is not there. InputError for a negative tolerance.
 std::vector<Segment> fundamental_segments(const std::vector<Segment>& segments, double merge_tolerance = 0.05);
 
+// A segment that runs through a mirror plane of the cell (or a centre of
+// inversion, or a two-fold axis, at its midpoint) and is its own mirror
+// image there is rebuilt by rasterization from the part on either side: the
+// longer part, whose images cover the other within `tolerance` (unit-cell
+// units), repeated while a cut removes at least `tolerance`. A whole edge of
+// a cube frame becomes the half from a corner to the edge's midpoint, whose
+// free end can then move off the edge where a whole beam could only tilt.
+// InputError for a negative tolerance.
+Segment cut_at_mirrors(const Segment& segment, double tolerance = 0.05);
+
 }  // namespace msfab

@@ -196,6 +196,34 @@ TEST(FamiliesSkeleton, FundamentalSegmentsOfASymmetricFrame) {
   }
 }
 
+TEST(FamiliesSkeleton, CutAtMirrorsKeepsThePartThatRebuildsTheSegment) {
+  // A whole edge of a cube frame, as thinning leaves it: half a voxel of
+  // n = 24 off the edge, a closed loop through the cell. The mirror plane
+  // z = 1/2 maps the part beyond it onto the part before it.
+  const double off = 0.5 / 24;
+  const Segment edge{Vec3(off, off, -off), Vec3(off, off, 1 - off)};
+  const Segment half = cut_at_mirrors(edge);
+  std::printf("[ measured ] frame edge cut to (%.4f %.4f %.4f)-(%.4f %.4f %.4f)\n", half.a.x(), half.a.y(), half.a.z(),
+              half.b.x(), half.b.y(), half.b.z());
+  EXPECT_NEAR(std::abs(half.b.z() - half.a.z()), 0.5 + off, 1e-12);
+  EXPECT_NEAR(std::max(half.a.z(), half.b.z()), 0.5, 1e-12);
+  for (const Vec3& p : {half.a, half.b}) {
+    EXPECT_NEAR(p.x(), off, 1e-12);
+    EXPECT_NEAR(p.y(), off, 1e-12);
+  }
+  // A bar from a corner to the body centre is no image of itself, nor is a
+  // bar that crosses a mirror plane obliquely or one in general position.
+  const Segment others[] = {{Vec3(0, 0, 0), Vec3(0.5, 0.5, 0.5)},
+                            {Vec3(0.4, 0.2, 0.2), Vec3(0.6, 0.3, 0.3)},
+                            {Vec3(0.083, 0.201, 0.337), Vec3(0.167, 0.299, 0.413)}};
+  for (const Segment& s : others) {
+    const Segment same = cut_at_mirrors(s);
+    EXPECT_EQ(same.a, s.a);
+    EXPECT_EQ(same.b, s.b);
+  }
+  EXPECT_THROW(cut_at_mirrors(edge, -1), InputError);
+}
+
 // A beam about the centroid of the fundamental tetrahedron, in general
 // position, clear of its 47 images (some would touch it were its section
 // one voxel of n = 32 wider on each side).
@@ -283,6 +311,32 @@ TEST(FamiliesTemplate, BeamGeometryFollowsTheSectionFrame) {
   const BeamFrame up = beam_frame({Vec3(0, 0, 0), Vec3(0.1, 1, 0), 0.1, 0.1, 0});
   EXPECT_NEAR(std::abs(up.y.dot(up.x)), 0.0, 1e-12);
   EXPECT_GT(std::abs(up.y.x()), 0.9);
+}
+
+TEST(FamiliesTemplate, SharpenedOccupancyTendsToThePointSampling) {
+  // Sharpened, the occupancy says whether a voxel's centre lies in the
+  // beam, as rasterize_template samples it; unsharpened, a thin beam fills
+  // the voxels along its faces only in part.
+  const Beam b = general_beam();
+  const int n = 16;
+  const FundamentalVoxels fv = fundamental_voxels(n);
+  const std::vector<double> distance = beam_distance(b, true, fv, 1.0);
+  const std::vector<double> sharp = beam_occupancy(b, true, fv, 64), soft = beam_occupancy(b, true, fv);
+  double worst_sharp = 0, worst_soft = 0;
+  int clear = 0;
+  for (std::size_t v = 0; v < fv.voxel.size(); ++v) {
+    if (std::abs(distance[v]) < 0.1 / n) continue;  // the centre on the surface, give or take
+    ++clear;
+    const double solid = distance[v] <= 0;
+    worst_sharp = std::max(worst_sharp, std::abs(sharp[v] - solid));
+    worst_soft = std::max(worst_soft, std::abs(soft[v] - solid));
+  }
+  std::printf("[ measured ] %d voxels clear of the surface: sharpened %.2g, unsharpened %.2f from the point sampling\n",
+              clear, worst_sharp, worst_soft);
+  EXPECT_GT(clear, 100);
+  EXPECT_LT(worst_sharp, 1e-6);
+  EXPECT_GT(worst_soft, 0.2);
+  EXPECT_THROW(beam_occupancy(b, true, fv, 0.5), InputError);
 }
 
 TEST(FamiliesTemplate, SolidFractionConvergesUnderRefinement) {
@@ -439,6 +493,12 @@ TEST(FamiliesFit, BadInput) {
   EXPECT_THROW(fit_template(cell, bad), InputError);
   EXPECT_THROW(fit_template(VoxelGrid(16, 16, 8, 1.0)), InputError);
   EXPECT_THROW(fit_template(empty_cell(16)), InputError);  // no skeleton, no beams
+  TemplateFitOptions restarts;
+  restarts.restart_difference = -0.01;
+  EXPECT_THROW(fit_template(cell, restarts), InputError);
+  restarts = {};
+  restarts.max_restarts = -1;
+  EXPECT_THROW(fit_template(cell, restarts), InputError);
   BeamTemplate negative{{general_beam()}, true};
   negative.beams[0].r1 = -0.01;
   EXPECT_THROW(refine_template(cell, negative), InputError);
@@ -477,6 +537,38 @@ TEST(FamiliesFit, FitFromItsOwnSkeleton) {
   EXPECT_GE(lone.fitted.beams.size(), 1u);
   EXPECT_LE(lone.fitted.beams.size(), 2u);
   EXPECT_LT(lone.voxel_difference, 0.01);
+}
+
+TEST(FamiliesFit, FitsTemplateDrawnCellsFromTheirSkeletons) {
+  // One-beam templates drawn at 16^3 where a beam's images meet near, not
+  // at, a point they share: body-centred lattices whose beams start off the
+  // corner along an axis, and cube frames whose edges bend out at their
+  // midpoints. The skeleton puts the joint on the shared point, or runs
+  // straight along the edge.
+  struct Case {
+    const char* name;
+    Beam beam;
+  };
+  const Case cases[] = {
+      {"body-centred, corner end 1.9 voxels off", {Vec3(0.12, 0, 0), Vec3(0.5, 0.5, 0.5), 0.088, 0.088, 0}},
+      {"body-centred, corner end 1.3 voxels off", {Vec3(0.08, 0, 0), Vec3(0.5, 0.5, 0.5), 0.104, 0.104, 0}},
+      {"frame, edge bent 1.3 voxels", {Vec3(0, 0, 0), Vec3(0.5, 0.08, 0), 0.096, 0.096, 0}},
+      {"frame, edge bent 2.6 voxels", {Vec3(0, 0, 0), Vec3(0.5, 0.16, 0), 0.12, 0.12, 0}},
+  };
+  const int n = 16;
+  for (const Case& c : cases) {
+    BeamTemplate truth;
+    truth.beams.push_back(c.beam);
+    const VoxelGrid target = rasterize_template(truth, n);
+    const TemplateFit fit = fit_template(target);
+    std::printf("[ measured ] %s: %zu beams, voxel difference %.4f, objective %.3g (the drawing template's %.3g), "
+                "%d steps, %d evaluations\n",
+                c.name, fit.fitted.beams.size(), fit.voxel_difference, fit.objective.back(),
+                template_objective(target, truth), fit.steps, fit.evaluations);
+    EXPECT_LT(fit.voxel_difference, 0.02) << c.name;
+    EXPECT_DOUBLE_EQ(fit.objective.back(), template_objective(target, fit.fitted)) << c.name;
+    for (std::size_t i = 1; i < fit.objective.size(); ++i) EXPECT_LE(fit.objective[i], fit.objective[i - 1]) << c.name;
+  }
 }
 
 }  // namespace
