@@ -94,8 +94,8 @@ FamiliesResult read_families_artifact(const std::string& path) {
   const int families = f.read_attribute<std::int32_t>("/", "families");
   r.selection = f.read_vector<std::int64_t>("/selection");
   r.embedding = f.read_matrix<double>("/embedding/coordinates");
-  r.eigenvalues = Eigen::Map<const VecX>(f.read_vector<double>("/embedding/eigenvalues").data(),
-                                         Eigen::Index(f.dataset_shape("/embedding/eigenvalues")[0]));
+  const std::vector<double> eigenvalues = f.read_vector<double>("/embedding/eigenvalues");
+  r.eigenvalues = Eigen::Map<const VecX>(eigenvalues.data(), Eigen::Index(eigenvalues.size()));
   r.residual_variance = f.read_attribute<double>("/embedding", "residual_variance");
   r.labels = f.read_vector<int>("/clusters/label");
   r.family_of = f.read_vector<int>("/clusters/family");

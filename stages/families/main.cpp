@@ -29,6 +29,7 @@
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "families/beam_template.hpp"
 #include "families/families_artifact.hpp"
 #include "families/family_selection.hpp"
@@ -145,10 +146,6 @@ Settings read_settings(const Config& config) {
     config.fail("reduced.variance_kept", "must be in (0, 1]");
   s.plots = config.get_or<bool>("plots", true);
   return s;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 VoxelGrid cell_of(const MicrostructureSet& set, std::int64_t s) {

@@ -22,6 +22,7 @@
 
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/artifact.hpp"
 #include "io/sha256.hpp"
 #include "models.hpp"
@@ -74,10 +75,6 @@ Settings read_settings(const Config& config, const std::string& solver_option) {
   s.tolerance = config.get_or<double>("tolerance", 1e-8);
   if (!(s.tolerance > 0 && s.tolerance < 1)) config.fail("tolerance", "must be in (0, 1)");
   return s;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 std::string grid_text(int nx, int ny, int nz) {
