@@ -1,0 +1,448 @@
+#include "dynamics/newmark_integrator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/timing.hpp"
+#include "dynamics/contact_problem.hpp"
+#include "dynamics/mass_matrix.hpp"
+#include "fem/hex_boundary.hpp"
+#include "material/scaled_material.hpp"
+#include "solve/cholmod_solver.hpp"
+
+namespace msfab {
+
+struct NewmarkIntegrator::Contact {
+  int node = 0;
+  int obstacle = 0;
+  ContactPlane plane;
+  Mat3 frame;  // columns: normal, tangent 1, tangent 2
+  double mu = 0;
+};
+
+namespace {
+
+double smallest_edge(const HexMesh& mesh) {
+  double h = std::numeric_limits<double>::infinity();
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const hex8::NodeMatrix X = mesh.element_rest_positions(e);
+    for (int i = 0; i < 8; ++i)
+      for (int bit = 1; bit < 8; bit <<= 1)
+        if (!(i & bit)) h = std::min(h, (X.row(i) - X.row(i | bit)).norm());
+  }
+  return h;
+}
+
+// The mesh with every element's materials scaled by its own factor.
+HexMesh scale_materials(const HexMesh& mesh, const std::vector<double>& factor) {
+  HexMesh scaled = mesh;
+  scaled.materials.clear();
+  scaled.element_material.assign(mesh.num_elements(), 0);
+  std::map<std::pair<int, double>, int> index;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int base = mesh.element_material[e];
+    const auto [it, inserted] = index.try_emplace({base, factor[e]}, static_cast<int>(scaled.materials.size()));
+    if (inserted) {
+      QuadratureMaterials q;
+      for (const auto& m : mesh.materials[base].at_point) q.at_point.push_back(std::make_shared<ScaledMaterial>(m, factor[e]));
+      scaled.materials.push_back(std::move(q));
+    }
+    scaled.element_material[e] = it->second;
+  }
+  return scaled;
+}
+
+bool all_equal(const std::vector<double>& v) {
+  return std::all_of(v.begin(), v.end(), [&](double x) { return x == v.front(); });
+}
+
+}  // namespace
+
+NewmarkIntegrator::NewmarkIntegrator(const DynamicsModel& model, const NewmarkOptions& options)
+    : model_(model), options_(options), assembler_((validate_dynamics_model(model), model.mesh)) {
+  if (!(options.time_step > 0) || !std::isfinite(options.time_step))
+    throw InputError("dynamics: time_step must be positive (got " + std::to_string(options.time_step) + ")");
+  const HexMesh& mesh = model.mesh;
+  const int n = mesh.num_dofs();
+
+  if (all_equal(model.damping_b)) {
+    uniform_b_ = model.damping_b.front();
+  } else {
+    damping_mesh_ = std::make_unique<HexMesh>(scale_materials(mesh, model.damping_b));
+    damping_assembler_ = std::make_unique<ElasticAssembler>(*damping_mesh_);
+  }
+
+  scalar_mass_ = msfab::scalar_mass_matrix(mesh, model.density);
+  mass_ = expand_to_dofs(scalar_mass_);
+  const SpMat pattern = assembler_.pattern();
+  mass_in_pattern_ = pattern + mass_;
+  std::vector<double> rho_a(mesh.num_elements());
+  for (int e = 0; e < mesh.num_elements(); ++e) rho_a[e] = model.density[e] * model.damping_a[e];
+  damping_mass_in_pattern_ = pattern + expand_to_dofs(weighted_mass_matrix(mesh, rho_a));
+  if (mass_in_pattern_.nonZeros() != pattern.nonZeros() || damping_mass_in_pattern_.nonZeros() != pattern.nonZeros())
+    throw std::logic_error("mass matrix pattern is not contained in the stiffness pattern");
+  jacobian_ = mass_in_pattern_;
+
+  const std::vector<char> fixed = model.fixed.empty() ? std::vector<char>(n, 0) : model.fixed;
+  for (int j = 0; j < n; ++j)
+    for (int k = jacobian_.outerIndexPtr()[j]; k < jacobian_.outerIndexPtr()[j + 1]; ++k) {
+      const int i = jacobian_.innerIndexPtr()[k];
+      if (fixed[i] || fixed[j]) (i == j ? fixed_diagonal_index_ : fixed_value_index_).push_back(k);
+    }
+
+  VecX g(n);
+  for (int i = 0; i < mesh.num_nodes(); ++i) g.segment<3>(3 * i) = model.gravity;
+  gravity_force_ = mass_ * g;
+  apply_fixed(gravity_force_);
+
+  for (int node : hex_boundary(mesh).nodes)
+    if (!(fixed[3 * node] && fixed[3 * node + 1] && fixed[3 * node + 2])) boundary_nodes_.push_back(node);
+  node_material_.assign(mesh.num_nodes(), std::string());
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    for (int node : mesh.elements[e])
+      if (node_material_[node].empty()) node_material_[node] = model.element_material_name[e];
+  dx_ = smallest_edge(mesh);
+
+  solver_ = std::make_unique<CholmodSolver>();
+  solver_->analyze(jacobian_);
+  lumped_mass_ = VecX::Zero(mesh.num_nodes());
+  for (int j = 0; j < scalar_mass_.outerSize(); ++j)
+    for (SpMat::InnerIterator it(scalar_mass_, j); it; ++it) lumped_mass_(it.row()) += it.value();
+  q_ = assembler_.rest_positions();
+  v_ = VecX::Zero(n);
+}
+
+NewmarkIntegrator::~NewmarkIntegrator() = default;
+
+void NewmarkIntegrator::apply_fixed(VecX& x) const {
+  if (model_.fixed.empty()) return;
+  for (int i = 0; i < x.size(); ++i)
+    if (model_.fixed[i]) x(i) = 0;
+}
+
+void NewmarkIntegrator::set_state(const VecX& q, const VecX& v, double time) {
+  const int n = model_.mesh.num_dofs();
+  if (q.size() != n || v.size() != n)
+    throw InputError("dynamics: state has " + std::to_string(q.size()) + " positions and " + std::to_string(v.size()) +
+                     " velocities for " + std::to_string(n) + " DOFs");
+  if (!q.allFinite() || !v.allFinite()) throw InputError("dynamics: initial state is not finite");
+  if (!std::isfinite(assembler_.energy(q))) throw InputError("dynamics: an element is inverted in the initial state");
+  q_ = q;
+  v_ = v;
+  apply_fixed(v_);
+  time_ = time;
+}
+
+Energies NewmarkIntegrator::energies() const {
+  Energies e;
+  e.kinetic = 0.5 * v_.dot(mass_ * v_);
+  e.elastic = assembler_.energy(q_);
+  e.gravity = -gravity_force_.dot(q_ - assembler_.rest_positions());
+  return e;
+}
+
+void NewmarkIntegrator::assemble_damping(const SpMat& K, const SpMat* Kb) {
+  damping_ = damping_mass_in_pattern_;
+  double* d = damping_.valuePtr();
+  const Eigen::Index nnz = damping_.nonZeros();
+  if (Kb) {
+    const double* kb = Kb->valuePtr();
+    for (Eigen::Index i = 0; i < nnz; ++i) d[i] += kb[i];
+  } else if (uniform_b_ != 0) {
+    const double* k = K.valuePtr();
+    for (Eigen::Index i = 0; i < nnz; ++i) d[i] += uniform_b_ * k[i];
+  }
+  // M + h/2 D, the constant part of this step's Jacobian.
+  const double h = options_.time_step;
+  inertia_ = mass_in_pattern_;
+  double* m = inertia_.valuePtr();
+  for (Eigen::Index i = 0; i < nnz; ++i) m[i] += h / 2 * d[i];
+}
+
+void NewmarkIntegrator::assemble_jacobian(const SpMat& K) {
+  const double h = options_.time_step;
+  const double* m = inertia_.valuePtr();
+  const double* k = K.valuePtr();
+  double* H = jacobian_.valuePtr();
+  const Eigen::Index nnz = jacobian_.nonZeros();
+  for (Eigen::Index i = 0; i < nnz; ++i) H[i] = m[i] + h * h / 4 * k[i];
+  for (int i : fixed_value_index_) H[i] = 0;
+  for (int i : fixed_diagonal_index_) H[i] = 1;
+}
+
+std::vector<NewmarkIntegrator::Contact> NewmarkIntegrator::detect_contacts(const VecX& delta_predicted) const {
+  std::vector<Contact> contacts;
+  if (!model_.contact) return contacts;
+  const double margin = options_.contact_margin * dx_;
+  for (int node : boundary_nodes_) {
+    const Vec3 x0 = q_.segment<3>(3 * node);
+    const Vec3 x1 = x0 + delta_predicted.segment<3>(3 * node);
+    for (int o = 0; o < static_cast<int>(model_.obstacles.size()); ++o) {
+      const auto plane = first_contact(model_.obstacles[o], x0, x1, margin);
+      if (!plane) continue;
+      Contact c;
+      c.node = node;
+      c.obstacle = o;
+      c.plane = *plane;
+      c.frame = contact_frame(plane->normal);
+      c.mu = model_.friction ? model_.friction_table.mu(node_material_[node], model_.obstacles[o].surface) : 0.0;
+      contacts.push_back(c);
+    }
+  }
+  return contacts;
+}
+
+void NewmarkIntegrator::add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const {
+  const double tolerance = options_.penetration_tolerance * dx_;
+  std::vector<std::pair<int, int>> present;
+  for (const Contact& c : contacts) present.emplace_back(c.node, c.obstacle);
+  std::sort(present.begin(), present.end());
+  for (int node : boundary_nodes_) {
+    const Vec3 x0 = q_.segment<3>(3 * node);
+    const Vec3 x1 = x0 + delta.segment<3>(3 * node);
+    for (int o = 0; o < static_cast<int>(model_.obstacles.size()); ++o) {
+      if (std::binary_search(present.begin(), present.end(), std::make_pair(node, o))) continue;
+      if (signed_distance(model_.obstacles[o], x1, nullptr) >= -tolerance) continue;
+      auto plane = first_contact(model_.obstacles[o], x0, x1, 0.0);
+      Contact c;
+      c.node = node;
+      c.obstacle = o;
+      if (plane) {
+        c.plane = *plane;
+      } else {
+        signed_distance(model_.obstacles[o], x1, &c.plane);
+      }
+      c.frame = contact_frame(c.plane.normal);
+      c.mu = model_.friction ? model_.friction_table.mu(node_material_[node], model_.obstacles[o].surface) : 0.0;
+      contacts.push_back(c);
+    }
+  }
+}
+
+double NewmarkIntegrator::step_potential(const VecX& delta) const {
+  const double h = options_.time_step;
+  const double elastic = assembler_.energy(q_ + delta);
+  if (!std::isfinite(elastic)) return elastic;
+  return 0.5 * delta.dot(inertia_ * delta) - step_rhs_.dot(delta) + h * h / 4 * (elastic - gravity_force_.dot(delta));
+}
+
+StepReport NewmarkIntegrator::step() {
+  const auto t0 = std::chrono::steady_clock::now();
+  StepReport report;
+  const double h = options_.time_step;
+  const int n = model_.mesh.num_dofs();
+
+  // b^t (Eq. 4.6).
+  VecX grad_t(n);
+  SpMat K_t = assembler_.pattern();
+  assembler_.evaluate(q_, &grad_t, &K_t);
+  SpMat Kb_t;
+  if (damping_assembler_) {
+    Kb_t = damping_assembler_->pattern();
+    damping_assembler_->evaluate(q_, nullptr, &Kb_t);
+  }
+  assemble_damping(K_t, damping_assembler_ ? &Kb_t : nullptr);
+  const VecX force_t = gravity_force_ - grad_t;
+  // With D held at q^t, the -h^2/4 D v^t of b^t cancels against the same
+  // term of the end-of-step damping force h^2/4 D (2/h delta - v^t), whose
+  // remaining h/2 D delta lives in inertia_.
+  step_rhs_ = h * (mass_ * v_) + h * h / 4 * force_t;
+  apply_fixed(step_rhs_);
+  force_scale_ = std::max({(mass_ * v_).norm() * h, h * h / 4 * gravity_force_.norm(), h * h / 4 * grad_t.norm(),
+                           1e-300});
+
+  // Predicted path for collision detection: free flight under gravity.
+  VecX delta = h * v_;
+  for (int i = 0; i < model_.mesh.num_nodes(); ++i) delta.segment<3>(3 * i) += 0.5 * h * h * model_.gravity;
+  apply_fixed(delta);
+  std::vector<Contact> contacts = detect_contacts(delta);
+  if (!std::isfinite(assembler_.energy(q_ + delta))) delta.setZero();
+
+  VecX impulses;
+  for (int round = 1;; ++round) {
+    VecX warm = VecX::Zero(3 * static_cast<Eigen::Index>(contacts.size()));
+    warm.head(std::min(warm.size(), impulses.size())) = impulses.head(std::min(warm.size(), impulses.size()));
+    impulses = warm;
+    report.newton_iterations += solve_step(delta, contacts, impulses, report);
+    report.contact_rounds = round;
+    if (!model_.contact) break;
+    const size_t before = contacts.size();
+    add_penetrating_contacts(delta, contacts);
+    if (contacts.size() == before) break;
+    if (round == options_.max_contact_rounds)
+      throw NumericalError("dynamics: step at t = " + std::to_string(time_) + " s still finds new penetrating nodes after " +
+                           std::to_string(round) + " contact rounds; reduce the time step");
+  }
+
+  const VecX v_new = impact_velocity(delta, contacts, impulses);
+  report.contacts = static_cast<int>(contacts.size());
+  for (size_t k = 0; k < contacts.size(); ++k) {
+    const Vec3 p = impulses.segment<3>(3 * k);
+    if (p(0) > 0) ++report.active_contacts;
+    // p is the impulse scaled by h^2/2; the physical impulse over the step is h * force = (2/h) p.
+    report.contact_impulse += (2.0 / h) * (contacts[k].frame * p);
+  }
+  q_ += delta;
+  v_ = v_new;
+  time_ += h;
+  for (int node : boundary_nodes_)
+    for (const Obstacle& o : model_.obstacles)
+      if (model_.contact)
+        report.max_penetration = std::max(report.max_penetration, -signed_distance(o, q_.segment<3>(3 * node), nullptr));
+  report.seconds = seconds_since(t0);
+  return report;
+}
+
+int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses, StepReport& report) {
+  const double h = options_.time_step;
+  const int n = model_.mesh.num_dofs();
+  const int m = static_cast<int>(contacts.size());
+  SpMat K = assembler_.pattern();
+  VecX grad(n), f(n);
+  std::vector<double> history;
+  double last_step = std::numeric_limits<double>::infinity();
+
+  auto contact_force = [&](const VecX& p) {
+    VecX Gp = VecX::Zero(n);
+    for (int k = 0; k < m; ++k) Gp.segment<3>(3 * contacts[k].node) += contacts[k].frame * p.segment<3>(3 * k);
+    apply_fixed(Gp);
+    return Gp;
+  };
+
+  for (int it = 1; it <= options_.max_newton_iterations; ++it) {
+    const VecX x = q_ + delta;
+    assembler_.evaluate(x, &grad, &K);
+    f = inertia_ * delta - step_rhs_ + h * h / 4 * (grad - gravity_force_);
+    apply_fixed(f);
+    const double residual = (f - contact_force(impulses)).norm() / force_scale_;
+    history.push_back(residual);
+    report.residual = residual;
+    if (it > 1 && (residual <= options_.newton_tolerance || last_step <= 1e-13 * dx_)) return it - 1;
+
+    assemble_jacobian(K);
+    double shift = 0;
+    while (!solver_->factorize(jacobian_, shift)) {
+      shift = shift == 0 ? 1e-10 * jacobian_.diagonal().cwiseAbs().maxCoeff() : 10 * shift;
+      if (shift > jacobian_.diagonal().cwiseAbs().maxCoeff())
+        throw NumericalError("dynamics: the Newmark Jacobian is not positive definite at t = " + std::to_string(time_) + " s; reduce the time step");
+    }
+    const VecX delta_free = delta - solver_->solve(f);
+    VecX candidate = delta_free;
+    if (m > 0) {
+      HinvG_.resize(n, 3 * m);
+      VecX rhs = VecX::Zero(n);
+      for (int k = 0; k < m; ++k)
+        for (int c = 0; c < 3; ++c) {
+          rhs.segment<3>(3 * contacts[k].node) = contacts[k].frame.col(c);
+          apply_fixed(rhs);
+          HinvG_.col(3 * k + c) = solver_->solve(rhs);
+          rhs.segment<3>(3 * contacts[k].node).setZero();
+        }
+      ContactProblem problem;
+      problem.h = h;
+      problem.W.resize(3 * m, 3 * m);
+      problem.u_free.resize(3 * m);
+      problem.tangential_velocity_start.resize(2 * m);
+      for (int k = 0; k < m; ++k) {
+        const int node = contacts[k].node;
+        const Mat3& F = contacts[k].frame;
+        problem.W.middleRows<3>(3 * k) = F.transpose() * HinvG_.middleRows<3>(3 * node);
+        problem.u_free.segment<3>(3 * k) = F.transpose() * delta_free.segment<3>(3 * node);
+        problem.gap0.push_back(contacts[k].plane.gap(q_.segment<3>(3 * node)));
+        problem.mu.push_back(contacts[k].mu);
+        problem.tangential_velocity_start.segment<2>(2 * k) = F.rightCols<2>().transpose() * v_.segment<3>(3 * node);
+      }
+      // Symmetrize against round-off so Gauss-Seidel sees one matrix.
+      problem.W = 0.5 * (problem.W + problem.W.transpose()).eval();
+      ContactSolveOptions gs;
+      gs.max_sweeps = options_.gauss_seidel_sweeps;
+      gs.tolerance = options_.gauss_seidel_tolerance;
+      const ContactSolveResult solved = solve_contact_problem(problem, impulses, gs);
+      report.gauss_seidel_sweeps += solved.sweeps;
+      if (!solved.converged && solved.max_change > 1e-6)
+        throw NumericalError("dynamics: contact Gauss-Seidel did not converge at t = " + std::to_string(time_) + " s (" +
+                             std::to_string(m) + " contacts, last relative change " + std::to_string(solved.max_change) + ")");
+      impulses = solved.p;
+      delassus_ = std::move(problem.W);
+      candidate += HinvG_ * impulses;
+    }
+    // Backtracking on the step's incremental potential (Armijo) when the
+    // direction descends it, which the frictionless contact step from an
+    // admissible iterate always does; otherwise only until no element is
+    // inverted. The contact constraints are linear in delta, so every point
+    // between two admissible iterates is admissible too.
+    VecX step = candidate - delta;
+    const double phi0 = step_potential(delta);
+    const double slope = f.dot(step);
+    double phi = step_potential(delta + step);
+    for (int ls = 0; ls < 40; ++ls) {
+      const bool finite = std::isfinite(phi);
+      if (finite && (slope >= 0 || phi <= phi0 + 1e-4 * slope * std::pow(0.5, ls) || ls > 30)) break;
+      step *= 0.5;
+      phi = step_potential(delta + step);
+    }
+    if (!std::isfinite(phi))
+      throw NumericalError("dynamics: no uninverted step at t = " + std::to_string(time_) + " s; reduce the time step");
+    delta += step;
+    last_step = step.cwiseAbs().maxCoeff();
+  }
+  std::ostringstream msg;
+  msg << "dynamics: Newton did not converge in " << options_.max_newton_iterations << " iterations at t = " << time_
+      << " s (" << m << " contacts); relative residuals:";
+  for (size_t i = 0; i < history.size(); ++i)
+    if (i < 5 || i + 5 >= history.size()) msg << ' ' << history[i];
+  throw NumericalError(msg.str());
+}
+
+VecX NewmarkIntegrator::impact_velocity(const VecX& delta, const std::vector<Contact>& contacts, const VecX& impulses) {
+  const double h = options_.time_step;
+  const VecX c = 2.0 * delta - h * v_;
+  if (model_.impact == ImpactModel::kComplementarity) return c / h;
+  std::vector<int> active;
+  for (size_t k = 0; k < contacts.size(); ++k)
+    if (impulses(3 * k) > 0) active.push_back(static_cast<int>(k));
+  if (active.empty()) return c / h;
+  const int a = static_cast<int>(active.size());
+  // Y = A^{-1} N_a with A = H (BBI, reusing the last Newton factorization's
+  // columns) or A = M (DKE).
+  MatX Y(c.size(), a);
+  MatX S(a, a);
+  if (model_.impact == ImpactModel::kBbi) {
+    for (int j = 0; j < a; ++j) Y.col(j) = HinvG_.col(3 * active[j]);
+    for (int i = 0; i < a; ++i)
+      for (int j = 0; j < a; ++j) S(i, j) = delassus_(3 * active[i], 3 * active[j]);
+  } else {
+    // DKE: the L2 projection with the lumped (row-sum) mass, which is
+    // nodewise: each force-carrying node loses its normal velocity and
+    // nothing else changes.
+    Y.setZero();
+    S.setZero();
+    for (int j = 0; j < a; ++j) {
+      const Contact& ct = contacts[active[j]];
+      Y.col(j).segment<3>(3 * ct.node) = ct.frame.col(0) / lumped_mass_(ct.node);
+    }
+    for (int i = 0; i < a; ++i)
+      for (int j = 0; j < a; ++j) {
+        const Contact& ci = contacts[active[i]];
+        S(i, j) = ci.frame.col(0).dot(Y.col(j).segment<3>(3 * ci.node));
+      }
+  }
+  VecX normal_c(a);
+  for (int i = 0; i < a; ++i) {
+    const Contact& ct = contacts[active[i]];
+    normal_c(i) = ct.frame.col(0).dot(c.segment<3>(3 * ct.node));
+  }
+  // Zero normal velocity at every force-carrying contact, nearest to c in
+  // the chosen metric: d = c + Y mu with N_a^T d = 0.
+  const VecX mu = S.ldlt().solve(-normal_c);
+  VecX d = c + Y * mu;
+  apply_fixed(d);
+  return d / h;
+}
+
+}  // namespace msfab

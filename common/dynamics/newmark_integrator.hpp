@@ -1,0 +1,137 @@
+#pragma once
+// Implicit (trapezoidal) Newmark with Rayleigh damping, gravity and
+// frictional contact against static obstacles (thesis Eq. 4.2-4.14, 4.19,
+// App. B.1). One step from (q^t, v^t):
+//
+//   1. b^t = h M v^t + h^2/4 F(q^t) - h^2/4 D(q^t) v^t               (4.6)
+//      The damping matrix is held at q^t for the whole step (the thesis
+//      evaluates it at q^{t+1} and drops dD/dq from the Jacobian, B.8). With
+//      D fixed the step minimizes an incremental potential, Newton is exact
+//      and the line search has a merit function; the dropped term made
+//      Newton diverge on stiff, strongly damped impacts (docs/dynamics.md).
+//   2. continuous collision detection of each boundary node along the
+//      predicted path q^t -> q^t + h v^t + h^2/2 g gathers the contact set
+//   3. Newton on (B.1): per iterate factor H = M + h^2/4 K + h/2 D, take
+//      the free step,
+//      and solve the contacts' normal and friction impulses by Gauss-Seidel
+//      on the Delassus matrix (B.15-B.19; see contact_problem.hpp); a
+//      backtracking line search keeps every element uninverted
+//   4. nodes that still end the step inside an obstacle join the contact
+//      set and the step is solved again
+//   5. velocity: Newmark v = 2/h delta - v^t (complementarity), or the
+//      impact projection of the velocity displacement c = 2 delta - h v^t
+//      onto zero normal velocity at the contacts that carry force, in the
+//      lumped-mass metric (DKE) or A = M + h^2/4 K + h/2 D (BBI). docs/dynamics.md
+//      explains this reading of Eq. 4.19 / B.20.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynamics/dynamics_model.hpp"
+#include "fem/elastic_assembler.hpp"
+
+namespace msfab {
+
+class CholmodSolver;
+
+struct NewmarkOptions {
+  double time_step = 1e-4;
+  double newton_tolerance = 1e-9;  // on the residual relative to the step's force scale
+  int max_newton_iterations = 60;
+  int max_contact_rounds = 6;
+  // Contact candidates: nodes whose predicted path comes within this
+  // fraction of the smallest element edge of an obstacle.
+  double contact_margin = 0.05;
+  // Reported (never enforced silently): the largest penetration tolerated
+  // at the end of a step, as a fraction of the smallest element edge.
+  double penetration_tolerance = 1e-3;
+  int gauss_seidel_sweeps = 2000;
+  double gauss_seidel_tolerance = 1e-11;
+};
+
+struct Energies {
+  double kinetic = 0, elastic = 0, gravity = 0;  // gravity relative to the initial state
+  double total() const { return kinetic + elastic + gravity; }
+};
+
+struct StepReport {
+  int newton_iterations = 0;
+  int contact_rounds = 0;
+  int contacts = 0;         // in the contact set
+  int active_contacts = 0;  // carrying a normal impulse at the end
+  int gauss_seidel_sweeps = 0;
+  double residual = 0;        // final relative residual
+  double max_penetration = 0; // deepest node below an obstacle surface at the end (m, >= 0)
+  Vec3 contact_impulse = Vec3::Zero();  // total contact impulse of the step (N s)
+  double seconds = 0;
+};
+
+class NewmarkIntegrator {
+ public:
+  NewmarkIntegrator(const DynamicsModel& model, const NewmarkOptions& options);
+  ~NewmarkIntegrator();
+  NewmarkIntegrator(const NewmarkIntegrator&) = delete;
+  NewmarkIntegrator& operator=(const NewmarkIntegrator&) = delete;
+
+  // InputError if sizes mismatch, a value is not finite or an element is
+  // inverted.
+  void set_state(const VecX& q, const VecX& v, double time = 0.0);
+  // One time step; NumericalError with the residual history if Newton or
+  // the contact solve does not converge.
+  StepReport step();
+
+  const VecX& positions() const { return q_; }
+  const VecX& velocities() const { return v_; }
+  double time() const { return time_; }
+  Energies energies() const;
+  const SpMat& mass_matrix() const { return mass_; }
+  const SpMat& scalar_mass_matrix() const { return scalar_mass_; }
+  const VecX& gravity_force() const { return gravity_force_; }
+  const DynamicsModel& model() const { return model_; }
+  const ElasticAssembler& assembler() const { return assembler_; }
+  // Smallest element edge at rest (sets contact margins and tolerances).
+  double element_size() const { return dx_; }
+  const std::vector<int>& boundary_nodes() const { return boundary_nodes_; }
+
+ private:
+  struct Contact;
+  std::vector<Contact> detect_contacts(const VecX& delta_predicted) const;
+  void add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const;
+  // Newton on (B.1) with a fixed contact set; returns the iterations.
+  int solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses, StepReport& report);
+  // D(q^t) = sum a_e M_e + b K(q^t) and M + h/2 D for the current step.
+  void assemble_damping(const SpMat& K, const SpMat* Kb);
+  void assemble_jacobian(const SpMat& K);
+  // Phi(delta) = 1/2 delta^T (M + h/2 D) delta - b^T delta + h^2/4 (E(q^t + delta) - f_g^T delta),
+  // whose gradient is the residual of (B.6) with D held at q^t.
+  double step_potential(const VecX& delta) const;
+  void apply_fixed(VecX& x) const;
+  VecX impact_velocity(const VecX& delta, const std::vector<Contact>& contacts, const VecX& impulses);
+
+  const DynamicsModel& model_;
+  NewmarkOptions options_;
+  ElasticAssembler assembler_;
+  // Materials scaled by each element's b, when b is not uniform.
+  std::unique_ptr<HexMesh> damping_mesh_;
+  std::unique_ptr<ElasticAssembler> damping_assembler_;
+  double uniform_b_ = 0;
+  SpMat scalar_mass_, mass_;
+  SpMat mass_in_pattern_, damping_mass_in_pattern_;  // M and sum_e a_e M_e on the stiffness pattern
+  SpMat damping_, inertia_, jacobian_;
+  std::vector<int> fixed_value_index_, fixed_diagonal_index_;
+  std::unique_ptr<CholmodSolver> solver_;
+  VecX lumped_mass_;  // per node, the DKE projection's metric
+  VecX gravity_force_;
+  std::vector<int> boundary_nodes_;
+  std::vector<std::string> node_material_;
+  double dx_ = 0;
+  VecX q_, v_, q0_;
+  double time_ = 0;
+  VecX step_rhs_;          // b^t of the current step
+  double force_scale_ = 1; // what the current step's residual is relative to
+  // Last Newton iterate's H^{-1} G and Delassus matrix, reused by BBI.
+  MatX HinvG_;
+  MatX delassus_;
+};
+
+}  // namespace msfab
