@@ -1,0 +1,204 @@
+#include "dynamics/dynamics_run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/timing.hpp"
+#include "dynamics/quasistatic_loading.hpp"
+#include "dynamics/rigid_body.hpp"
+#include "solve/newton.hpp"
+
+namespace msfab {
+
+namespace {
+
+std::string format_time(double t) {
+  std::ostringstream s;
+  s.precision(6);
+  s << t << " s";
+  return s.str();
+}
+
+// Smallest clearance of the boundary nodes to the obstacles, less the
+// distance each node covers in `horizon` seconds at its current speed.
+double clearance(const DynamicsModel& model, const std::vector<int>& nodes, const VecX& q, const VecX& v,
+                 double horizon) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (int node : nodes)
+    for (const Obstacle& o : model.obstacles)
+      worst = std::min(worst, signed_distance(o, q.segment<3>(3 * node), nullptr) -
+                                  horizon * v.segment<3>(3 * node).norm());
+  return worst;
+}
+
+class Recorder {
+ public:
+  Recorder(const DynamicsScene& scene, const NewmarkIntegrator& sim, Trajectory& out)
+      : scene_(scene), sim_(sim), out_(out), body_(make_rigid_body(sim.scalar_mass_matrix(), sim.assembler().rest_positions())) {
+    R0_ = project_to_rigid(body_, scene.initial_positions, scene.initial_velocities).R;
+  }
+
+  void sample(SimulationPhase phase, const VecX& q, const VecX& v, const StepReport& step, double time) {
+    TrajectorySample s;
+    s.time = time;
+    s.phase = phase;
+    s.kinetic = 0.5 * v.dot(sim_.mass_matrix() * v);
+    s.elastic = sim_.assembler().energy(q);
+    s.gravity = -sim_.gravity_force().dot(q - sim_.assembler().rest_positions());
+    const RigidState r = project_to_rigid(body_, q, v);
+    s.center_of_mass = r.t;
+    s.com_velocity = r.l / body_.mass;
+    const Eigen::AngleAxisd rotation(r.R * R0_.transpose());
+    s.rotation = rotation.angle() * rotation.axis();
+    s.contacts = step.contacts;
+    s.active_contacts = step.active_contacts;
+    s.newton_iterations = step.newton_iterations;
+    s.max_penetration = step.max_penetration;
+    s.seconds = step.seconds;
+    out_.samples.push_back(s);
+    if (out_.samples.size() % scene_.output_every == 1 || scene_.output_every == 1) frame(q, v, time);
+  }
+  void frame(const VecX& q, const VecX& v, double time) {
+    if (!out_.frames.empty() && out_.frames.back().time == time) return;
+    out_.frames.push_back({time, q, v});
+  }
+  void event(double time, const std::string& kind, const std::string& detail) {
+    out_.events.push_back({time, kind, detail});
+  }
+  const RigidBody& body() const { return body_; }
+
+ private:
+  const DynamicsScene& scene_;
+  const NewmarkIntegrator& sim_;
+  Trajectory& out_;
+  RigidBody body_;
+  Mat3 R0_;
+};
+
+// The preloaded state: the scene's initial positions, or the equilibrium
+// under the pluck or press load (with gravity).
+VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder& rec, Trajectory& out) {
+  if (scene.preload == Preload::kNone) return scene.initial_positions;
+  const auto t0 = std::chrono::steady_clock::now();
+  const VecX force = region_force(scene, scene.load, scene.preload == Preload::kStaticPluck ? "pluck" : "press") +
+                     sim.gravity_force();
+  VecX q;
+  std::ostringstream detail;
+  if (scene.preload == Preload::kStaticPluck) {
+    DirichletConditions bc = DirichletConditions::none(sim.model().mesh.num_dofs());
+    bc.fixed = sim.model().fixed;
+    bc.displacement = scene.initial_positions - sim.assembler().rest_positions();
+    NewtonOptions newton;
+    newton.relative_tolerance = 1e-10;
+    newton.load_steps = scene.preload_steps;
+    newton.linear_solver = "cholmod";
+    const NewtonResult r = solve_static(sim.assembler(), bc, force, newton, scene.initial_positions);
+    if (!r.converged) throw NumericalError("pluck preload: " + r.failure + "\n" + format_history(r.history));
+    q = r.x;
+    detail << "static pluck: " << r.iterations << " Newton iterations";
+  } else {
+    QuasistaticOptions options;
+    options.load_steps = scene.preload_steps;
+    const QuasistaticResult r =
+        solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, force, scene.initial_positions, options);
+    q = r.x;
+    detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
+  }
+  out.seconds_quasistatic = seconds_since(t0);
+  rec.event(0.0, "preload", detail.str());
+  StepReport none;
+  rec.sample(SimulationPhase::kQuasistatic, q, VecX::Zero(q.size()), none, 0.0);
+  rec.event(0.0, "release", "load removed, dynamics start from rest");
+  return q;
+}
+
+}  // namespace
+
+Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& callbacks) {
+  const auto t_start = std::chrono::steady_clock::now();
+  Trajectory out;
+  out.scene = scene.name;
+  out.rest_nodes = scene.model.mesh.nodes;
+  out.elements = scene.model.mesh.elements;
+  out.element_tag = scene.model.mesh.element_tag;
+  out.material_names.push_back("void");
+  for (const SceneMaterial& m : scene.materials) out.material_names.push_back(m.name);
+  out.time_step = scene.newmark.time_step;
+  out.impact_model = impact_model_name(scene.model.impact);
+
+  NewmarkIntegrator sim(scene.model, scene.newmark);
+  Recorder rec(scene, sim, out);
+  const VecX q0 = preload(scene, sim, rec, out);
+  const VecX v0 = scene.preload == Preload::kNone ? scene.initial_velocities : VecX::Zero(q0.size());
+  sim.set_state(q0, v0, 0.0);
+  if (scene.preload == Preload::kNone) rec.sample(SimulationPhase::kElastic, q0, v0, StepReport{}, 0.0);
+
+  const double h = scene.newmark.time_step;
+  const int steps = static_cast<int>(std::ceil(scene.duration / h - 1e-9));
+  const RigidBody& body = rec.body();
+  const double horizon = scene.rigid.lookahead_steps * h;
+  const double margin = 0.05 * sim.element_size();
+  bool rigid = false, touching = false;
+  RigidState state;
+  double time = 0;
+  for (int k = 1; k <= steps; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (rigid) {
+      RigidState next = state;
+      dmv_step(body, scene.model.gravity, h, &next);
+      VecX q, v;
+      project_to_fe(body, next, &q, &v);
+      if (clearance(scene.model, sim.boundary_nodes(), q, v, horizon) > margin) {
+        state = next;
+        time += h;
+        StepReport r;
+        r.seconds = seconds_since(t0);
+        out.seconds_rigid += r.seconds;
+        rec.sample(SimulationPhase::kRigid, q, v, r, time);
+        if (callbacks.on_step) callbacks.on_step(time);
+        continue;
+      }
+      // A contact is near: back to the elastic model from the rigid state.
+      project_to_fe(body, state, &q, &v);
+      sim.set_state(q, v, time);
+      rigid = false;
+      rec.event(time, "elastic", "contact ahead: projected back to the FE model (B.23)");
+    }
+    const StepReport r = sim.step();
+    time = sim.time();
+    out.seconds_elastic += r.seconds;
+    rec.sample(SimulationPhase::kElastic, sim.positions(), sim.velocities(), r, time);
+    if (r.active_contacts > 0 && !touching) rec.event(time, "contact", std::to_string(r.active_contacts) + " nodes");
+    if (r.active_contacts == 0 && touching) rec.event(time, "lift-off", "");
+    touching = r.active_contacts > 0;
+    if (callbacks.on_step) callbacks.on_step(time);
+
+    if (scene.rigid.enabled && !touching) {
+      const Energies e = sim.energies();
+      if (e.elastic < scene.rigid.elastic_fraction * e.kinetic &&
+          clearance(scene.model, sim.boundary_nodes(), sim.positions(), sim.velocities(), horizon) > margin) {
+        state = project_to_rigid(body, sim.positions(), sim.velocities());
+        rigid = true;
+        std::ostringstream d;
+        d << "elastic energy " << e.elastic << " J < " << scene.rigid.elastic_fraction << " x kinetic " << e.kinetic
+          << " J: projected to a rigid body (B.22)";
+        rec.event(time, "rigid", d.str());
+      }
+    }
+  }
+  if (rigid) {
+    VecX q, v;
+    project_to_fe(body, state, &q, &v);
+    rec.frame(q, v, time);
+  } else {
+    rec.frame(sim.positions(), sim.velocities(), time);
+  }
+  rec.event(time, "end", format_time(time) + " simulated");
+  out.seconds_total = seconds_since(t_start);
+  return out;
+}
+
+}  // namespace msfab

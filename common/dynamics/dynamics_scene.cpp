@@ -1,0 +1,263 @@
+#include "dynamics/dynamics_scene.hpp"
+
+#include <cmath>
+
+#include "core/errors.hpp"
+#include "fem/voxel_shapes.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+
+namespace {
+
+Vec3 vec3(const Config& c, const std::string& key) {
+  const auto v = c.get<std::vector<double>>(key);
+  if (v.size() != 3) c.fail(key, "needs three numbers [x, y, z]");
+  for (double x : v)
+    if (!std::isfinite(x)) c.fail(key, "must be finite");
+  return Vec3(v[0], v[1], v[2]);
+}
+
+void read_box(const Config& c, Vec3& lo, Vec3& hi) {
+  lo = vec3(c, "min");
+  hi = vec3(c, "max");
+  if (!(lo.array() < hi.array()).all()) c.fail("max", "must exceed min in every coordinate");
+}
+
+Mat3 rotation_from_degrees(const Vec3& deg) {
+  const Vec3 r = deg * M_PI / 180.0;
+  return (Eigen::AngleAxisd(r.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
+          Eigen::AngleAxisd(r.x(), Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+std::vector<SceneMaterial> read_materials(const Config& c) {
+  std::vector<SceneMaterial> out;
+  for (const Config& m : c.children("materials")) {
+    SceneMaterial s;
+    s.name = m.get<std::string>("name");
+    s.E = m.require_positive<double>("E", "Young's modulus (the numerical modulus E_n for coarse meshes)");
+    s.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open);
+    s.density = m.require_positive<double>("density", "density (kg/m^3)");
+    s.damping_a = m.get_or<double>("damping_a", 0.0);
+    s.damping_b = m.get_or<double>("damping_b", 0.0);
+    if (!(s.damping_a >= 0) || !std::isfinite(s.damping_a)) m.fail("damping_a", "must be finite and >= 0");
+    if (!(s.damping_b >= 0) || !std::isfinite(s.damping_b)) m.fail("damping_b", "must be finite and >= 0");
+    for (const SceneMaterial& other : out)
+      if (other.name == s.name) m.fail("name", "material '" + s.name + "' is defined twice");
+    out.push_back(s);
+  }
+  if (out.empty()) c.fail("materials", "needs at least one material");
+  return out;
+}
+
+int material_index(const Config& c, const std::string& key, const std::vector<SceneMaterial>& materials) {
+  const std::string name = c.get<std::string>(key);
+  for (size_t i = 0; i < materials.size(); ++i)
+    if (materials[i].name == name) return static_cast<int>(i);
+  std::string known;
+  for (const auto& m : materials) known += (known.empty() ? "" : ", ") + m.name;
+  c.fail(key, "unknown material '" + name + "' (defined: " + known + ")");
+}
+
+VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& materials) {
+  const double h = g.require_positive<double>("voxel_size", "voxel edge length (m)");
+  struct Box {
+    Vec3 lo, hi;
+    int id;
+  };
+  std::vector<Box> boxes;
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  for (const Config& b : g.children("boxes")) {
+    Box box;
+    read_box(b, box.lo, box.hi);
+    box.id = material_index(b, "material", materials) + 1;
+    lo = lo.cwiseMin(box.lo);
+    hi = hi.cwiseMax(box.hi);
+    boxes.push_back(box);
+  }
+  if (boxes.empty()) g.fail("boxes", "needs at least one box");
+  Eigen::Vector3i n;
+  for (int a = 0; a < 3; ++a) {
+    n(a) = static_cast<int>(std::lround((hi(a) - lo(a)) / h));
+    if (n(a) < 1) g.fail("voxel_size", "is larger than the geometry");
+    if (std::abs(n(a) * h - (hi(a) - lo(a))) > 1e-6 * h)
+      g.fail("voxel_size", "does not divide the geometry's extent along " + std::string(1, "xyz"[a]) +
+                               " (the voxels must resolve every box)");
+  }
+  if (double(n(0)) * n(1) * n(2) > 5e7) g.fail("voxel_size", "gives more than 5e7 voxels");
+  VoxelGrid grid(n(0), n(1), n(2), h, 0);
+  grid.origin = lo;
+  for (const Box& b : boxes) paint_box(grid, b.lo, b.hi, b.id);
+  if (grid.count_solid() == 0) g.fail("boxes", "paint no voxel");
+  return grid;
+}
+
+std::vector<Obstacle> read_obstacles(const Config& c) {
+  std::vector<Obstacle> out;
+  if (!c.has("obstacles")) return out;
+  int index = 0;
+  for (const Config& o : c.children("obstacles")) {
+    Obstacle ob;
+    const std::string type = o.one_of("type", {"ground", "box"});
+    ob.name = o.get_or("name", type == "ground" ? "ground" : "box" + std::to_string(index));
+    ob.surface = o.get_or("surface", "default");
+    if (type == "ground") {
+      ob.kind = Obstacle::Kind::kGround;
+      ob.ground_z = o.get_or<double>("z", 0.0);
+    } else {
+      ob.kind = Obstacle::Kind::kBox;
+      read_box(o, ob.lo, ob.hi);
+    }
+    out.push_back(ob);
+    ++index;
+  }
+  return out;
+}
+
+FrictionTable read_friction(const Config& c, const std::vector<SceneMaterial>& materials) {
+  FrictionTable t;
+  if (!c.has("friction")) return t;
+  const Config f = c.child("friction");
+  t.default_mu = f.get_or<double>("default", 0.0);
+  if (!(t.default_mu >= 0) || !std::isfinite(t.default_mu))
+    f.fail("default", "friction coefficient must be >= 0 (got " + std::to_string(t.default_mu) + ")");
+  if (f.has("pairs"))
+    for (const Config& p : f.children("pairs")) {
+      const std::string material = materials[material_index(p, "material", materials)].name;
+      const std::string surface = p.get<std::string>("surface");
+      const double mu = p.get<double>("mu");
+      if (!(mu >= 0) || !std::isfinite(mu)) p.fail("mu", "friction coefficient must be >= 0 (got " + std::to_string(mu) + ")");
+      t.pairs[{material, surface}] = mu;
+    }
+  return t;
+}
+
+RegionLoad read_region_load(const Config& c) {
+  RegionLoad r;
+  read_box(c.child("region"), r.lo, r.hi);
+  r.force = vec3(c, "force");
+  return r;
+}
+
+}  // namespace
+
+VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::string& what) {
+  const int nodes = s.model.mesh.num_nodes();
+  std::vector<int> inside;
+  for (int i = 0; i < nodes; ++i) {
+    const Vec3 x = s.initial_positions.segment<3>(3 * i);
+    if ((x.array() >= load.lo.array() - 1e-12).all() && (x.array() <= load.hi.array() + 1e-12).all()) inside.push_back(i);
+  }
+  if (inside.empty()) throw InputError(what + ": the region holds no node of the body");
+  VecX f = VecX::Zero(3 * nodes);
+  for (int i : inside) f.segment<3>(3 * i) = load.force / static_cast<double>(inside.size());
+  return f;
+}
+
+DynamicsScene read_dynamics_scene(const Config& c) {
+  DynamicsScene s;
+  s.name = c.get_or("name", "dynamics");
+  s.materials = read_materials(c);
+  s.grid = paint_geometry(c.child("geometry"), s.materials);
+
+  std::vector<MaterialPtr> palette{nullptr};
+  for (const SceneMaterial& m : s.materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
+  DynamicsModel& model = s.model;
+  model.mesh = build_voxel_mesh(s.grid, palette).mesh;
+  const int ne = model.mesh.num_elements();
+  for (int e = 0; e < ne; ++e) {
+    const SceneMaterial& m = s.materials[model.mesh.element_tag[e] - 1];
+    model.density.push_back(m.density);
+    model.damping_a.push_back(m.damping_a);
+    model.damping_b.push_back(m.damping_b);
+    model.element_material_name.push_back(m.name);
+  }
+  model.gravity = c.has("gravity") ? vec3(c, "gravity") : Vec3(0, 0, -9.81);
+
+  // Placement: rotate about the geometry's centre, then translate. The rest
+  // configuration stays axis-aligned; only the initial state moves.
+  const Config place = c.has("placement") ? c.child("placement") : Config();
+  const Mat3 R = c.has("placement") && place.has("rotation_deg") ? rotation_from_degrees(vec3(place, "rotation_deg"))
+                                                                 : Mat3::Identity();
+  const Vec3 t = c.has("placement") && place.has("translation") ? vec3(place, "translation") : Vec3::Zero();
+  const Vec3 center = 0.5 * (model.mesh.bbox_min() + model.mesh.bbox_max());
+  const int nn = model.mesh.num_nodes();
+  s.initial_positions.resize(3 * nn);
+  for (int i = 0; i < nn; ++i)
+    s.initial_positions.segment<3>(3 * i) = center + t + R * (model.mesh.nodes.row(i).transpose() - center);
+  s.initial_velocities = VecX::Zero(3 * nn);
+  if (c.has("initial_velocity")) {
+    const Vec3 v = vec3(c, "initial_velocity");
+    for (int i = 0; i < nn; ++i) s.initial_velocities.segment<3>(3 * i) = v;
+  }
+
+  if (c.has("clamp")) {
+    Vec3 lo, hi;
+    read_box(c.child("clamp"), lo, hi);
+    model.fixed.assign(3 * nn, 0);
+    int count = 0;
+    for (int i = 0; i < nn; ++i) {
+      const Vec3 x = s.initial_positions.segment<3>(3 * i);
+      if ((x.array() >= lo.array() - 1e-12).all() && (x.array() <= hi.array() + 1e-12).all()) {
+        model.fixed[3 * i] = model.fixed[3 * i + 1] = model.fixed[3 * i + 2] = 1;
+        ++count;
+      }
+    }
+    if (count == 0) c.child("clamp").fail("min", "the clamp box holds no node of the body");
+  }
+
+  model.obstacles = read_obstacles(c);
+  model.friction_table = read_friction(c, s.materials);
+
+  const Config sim = c.child("simulation");
+  s.newmark.time_step = sim.get<double>("time_step");
+  if (!(s.newmark.time_step > 0) || !std::isfinite(s.newmark.time_step))
+    sim.fail("time_step", "must be positive (got " + std::to_string(s.newmark.time_step) + ")");
+  s.duration = sim.require_positive<double>("duration", "simulated time (s)");
+  s.output_every = sim.get_or<int>("output_every", 10);
+  if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
+  model.contact = sim.get_or<bool>("contact", !model.obstacles.empty());
+  model.friction = sim.get_or<bool>("friction", c.has("friction"));
+  if (model.contact && model.obstacles.empty()) sim.fail("contact", "is on but the scene has no obstacles");
+  model.impact = parse_impact_model(sim.get_or("impact", "bbi"), sim.key_path("impact"));
+  s.newmark.newton_tolerance = sim.get_or<double>("newton_tolerance", s.newmark.newton_tolerance);
+  if (sim.has("rigid_flight")) {
+    const Config r = sim.child("rigid_flight");
+    s.rigid.enabled = r.get_or<bool>("enabled", true);
+    s.rigid.elastic_fraction = r.get_or<double>("elastic_fraction", s.rigid.elastic_fraction);
+    s.rigid.lookahead_steps = r.get_or<int>("lookahead_steps", s.rigid.lookahead_steps);
+    if (!(s.rigid.elastic_fraction > 0)) r.fail("elastic_fraction", "must be positive");
+    if (s.rigid.lookahead_steps < 1) r.fail("lookahead_steps", "must be >= 1");
+  }
+
+  if (c.has("pluck") && c.has("press")) c.fail("press", "a scene has either a pluck or a press preload, not both");
+  if (c.has("pluck")) {
+    s.preload = Preload::kStaticPluck;
+    s.load = read_region_load(c.child("pluck"));
+    s.preload_steps = c.child("pluck").get_or<int>("steps", s.preload_steps);
+    if (model.fixed.empty()) c.fail("pluck", "needs a clamp (a free body has no static equilibrium)");
+  } else if (c.has("press")) {
+    s.preload = Preload::kQuasistaticPress;
+    s.load = read_region_load(c.child("press"));
+    s.preload_steps = c.child("press").get_or<int>("steps", s.preload_steps);
+    if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
+  }
+  if (s.preload_steps < 1) c.fail(s.preload == Preload::kStaticPluck ? "pluck.steps" : "press.steps", "must be >= 1");
+  validate_dynamics_model(model);
+
+  // Bodies must not start inside an obstacle.
+  if (model.contact) {
+    const double tolerance = 1e-6 * s.grid.voxel_size;
+    for (int i = 0; i < nn; ++i)
+      for (const Obstacle& o : model.obstacles)
+        if (signed_distance(o, s.initial_positions.segment<3>(3 * i), nullptr) < -tolerance)
+          c.fail("placement", "the body starts inside obstacle '" + o.name + "' (node at " +
+                                  std::to_string(s.initial_positions(3 * i)) + ", " +
+                                  std::to_string(s.initial_positions(3 * i + 1)) + ", " +
+                                  std::to_string(s.initial_positions(3 * i + 2)) + ")");
+  }
+  return s;
+}
+
+}  // namespace msfab

@@ -1,0 +1,63 @@
+#pragma once
+// A dynamics scene read from YAML (configs/dynamics/*.yaml, documented in
+// docs/dynamics.md): materials with their identified parameters, voxel
+// geometry painted from boxes, placement and initial velocity, clamps,
+// obstacles and friction, an optional preload (a static pluck or a
+// quasistatic press against the obstacles) that is released at t = 0, and
+// the integration settings.
+#include <string>
+#include <vector>
+
+#include "dynamics/dynamics_model.hpp"
+#include "dynamics/newmark_integrator.hpp"
+#include "fem/voxel_grid.hpp"
+#include "io/config.hpp"
+
+namespace msfab {
+
+struct SceneMaterial {
+  std::string name;
+  double E = 0, nu = 0, density = 0, damping_a = 0, damping_b = 0;
+};
+
+// Nodes whose initial position lies in [lo, hi] get a force; the total is
+// spread equally over them.
+struct RegionLoad {
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
+  Vec3 force = Vec3::Zero();
+};
+
+enum class Preload { kNone, kStaticPluck, kQuasistaticPress };
+
+struct RigidFlightSettings {
+  bool enabled = false;
+  // Switch to the rigid model when the elastic energy is below this fraction
+  // of the kinetic energy and no contact is within `lookahead_steps` steps.
+  double elastic_fraction = 1e-3;
+  int lookahead_steps = 10;
+};
+
+struct DynamicsScene {
+  std::string name;
+  std::vector<SceneMaterial> materials;
+  VoxelGrid grid;  // material ids = index in `materials` + 1
+  DynamicsModel model;
+  VecX initial_positions, initial_velocities;
+  NewmarkOptions newmark;
+  double duration = 0;
+  int output_every = 1;
+  Preload preload = Preload::kNone;
+  RegionLoad load;
+  int preload_steps = 4;
+  RigidFlightSettings rigid;
+};
+
+// Reads and validates everything (InputError naming file, key and problem);
+// the caller runs check_no_unknown_keys() afterwards.
+DynamicsScene read_dynamics_scene(const Config& config);
+
+// The nodal force vector of a region load on the initial positions
+// (InputError if the region holds no node).
+VecX region_force(const DynamicsScene& scene, const RegionLoad& load, const std::string& what);
+
+}  // namespace msfab

@@ -1,0 +1,85 @@
+#pragma once
+// The record of one dynamics run: per-step samples (energies, centre of
+// mass, contacts, cost), full states at output frames, and events. It is
+// what `msfab-dynamics` writes as the `msfab.trajectory` artifact
+// (docs/artifacts.md) with an XDMF time series for ParaView and plots.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "fem/hex_mesh.hpp"
+
+namespace msfab {
+
+enum class SimulationPhase : int {
+  kQuasistatic = 0,  // loading (B.3)
+  kElastic = 1,      // Newmark FE dynamics
+  kRigid = 2,        // free flight with DMV (B.2)
+};
+const char* phase_name(SimulationPhase phase);
+
+struct TrajectorySample {
+  double time = 0;
+  SimulationPhase phase = SimulationPhase::kElastic;
+  double kinetic = 0, elastic = 0, gravity = 0;  // J; gravity relative to the rest state
+  Vec3 center_of_mass = Vec3::Zero();
+  Vec3 com_velocity = Vec3::Zero();
+  Vec3 rotation = Vec3::Zero();  // best-fit rotation from rest as a rotation vector (axis * angle, rad)
+  int contacts = 0, active_contacts = 0;
+  int newton_iterations = 0;
+  double max_penetration = 0;  // m
+  double seconds = 0;          // wall time of the step
+  double total() const { return kinetic + elastic + gravity; }
+};
+
+struct TrajectoryFrame {
+  double time = 0;
+  VecX positions;   // 3N, node-major
+  VecX velocities;  // 3N
+};
+
+struct TrajectoryEvent {
+  double time = 0;
+  std::string kind;    // e.g. "contact", "lift-off", "rigid", "elastic", "release", "end"
+  std::string detail;  // free text
+};
+
+struct Trajectory {
+  std::string scene;
+  NodeArray rest_nodes;                       // rest positions
+  std::vector<std::array<int, 8>> elements;   // toolkit node order
+  std::vector<int> element_tag;               // material index per element
+  std::vector<std::string> material_names;    // tag -> name
+  std::vector<TrajectorySample> samples;      // one per step (and the initial state)
+  std::vector<TrajectoryFrame> frames;        // at output times
+  std::vector<TrajectoryEvent> events;
+  // Wall time by phase (s) and in total.
+  double seconds_quasistatic = 0, seconds_elastic = 0, seconds_rigid = 0, seconds_total = 0;
+  double time_step = 0;
+  std::string impact_model;
+};
+
+struct TrajectoryProvenance {
+  std::string executable = "msfab-dynamics";
+  std::string config_text;
+  std::vector<std::string> inputs;  // artifact paths used (e.g. a dac_model)
+  std::uint64_t seed = 0;
+};
+
+// Writes the artifact atomically and its XDMF sidecar (one grid per frame
+// with displacement and velocity fields); returns the sidecar's path.
+std::string write_trajectory_artifact(const std::string& path, const Trajectory& trajectory,
+                                      const TrajectoryProvenance& provenance);
+
+// Reads what write_trajectory_artifact wrote (InputError naming the file and
+// field on anything missing or inconsistent).
+Trajectory read_trajectory_artifact(const std::string& path);
+
+// PNG plots: "<prefix>energy.png" (kinetic, elastic, gravity, total against
+// time, phases shaded or marked) and "<prefix>com_height.png" (centre-of-mass
+// height against time). Returns the paths written.
+std::vector<std::string> write_trajectory_plots(const std::string& prefix, const Trajectory& trajectory);
+
+}  // namespace msfab
