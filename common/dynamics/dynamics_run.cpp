@@ -92,7 +92,7 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     bc.fixed = sim.model().fixed;
     bc.displacement = scene.initial_positions - sim.assembler().rest_positions();
     NewtonOptions newton;
-    newton.relative_tolerance = 1e-10;
+    newton.relative_tolerance = 1e-8;
     newton.load_steps = scene.preload_steps;
     newton.linear_solver = "cholmod";
     const NewtonResult r = solve_static(sim.assembler(), bc, force, newton, scene.initial_positions);
@@ -158,7 +158,7 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
         r.seconds = seconds_since(t0);
         out.seconds_rigid += r.seconds;
         rec.sample(SimulationPhase::kRigid, q, v, r, time);
-        if (callbacks.on_step) callbacks.on_step(time);
+        if (callbacks.on_step) callbacks.on_step(time, q);
         continue;
       }
       // A contact is near: back to the elastic model from the rigid state.
@@ -171,10 +171,17 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
     time = sim.time();
     out.seconds_elastic += r.seconds;
     rec.sample(SimulationPhase::kElastic, sim.positions(), sim.velocities(), r, time);
-    if (r.active_contacts > 0 && !touching) rec.event(time, "contact", std::to_string(r.active_contacts) + " nodes");
-    if (r.active_contacts == 0 && touching) rec.event(time, "lift-off", "");
-    touching = r.active_contacts > 0;
-    if (callbacks.on_step) callbacks.on_step(time);
+    // Contact and lift-off events: a resting body's contacts flicker between
+    // carrying force and touching without force, so lift-off needs a gap.
+    if (r.active_contacts > 0 && !touching) {
+      rec.event(time, "contact", std::to_string(r.active_contacts) + " nodes");
+      touching = true;
+    } else if (r.active_contacts == 0 && touching &&
+               clearance(scene.model, sim.boundary_nodes(), sim.positions(), sim.velocities(), 0.0) > margin) {
+      rec.event(time, "lift-off", "");
+      touching = false;
+    }
+    if (callbacks.on_step) callbacks.on_step(time, sim.positions());
 
     if (scene.rigid.enabled && !touching) {
       const Energies e = sim.energies();

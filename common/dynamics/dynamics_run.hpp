@@ -16,8 +16,9 @@
 namespace msfab {
 
 struct RunCallbacks {
-  // Called after every step with the simulated time reached.
-  std::function<void(double time)> on_step;
+  // Called after every step with the simulated time reached and the node
+  // positions then (3N, node-major).
+  std::function<void(double time, const VecX& positions)> on_step;
 };
 
 Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& callbacks = {});

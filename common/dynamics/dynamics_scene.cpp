@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "dynamics/dac_model_artifact.hpp"
 #include "fem/voxel_shapes.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -18,10 +19,12 @@ Vec3 vec3(const Config& c, const std::string& key) {
   return Vec3(v[0], v[1], v[2]);
 }
 
-void read_box(const Config& c, Vec3& lo, Vec3& hi) {
+// Solid boxes need volume; selection regions (clamps, loads) may be flat.
+void read_box(const Config& c, Vec3& lo, Vec3& hi, bool flat_allowed = false) {
   lo = vec3(c, "min");
   hi = vec3(c, "max");
-  if (!(lo.array() < hi.array()).all()) c.fail("max", "must exceed min in every coordinate");
+  if (flat_allowed ? !(lo.array() <= hi.array()).all() : !(lo.array() < hi.array()).all())
+    c.fail("max", flat_allowed ? "must not be below min in any coordinate" : "must exceed min in every coordinate");
 }
 
 Mat3 rotation_from_degrees(const Vec3& deg) {
@@ -36,11 +39,21 @@ std::vector<SceneMaterial> read_materials(const Config& c) {
   for (const Config& m : c.children("materials")) {
     SceneMaterial s;
     s.name = m.get<std::string>("name");
-    s.E = m.require_positive<double>("E", "Young's modulus (the numerical modulus E_n for coarse meshes)");
     s.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open);
     s.density = m.require_positive<double>("density", "density (kg/m^3)");
-    s.damping_a = m.get_or<double>("damping_a", 0.0);
-    s.damping_b = m.get_or<double>("damping_b", 0.0);
+    if (m.has("dac_model")) {
+      // The numerical modulus and damping fitted by msfab-dac-calibrate.
+      for (const char* key : {"E", "damping_a", "damping_b"})
+        if (m.has(key)) m.fail(key, "is taken from dac_model; give one or the other");
+      const DacModel dac = read_dac_model_artifact(m.get_path("dac_model"));
+      s.E = dac.youngs_modulus;
+      s.damping_a = dac.damping_a;
+      s.damping_b = dac.damping_b;
+    } else {
+      s.E = m.require_positive<double>("E", "Young's modulus (the numerical modulus E_n for coarse meshes)");
+      s.damping_a = m.get_or<double>("damping_a", 0.0);
+      s.damping_b = m.get_or<double>("damping_b", 0.0);
+    }
     if (!(s.damping_a >= 0) || !std::isfinite(s.damping_a)) m.fail("damping_a", "must be finite and >= 0");
     if (!(s.damping_b >= 0) || !std::isfinite(s.damping_b)) m.fail("damping_b", "must be finite and >= 0");
     for (const SceneMaterial& other : out)
@@ -135,7 +148,7 @@ FrictionTable read_friction(const Config& c, const std::vector<SceneMaterial>& m
 
 RegionLoad read_region_load(const Config& c) {
   RegionLoad r;
-  read_box(c.child("region"), r.lo, r.hi);
+  read_box(c.child("region"), r.lo, r.hi, true);
   r.force = vec3(c, "force");
   return r;
 }
@@ -194,7 +207,7 @@ DynamicsScene read_dynamics_scene(const Config& c) {
 
   if (c.has("clamp")) {
     Vec3 lo, hi;
-    read_box(c.child("clamp"), lo, hi);
+    read_box(c.child("clamp"), lo, hi, true);
     model.fixed.assign(3 * nn, 0);
     int count = 0;
     for (int i = 0; i < nn; ++i) {

@@ -99,8 +99,10 @@ class NewmarkIntegrator {
   void add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const;
   // Newton on (B.1) with a fixed contact set; returns the iterations.
   int solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses, StepReport& report);
-  // D(q^t) = sum a_e M_e + b K(q^t) and M + h/2 D for the current step.
-  void assemble_damping(const SpMat& K, const SpMat* Kb);
+  // D(q^t) = sum a_e M_e + sum b_e K_e(q^t)_+ and M + h/2 D for the current
+  // step; K_e(q)_+ is the element stiffness with dP/dF clamped to its
+  // positive semidefinite part (material/scaled_material.hpp).
+  void assemble_damping(const SpMat* Kb);
   void assemble_jacobian(const SpMat& K);
   // Phi(delta) = 1/2 delta^T (M + h/2 D) delta - b^T delta + h^2/4 (E(q^t + delta) - f_g^T delta),
   // whose gradient is the residual of (B.6) with D held at q^t.
@@ -111,10 +113,9 @@ class NewmarkIntegrator {
   const DynamicsModel& model_;
   NewmarkOptions options_;
   ElasticAssembler assembler_;
-  // Materials scaled by each element's b, when b is not uniform.
+  // Materials scaled by each element's b (PSD-projected), when any b > 0.
   std::unique_ptr<HexMesh> damping_mesh_;
   std::unique_ptr<ElasticAssembler> damping_assembler_;
-  double uniform_b_ = 0;
   SpMat scalar_mass_, mass_;
   SpMat mass_in_pattern_, damping_mass_in_pattern_;  // M and sum_e a_e M_e on the stiffness pattern
   SpMat damping_, inertia_, jacobian_;

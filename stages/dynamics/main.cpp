@@ -1,0 +1,163 @@
+// msfab-dynamics: transient dynamics of a dynamics scene (thesis ch. 4,
+// App. B), phase by phase:
+//
+//   1. read the scene: materials with identified E_n and Rayleigh damping,
+//      voxel geometry, placement, clamps, obstacles, friction, preload
+//   2. preload: a static pluck or a quasistatic press with no-slip contact
+//      (B.3), released at t = 0
+//   3. implicit Newmark steps (Eq. 4.2-4.6) with frictional contact
+//      (4.11-4.14, B.13-B.19) and the scene's impact model: complementarity,
+//      DKE or BBI (4.19, B.20-B.21)
+//   4. with rigid flight enabled: rigid projection (B.22), DMV free flight,
+//      projection back before the next contact (B.23)
+//   5. write the `msfab.trajectory` artifact, its ParaView time series and
+//      the energy and centre-of-mass plots
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "cli/progress.hpp"
+#include "cli/stage_app.hpp"
+#include "core/errors.hpp"
+#include "default_scene.hpp"
+#include "dynamics/dynamics_run.hpp"
+#include "dynamics/dynamics_scene.hpp"
+#include "dynamics/trajectory.hpp"
+
+using namespace msfab;
+
+namespace {
+
+std::string plot_prefix(const std::string& out) {
+  const auto dot = out.rfind(".h5");
+  return (dot == std::string::npos ? out : out.substr(0, dot)) + "_";
+}
+
+struct MarkerTrace {
+  int node = -1;
+  std::vector<double> time;
+  std::vector<Vec3> position;
+  void add(double t, const VecX& q) {
+    time.push_back(t);
+    position.push_back(q.segment<3>(3 * node));
+  }
+};
+
+int nearest_rest_node(const DynamicsScene& scene, const Vec3& x) {
+  int best = 0;
+  for (int i = 1; i < scene.model.mesh.num_nodes(); ++i)
+    if ((scene.model.mesh.nodes.row(i).transpose() - x).norm() < (scene.model.mesh.nodes.row(best).transpose() - x).norm())
+      best = i;
+  return best;
+}
+
+// Written to "<path>.tmp" and renamed, so an existing file survives a failure.
+void write_marker_csv(const std::string& path, const MarkerTrace& trace) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "w");
+  if (!f) throw InputError(path + ": cannot write the marker CSV");
+  std::fprintf(f, "t,x,y,z\n");
+  for (size_t i = 0; i < trace.time.size(); ++i)
+    std::fprintf(f, "%.10g,%.12g,%.12g,%.12g\n", trace.time[i], trace.position[i].x(), trace.position[i].y(),
+                 trace.position[i].z());
+  if (std::fclose(f) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw InputError(path + ": cannot write the marker CSV");
+  }
+}
+
+void print_summary(const DynamicsScene& scene, const Trajectory& t) {
+  int elastic_steps = 0, rigid_steps = 0, newton = 0, max_contacts = 0;
+  double max_penetration = 0, max_z = -INFINITY, step_seconds = 0;
+  for (const TrajectorySample& s : t.samples) {
+    if (s.phase == SimulationPhase::kElastic && s.time > 0) ++elastic_steps, newton += s.newton_iterations,
+                                                            step_seconds += s.seconds;
+    if (s.phase == SimulationPhase::kRigid) ++rigid_steps;
+    max_contacts = std::max(max_contacts, s.active_contacts);
+    max_penetration = std::max(max_penetration, s.max_penetration);
+    max_z = std::max(max_z, s.center_of_mass.z());
+  }
+  const TrajectorySample& first = t.samples.front();
+  const TrajectorySample& last = t.samples.back();
+  std::printf("msfab-dynamics: scene '%s', %d elements, %d DOFs, impact model %s, h = %g s\n", scene.name.c_str(),
+              scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(), t.impact_model.c_str(), t.time_step);
+  std::printf("  %d elastic steps (%.2f Newton iterations, %.3f ms each), %d rigid steps\n", elastic_steps,
+              elastic_steps ? double(newton) / elastic_steps : 0.0, elastic_steps ? 1e3 * step_seconds / elastic_steps : 0.0,
+              rigid_steps);
+  std::printf("  centre of mass: start (%.5f, %.5f, %.5f) m, end (%.5f, %.5f, %.5f) m, highest z %.5f m\n",
+              first.center_of_mass.x(), first.center_of_mass.y(), first.center_of_mass.z(), last.center_of_mass.x(),
+              last.center_of_mass.y(), last.center_of_mass.z(), max_z);
+  std::printf("  rotation at the end: %.2f deg; energy start %.4e J, end %.4e J\n", last.rotation.norm() * 180 / M_PI,
+              first.total(), last.total());
+  std::printf("  contacts: up to %d active nodes, deepest penetration %.3e m\n", max_contacts, max_penetration);
+  // Rebound: the highest centre of mass after the first contact, above
+  // where the body ends.
+  bool touched = false;
+  double after_contact = -INFINITY;
+  for (const TrajectorySample& s : t.samples) {
+    touched = touched || s.active_contacts > 0;
+    if (touched) after_contact = std::max(after_contact, s.center_of_mass.z());
+  }
+  if (touched)
+    std::printf("  rebound after the first contact: %.4e m (highest centre of mass %.5f m, final %.5f m)\n",
+                after_contact - last.center_of_mass.z(), after_contact, last.center_of_mass.z());
+  for (const TrajectoryEvent& e : t.events)
+    std::printf("  event %-9s t = %.5f s  %s\n", e.kind.c_str(), e.time, e.detail.c_str());
+  std::printf("  time: preload %.3f s, elastic %.3f s, rigid %.3f s, total %.3f s\n", t.seconds_quasistatic,
+              t.seconds_elastic, t.seconds_rigid, t.seconds_total);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  StageApp app("msfab-dynamics", "Implicit Newmark dynamics with frictional contact and impact (thesis ch. 4)");
+  app.add_common_options();
+  app.set_default_config(kDefaultDynamicsScene);
+  std::vector<double> marker;
+  std::string marker_csv;
+  app.cli()
+      .add_option("--marker", marker, "rest position X Y Z of a tracked node (the node nearest to it)")
+      ->expected(3);
+  app.cli().add_option("--marker-csv", marker_csv, "write the tracked node's position at every step as CSV (t,x,y,z)");
+  return app.run(argc, argv, [&](StageContext& ctx) {
+    if (marker_csv.empty() != marker.empty()) throw InputError("--marker and --marker-csv go together");
+    const std::string& out = ctx.require_out();
+
+    // 1. Scene.
+    const DynamicsScene scene = read_dynamics_scene(ctx.config);
+    ctx.config.check_no_unknown_keys();
+    ctx.check_out_folder();
+    spdlog::info("scene '{}': {} elements, {} DOFs, {} obstacles, contact {}, friction {}, impact {}, h = {} s, {} s",
+                 scene.name, scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(),
+                 scene.model.obstacles.size(), scene.model.contact ? "on" : "off",
+                 scene.model.friction ? "on" : "off", impact_model_name(scene.model.impact), scene.newmark.time_step,
+                 scene.duration);
+
+    // 2-4. Preload, release, dynamics and flight.
+    const std::uint64_t total_steps = static_cast<std::uint64_t>(std::ceil(scene.duration / scene.newmark.time_step));
+    Progress progress("dynamics steps", total_steps);
+    RunCallbacks callbacks;
+    MarkerTrace trace;
+    if (!marker.empty()) trace.node = nearest_rest_node(scene, Vec3(marker[0], marker[1], marker[2]));
+    callbacks.on_step = [&](double t, const VecX& q) {
+      progress.tick();
+      if (trace.node >= 0) trace.add(t, q);
+    };
+    const Trajectory trajectory = run_dynamics_scene(scene, callbacks);
+    progress.done();
+    if (trace.node >= 0) write_marker_csv(marker_csv, trace);
+
+    // 5. Artifact and plots.
+    TrajectoryProvenance provenance;
+    provenance.config_text = ctx.config.resolved_text();
+    provenance.seed = ctx.options.seed;
+    const std::string xmf = write_trajectory_artifact(out, trajectory, provenance);
+    const std::vector<std::string> plots = write_trajectory_plots(plot_prefix(out), trajectory);
+
+    print_summary(scene, trajectory);
+    std::printf("  artifact: %s\n  ParaView: %s\n", out.c_str(), xmf.c_str());
+    for (const std::string& p : plots) std::printf("  plot: %s\n", p.c_str());
+  });
+}

@@ -1,0 +1,59 @@
+#!/bin/bash
+# msfab-dynamics and msfab-dac-calibrate: the block drop with the three
+# impact models, DAC calibration of a coarse cantilever against a finer
+# one (closed loop), and bad input.
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+cd "$SRC"
+S=configs/dynamics
+
+# Drop test: BBI leaves no visible rebound, complementarity bounces.
+for model in bbi complementarity; do
+  "$BIN/msfab-dynamics" --quiet --out "$WORK/drop_$model.h5" --set simulation.impact=$model > "$WORK/drop_$model.txt"
+  check "drop with $model writes the trajectory" -- test -s "$WORK/drop_$model.h5" -a -s "$WORK/drop_$model.xmf"
+  check "drop with $model writes the plots" -- test -s "$WORK/drop_${model}_energy.png" -a -s "$WORK/drop_${model}_com_height.png"
+done
+rebound() { awk '/rebound after the first contact/ {print $6}' "$1"; }
+bbi=$(rebound "$WORK/drop_bbi.txt") comp=$(rebound "$WORK/drop_complementarity.txt")
+echo "rebound from 3 cm: BBI $bbi m, complementarity $comp m"
+check "BBI rebound below 0.5 mm" -- awk -v r="$bbi" 'BEGIN { exit !(r < 5e-4) }'
+check "complementarity rebound above 5 mm" -- awk -v r="$comp" 'BEGIN { exit !(r > 5e-3) }'
+check "no penetration beyond 1e-3 voxel" -- awk '/deepest penetration/ { exit !($NF + 0 <= 5e-6 || $(NF-1) + 0 <= 5e-6) }' "$WORK/drop_bbi.txt"
+
+# DAC closed loop: a finer rig is the reference; the coarse rig calibrated
+# on its tip marker reproduces its first frequency.
+"$BIN/msfab-dynamics" --quiet --config $S/cantilever_pluck.yaml --set geometry.voxel_size=0.0015 \
+  --set simulation.duration=0.03 --marker 0.06 0 0.006 --marker-csv "$WORK/fine_tip.csv" --out "$WORK/fine.h5" > /dev/null
+check "fine rig writes its tip track" -- test -s "$WORK/fine_tip.csv"
+cat > "$WORK/cal.yaml" <<YAML
+scene: $SRC/$S/cantilever_pluck.yaml
+material: rigur
+marker_csv: $WORK/fine_tip.csv
+column: z
+YAML
+"$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" --out "$WORK/dac.h5" > "$WORK/cal.txt"
+cat "$WORK/cal.txt"
+sed -e "s|E: 1.9e9, nu: 0.45, density: 1200, damping_a: 0, damping_b: 2.0e-5|dac_model: $WORK/dac.h5, nu: 0.45, density: 1200|" \
+  $S/cantilever_pluck.yaml > "$WORK/coarse_dac.yaml"
+"$BIN/msfab-dynamics" --quiet --config "$WORK/coarse_dac.yaml" --set simulation.duration=0.03 \
+  --marker 0.06 0 0.006 --marker-csv "$WORK/coarse_tip.csv" --out "$WORK/coarse.h5" > /dev/null
+sed -e "s|$WORK/fine_tip.csv|$WORK/coarse_tip.csv|" -e "s|scene: .*|scene: $WORK/coarse_dac.yaml|" "$WORK/cal.yaml" > "$WORK/recal.yaml"
+"$BIN/msfab-dac-calibrate" --config "$WORK/recal.yaml" --out "$WORK/dac2.h5" > "$WORK/recal.txt"
+cat "$WORK/recal.txt"
+scale=$(awk '/E_n =/ { gsub(/[()x]/, "", $(NF-4)); print $(NF-4) }' "$WORK/recal.txt")
+echo "stiffness scale of the calibrated coarse rig against its own track: $scale"
+check "calibrated coarse rig reproduces the fine f1 within 1%" -- awk -v s="$scale" 'BEGIN { exit !(s > 0.98 && s < 1.02) }'
+
+# Bad input.
+expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
+expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=-1e-4
+expect_exit 2 "friction coefficient must be >= 0" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set friction.default=-0.2
+expect_exit 2 "starts inside obstacle 'ground'" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set 'placement.translation=[0,0,-0.002]'
+expect_exit 2 "unknown impact model" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.impact=bouncy
+printf 't,z\n0,1\n0.001,nan\n' > "$WORK/nan.csv"
+for i in $(seq 2 40); do printf '0.%03d,1\n' $i >> "$WORK/nan.csv"; done
+expect_exit 2 "nan.csv.*line 3.*finite" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" --set marker_csv="$WORK/nan.csv" --out "$WORK/x.h5"
+printf 't,z\n0,1\n0.001,2\n0.002,1\n' > "$WORK/short.csv"
+expect_exit 2 "short.csv.*samples" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" --set marker_csv="$WORK/short.csv" --out "$WORK/x.h5"
+check "failed runs leave no artifact" -- test ! -e "$WORK/x.h5"
+finish
