@@ -2,7 +2,7 @@
 # msfab-dynamics and msfab-dac-calibrate: the block drop with the three
 # impact models, DAC calibration of a coarse cantilever against a finer
 # one (closed loop), and bad input.
-BIN=$1 SRC=$2
+BIN=$1 SRC=$(cd "$2" && pwd)
 source "$SRC/tests/stage/lib.sh"
 cd "$SRC"
 S=configs/dynamics
@@ -17,7 +17,7 @@ rebound() { awk '/rebound after the first contact/ {print $6}' "$1"; }
 bbi=$(rebound "$WORK/drop_bbi.txt") comp=$(rebound "$WORK/drop_complementarity.txt")
 echo "rebound from 3 cm: BBI $bbi m, complementarity $comp m"
 check "BBI rebound below 0.5 mm" -- awk -v r="$bbi" 'BEGIN { exit !(r < 5e-4) }'
-check "complementarity rebound above 5 mm" -- awk -v r="$comp" 'BEGIN { exit !(r > 5e-3) }'
+check "complementarity rebounds visibly, BBI does not" -- awk -v r="$comp" -v b="$bbi" 'BEGIN { exit !(r > 5e-4 && r > 100 * b) }'
 check "no penetration beyond 1e-3 voxel" -- awk '/deepest penetration/ { exit !($NF + 0 <= 5e-6 || $(NF-1) + 0 <= 5e-6) }' "$WORK/drop_bbi.txt"
 
 # DAC closed loop: a finer rig is the reference; the coarse rig calibrated
@@ -40,9 +40,11 @@ sed -e "s|E: 1.9e9, nu: 0.45, density: 1200, damping_a: 0, damping_b: 2.0e-5|dac
 sed -e "s|$WORK/fine_tip.csv|$WORK/coarse_tip.csv|" -e "s|scene: .*|scene: $WORK/coarse_dac.yaml|" "$WORK/cal.yaml" > "$WORK/recal.yaml"
 "$BIN/msfab-dac-calibrate" --config "$WORK/recal.yaml" --out "$WORK/dac2.h5" > "$WORK/recal.txt"
 cat "$WORK/recal.txt"
-scale=$(awk '/E_n =/ { gsub(/[()x]/, "", $(NF-4)); print $(NF-4) }' "$WORK/recal.txt")
-echo "stiffness scale of the calibrated coarse rig against its own track: $scale"
-check "calibrated coarse rig reproduces the fine f1 within 1%" -- awk -v s="$scale" 'BEGIN { exit !(s > 0.98 && s < 1.02) }'
+f_fine=$(awk '/target f_t =/ { print $4 }' "$WORK/cal.txt")
+f_coarse=$(awk '/target f_t =/ { print $4 }' "$WORK/recal.txt")
+echo "tip frequency: fine rig $f_fine Hz, calibrated coarse rig $f_coarse Hz"
+check "calibrated coarse rig reproduces the fine f1 within 1%" -- \
+  awk -v a="$f_fine" -v b="$f_coarse" 'BEGIN { d = (b - a) / a; if (d < 0) d = -d; exit !(a > 0 && d < 0.01) }'
 
 # Bad input.
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
