@@ -92,7 +92,9 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     bc.fixed = sim.model().fixed;
     bc.displacement = scene.initial_positions - sim.assembler().rest_positions();
     NewtonOptions newton;
-    newton.relative_tolerance = 1e-8;
+    // The energy line search of solve_static stalls near 1e-6 on stiff rigs
+    // (round-off in the energy); 1e-5 of the load is ample for a release state.
+    newton.relative_tolerance = 1e-5;
     newton.load_steps = scene.preload_steps;
     newton.linear_solver = "cholmod";
     const NewtonResult r = solve_static(sim.assembler(), bc, force, newton, scene.initial_positions);

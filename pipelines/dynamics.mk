@@ -1,0 +1,41 @@
+# Dynamics (thesis ch. 4; docs/dynamics.md).
+#
+#   make -f Makefile.pipeline dynamics-drops     the 1 cm block dropped face-first from 3 cm with the
+#                                                complementarity, DKE and BBI impact models, and obliquely (BBI)
+#   make -f Makefile.pipeline dac-cantilever     DAC on the calibration rig: a fine rig (0.75 mm voxels) is the
+#                                                reference; its tip track calibrates the 3 mm rig, which runs again
+#                                                with the fitted dac_model (minutes)
+#   make -f Makefile.pipeline dynamics-flipper   the flipper jumper pressed, released, jumping (about a minute)
+#
+# Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots.
+DYN := $(OUT)/dynamics
+
+$(DYN)/drop_face_%.trajectory.h5: configs/dynamics/block_drop_face.yaml $(BIN)/msfab-dynamics
+	@mkdir -p $(@D)
+	$(BIN)/msfab-dynamics --config $< --set simulation.impact=$* --threads $(THREADS) --quiet --out $@
+
+$(DYN)/drop_oblique.trajectory.h5: configs/dynamics/block_drop_oblique.yaml $(BIN)/msfab-dynamics
+	@mkdir -p $(@D)
+	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --quiet --out $@
+
+$(DYN)/rig_fine.trajectory.h5: configs/dynamics/cantilever_pluck.yaml $(BIN)/msfab-dynamics
+	@mkdir -p $(@D)
+	$(BIN)/msfab-dynamics --config $< --set geometry.voxel_size=0.00075 --set simulation.duration=0.03 \
+	  --marker 0.06 0 0.006 --marker-csv $(DYN)/rig_fine_tip.csv --threads $(THREADS) --quiet --out $@
+
+$(DYN)/rig.dac_model.h5: configs/dac/cantilever_from_fine.yaml $(DYN)/rig_fine.trajectory.h5 $(BIN)/msfab-dac-calibrate
+	$(BIN)/msfab-dac-calibrate --config $< --set marker_csv=$(abspath $(DYN))/rig_fine_tip.csv --out $@
+
+$(DYN)/rig_dac.trajectory.h5: configs/dynamics/cantilever_dac.yaml $(DYN)/rig.dac_model.h5 $(BIN)/msfab-dynamics
+	$(BIN)/msfab-dynamics --config $< --set 'materials[0].dac_model=$(abspath $(DYN))/rig.dac_model.h5' \
+	  --marker 0.06 0 0.006 --marker-csv $(DYN)/rig_dac_tip.csv --threads $(THREADS) --quiet --out $@
+
+$(DYN)/flipper.trajectory.h5: configs/dynamics/flipper_jumper.yaml $(BIN)/msfab-dynamics
+	@mkdir -p $(@D)
+	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
+
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper
+dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
+    $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
+dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
+dynamics-flipper: build $(DYN)/flipper.trajectory.h5
