@@ -92,17 +92,17 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
   std::printf("  rotation at the end: %.2f deg; energy start %.4e J, end %.4e J\n", last.rotation.norm() * 180 / M_PI,
               first.total(), last.total());
   std::printf("  contacts: up to %d active nodes, deepest penetration %.3e m\n", max_contacts, max_penetration);
-  // Rebound: the highest centre of mass after the first contact, above
-  // where the body ends.
-  bool touched = false;
+  // Rebound: how far the centre of mass rises after the first contact above
+  // its height at that contact.
+  const TrajectorySample* contact = nullptr;
   double after_contact = -INFINITY;
   for (const TrajectorySample& s : t.samples) {
-    touched = touched || s.active_contacts > 0;
-    if (touched) after_contact = std::max(after_contact, s.center_of_mass.z());
+    if (!contact && s.active_contacts > 0) contact = &s;
+    if (contact) after_contact = std::max(after_contact, s.center_of_mass.z());
   }
-  if (touched)
-    std::printf("  rebound after the first contact: %.4e m (highest centre of mass %.5f m, final %.5f m)\n",
-                after_contact - last.center_of_mass.z(), after_contact, last.center_of_mass.z());
+  if (contact)
+    std::printf("  rebound after the first contact: %.4e m (centre of mass at contact %.5f m, highest after %.5f m)\n",
+                after_contact - contact->center_of_mass.z(), contact->center_of_mass.z(), after_contact);
   for (const TrajectoryEvent& e : t.events)
     std::printf("  event %-9s t = %.5f s  %s\n", e.kind.c_str(), e.time, e.detail.c_str());
   std::printf("  time: preload %.3f s, elastic %.3f s, rigid %.3f s, total %.3f s\n", t.seconds_quasistatic,
