@@ -186,7 +186,7 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
     if (callbacks.on_step) callbacks.on_step(time, sim.positions());
 
     if (scene.rigid.enabled && !touching) {
-      const Energies e = sim.energies();
+      const TrajectorySample& e = out.samples.back();  // this step's energies
       if (e.elastic < scene.rigid.elastic_fraction * e.kinetic &&
           clearance(scene.model, sim.boundary_nodes(), sim.positions(), sim.velocities(), horizon) > margin) {
         state = project_to_rigid(body, sim.positions(), sim.velocities());

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "fem/hex_boundary.hpp"
 
 namespace msfab {
 
@@ -245,49 +246,7 @@ BoundarySurface boundary_surface(const HexMesh& mesh) {
   if (mesh.num_elements() == 0) throw InputError("boundary surface: the mesh has no elements");
   s.diagonal = (mesh.bbox_max() - mesh.bbox_min()).norm();
 
-  // Face f = 2 a + side of local axis a: the corners whose natural coordinate
-  // along a is `side`, in cyclic order over the two remaining axes.
-  struct FaceRef {
-    std::array<int, 4> key;
-    int element, face;
-  };
-  std::vector<FaceRef> all;
-  all.reserve(size_t(6) * mesh.num_elements());
-  for (int e = 0; e < mesh.num_elements(); ++e)
-    for (int f = 0; f < 6; ++f) {
-      FaceRef r{{}, e, f};
-      const int axis = f / 2, side = f % 2;
-      const int b = axis == 0 ? 1 : 0, c = axis == 2 ? 1 : 2;
-      const int cyc[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-      for (int q = 0; q < 4; ++q) {
-        const int local = (side << (2 - axis)) | (cyc[q][0] << (2 - b)) | (cyc[q][1] << (2 - c));
-        r.key[static_cast<size_t>(q)] = mesh.elements[static_cast<size_t>(e)][static_cast<size_t>(local)];
-      }
-      all.push_back(r);
-    }
-  std::vector<int> order(all.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  auto sorted_key = [&](int i) {
-    std::array<int, 4> k = all[static_cast<size_t>(i)].key;
-    std::sort(k.begin(), k.end());
-    return k;
-  };
-  std::vector<std::array<int, 4>> keys(all.size());
-  for (size_t i = 0; i < all.size(); ++i) keys[i] = sorted_key(static_cast<int>(i));
-  std::sort(order.begin(), order.end(), [&](int x, int y) {
-    return keys[static_cast<size_t>(x)] != keys[static_cast<size_t>(y)]
-               ? keys[static_cast<size_t>(x)] < keys[static_cast<size_t>(y)]
-               : x < y;
-  });
-  std::vector<char> boundary(all.size(), 0);
-  for (size_t i = 0; i < order.size();) {
-    size_t j = i + 1;
-    while (j < order.size() && keys[static_cast<size_t>(order[j])] == keys[static_cast<size_t>(order[i])]) ++j;
-    if (j - i == 1) boundary[static_cast<size_t>(order[i])] = 1;
-    i = j;
-  }
-  for (size_t i = 0; i < all.size(); ++i)
-    if (boundary[i]) s.faces.push_back(all[i].key);
+  s.faces = hex_boundary(mesh).faces;
   return s;
 }
 

@@ -272,12 +272,8 @@ StepReport NewmarkIntegrator::step() {
 
   const VecX v_new = impact_velocity(delta, contacts, impulses);
   report.contacts = static_cast<int>(contacts.size());
-  for (size_t k = 0; k < contacts.size(); ++k) {
-    const Vec3 p = impulses.segment<3>(3 * k);
-    if (p(0) > 0) ++report.active_contacts;
-    // p is the impulse scaled by h^2/2; the physical impulse over the step is h * force = (2/h) p.
-    report.contact_impulse += (2.0 / h) * (contacts[k].frame * p);
-  }
+  for (size_t k = 0; k < contacts.size(); ++k)
+    if (impulses(3 * k) > 0) ++report.active_contacts;
   q_ += delta;
   v_ = v_new;
   time_ += h;

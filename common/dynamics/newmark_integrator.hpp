@@ -62,7 +62,6 @@ struct StepReport {
   int gauss_seidel_sweeps = 0;
   double residual = 0;        // final relative residual
   double max_penetration = 0; // deepest node below an obstacle surface at the end (m, >= 0)
-  Vec3 contact_impulse = Vec3::Zero();  // total contact impulse of the step (N s)
   double seconds = 0;
 };
 

@@ -73,15 +73,6 @@ bool penetrates(const Obstacle& o, const Vec3& x0, const Vec3& x1, double depth)
   return false;
 }
 
-// Zeroes the rows and columns of fixed DOFs and puts `diag` on their diagonal.
-void constrain_matrix(SpMat& K, const std::vector<char>& fixed, double diag) {
-  for (int c = 0; c < K.outerSize(); ++c)
-    for (SpMat::InnerIterator it(K, c); it; ++it) {
-      const int r = static_cast<int>(it.row());
-      if (fixed[c] || fixed[r]) it.valueRef() = (r == c) ? diag : 0.0;
-    }
-}
-
 void validate(const ElasticAssembler& assembler, const std::vector<Obstacle>& obstacles, const VecX& force,
               const VecX& x0, const QuasistaticOptions& opt) {
   const int n = assembler.mesh().num_dofs();

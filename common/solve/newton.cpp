@@ -16,18 +16,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Zeroes the rows and columns of fixed DOFs and puts `diag` on their
-// diagonal, so the system decouples into the free block and an identity-like
-// block whose solution is the prescribed gap.
-void constrain_matrix(SpMat& K, const std::vector<char>& fixed, double diag) {
-  for (int c = 0; c < K.outerSize(); ++c) {
-    for (SpMat::InnerIterator it(K, c); it; ++it) {
-      const int r = static_cast<int>(it.row());
-      if (fixed[c] || fixed[r]) it.valueRef() = (r == c) ? diag : 0.0;
-    }
-  }
-}
-
 double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
   double sum = 0;
   int count = 0;
@@ -40,6 +28,15 @@ double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
 }
 
 }  // namespace
+
+void constrain_matrix(SpMat& K, const std::vector<char>& fixed, double diag) {
+  for (int c = 0; c < K.outerSize(); ++c) {
+    for (SpMat::InnerIterator it(K, c); it; ++it) {
+      const int r = static_cast<int>(it.row());
+      if (fixed[c] || fixed[r]) it.valueRef() = (r == c) ? diag : 0.0;
+    }
+  }
+}
 
 int DirichletConditions::count_fixed() const {
   int n = 0;

@@ -77,6 +77,11 @@ struct NewtonResult {
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                           const VecX& force, const NewtonOptions& options, const VecX& x0 = VecX());
 
+// Zeroes the rows and columns of fixed DOFs and puts `diag` on their
+// diagonal, so the system decouples into the free block and an identity-like
+// block whose solution is the prescribed gap.
+void constrain_matrix(SpMat& K, const std::vector<char>& fixed, double diag);
+
 // The residual history as readable text, for error messages.
 std::string format_history(const std::vector<NewtonIteration>& history, size_t max_lines = 30);
 
