@@ -34,6 +34,12 @@ struct FrictionTable {
     const auto it = pairs.find({body_material, surface});
     return it == pairs.end() ? default_mu : it->second;
   }
+  // Between two bodies' materials: a pair listed either way round.
+  double mu_between(const std::string& a, const std::string& b) const {
+    auto it = pairs.find({a, b});
+    if (it == pairs.end()) it = pairs.find({b, a});
+    return it == pairs.end() ? default_mu : it->second;
+  }
 };
 
 struct DynamicsModel {
@@ -47,6 +53,9 @@ struct DynamicsModel {
   std::vector<char> fixed;
   bool contact = false;   // obstacles act only when true
   bool friction = false;  // friction acts only when true
+  // Vertex-face contact between the mesh's bodies and of a body with itself
+  // (B.5), when true; needs `contact`.
+  bool body_contact = false;
   std::vector<Obstacle> obstacles;
   FrictionTable friction_table;
   ImpactModel impact = ImpactModel::kBbi;

@@ -1,6 +1,7 @@
 #include "dynamics/newmark_integrator.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -11,21 +12,55 @@
 #include "core/timing.hpp"
 #include "dynamics/contact_problem.hpp"
 #include "dynamics/mass_matrix.hpp"
+#include "dynamics/surface_contact.hpp"
 #include "fem/hex_boundary.hpp"
 #include "material/scaled_material.hpp"
 #include "solve/cholmod_solver.hpp"
 
 namespace msfab {
 
+// A contact row of G (B.5): a boundary node against an obstacle's face
+// plane, or a node against a boundary face (weights w of the face's closest
+// point). Its relative position is x_p - sum_i w_i x_i, and a force f on it
+// pushes the node by f and the face's nodes by -w_i f.
 struct NewmarkIntegrator::Contact {
   int node = 0;
-  int obstacle = 0;
-  ContactPlane plane;
-  Mat3 frame;  // columns: normal, tangent 1, tangent 2
+  // What is touched: an obstacle index, or obstacles.size() + boundary face.
+  int target = 0;
+  int face_nodes = 0;  // 0 (obstacle) or 4
+  std::array<int, 4> face{};
+  std::array<double, 4> weight{};
+  double gap0 = 0;  // n . relative position at q^t
+  Mat3 frame;       // columns: normal, tangent 1, tangent 2
   double mu = 0;
+
+  Vec3 relative(const VecX& x) const {
+    Vec3 r = x.segment<3>(3 * node);
+    for (int i = 0; i < face_nodes; ++i) r -= weight[i] * x.segment<3>(3 * face[i]);
+    return r;
+  }
+  // Rows of the relative position of a block of columns (3 x cols).
+  MatX relative_rows(const MatX& X) const {
+    MatX r = X.middleRows<3>(3 * node);
+    for (int i = 0; i < face_nodes; ++i) r -= weight[i] * X.middleRows<3>(3 * face[i]);
+    return r;
+  }
+  // out += G_k f, each node's share divided by scale(node).
+  template <class Scale>
+  void scatter(const Vec3& f, VecX& out, Scale scale) const {
+    out.segment<3>(3 * node) += f / scale(node);
+    for (int i = 0; i < face_nodes; ++i) out.segment<3>(3 * face[i]) -= weight[i] * f / scale(face[i]);
+  }
+  void scatter(const Vec3& f, VecX& out) const {
+    scatter(f, out, [](int) { return 1.0; });
+  }
 };
 
 namespace {
+
+// Node-face pairs count only for nodes starting no deeper than this
+// fraction of an element behind the face (surface_contact.hpp).
+constexpr double kSurfaceDepthLimit = 0.25;
 
 double smallest_edge(const HexMesh& mesh) {
   double h = std::numeric_limits<double>::infinity();
@@ -102,6 +137,7 @@ NewmarkIntegrator::NewmarkIntegrator(const DynamicsModel& model, const NewmarkOp
     for (int node : mesh.elements[e])
       if (node_material_[node].empty()) node_material_[node] = model.element_material_name[e];
   dx_ = smallest_edge(mesh);
+  if (model.contact && model.body_contact) surface_ = std::make_unique<BoundarySurface>(hex_boundary(mesh), boundary_nodes_);
 
   solver_ = std::make_unique<CholmodSolver>();
   solver_->analyze(jacobian_);
@@ -167,6 +203,40 @@ void NewmarkIntegrator::assemble_jacobian(const SpMat& K) {
   for (int i : fixed_diagonal_index_) H[i] = 1;
 }
 
+NewmarkIntegrator::Contact NewmarkIntegrator::obstacle_contact(int node, int obstacle, const ContactPlane& plane) const {
+  Contact c;
+  c.node = node;
+  c.target = obstacle;
+  c.gap0 = plane.gap(q_.segment<3>(3 * node));
+  c.frame = contact_frame(plane.normal);
+  c.mu = model_.friction ? model_.friction_table.mu(node_material_[node], model_.obstacles[obstacle].surface) : 0.0;
+  return c;
+}
+
+void NewmarkIntegrator::add_surface_contacts(const VecX& delta, double margin, std::vector<Contact>& contacts) const {
+  if (!surface_) return;
+  std::vector<std::pair<int, int>> pairs;
+  for (const Contact& c : contacts) pairs.emplace_back(c.node, c.target);
+  std::sort(pairs.begin(), pairs.end());
+  const int first_face = static_cast<int>(model_.obstacles.size());
+  const HexBoundary& boundary = surface_->boundary();
+  for (const NodeFaceContact& f : surface_->find(q_, q_ + delta, margin, kSurfaceDepthLimit * dx_)) {
+    if (std::binary_search(pairs.begin(), pairs.end(), std::make_pair(f.node, first_face + f.face))) continue;
+    Contact c;
+    c.node = f.node;
+    c.target = first_face + f.face;
+    c.face_nodes = 4;
+    c.face = boundary.faces[f.face];
+    c.weight = f.weights;
+    c.gap0 = f.gap_start;
+    c.frame = contact_frame(f.normal);
+    c.mu = model_.friction ? model_.friction_table.mu_between(node_material_[f.node],
+                                                              model_.element_material_name[boundary.face_element[f.face]])
+                           : 0.0;
+    contacts.push_back(c);
+  }
+}
+
 std::vector<NewmarkIntegrator::Contact> NewmarkIntegrator::detect_contacts(const VecX& delta_predicted) const {
   std::vector<Contact> contacts;
   if (!model_.contact) return contacts;
@@ -174,25 +244,18 @@ std::vector<NewmarkIntegrator::Contact> NewmarkIntegrator::detect_contacts(const
   for (int node : boundary_nodes_) {
     const Vec3 x0 = q_.segment<3>(3 * node);
     const Vec3 x1 = x0 + delta_predicted.segment<3>(3 * node);
-    for (int o = 0; o < static_cast<int>(model_.obstacles.size()); ++o) {
-      const auto plane = first_contact(model_.obstacles[o], x0, x1, margin);
-      if (!plane) continue;
-      Contact c;
-      c.node = node;
-      c.obstacle = o;
-      c.plane = *plane;
-      c.frame = contact_frame(plane->normal);
-      c.mu = model_.friction ? model_.friction_table.mu(node_material_[node], model_.obstacles[o].surface) : 0.0;
-      contacts.push_back(c);
-    }
+    for (int o = 0; o < static_cast<int>(model_.obstacles.size()); ++o)
+      if (const auto plane = first_contact(model_.obstacles[o], x0, x1, margin))
+        contacts.push_back(obstacle_contact(node, o, *plane));
   }
+  add_surface_contacts(delta_predicted, margin, contacts);
   return contacts;
 }
 
 void NewmarkIntegrator::add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const {
   const double tolerance = options_.penetration_tolerance * dx_;
   std::vector<std::pair<int, int>> present;
-  for (const Contact& c : contacts) present.emplace_back(c.node, c.obstacle);
+  for (const Contact& c : contacts) present.emplace_back(c.node, c.target);
   std::sort(present.begin(), present.end());
   for (int node : boundary_nodes_) {
     const Vec3 x0 = q_.segment<3>(3 * node);
@@ -200,20 +263,16 @@ void NewmarkIntegrator::add_penetrating_contacts(const VecX& delta, std::vector<
     for (int o = 0; o < static_cast<int>(model_.obstacles.size()); ++o) {
       if (std::binary_search(present.begin(), present.end(), std::make_pair(node, o))) continue;
       if (signed_distance(model_.obstacles[o], x1, nullptr) >= -tolerance) continue;
-      auto plane = first_contact(model_.obstacles[o], x0, x1, 0.0);
-      Contact c;
-      c.node = node;
-      c.obstacle = o;
-      if (plane) {
-        c.plane = *plane;
+      ContactPlane plane;
+      if (auto hit = first_contact(model_.obstacles[o], x0, x1, 0.0)) {
+        plane = *hit;
       } else {
-        signed_distance(model_.obstacles[o], x1, &c.plane);
+        signed_distance(model_.obstacles[o], x1, &plane);
       }
-      c.frame = contact_frame(c.plane.normal);
-      c.mu = model_.friction ? model_.friction_table.mu(node_material_[node], model_.obstacles[o].surface) : 0.0;
-      contacts.push_back(c);
+      contacts.push_back(obstacle_contact(node, o, plane));
     }
   }
+  add_surface_contacts(delta, -tolerance, contacts);
 }
 
 double NewmarkIntegrator::step_potential(const VecX& delta) const {
@@ -272,8 +331,11 @@ StepReport NewmarkIntegrator::step() {
 
   const VecX v_new = impact_velocity(delta, contacts, impulses);
   report.contacts = static_cast<int>(contacts.size());
-  for (size_t k = 0; k < contacts.size(); ++k)
+  for (size_t k = 0; k < contacts.size(); ++k) {
     if (impulses(3 * k) > 0) ++report.active_contacts;
+    if (contacts[k].face_nodes > 0)
+      report.max_penetration = std::max(report.max_penetration, -(contacts[k].gap0 + contacts[k].frame.col(0).dot(contacts[k].relative(delta))));
+  }
   q_ += delta;
   v_ = v_new;
   time_ += h;
@@ -296,7 +358,7 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
 
   auto contact_force = [&](const VecX& p) {
     VecX Gp = VecX::Zero(n);
-    for (int k = 0; k < m; ++k) Gp.segment<3>(3 * contacts[k].node) += contacts[k].frame * p.segment<3>(3 * k);
+    for (int k = 0; k < m; ++k) contacts[k].scatter(contacts[k].frame * p.segment<3>(3 * k), Gp);
     apply_fixed(Gp);
     return Gp;
   };
@@ -321,28 +383,28 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     const VecX delta_free = delta - solver_->solve(f);
     VecX candidate = delta_free;
     if (m > 0) {
-      HinvG_.resize(n, 3 * m);
-      VecX rhs = VecX::Zero(n);
+      MatX G = MatX::Zero(n, 3 * m);
       for (int k = 0; k < m; ++k)
         for (int c = 0; c < 3; ++c) {
-          rhs.segment<3>(3 * contacts[k].node) = contacts[k].frame.col(c);
-          apply_fixed(rhs);
-          HinvG_.col(3 * k + c) = solver_->solve(rhs);
-          rhs.segment<3>(3 * contacts[k].node).setZero();
+          VecX column = VecX::Zero(n);
+          contacts[k].scatter(contacts[k].frame.col(c), column);
+          apply_fixed(column);
+          G.col(3 * k + c) = column;
         }
+      HinvG_ = solver_->solve_columns(G);
       ContactProblem problem;
       problem.h = h;
       problem.W.resize(3 * m, 3 * m);
       problem.u_free.resize(3 * m);
       problem.tangential_velocity_start.resize(2 * m);
       for (int k = 0; k < m; ++k) {
-        const int node = contacts[k].node;
-        const Mat3& F = contacts[k].frame;
-        problem.W.middleRows<3>(3 * k) = F.transpose() * HinvG_.middleRows<3>(3 * node);
-        problem.u_free.segment<3>(3 * k) = F.transpose() * delta_free.segment<3>(3 * node);
-        problem.gap0.push_back(contacts[k].plane.gap(q_.segment<3>(3 * node)));
-        problem.mu.push_back(contacts[k].mu);
-        problem.tangential_velocity_start.segment<2>(2 * k) = F.rightCols<2>().transpose() * v_.segment<3>(3 * node);
+        const Contact& ct = contacts[k];
+        const Mat3& F = ct.frame;
+        problem.W.middleRows<3>(3 * k) = F.transpose() * ct.relative_rows(HinvG_);
+        problem.u_free.segment<3>(3 * k) = F.transpose() * ct.relative(delta_free);
+        problem.gap0.push_back(ct.gap0);
+        problem.mu.push_back(ct.mu);
+        problem.tangential_velocity_start.segment<2>(2 * k) = F.rightCols<2>().transpose() * ct.relative(v_);
       }
       // Symmetrize against round-off so Gauss-Seidel sees one matrix.
       problem.W = 0.5 * (problem.W + problem.W.transpose()).eval();
@@ -411,18 +473,21 @@ VecX NewmarkIntegrator::impact_velocity(const VecX& delta, const std::vector<Con
     S.setZero();
     for (int j = 0; j < a; ++j) {
       const Contact& ct = contacts[active[j]];
-      Y.col(j).segment<3>(3 * ct.node) = ct.frame.col(0) / lumped_mass_(ct.node);
+      VecX column = VecX::Zero(c.size());
+      ct.scatter(ct.frame.col(0), column, [&](int node) { return lumped_mass_(node); });
+      apply_fixed(column);
+      Y.col(j) = column;
     }
     for (int i = 0; i < a; ++i)
       for (int j = 0; j < a; ++j) {
         const Contact& ci = contacts[active[i]];
-        S(i, j) = ci.frame.col(0).dot(Y.col(j).segment<3>(3 * ci.node));
+        S(i, j) = ci.frame.col(0).dot(ci.relative(Y.col(j)));
       }
   }
   VecX normal_c(a);
   for (int i = 0; i < a; ++i) {
     const Contact& ct = contacts[active[i]];
-    normal_c(i) = ct.frame.col(0).dot(c.segment<3>(3 * ct.node));
+    normal_c(i) = ct.frame.col(0).dot(ct.relative(c));
   }
   // Zero normal velocity at every force-carrying contact, nearest to c in
   // the chosen metric: d = c + Y mu with N_a^T d = 0.

@@ -1,6 +1,6 @@
 #pragma once
 // Implicit (trapezoidal) Newmark with Rayleigh damping, gravity and
-// frictional contact against static obstacles (thesis Eq. 4.2-4.14, 4.19,
+// frictional contact against static obstacles and between bodies (thesis Eq. 4.2-4.14, 4.19,
 // App. B.1). One step from (q^t, v^t):
 //
 //   1. b^t = h M v^t + h^2/4 F(q^t) - h^2/4 D(q^t) v^t               (4.6)
@@ -10,7 +10,10 @@
 //      and the line search has a merit function; the dropped term made
 //      Newton diverge on stiff, strongly damped impacts (docs/dynamics.md).
 //   2. continuous collision detection of each boundary node along the
-//      predicted path q^t -> q^t + h v^t + h^2/2 g gathers the contact set
+//      predicted path q^t -> q^t + h v^t + h^2/2 g gathers the contact set:
+//      node-obstacle contacts and, with body contact on, five-node
+//      node-face contacts between and within bodies (B.5,
+//      surface_contact.hpp)
 //   3. Newton on (B.1): per iterate factor H = M + h^2/4 K + h/2 D, take
 //      the free step,
 //      and solve the contacts' normal and friction impulses by Gauss-Seidel
@@ -32,6 +35,7 @@
 
 namespace msfab {
 
+class BoundarySurface;
 class CholmodSolver;
 
 struct NewmarkOptions {
@@ -94,6 +98,10 @@ class NewmarkIntegrator {
 
  private:
   struct Contact;
+  Contact obstacle_contact(int node, int obstacle, const ContactPlane& plane) const;
+  // Node-face contacts (bodies and self) whose gap at q^t + delta is below
+  // `margin`, appended unless already present.
+  void add_surface_contacts(const VecX& delta, double margin, std::vector<Contact>& contacts) const;
   std::vector<Contact> detect_contacts(const VecX& delta_predicted) const;
   void add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const;
   // Newton on (B.1) with a fixed contact set; returns the iterations.
@@ -123,6 +131,7 @@ class NewmarkIntegrator {
   VecX lumped_mass_;  // per node, the DKE projection's metric
   VecX gravity_force_;
   std::vector<int> boundary_nodes_;
+  std::unique_ptr<BoundarySurface> surface_;  // with body contact
   std::vector<std::string> node_material_;
   double dx_ = 0;
   VecX q_, v_, q0_;

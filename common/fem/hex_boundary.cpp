@@ -21,21 +21,29 @@ constexpr int kFaces[6][4] = {
 }  // namespace
 
 HexBoundary hex_boundary(const HexMesh& mesh) {
-  // Key: the sorted node quadruple; value: (count, the oriented face).
-  std::map<std::array<int, 4>, std::pair<int, std::array<int, 4>>> faces;
-  for (const auto& el : mesh.elements)
+  struct Entry {
+    int count = 0;
+    std::array<int, 4> face;
+    int element = 0;
+  };
+  // Key: the sorted node quadruple.
+  std::map<std::array<int, 4>, Entry> faces;
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const auto& el = mesh.elements[e];
     for (const auto& f : kFaces) {
       std::array<int, 4> face{el[f[0]], el[f[1]], el[f[2]], el[f[3]]};
       std::array<int, 4> key = face;
       std::sort(key.begin(), key.end());
-      auto [it, inserted] = faces.try_emplace(key, 0, face);
-      ++it->second.first;
+      auto [it, inserted] = faces.try_emplace(key, Entry{0, face, e});
+      ++it->second.count;
     }
+  }
   HexBoundary b;
   std::vector<char> on_boundary(mesh.num_nodes(), 0);
   for (const auto& [key, entry] : faces)
-    if (entry.first == 1) {
-      b.faces.push_back(entry.second);
+    if (entry.count == 1) {
+      b.faces.push_back(entry.face);
+      b.face_element.push_back(entry.element);
       for (int n : key) on_boundary[n] = 1;
     }
   for (int n = 0; n < mesh.num_nodes(); ++n)

@@ -5,7 +5,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstring>
+#include <stdexcept>
 #include <mutex>
 #include <string>
 
@@ -44,14 +46,14 @@ cholmod_sparse lower_triangle_view(const SpMat& A) {
   return view;
 }
 
-cholmod_dense vector_view(const VecX& v) {
+cholmod_dense dense_view(const double* data, Eigen::Index rows, Eigen::Index cols) {
   cholmod_dense view;
   std::memset(&view, 0, sizeof(view));
-  view.nrow = static_cast<size_t>(v.size());
-  view.ncol = 1;
-  view.nzmax = static_cast<size_t>(v.size());
-  view.d = static_cast<size_t>(v.size());
-  view.x = const_cast<double*>(v.data());
+  view.nrow = static_cast<size_t>(rows);
+  view.ncol = static_cast<size_t>(cols);
+  view.nzmax = static_cast<size_t>(rows * cols);
+  view.d = static_cast<size_t>(rows);
+  view.x = const_cast<double*>(data);
   view.z = nullptr;
   view.xtype = CHOLMOD_REAL;
   view.dtype = CHOLMOD_DOUBLE;
@@ -223,7 +225,7 @@ VecX CholmodSolver::solve(const VecX& b) {
   require_rhs_size(b, c.n, "CholmodSolver");
   VecX x = VecX::Zero(c.n);
   if (c.n > 0) {
-    cholmod_dense rhs = vector_view(b);
+    cholmod_dense rhs = dense_view(b.data(), b.size(), 1);
     if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e,
                         &c.common)) {
       throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
@@ -238,6 +240,39 @@ VecX CholmodSolver::solve(const VecX& b) {
                          std::to_string(stats_.relative_residual) + ")");
   }
   return x;
+}
+
+MatX CholmodSolver::solve_columns(const MatX& B) {
+  const auto start = std::chrono::steady_clock::now();
+  Cholmod& c = *cholmod_;
+  if (!c.factor_ready)
+    throw NumericalError("CHOLMOD solve without a valid factorization; factorize with a larger shift first");
+  if (B.rows() != c.n)
+    throw std::invalid_argument("CholmodSolver: right-hand sides have " + std::to_string(B.rows()) + " rows, expected " +
+                                std::to_string(c.n));
+  MatX X = MatX::Zero(c.n, B.cols());
+  if (c.n > 0 && B.cols() > 0) {
+    cholmod_dense rhs = dense_view(B.data(), B.rows(), B.cols());
+    // Its own workspace: c.x and c.y are sized for one column.
+    cholmod_dense *x = nullptr, *y = nullptr, *e = nullptr;
+    const int ok = cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &x, nullptr, &y, &e, &c.common);
+    if (ok) X = Eigen::Map<const MatX>(static_cast<const double*>(x->x), c.n, B.cols());
+    cholmod_free_dense(&x, &c.common);
+    cholmod_free_dense(&y, &c.common);
+    cholmod_free_dense(&e, &c.common);
+    if (!ok) throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
+  }
+  stats_.iterations = 0;
+  stats_.relative_residual = 0;
+  for (Eigen::Index j = 0; j < B.cols(); ++j)
+    if (B.col(j).squaredNorm() > 0)
+      stats_.relative_residual =
+          std::max(stats_.relative_residual, relative_residual(*factorized_, X.col(j), B.col(j), shift_, options_.threads));
+  stats_.solve_seconds = seconds_since(start);
+  if (!std::isfinite(stats_.relative_residual))
+    throw NumericalError("CHOLMOD solve produced a non-finite solution (relative residual " +
+                         std::to_string(stats_.relative_residual) + ")");
+  return X;
 }
 
 }  // namespace msfab
