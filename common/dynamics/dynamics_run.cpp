@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "dynamics/passenger_bodies.hpp"
 #include "dynamics/quasistatic_loading.hpp"
 #include "dynamics/rigid_body.hpp"
 #include "solve/newton.hpp"
@@ -39,6 +40,17 @@ class Recorder {
   Recorder(const DynamicsScene& scene, const NewmarkIntegrator& sim, Trajectory& out)
       : scene_(scene), sim_(sim), out_(out), body_(make_rigid_body(sim.scalar_mass_matrix(), sim.assembler().rest_positions())) {
     R0_ = project_to_rigid(body_, scene.initial_positions, scene.initial_velocities).R;
+    if (scene.body_names.size() > 1) {
+      // Lumped nodal masses per body, for each body's centre of mass.
+      node_mass_ = VecX::Zero(scene.model.mesh.num_nodes());
+      const SpMat& m = sim.scalar_mass_matrix();
+      for (int j = 0; j < m.outerSize(); ++j)
+        for (SpMat::InnerIterator it(m, j); it; ++it) node_mass_(it.row()) += it.value();
+      node_body_.assign(scene.model.mesh.num_nodes(), 0);
+      for (int e = 0; e < scene.model.mesh.num_elements(); ++e)
+        for (int node : scene.model.mesh.elements[e]) node_body_[node] = scene.element_body[e];
+      out.body_names = scene.body_names;
+    }
   }
 
   void sample(SimulationPhase phase, const VecX& q, const VecX& v, const StepReport& step, double time) {
@@ -53,6 +65,15 @@ class Recorder {
     s.com_velocity = r.l / body_.mass;
     const Eigen::AngleAxisd rotation(r.R * R0_.transpose());
     s.rotation = rotation.angle() * rotation.axis();
+    if (!node_body_.empty()) {
+      std::vector<double> mass(scene_.body_names.size(), 0.0);
+      s.body_center_of_mass.assign(scene_.body_names.size(), Vec3::Zero());
+      for (size_t i = 0; i < node_body_.size(); ++i) {
+        mass[node_body_[i]] += node_mass_(Eigen::Index(i));
+        s.body_center_of_mass[node_body_[i]] += node_mass_(Eigen::Index(i)) * q.segment<3>(3 * Eigen::Index(i));
+      }
+      for (size_t b = 0; b < mass.size(); ++b) s.body_center_of_mass[b] /= mass[b];
+    }
     s.contacts = step.contacts;
     s.active_contacts = step.active_contacts;
     s.newton_iterations = step.newton_iterations;
@@ -76,6 +97,8 @@ class Recorder {
   Trajectory& out_;
   RigidBody body_;
   Mat3 R0_;
+  VecX node_mass_;              // lumped, with several bodies
+  std::vector<int> node_body_;  // empty with one body
 };
 
 // The preloaded state: the scene's initial positions, or the equilibrium
@@ -83,13 +106,17 @@ class Recorder {
 VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder& rec, Trajectory& out) {
   if (scene.preload == Preload::kNone) return scene.initial_positions;
   const auto t0 = std::chrono::steady_clock::now();
-  const VecX force = region_force(scene, scene.load, scene.preload == Preload::kStaticPluck ? "pluck" : "press") +
-                     sim.gravity_force();
+  const VecX load = region_force(scene, scene.load, scene.preload == Preload::kStaticPluck ? "pluck" : "press");
+  const VecX force = load + sim.gravity_force();
   VecX q;
   std::ostringstream detail;
   if (scene.preload == Preload::kStaticPluck) {
     DirichletConditions bc = DirichletConditions::none(sim.model().mesh.num_dofs());
     bc.fixed = sim.model().fixed;
+    if (bc.fixed.empty()) bc.fixed.assign(sim.model().mesh.num_dofs(), 0);
+    const std::vector<char> passenger = passenger_bodies(scene, load);
+    const std::vector<char> riding = passenger_dofs(scene, passenger);
+    for (size_t i = 0; i < riding.size(); ++i) bc.fixed[i] = bc.fixed[i] || riding[i];
     bc.displacement = scene.initial_positions - sim.assembler().rest_positions();
     NewtonOptions newton;
     // The energy line search of solve_static stalls near 1e-6 on stiff rigs
@@ -99,8 +126,10 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     newton.linear_solver = "cholmod";
     const NewtonResult r = solve_static(sim.assembler(), bc, force, newton, scene.initial_positions);
     if (!r.converged) throw NumericalError("pluck preload: " + r.failure + "\n" + format_history(r.history));
-    q = r.x;
+    std::vector<std::string> notes;
+    q = carry_passengers(scene, passenger, scene.initial_positions, r.x, &notes);
     detail << "static pluck: " << r.iterations << " Newton iterations";
+    for (const std::string& n : notes) detail << "; " << n;
   } else {
     QuasistaticOptions options;
     options.load_steps = scene.preload_steps;

@@ -41,6 +41,10 @@ struct DynamicsScene {
   std::string name;
   std::vector<SceneMaterial> materials;
   VoxelGrid grid;  // material ids = index in `materials` + 1
+  // Bodies: geometry boxes name theirs (`body:`); elements of different
+  // bodies share no node and meet only through contact.
+  std::vector<std::string> body_names;
+  std::vector<int> element_body;
   DynamicsModel model;
   VecX initial_positions, initial_velocities;
   NewmarkOptions newmark;

@@ -152,6 +152,22 @@ void write_samples(H5File& f, const std::vector<TrajectorySample>& samples) {
   write_sample_column<double>(f, "seconds", samples, [](const S& s) { return s.seconds; }, "s");
 }
 
+// Only for scenes with several bodies: one row per sample, x y z per body.
+void write_body_centers(H5File& f, const Trajectory& t) {
+  if (t.body_names.size() < 2) return;
+  const Eigen::Index bodies = Eigen::Index(t.body_names.size());
+  MatX rows(Eigen::Index(t.samples.size()), 3 * bodies);
+  for (std::size_t i = 0; i < t.samples.size(); ++i) {
+    if (Eigen::Index(t.samples[i].body_center_of_mass.size()) != bodies)
+      throw std::logic_error("trajectory sample without a centre of mass per body");
+    for (Eigen::Index b = 0; b < bodies; ++b)
+      rows.block<1, 3>(Eigen::Index(i), 3 * b) = t.samples[i].body_center_of_mass[b].transpose();
+  }
+  f.write_matrix("/samples/body_center_of_mass", rows);
+  f.write_attribute("/samples/body_center_of_mass", "units", "m");
+  f.write_attribute("/samples/body_center_of_mass", "bodies", format_name_list(t.body_names));
+}
+
 // Positions are the record; the displacement is what the XDMF sidecar shows
 // (rest + displacement need not round to the stored positions bitwise, so
 // both are kept).
@@ -417,6 +433,7 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
   f.write_attribute("/mesh", "material_names", format_name_list(t.material_names));
 
   write_samples(f, t.samples);
+  write_body_centers(f, t);
   write_frames(f, t);
   write_events(f, t.events);
 
@@ -450,6 +467,17 @@ Trajectory read_trajectory_artifact(const std::string& path) {
   t.material_names = parse_name_list(f.read_string_attribute("/mesh", "material_names"));
 
   read_samples(f, t);
+  if (f.exists("/samples/body_center_of_mass")) {
+    t.body_names = parse_name_list(f.read_string_attribute("/samples/body_center_of_mass", "bodies"));
+    const Eigen::Index bodies = Eigen::Index(t.body_names.size());
+    const MatX rows = f.read_matrix<double>("/samples/body_center_of_mass", 3 * bodies);
+    if (rows.rows() != Eigen::Index(t.samples.size()))
+      throw InputError(path + ": dataset '/samples/body_center_of_mass' has " + std::to_string(rows.rows()) +
+                       " rows, expected " + std::to_string(t.samples.size()) + " (one per /samples/time)");
+    for (std::size_t i = 0; i < t.samples.size(); ++i)
+      for (Eigen::Index b = 0; b < bodies; ++b)
+        t.samples[i].body_center_of_mass.push_back(rows.block<1, 3>(Eigen::Index(i), 3 * b).transpose());
+  }
   read_frames(f, t);
   read_events(f, t);
 

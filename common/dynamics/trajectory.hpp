@@ -27,6 +27,8 @@ struct TrajectorySample {
   Vec3 center_of_mass = Vec3::Zero();
   Vec3 com_velocity = Vec3::Zero();
   Vec3 rotation = Vec3::Zero();  // best-fit rotation from rest as a rotation vector (axis * angle, rad)
+  // With several bodies: each body's centre of mass (Trajectory::body_names order).
+  std::vector<Vec3> body_center_of_mass;
   int contacts = 0, active_contacts = 0;
   int newton_iterations = 0;
   double max_penetration = 0;  // m
@@ -52,6 +54,7 @@ struct Trajectory {
   std::vector<std::array<int, 8>> elements;   // toolkit node order
   std::vector<int> element_tag;               // material index per element
   std::vector<std::string> material_names;    // tag -> name
+  std::vector<std::string> body_names;        // empty or one name per body
   std::vector<TrajectorySample> samples;      // one per step (and the initial state)
   std::vector<TrajectoryFrame> frames;        // at output times
   std::vector<TrajectoryEvent> events;

@@ -103,6 +103,15 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
   if (contact)
     std::printf("  rebound after the first contact: %.4e m (centre of mass at contact %.5f m, highest after %.5f m)\n",
                 after_contact - contact->center_of_mass.z(), contact->center_of_mass.z(), after_contact);
+  // Each body of a multi-body scene: where it starts, how high it gets and
+  // where it ends (a thrown projectile's landing spot once it has settled).
+  for (size_t b = 0; b < t.body_names.size(); ++b) {
+    double top = -INFINITY;
+    for (const TrajectorySample& s : t.samples) top = std::max(top, s.body_center_of_mass[b].z());
+    const Vec3 a = first.body_center_of_mass[b], e = last.body_center_of_mass[b];
+    std::printf("  body %-10s centre of mass start (%.5f, %.5f, %.5f) m, end (%.5f, %.5f, %.5f) m, highest z %.5f m\n",
+                t.body_names[b].c_str(), a.x(), a.y(), a.z(), e.x(), e.y(), e.z(), top);
+  }
   for (const TrajectoryEvent& e : t.events)
     std::printf("  event %-9s t = %.5f s  %s\n", e.kind.c_str(), e.time, e.detail.c_str());
   std::printf("  time: preload %.3f s, elastic %.3f s, rigid %.3f s, total %.3f s\n", t.seconds_quasistatic,

@@ -46,7 +46,20 @@ echo "tip frequency: fine rig $f_fine Hz, calibrated coarse rig $f_coarse Hz"
 check "calibrated coarse rig reproduces the fine f1 within 1%" -- \
   awk -v a="$f_fine" -v b="$f_coarse" 'BEGIN { d = (b - a) / a; if (d < 0) d = -d; exit !(a > 0 && d < 0.01) }'
 
+# Catapult: the cube lying in the basket is carried into the loaded basket,
+# then thrown upward by the released arm through body contact.
+OMP_NUM_THREADS=1 "$BIN/msfab-dynamics" --quiet --config $S/catapult.yaml --set simulation.duration=0.02 \
+  --out "$WORK/catapult.h5" > "$WORK/catapult.txt"
+check "catapult places the cube in the loaded basket" -- grep -q "cube carried with its support" "$WORK/catapult.txt"
+check "catapult records each body's centre of mass" -- h5ls "$WORK/catapult.h5/samples/body_center_of_mass"
+cube=$(awk '$1 == "body" && $2 == "cube" { gsub(/[(),]/, " "); print $9, $14 }' "$WORK/catapult.txt")
+echo "cube centre of mass height: start and after 20 ms: $cube"
+check "the cube is thrown upward (> 1 cm in 20 ms)" -- awk -v s="${cube% *}" -v e="${cube#* }" 'BEGIN { exit !(e - s > 0.01) }'
+check "no body penetrates beyond 1e-3 voxel" -- awk '/deepest penetration/ { exit !($NF + 0 <= 2e-6 || $(NF-1) + 0 <= 2e-6) }' "$WORK/catapult.txt"
+
 # Bad input.
+expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml \
+  --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=-1e-4
 expect_exit 2 "friction coefficient must be >= 0" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set friction.default=-0.2
