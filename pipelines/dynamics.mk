@@ -5,7 +5,10 @@
 #   make -f Makefile.pipeline dac-cantilever     DAC on the calibration rig: a fine rig (0.75 mm voxels) is the
 #                                                reference; its tip track calibrates the 3 mm rig, which runs again
 #                                                with the fitted dac_model (minutes)
-#   make -f Makefile.pipeline dynamics-flipper   the flipper jumper pressed, released, jumping (about a minute)
+#   make -f Makefile.pipeline dynamics-flipper   the flipper jumper pressed, released, jumping, flying as a
+#                                                rigid body, landing (about half a minute)
+#   make -f Makefile.pipeline dynamics-catapult  the catapult throwing a cube that lies in its basket (body
+#                                                contact; about a minute)
 #
 # Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots.
 DYN := $(OUT)/dynamics
@@ -34,8 +37,13 @@ $(DYN)/flipper.trajectory.h5: configs/dynamics/flipper_jumper.yaml $(BIN)/msfab-
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
 
-.PHONY: dynamics-drops dac-cantilever dynamics-flipper
+$(DYN)/catapult.trajectory.h5: configs/dynamics/catapult.yaml $(BIN)/msfab-dynamics
+	@mkdir -p $(@D)
+	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
+
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper dynamics-catapult
 dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
 dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
 dynamics-flipper: build $(DYN)/flipper.trajectory.h5
+dynamics-catapult: build $(DYN)/catapult.trajectory.h5

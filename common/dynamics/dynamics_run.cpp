@@ -10,6 +10,8 @@
 #include "dynamics/passenger_bodies.hpp"
 #include "dynamics/quasistatic_loading.hpp"
 #include "dynamics/rigid_body.hpp"
+#include "dynamics/surface_contact.hpp"
+#include "fem/hex_boundary.hpp"
 #include "solve/newton.hpp"
 
 namespace msfab {
@@ -101,6 +103,25 @@ class Recorder {
   std::vector<int> node_body_;  // empty with one body
 };
 
+// Neither preload solver knows contact between or within bodies, so a load
+// too large for the geometry folds a body through itself (a pressed plate
+// through the plate below it) and the dynamics would start from an
+// impossible state. Refused here, with the node that went through.
+void check_preload_not_folded(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
+  const HexBoundary boundary = hex_boundary(scene.model.mesh);
+  const BoundarySurface surface(boundary, sim.boundary_nodes());
+  const double dx = sim.element_size();
+  const auto through = surface.find(scene.initial_positions, q, -0.05 * dx, 0.25 * dx);
+  if (through.empty()) return;
+  const NodeFaceContact& c = through.front();
+  std::ostringstream msg;
+  msg << (scene.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
+      << through.size() << " boundary nodes end behind a face; node at rest (" << scene.model.mesh.nodes(c.node, 0)
+      << ", " << scene.model.mesh.nodes(c.node, 1) << ", " << scene.model.mesh.nodes(c.node, 2) << ") ends "
+      << -c.gap_end * 1e3 << " mm deep); the preload solvers have no self-contact: reduce the force";
+  throw InputError(msg.str());
+}
+
 // The preloaded state: the scene's initial positions, or the equilibrium
 // under the pluck or press load (with gravity).
 VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder& rec, Trajectory& out) {
@@ -138,6 +159,7 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     q = r.x;
     detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
   }
+  check_preload_not_folded(scene, sim, q);
   out.seconds_quasistatic = seconds_since(t0);
   rec.event(0.0, "preload", detail.str());
   StepReport none;

@@ -58,6 +58,8 @@ check "the cube is thrown upward (> 1 cm in 20 ms)" -- awk -v s="${cube% *}" -v 
 check "no body penetrates beyond 1e-3 voxel" -- awk '/deepest penetration/ { exit !($NF + 0 <= 2e-6 || $(NF-1) + 0 <= 2e-6) }' "$WORK/catapult.txt"
 
 # Bad input.
+expect_exit 2 "press: the preload folds the body through itself" -- "$BIN/msfab-dynamics" \
+  --config $S/flipper_jumper.yaml --out "$WORK/x.h5" --set 'press.force=[0,0,-3]'
 expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml \
   --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
