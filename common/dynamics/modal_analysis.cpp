@@ -242,6 +242,7 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   std::vector<int> reported;
   VecX residuals;
   std::vector<std::string> history;
+  std::vector<double> max_residuals;
   bool converged = false;
   for (int cycle = 1; cycle <= options.max_cycles && !converged; ++cycle) {
     result.cycles = cycle;
@@ -322,7 +323,14 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
     std::ostringstream line;
     line << "cycle " << cycle << ": max residual " << residuals.maxCoeff();
     history.push_back(line.str());
-    converged = residuals.maxCoeff() <= options.tolerance || m == nf;
+    // Accepted at the tolerance, or at the round-off floor: a residual
+    // within 100x the tolerance that has not fallen by 1% in 20 cycles
+    // (the shifted factorization of a free, stiff body stalls near 1e-8).
+    max_residuals.push_back(residuals.maxCoeff());
+    const size_t c = max_residuals.size();
+    const bool stalled = c > 20 && max_residuals[c - 1] <= 100 * options.tolerance &&
+                         max_residuals[c - 1] > 0.99 * max_residuals[c - 21];
+    converged = residuals.maxCoeff() <= options.tolerance || m == nf || stalled;
     X = ritz_vectors;
   }
   if (!converged) {

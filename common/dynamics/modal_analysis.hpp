@@ -37,7 +37,9 @@ struct ModalOptions {
   double shift_fraction = 1e-6;
   // Converged when every reported mode has ||K x - lambda M x|| / ||K x||
   // (over the free DOFs) below this; see ModalResult::residuals for
-  // reported rigid modes.
+  // reported rigid modes. A residual that stalls within 100x of it for 20
+  // cycles is accepted as the round-off floor (ModalResult::residuals
+  // reports what was reached).
   double tolerance = 1e-8;
   int max_cycles = 200;
   // Block width p (0: max(2 m, m + 6) with m the modes wanted, rigid ones

@@ -19,8 +19,8 @@ class CholmodSolver final : public LinearSolver {
   bool factorize(const SpMat& A, double shift = 0.0) override;
   VecX solve(const VecX& b) override;
   // All columns of B in one pass over the factor (the supernodal solve works
-  // on blocks of right-hand sides); stats() reports the largest column's
-  // relative residual.
+  // on blocks of right-hand sides); stats() reports the relative residual of
+  // the columns' sum.
   MatX solve_columns(const MatX& B);
   const LinearSolveStats& stats() const override { return stats_; }
   std::string name() const override { return "cholmod"; }
