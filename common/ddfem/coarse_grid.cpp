@@ -5,6 +5,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -12,10 +13,6 @@ namespace msfab {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 struct ChildIdsHash {
   size_t operator()(const ChildIds& c) const {

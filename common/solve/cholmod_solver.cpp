@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
@@ -18,10 +19,6 @@
 namespace msfab {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to
 // read only the lower triangle of the full symmetric matrix.

@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/chebyshev_kernels.hpp"
 #include "solve/hex_lattice.hpp"
@@ -17,10 +18,6 @@ namespace msfab {
 namespace {
 
 using namespace hex_lattice;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 std::string dims_text(const int n[3]) {
   return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);

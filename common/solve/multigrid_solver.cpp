@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_smoother.hpp"
@@ -23,10 +24,6 @@ constexpr int kMaxLevels = 24;
 constexpr int kCoarseDegreeFactor = 2;
 // Coarse corrections per visit of a level below the finest (2: W-cycle).
 constexpr int kCoarseCorrections = 2;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 }  // namespace
 

@@ -6,15 +6,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 
 namespace msfab {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
   double sum = 0;

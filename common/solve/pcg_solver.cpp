@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/solver_checks.hpp"
@@ -17,10 +18,6 @@ namespace msfab {
 static_assert(kReductionChunk % 3 == 0, "reduction chunks must hold whole node blocks");
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 }  // namespace
 

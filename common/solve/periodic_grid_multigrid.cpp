@@ -6,6 +6,7 @@
 #include <string>
 #include <utility>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_kernels.hpp"
@@ -29,10 +30,6 @@ using namespace hex_lattice;
 
 std::string dims_text(const std::array<int, 3>& n) {
   return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // x -= its mean, per displacement component.

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "topopt/topology_optimizers.hpp"
 
 namespace msfab {
@@ -17,10 +18,6 @@ namespace {
 
 using Ipopt::Index;
 using Ipopt::Number;
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: one
 // Phi per design cell (when the space has a constraint), then the mass

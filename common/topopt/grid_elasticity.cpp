@@ -3,15 +3,13 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/dirichlet_grid_multigrid.hpp"
 
 namespace msfab {
 
 namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs) {

@@ -8,15 +8,12 @@
 #include <exception>
 #include <limits>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 
 namespace msfab {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // Volume excess accepted as feasible, in cell volumes. MMA's approximation
 // of a linear constraint is conservative, so feasible iterates stay feasible

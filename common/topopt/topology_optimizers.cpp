@@ -5,14 +5,12 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 
 namespace msfab {
 
 namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 }  // namespace
 
 double max_gamut_violation(const CellMaterialModel& model, const MatX& p) {

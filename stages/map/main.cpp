@@ -21,6 +21,7 @@
 #include <cstdio>
 
 #include "cli/stage_app.hpp"
+#include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "mapping/mapper.hpp"
 #include "mapping/voxel_model.hpp"
@@ -72,10 +73,6 @@ std::string stem_of(const std::string& out) {
     if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
       return out.substr(0, out.size() - suffix.size());
   return out;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
 }  // namespace

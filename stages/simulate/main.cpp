@@ -17,6 +17,7 @@
 #include <cstdio>
 
 #include "cli/progress.hpp"
+#include "core/timing.hpp"
 #include "cli/stage_app.hpp"
 #include "coarse_model.hpp"
 #include "core/errors.hpp"
@@ -28,10 +29,6 @@
 using namespace msfab;
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticConditions& conditions,
                             const NewtonOptions& options, const char* label) {
