@@ -59,7 +59,7 @@ column() {  # file dataset columns
 }
 for r in fine coarse dac; do column $r.h5 center_of_mass 3 > $r.com; column $r.h5 rotation 3 > $r.rot; done
 column fine.h5 time 1 > t.txt
-paste t.txt fine.com fine.rot dac.com dac.rot coarse.com coarse.rot | awk '{ d = 57.29578;
+paste t.txt fine.com fine.rot dac.com dac.rot coarse.com coarse.rot | awk 'NF == 19 { d = 57.29578;
   printf "t %.2f s  fine z %5.2f mm turn %6.1f deg | DAC dCOM %5.2f mm dturn %5.1f | E_m dCOM %5.2f mm dturn %5.1f\n",
   $1, 1e3 * $4, d * $6, 1e3 * sqrt(($2 - $8)^2 + ($4 - $10)^2), d * ($12 - $6),
   1e3 * sqrt(($2 - $14)^2 + ($4 - $16)^2), d * ($18 - $6) }'
