@@ -41,9 +41,20 @@ $(DYN)/catapult.trajectory.h5: configs/dynamics/catapult.yaml $(BIN)/msfab-dynam
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
 
-.PHONY: dynamics-drops dac-cantilever dynamics-flipper dynamics-catapult
+$(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(BIN)/msfab-jump-design
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-jump-design --config $< --out $@
+
+$(OUT)/design/flipper.jump_design.h5: configs/dynamics/flipper_param.yaml
+$(OUT)/design/jump_onto.jump_design.h5: configs/dynamics/jumper_onto.yaml
+$(OUT)/design/jump_over.jump_design.h5: configs/dynamics/jumper_over.yaml
+
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over dynamics-catapult
 dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
 dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
 dynamics-flipper: build $(DYN)/flipper.trajectory.h5
 dynamics-catapult: build $(DYN)/catapult.trajectory.h5
+design-flipper: build $(OUT)/design/flipper.jump_design.h5
+design-jump-onto: build $(OUT)/design/jump_onto.jump_design.h5
+design-jump-over: build $(OUT)/design/jump_over.jump_design.h5

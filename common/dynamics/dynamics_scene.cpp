@@ -1,9 +1,12 @@
 #include "dynamics/dynamics_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.hpp"
 #include "dynamics/dac_model_artifact.hpp"
+#include "dynamics/scene_parameters.hpp"
+#include "fem/hex_mesh_bodies.hpp"
 #include "fem/voxel_shapes.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -73,11 +76,15 @@ int material_index(const Config& c, const std::string& key, const std::vector<Sc
   c.fail(key, "unknown material '" + name + "' (defined: " + known + ")");
 }
 
-VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& materials) {
+// The voxel materials, and in `body` each voxel's body (boxes with the same
+// `body:` name, default "body", form one body; numbered in order of first
+// appearance).
+VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& materials, VoxelGrid& body,
+                         std::vector<std::string>& body_names) {
   const double h = g.require_positive<double>("voxel_size", "voxel edge length (m)");
   struct Box {
     Vec3 lo, hi;
-    int id;
+    int id, body;
   };
   std::vector<Box> boxes;
   Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
@@ -85,6 +92,9 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
     Box box;
     read_box(b, box.lo, box.hi);
     box.id = material_index(b, "material", materials) + 1;
+    const std::string name = b.get_or("body", "body");
+    box.body = static_cast<int>(std::find(body_names.begin(), body_names.end(), name) - body_names.begin());
+    if (box.body == static_cast<int>(body_names.size())) body_names.push_back(name);
     lo = lo.cwiseMin(box.lo);
     hi = hi.cwiseMax(box.hi);
     boxes.push_back(box);
@@ -101,7 +111,23 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
   if (double(n(0)) * n(1) * n(2) > 5e7) g.fail("voxel_size", "gives more than 5e7 voxels");
   VoxelGrid grid(n(0), n(1), n(2), h, 0);
   grid.origin = lo;
-  for (const Box& b : boxes) paint_box(grid, b.lo, b.hi, b.id);
+  // Body labels are painted as body + 1 so that 0 marks an unpainted voxel:
+  // a box may repaint its own body's voxels, never another body's.
+  body = VoxelGrid(n(0), n(1), n(2), h, 0);
+  body.origin = lo;
+  for (size_t k = 0; k < boxes.size(); ++k) {
+    const Box& b = boxes[k];
+    VoxelGrid mine(n(0), n(1), n(2), h, 0);
+    mine.origin = lo;
+    paint_box(mine, b.lo, b.hi, 1);
+    for (size_t v = 0; v < mine.size(); ++v)
+      if (mine.ids[v] && body.ids[v] && body.ids[v] != b.body + 1)
+        g.fail("boxes[" + std::to_string(k) + "]", "overlaps a box of body '" + body_names[body.ids[v] - 1] +
+                                                       "' (bodies may touch, not overlap)");
+    paint_box(grid, b.lo, b.hi, b.id);
+    paint_box(body, b.lo, b.hi, b.body + 1);
+  }
+  for (int& v : body.ids) v = std::max(v - 1, 0);
   if (grid.count_solid() == 0) g.fail("boxes", "paint no voxel");
   return grid;
 }
@@ -170,14 +196,22 @@ VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::str
 
 DynamicsScene read_dynamics_scene(const Config& c) {
   DynamicsScene s;
+  // Named parameters: expressions become numbers, the mesh is built at the
+  // reference values and morphed to the current ones (scene_parameters.hpp).
+  const GeometryMorph morph = apply_scene_parameters(c);
   s.name = c.get_or("name", "dynamics");
   s.materials = read_materials(c);
-  s.grid = paint_geometry(c.child("geometry"), s.materials);
+  VoxelGrid body_grid;
+  s.grid = paint_geometry(c.child("geometry"), s.materials, body_grid, s.body_names);
 
   std::vector<MaterialPtr> palette{nullptr};
   for (const SceneMaterial& m : s.materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
   DynamicsModel& model = s.model;
-  model.mesh = build_voxel_mesh(s.grid, palette).mesh;
+  const VoxelMesh voxels = build_voxel_mesh(s.grid, palette);
+  model.mesh = voxels.mesh;
+  for (int e = 0; e < model.mesh.num_elements(); ++e) s.element_body.push_back(body_grid.ids[voxels.element_voxel[e]]);
+  if (s.body_names.size() > 1) separate_bodies(model.mesh, s.element_body);
+  morph.apply(model.mesh);
   const int ne = model.mesh.num_elements();
   for (int e = 0; e < ne; ++e) {
     const SceneMaterial& m = s.materials[model.mesh.element_tag[e] - 1];
@@ -230,9 +264,12 @@ DynamicsScene read_dynamics_scene(const Config& c) {
   s.duration = sim.require_positive<double>("duration", "simulated time (s)");
   s.output_every = sim.get_or<int>("output_every", 10);
   if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
-  model.contact = sim.get_or<bool>("contact", !model.obstacles.empty());
+  model.body_contact = sim.get_or<bool>("body_contact", s.body_names.size() > 1);
+  model.contact = sim.get_or<bool>("contact", !model.obstacles.empty() || model.body_contact);
   model.friction = sim.get_or<bool>("friction", c.has("friction"));
-  if (model.contact && model.obstacles.empty()) sim.fail("contact", "is on but the scene has no obstacles");
+  if (model.contact && model.obstacles.empty() && !model.body_contact)
+    sim.fail("contact", "is on but the scene has no obstacles and body_contact is off");
+  if (model.body_contact && !model.contact) sim.fail("body_contact", "needs contact on");
   model.impact = parse_impact_model(sim.get_or("impact", "bbi"), sim.key_path("impact"));
   s.newmark.newton_tolerance = sim.get_or<double>("newton_tolerance", s.newmark.newton_tolerance);
   if (sim.has("rigid_flight")) {
@@ -242,6 +279,9 @@ DynamicsScene read_dynamics_scene(const Config& c) {
     s.rigid.lookahead_steps = r.get_or<int>("lookahead_steps", s.rigid.lookahead_steps);
     if (!(s.rigid.elastic_fraction > 0)) r.fail("elastic_fraction", "must be positive");
     if (s.rigid.lookahead_steps < 1) r.fail("lookahead_steps", "must be >= 1");
+    if (s.rigid.enabled && s.body_names.size() > 1)
+      r.fail("enabled", "rigid flight projects the whole mesh to one rigid body; the scene has " +
+                            std::to_string(s.body_names.size()) + " bodies");
   }
 
   if (c.has("pluck") && c.has("press")) c.fail("press", "a scene has either a pluck or a press preload, not both");
@@ -255,6 +295,8 @@ DynamicsScene read_dynamics_scene(const Config& c) {
     s.load = read_region_load(c.child("press"));
     s.preload_steps = c.child("press").get_or<int>("steps", s.preload_steps);
     if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
+    if (s.body_names.size() > 1)
+      c.fail("press", "the quasistatic press handles one body; a scene with several bodies preloads with a pluck");
   }
   if (s.preload_steps < 1) c.fail(s.preload == Preload::kStaticPluck ? "pluck.steps" : "press.steps", "must be >= 1");
   validate_dynamics_model(model);

@@ -31,8 +31,8 @@
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "fan_out.hpp"
 #include "gamut_plots.hpp"
+#include "parallel/fan_out.hpp"
 #include "sampler.hpp"
 #include "sampler_checkpoint.hpp"
 

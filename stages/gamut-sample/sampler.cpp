@@ -5,13 +5,13 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
-#include "fan_out.hpp"
 #include "gamut/continuous_refinement.hpp"
 #include "gamut/particle_scoring.hpp"
 #include "gamut/structure_evolution.hpp"
 #include "gamut/structure_ops.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
+#include "parallel/fan_out.hpp"
 
 namespace msfab {
 namespace {

@@ -1,4 +1,4 @@
-#include "fan_out.hpp"
+#include "parallel/fan_out.hpp"
 
 #include <mpi.h>
 #include <spdlog/spdlog.h>

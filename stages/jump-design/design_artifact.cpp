@@ -1,0 +1,105 @@
+#include "design_artifact.hpp"
+
+#include <cstdint>
+
+#include "io/artifact.hpp"
+
+namespace msfab {
+
+namespace {
+constexpr const char* kSchema = "msfab.jump_design";
+constexpr int kVersion = 1;
+
+std::vector<double> outcome_row(const Evaluation& e) {
+  const JumpOutcome& o = e.outcome;
+  return {double(o.lifted_off), double(o.landed), double(o.upright), o.lift_off_time, o.landing_time, o.end_time,
+          o.flip_at_landing, o.flip_at_end, o.com_at_landing.x(), o.com_at_landing.y(), o.com_at_landing.z(),
+          o.com_at_end.x(), o.com_at_end.y(), o.com_at_end.z(), o.com_highest.x(), o.com_highest.y(),
+          o.com_highest.z(), double(e.crossed_wall), e.z_over_wall};
+}
+
+void write_design(H5File& f, const std::string& group, const Evaluation& e) {
+  f.create_group(group);
+  f.write_vector(group + "/parameters", e.parameters);
+  if (!e.constraints.empty()) f.write_vector(group + "/constraints", e.constraints);
+  f.write_vector(group + "/outcome", outcome_row(e));
+  f.write_attribute(group, "objective", e.objective);
+  f.write_attribute(group, "start", static_cast<std::int32_t>(e.start));
+  f.write_attribute(group, "evaluation", static_cast<std::int32_t>(e.index));
+  f.write_attribute(group, "feasible", static_cast<std::int32_t>(e.feasible()));
+  f.write_attribute(group, "simulated", static_cast<std::int32_t>(e.ok));
+}
+
+}  // namespace
+
+std::vector<std::string> outcome_columns() {
+  return {"lifted_off", "landed", "upright", "lift_off_time", "landing_time", "end_time", "flip_at_landing",
+          "flip_at_end", "com_landing_x", "com_landing_y", "com_landing_z", "com_end_x", "com_end_y", "com_end_z",
+          "com_highest_x", "com_highest_y", "com_highest_z", "crossed_wall", "z_over_wall"};
+}
+
+void write_jump_design_artifact(const std::string& path, const DesignProblem& p, const DesignRun& run,
+                                const std::string& config_text, std::uint64_t seed) {
+  ArtifactWriter out(path, kSchema, kVersion, "msfab-jump-design", config_text, {}, seed);
+  H5File& f = out.file();
+  std::vector<std::string> names;
+  std::vector<double> lower, upper, step, initial;
+  for (const DesignParameter& q : p.parameters) {
+    names.push_back(q.name);
+    lower.push_back(q.lower);
+    upper.push_back(q.upper);
+    step.push_back(q.step);
+    initial.push_back(q.initial);
+  }
+  f.write_attribute("/", "task", design_task_name(p.task));
+  f.write_attribute("/", "scene", p.scene_path);
+  f.write_attribute("/", "parameter_names", format_name_list(names));
+  f.write_attribute("/", "constraint_names", format_name_list(constraint_names(p.task)));
+  f.write_attribute("/", "outcome_columns", format_name_list(outcome_columns()));
+  f.write_attribute("/", "lower", lower);
+  f.write_attribute("/", "upper", upper);
+  f.write_attribute("/", "step", step);
+  f.write_attribute("/", "starts", static_cast<std::int32_t>(p.starts));
+  f.write_attribute("/", "max_evaluations", static_cast<std::int32_t>(p.max_evaluations));
+  f.write_attribute("/", "wall_seconds", run.wall_seconds);
+  f.write_attribute("/", "ranks", static_cast<std::int32_t>(run.ranks));
+  f.write_attribute("/", "threads", static_cast<std::int32_t>(run.threads));
+
+  const std::size_t n = run.evaluations.size(), np = names.size(), nc = constraint_names(p.task).size();
+  const std::size_t nk = outcome_columns().size();
+  std::vector<std::int32_t> start(n), index(n), ok(n), feasible(n);
+  std::vector<double> objective(n), seconds(n), parameters(n * np), constraints(n * nc), outcome(n * nk);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Evaluation& e = run.evaluations[i];
+    start[i] = e.start;
+    index[i] = e.index;
+    ok[i] = e.ok;
+    feasible[i] = e.feasible();
+    objective[i] = e.objective;
+    seconds[i] = e.seconds;
+    std::copy(e.parameters.begin(), e.parameters.end(), parameters.begin() + i * np);
+    std::copy(e.constraints.begin(), e.constraints.end(), constraints.begin() + i * nc);
+    const std::vector<double> row = outcome_row(e);
+    std::copy(row.begin(), row.end(), outcome.begin() + i * nk);
+  }
+  f.create_group("/evaluations");
+  f.write_vector("/evaluations/start", start);
+  f.write_vector("/evaluations/index", index);
+  f.write_vector("/evaluations/simulated", ok);
+  f.write_vector("/evaluations/feasible", feasible);
+  f.write_vector("/evaluations/objective", objective);
+  f.write_vector("/evaluations/seconds", seconds);
+  f.write_attribute("/evaluations/seconds", "units", "s (wall time; the only field that varies between runs)");
+  f.write_dataset("/evaluations/parameters", parameters, {hsize_t(n), hsize_t(np)});
+  if (nc > 0) {
+    f.write_dataset("/evaluations/constraints", constraints, {hsize_t(n), hsize_t(nc)});
+    f.write_attribute("/evaluations/constraints", "units", "m (feasible when <= 0)");
+  }
+  f.write_dataset("/evaluations/outcome", outcome, {hsize_t(n), hsize_t(nk)});
+  f.write_attribute("/evaluations/outcome", "columns", format_name_list(outcome_columns()));
+  write_design(f, "/initial", run.evaluations[run.initial]);
+  write_design(f, "/final", run.evaluations[run.final]);
+  out.commit();
+}
+
+}  // namespace msfab

@@ -1,0 +1,57 @@
+#pragma once
+// The design problem of msfab-jump-design (docs/design_loop.md): which
+// parameterized scene, which of its parameters vary within which bounds,
+// the task (objective and constraints of thesis Fig. 4-17) and the
+// optimizer's budget.
+#include <string>
+#include <vector>
+
+#include "dynamics/jump_outcome.hpp"
+#include "io/config.hpp"
+
+namespace msfab {
+
+struct DesignParameter {
+  std::string name;
+  double lower = 0, upper = 0, step = 0;
+  double initial = 0;  // the scene's value: the initial design
+};
+
+enum class DesignTask {
+  kFlip,      // minimize (theta at landing - target)^2
+  kTarget,    // minimize |x_c at landing - x_target|
+  kJumpOnto,  // upright at landing s.t. landing beyond the obstacle's near face and above its top
+  kJumpOver,  // upright at landing s.t. landing beyond the far face, clearing the top when over it
+};
+const char* design_task_name(DesignTask task);
+
+struct DesignProblem {
+  std::string scene_path;
+  std::vector<std::string> scene_set;  // --set style overrides of the scene
+  std::vector<DesignParameter> parameters;
+  DesignTask task = DesignTask::kFlip;
+  double target_flip = 0;    // rad: flip wanted at landing (flip and upright objectives)
+  double target_x = 0;       // m (target)
+  std::string obstacle;      // scene obstacle (jump-onto, jump-over)
+  double clearance = 0;      // m: extra height over the obstacle top the constraints ask for
+  JumpMeasureOptions measure;
+  double settle = 0.01;      // s: simulated after the landing before the run is stopped
+  // Optimizer.
+  int max_evaluations = 20;  // per start
+  int starts = 1;            // the initial design and starts - 1 perturbations of it
+  double spread = 1.0;       // perturbation size in initial steps
+  double xtol = 0.01;        // stop when a step changes no normalized parameter by more
+  double stop_below = 0;     // stop a start once its objective is below this (0: never)
+  double length_scale = 0.01;  // m: constraints and distances are divided by it for COBYLA
+  std::string config_source;
+};
+
+// Reads the design config and the scene's initial parameter values
+// (InputError naming the file, key and problem: unknown parameters, bounds
+// in the wrong order, an initial design outside its bounds).
+DesignProblem read_design_problem(const Config& config);
+
+// Names of the constraints of a task, in the order they are evaluated.
+std::vector<std::string> constraint_names(DesignTask task);
+
+}  // namespace msfab

@@ -1,0 +1,63 @@
+#pragma once
+// One evaluation of the design loop: the scene with the design parameters
+// substituted (meshed at the initial design, morphed to these values), run
+// through quasistatic press, Newmark dynamics with BBI and rigid flight,
+// measured, and turned into the task's objective and constraints.
+#include <string>
+#include <vector>
+
+#include "design_config.hpp"
+#include "dynamics/jump_outcome.hpp"
+#include "dynamics/obstacles.hpp"
+
+namespace msfab {
+
+struct Evaluation {
+  int start = 0, index = 0;          // which optimizer start, which of its evaluations
+  std::vector<double> parameters;    // physical values, in DesignProblem order
+  bool ok = false;                   // false: the simulation failed (penalty values below)
+  double objective = 0;              // rad^2 (flip, upright) or m (target)
+  std::vector<double> constraints;   // m, feasible when <= 0
+  double seconds = 0;                // wall time of the simulation
+  JumpOutcome outcome;
+  bool crossed_wall = false;         // jump-over: the centre of mass crossed the obstacle's middle
+  double z_over_wall = 0;            // its height there (m); the wall's foot if it never crossed
+  int elements = 0;
+
+  // Constraints met to within `tolerance` (m) and the simulation succeeded.
+  bool feasible(double tolerance = 1e-6) const;
+  double violation() const;  // sum of positive constraint values (m)
+};
+
+// Fixed-size rows of doubles for the MPI fan-out (layout in the .cpp).
+int evaluation_record_size(const DesignProblem& problem);
+void pack_evaluation(const Evaluation& e, double* row);
+Evaluation unpack_evaluation(const DesignProblem& problem, const double* row);
+
+class DesignEvaluator {
+ public:
+  // Builds and checks the scene at the initial design (InputError on a bad
+  // scene, an unknown or unsuitable obstacle).
+  explicit DesignEvaluator(const DesignProblem& problem);
+
+  // Safe to call from several threads at once (each call reads its own
+  // copy of the scene). A simulation that fails gives ok = false and
+  // penalty values; bad input still throws.
+  Evaluation evaluate(const std::vector<double>& parameters, int start, int index) const;
+
+  int elements() const { return elements_; }
+  const Obstacle* obstacle() const { return has_obstacle_ ? &obstacle_ : nullptr; }
+
+ private:
+  const DesignProblem& problem_;
+  Obstacle obstacle_;
+  bool has_obstacle_ = false;
+  int elements_ = 0;
+};
+
+// The penalty a failed simulation gets: far worse than any outcome, finite
+// so that COBYLA's linear models stay usable.
+constexpr double kFailedObjective = 100.0;
+constexpr double kFailedConstraint = 0.1;  // m
+
+}  // namespace msfab

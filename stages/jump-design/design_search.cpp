@@ -1,0 +1,161 @@
+#include "design_search.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlopt.hpp>
+#include <string>
+
+#include "core/errors.hpp"
+#include "parallel/fan_out.hpp"
+
+namespace msfab {
+
+std::vector<double> start_point(const DesignProblem& p, int start) {
+  std::vector<double> x;
+  const int n = static_cast<int>(p.parameters.size());
+  const int corners = n < 20 ? 1 << n : 1 << 20;
+  for (int i = 0; i < n; ++i) {
+    const DesignParameter& q = p.parameters[i];
+    double value = q.initial;
+    if (start > 0) {
+      // Corners first at `spread` steps, then again further out, so no two
+      // starts coincide before clamping.
+      const int k = start - 1;
+      const double sign = (k % corners >> i & 1) ? -1.0 : 1.0;
+      value += sign * p.spread * q.step * (1 + k / corners);
+    }
+    x.push_back(std::clamp(value, q.lower, q.upper));
+  }
+  return x;
+}
+
+namespace {
+
+struct StartState {
+  const DesignProblem* problem;
+  const DesignEvaluator* evaluator;
+  int start = 0;
+  std::vector<Evaluation> evaluations;
+  std::vector<double> last_x;  // normalized point of evaluations.back()
+};
+
+std::vector<double> physical(const DesignProblem& p, const double* u) {
+  std::vector<double> x;
+  for (std::size_t i = 0; i < p.parameters.size(); ++i) {
+    const DesignParameter& q = p.parameters[i];
+    x.push_back(q.lower + std::clamp(u[i], 0.0, 1.0) * (q.upper - q.lower));
+  }
+  return x;
+}
+
+double objective_scale(const DesignProblem& p) { return p.task == DesignTask::kTarget ? p.length_scale : 1.0; }
+
+void log_evaluation(const DesignProblem& p, const Evaluation& e) {
+  std::string params, constraints;
+  for (std::size_t i = 0; i < p.parameters.size(); ++i)
+    params += fmt::format("{}{} = {:.5f}", i ? ", " : "", p.parameters[i].name, e.parameters[i]);
+  const std::vector<std::string> names = constraint_names(p.task);
+  for (std::size_t i = 0; i < e.constraints.size(); ++i)
+    constraints += fmt::format(", {} = {:+.4f} m", names[i], e.constraints[i]);
+  spdlog::info("start {} evaluation {}: {}: objective {:.5g}{}, flip at landing {:.1f} deg{}, {:.1f} s", e.start,
+               e.index, params, e.objective, constraints, e.outcome.flip_at_landing * 180 / M_PI,
+               e.ok ? "" : " (simulation failed)", e.seconds);
+}
+
+// The evaluation at normalized point u, reusing the last one when COBYLA
+// asks for the constraints at the point whose objective it just had.
+const Evaluation& evaluation_at(StartState& s, const double* u) {
+  const std::size_t n = s.problem->parameters.size();
+  if (!s.evaluations.empty() && std::equal(u, u + n, s.last_x.begin())) return s.evaluations.back();
+  s.evaluations.push_back(s.evaluator->evaluate(physical(*s.problem, u), s.start, static_cast<int>(s.evaluations.size())));
+  s.last_x.assign(u, u + n);
+  log_evaluation(*s.problem, s.evaluations.back());
+  return s.evaluations.back();
+}
+
+double objective(unsigned, const double* u, double*, void* data) {
+  auto* s = static_cast<StartState*>(data);
+  return evaluation_at(*s, u).objective / objective_scale(*s->problem);
+}
+
+void constraints(unsigned m, double* result, unsigned, const double* u, double*, void* data) {
+  auto* s = static_cast<StartState*>(data);
+  const Evaluation& e = evaluation_at(*s, u);
+  for (unsigned i = 0; i < m; ++i) result[i] = e.constraints[i] / s->problem->length_scale;
+}
+
+}  // namespace
+
+std::vector<Evaluation> run_start(const DesignProblem& p, const DesignEvaluator& evaluator, int start) {
+  const unsigned n = static_cast<unsigned>(p.parameters.size());
+  StartState state{&p, &evaluator, start, {}, {}};
+  nlopt::opt opt(nlopt::LN_COBYLA, n);
+  std::vector<double> u(n), step(n);
+  const std::vector<double> x0 = start_point(p, start);
+  for (unsigned i = 0; i < n; ++i) {
+    const DesignParameter& q = p.parameters[i];
+    u[i] = (x0[i] - q.lower) / (q.upper - q.lower);
+    step[i] = q.step / (q.upper - q.lower);
+  }
+  opt.set_lower_bounds(std::vector<double>(n, 0.0));
+  opt.set_upper_bounds(std::vector<double>(n, 1.0));
+  opt.set_min_objective(objective, &state);
+  const std::size_t m = constraint_names(p.task).size();
+  if (m > 0) opt.add_inequality_mconstraint(constraints, &state, std::vector<double>(m, 1e-6 / p.length_scale));
+  opt.set_initial_step(step);
+  opt.set_maxeval(p.max_evaluations);
+  opt.set_xtol_abs(p.xtol);
+  if (p.stop_below > 0) opt.set_stopval(p.stop_below / objective_scale(p));
+  double f = 0;
+  try {
+    const nlopt::result r = opt.optimize(u, f);
+    spdlog::info("start {}: COBYLA stopped ({}) after {} evaluations", start,
+                 r == nlopt::MAXEVAL_REACHED ? "evaluation budget" : r == nlopt::STOPVAL_REACHED ? "objective reached"
+                 : r == nlopt::XTOL_REACHED ? "step below xtol" : "converged",
+                 state.evaluations.size());
+  } catch (const nlopt::roundoff_limited&) {
+    spdlog::info("start {}: COBYLA stopped on round-off after {} evaluations", start, state.evaluations.size());
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    // An NLopt failure keeps what was evaluated; the best of it still counts.
+    spdlog::warn("start {}: COBYLA failed: {}", start, e.what());
+  }
+  return state.evaluations;
+}
+
+std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvaluator& evaluator) {
+  const int per = evaluation_record_size(p);
+  const int row = 1 + p.max_evaluations * per;
+  const std::vector<double> records = fan_out(p.starts, row, [&](int start, double* r) {
+    const std::vector<Evaluation> evaluations = run_start(p, evaluator, start);
+    const std::size_t count = std::min<std::size_t>(evaluations.size(), static_cast<std::size_t>(p.max_evaluations));
+    r[0] = static_cast<double>(count);
+    for (std::size_t k = 0; k < count; ++k) pack_evaluation(evaluations[k], r + 1 + k * per);
+  });
+  std::vector<Evaluation> all;
+  for (int start = 0; start < p.starts; ++start) {
+    const double* r = records.data() + static_cast<std::size_t>(start) * row;
+    const int count = static_cast<int>(r[0]);
+    if (count == 0) spdlog::warn("start {}: no evaluation came back", start);
+    for (int k = 0; k < count; ++k) all.push_back(unpack_evaluation(p, r + 1 + k * per));
+  }
+  if (all.empty()) throw NumericalError("design loop: no start produced an evaluation");
+  return all;
+}
+
+std::size_t best_evaluation(const std::vector<Evaluation>& e) {
+  std::size_t best = 0;
+  auto better = [](const Evaluation& a, const Evaluation& b) {
+    if (a.feasible() != b.feasible()) return a.feasible();
+    if (!a.feasible() && a.violation() != b.violation()) return a.violation() < b.violation();
+    return a.objective < b.objective;  // equal: the earlier (start, index) stays
+  };
+  for (std::size_t i = 1; i < e.size(); ++i)
+    if (better(e[i], e[best])) best = i;
+  return best;
+}
+
+}  // namespace msfab

@@ -1,0 +1,34 @@
+#pragma once
+// The optimizer of the design loop: COBYLA (NLopt; derivative-free, with
+// inequality constraints, since the simulated outcome is not smooth in the
+// parameters) on parameters normalized to [0, 1] by their bounds, from the
+// initial design and from deterministic perturbations of it. Starts are
+// independent, so they fan out over MPI ranks (start i on rank i mod size)
+// and the threads of a rank; every result is the same for any rank or
+// thread count.
+#include <vector>
+
+#include "design_config.hpp"
+#include "design_evaluation.hpp"
+
+namespace msfab {
+
+// Start 0 is the initial design; start k > 0 moves every normalized
+// parameter by `spread` initial steps, the signs running through the
+// corners of the box (k - 1 in binary), clamped to the bounds.
+std::vector<double> start_point(const DesignProblem& problem, int start);
+
+// One COBYLA run of at most max_evaluations simulations; every evaluation
+// in order. `log` prints each one as it finishes.
+std::vector<Evaluation> run_start(const DesignProblem& problem, const DesignEvaluator& evaluator, int start);
+
+// Every start on every rank; the evaluations of all starts, ordered by start
+// and index, identical on every rank.
+std::vector<Evaluation> run_all_starts(const DesignProblem& problem, const DesignEvaluator& evaluator);
+
+// The final design: the feasible evaluation of least objective (ties: the
+// earlier start, then the earlier evaluation); with none feasible, the one
+// of least constraint violation. Index into `evaluations`.
+std::size_t best_evaluation(const std::vector<Evaluation>& evaluations);
+
+}  // namespace msfab

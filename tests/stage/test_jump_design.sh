@@ -1,0 +1,72 @@
+#!/bin/bash
+# msfab-jump-design on a tiny problem (a two-voxel block thrown at a target;
+# its length and launch speed are the parameters): the artifact, a final
+# design no worse than the initial one, the same result on 1 and 2 MPI
+# ranks, a parameterized scene run directly by msfab-dynamics, and bad
+# input (exit 2, nothing written).
+BIN=$1 SRC=$(cd "$2" && pwd)
+source "$SRC/tests/stage/lib.sh"
+DESIGN=$BIN/msfab-jump-design
+
+cat > "$WORK/throw.yaml" <<'YAML'
+name: tiny-throw
+parameters: {length: 0.010, vz: 0.5}
+materials: [{name: m, E: 1.0e7, nu: 0.3, density: 1000, damping_a: 0, damping_b: 1.0e-3}]
+geometry:
+  voxel_size: 0.005
+  boxes: [{material: m, min: [0, 0, 0], max: [length, 0.005, 0.005]}]
+placement: {translation: [0, 0, 0.001]}
+initial_velocity: [0.3, 0, vz]
+obstacles: [{type: ground, z: 0}]
+simulation: {time_step: 1.0e-3, duration: 0.4, impact: bbi, rigid_flight: {enabled: true}}
+YAML
+cat > "$WORK/design.yaml" <<YAML
+scene: $WORK/throw.yaml
+parameters:
+  - {name: length, lower: 0.008, upper: 0.014, step: 0.002}
+  - {name: vz, lower: 0.3, upper: 0.9, step: 0.1}
+task: target
+target_x: 0.05
+measure: {settle: 0.002}
+optimizer: {max_evaluations: 8, starts: 2}
+YAML
+
+check "one rank, two threads" -- "$DESIGN" --config "$WORK/design.yaml" --threads 2 --out "$WORK/one.h5" --quiet
+check "artifact schema" -- bash -c "h5dump -a /schema '$WORK/one.h5' | grep -q msfab.jump_design"
+check "every evaluation recorded" -- bash -c "h5dump -H -d /evaluations/parameters '$WORK/one.h5' | grep -Eq '\\( (9|1[0-6]), 2 \\)'"
+check "initial design is the scene's" -- bash -c "h5dump -d /initial/parameters '$WORK/one.h5' | grep -q '0.01, 0.5'"
+objective() { h5dump -a "/$2/objective" "$1" | awk '/\(0\)/ { print $2 }'; }
+initial=$(objective "$WORK/one.h5" initial) final=$(objective "$WORK/one.h5" final)
+echo "distance to target: initial $initial m, final $final m"
+check "final design no worse than the initial one" -- awk -v a="$initial" -v b="$final" 'BEGIN { exit !(b <= a) }'
+check "final design within 2 mm of the target" -- awk -v b="$final" 'BEGIN { exit !(b < 2e-3) }'
+check "it landed" -- bash -c "h5dump -d /final/outcome '$WORK/one.h5' | grep -q '(0): 1, 1,'"
+
+check "two ranks" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 "$DESIGN" --config "$WORK/design.yaml" \
+  --out "$WORK/two.h5" --quiet
+same() {
+  for d in /evaluations/start /evaluations/index /evaluations/parameters /evaluations/objective \
+           /evaluations/outcome /final/parameters /final/outcome /initial/outcome; do
+    [ "$(h5dump -d $d "$1" | tail -n +3)" = "$(h5dump -d $d "$2" | tail -n +3)" ] || { echo "differs: $d"; return 1; }
+  done
+}
+check "1 and 2 ranks give identical evaluations and designs" -- same "$WORK/one.h5" "$WORK/two.h5"
+
+# The parameterized scene runs directly, with overrides of its parameters.
+check "msfab-dynamics runs a parameterized scene" -- "$BIN/msfab-dynamics" --config "$WORK/throw.yaml" \
+  --set parameters.length=0.015 --set simulation.duration=0.01 --out "$WORK/direct.h5" --quiet
+
+# Bad input: exit 2, nothing written.
+sed -e 's/max: \[length,/max: ["lenght + 0.001",/' "$WORK/throw.yaml" > "$WORK/typo.yaml"
+sed -e "s|$WORK/throw.yaml|$WORK/typo.yaml|" "$WORK/design.yaml" > "$WORK/typo_design.yaml"
+expect_exit 2 "typo.yaml: geometry.boxes\[0\].max\[0\] = \"lenght \+ 0.001\": unknown parameter 'lenght'" -- \
+  "$DESIGN" --config "$WORK/typo_design.yaml" --out "$WORK/bad.h5"
+expect_exit 2 "parameters\[1\].upper.*must exceed lower" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set 'parameters[1].upper=0.2' --out "$WORK/bad.h5"
+expect_exit 2 "'width' is not a parameter" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set 'parameters[0].name=width' --out "$WORK/bad.h5"
+expect_exit 2 "corner of the bounds.*change order" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set 'parameters[0].lower=-0.001' --out "$WORK/bad.h5"
+expect_exit 2 "unknown parameter 'lenght'" -- "$BIN/msfab-dynamics" --config "$WORK/typo.yaml" --out "$WORK/bad.h5"
+check "failed runs leave nothing" -- bash -c "! ls '$WORK'/bad.h5* 2> /dev/null"
+finish
