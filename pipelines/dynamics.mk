@@ -9,8 +9,13 @@
 #                                                rigid body, landing (about half a minute)
 #   make -f Makefile.pipeline dynamics-catapult  the catapult throwing a cube that lies in its basket (body
 #                                                contact; about a minute)
+#   make -f Makefile.pipeline design-flipper     design loops of §4.5.1 (msfab-jump-design, COBYLA starts over
+#   make -f Makefile.pipeline design-jump-onto   MPI ranks; docs/design_loop.md): flip to land upright, jump onto
+#   make -f Makefile.pipeline design-jump-over   a platform, over a wall, throw the catapult's cube at a target
+#   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores)
 #
-# Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots.
+# Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots,
+# out/design/*.jump_design.h5.
 DYN := $(OUT)/dynamics
 
 $(DYN)/drop_face_%.trajectory.h5: configs/dynamics/block_drop_face.yaml $(BIN)/msfab-dynamics
@@ -48,8 +53,9 @@ $(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(BIN)/msfab-jump-design
 $(OUT)/design/flipper.jump_design.h5: configs/dynamics/flipper_param.yaml
 $(OUT)/design/jump_onto.jump_design.h5: configs/dynamics/jumper_onto.yaml
 $(OUT)/design/jump_over.jump_design.h5: configs/dynamics/jumper_over.yaml
+$(OUT)/design/catapult.jump_design.h5: configs/dynamics/catapult_param.yaml
 
-.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over dynamics-catapult
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult dynamics-catapult
 dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
 dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
@@ -58,3 +64,4 @@ dynamics-catapult: build $(DYN)/catapult.trajectory.h5
 design-flipper: build $(OUT)/design/flipper.jump_design.h5
 design-jump-onto: build $(OUT)/design/jump_onto.jump_design.h5
 design-jump-over: build $(OUT)/design/jump_over.jump_design.h5
+design-catapult: build $(OUT)/design/catapult.jump_design.h5

@@ -34,9 +34,10 @@ DesignTask parse_task(const Config& c) {
   return DesignTask::kJumpOver;
 }
 
-void read_measure(const Config& c, JumpMeasureOptions& m, double& settle) {
+void read_measure(const Config& c, JumpMeasureOptions& m, double& settle, std::string& body) {
   if (!c.has("measure")) return;
   const Config s = c.child("measure");
+  body = s.get_or("body", "");
   settle = s.get_or<double>("settle", settle);
   if (!(settle >= 0) || !std::isfinite(settle)) s.fail("settle", "must be >= 0 (s)");
   const std::string axis = s.get_or("flip_axis", "y");
@@ -112,7 +113,7 @@ DesignProblem read_design_problem(const Config& c) {
     p.clearance = c.get_or<double>("clearance", 0.0);
     if (!std::isfinite(p.clearance)) c.fail("clearance", "must be finite (m)");
   }
-  read_measure(c, p.measure, p.settle);
+  read_measure(c, p.measure, p.settle, p.body);
   read_optimizer(c, p);
   return p;
 }

@@ -33,6 +33,7 @@ struct DesignProblem {
   double target_flip = 0;    // rad: flip wanted at landing (flip and upright objectives)
   double target_x = 0;       // m (target)
   std::string obstacle;      // scene obstacle (jump-onto, jump-over)
+  std::string body;          // measured body (measure.body; empty: the whole mesh)
   double clearance = 0;      // m: extra height over the obstacle top the constraints ask for
   JumpMeasureOptions measure;
   double settle = 0.01;      // s: simulated after the landing before the run is stopped

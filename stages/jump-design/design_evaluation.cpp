@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -149,8 +150,12 @@ DesignEvaluator::DesignEvaluator(const DesignProblem& problem) : problem_(proble
                          ") the scene is invalid: " + e.what());
       }
     }
-  if (scene.preload != Preload::kQuasistaticPress)
-    spdlog::warn("scene {} has no press preload; the design loop runs it as it is", problem.scene_path);
+  if (scene.preload == Preload::kNone)
+    spdlog::warn("scene {} has no preload (press or pluck); the design loop runs it as it is", problem.scene_path);
+  if (!problem.body.empty() &&
+      std::find(scene.body_names.begin(), scene.body_names.end(), problem.body) == scene.body_names.end())
+    throw InputError(problem.config_source + ": measure.body = " + problem.body + ": the scene " + problem.scene_path +
+                     " has no body of that name");
   if (!problem.obstacle.empty()) {
     for (const Obstacle& o : scene.model.obstacles)
       if (o.name == problem.obstacle) obstacle_ = o, has_obstacle_ = true;
@@ -171,7 +176,7 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
   try {
     const DynamicsScene scene = build_scene(problem_, values);
     // The observer stops the run shortly after the landing (jump_observer.hpp).
-    JumpObserver observer(scene, {problem_.measure.min_flight, problem_.settle, 0.01});
+    JumpObserver observer(scene, {problem_.measure.min_flight, problem_.settle, 0.01, problem_.body});
     RunCallbacks callbacks;
     callbacks.on_step = [&](double time, const VecX& q) { observer.on_step(time, q); };
     try {
@@ -198,7 +203,10 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
     return e;
   }
   const JumpOutcome& o = e.outcome;
-  const double miss = o.flip_at_landing - problem_.target_flip;
+  // Flip: the turn itself is the goal (a backflip is -2 pi, not 0).
+  // Jump-onto / jump-over: landing upright after any number of turns.
+  const double turn = o.flip_at_landing - problem_.target_flip;
+  const double miss = problem_.task == DesignTask::kFlip ? turn : std::remainder(turn, 2 * M_PI);
   const double z_top = obstacle_.hi.z() + problem_.clearance;
   switch (problem_.task) {
     case DesignTask::kFlip: e.objective = miss * miss; break;

@@ -6,6 +6,8 @@
 // best-fit rotation, exactly as the run's recorder computes them, and the
 // nodes touching an obstacle) because a stopped run returns no Trajectory.
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "dynamics/dynamics_scene.hpp"
 #include "dynamics/jump_outcome.hpp"
@@ -18,6 +20,9 @@ struct ObserverOptions {
   double settle = 0.01;       // s: keep simulating this long after the landing
   // A node touches an obstacle when closer than this fraction of the voxel edge.
   double touch = 0.01;
+  // The body whose jump is measured (a catapult's projectile); empty: the
+  // whole mesh.
+  std::string body;
 };
 
 // Thrown from the step callback to end the run early.
@@ -36,6 +41,7 @@ class JumpObserver {
  private:
   const DynamicsScene& scene_;
   ObserverOptions options_;
+  std::vector<int> nodes_;  // the measured body's nodes
   RigidBody body_;
   Mat3 R0_;
   double tolerance_ = 0;

@@ -67,6 +67,8 @@ expect_exit 2 "'width' is not a parameter" -- \
   "$DESIGN" --config "$WORK/design.yaml" --set 'parameters[0].name=width' --out "$WORK/bad.h5"
 expect_exit 2 "corner of the bounds.*change order" -- \
   "$DESIGN" --config "$WORK/design.yaml" --set 'parameters[0].lower=-0.001' --out "$WORK/bad.h5"
+expect_exit 2 "measure.body = cube: the scene .* has no body of that name" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set 'measure.body=cube' --out "$WORK/bad.h5"
 expect_exit 2 "unknown parameter 'lenght'" -- "$BIN/msfab-dynamics" --config "$WORK/typo.yaml" --out "$WORK/bad.h5"
 check "failed runs leave nothing" -- bash -c "! ls '$WORK'/bad.h5* 2> /dev/null"
 finish
