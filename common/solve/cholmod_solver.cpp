@@ -2,6 +2,7 @@
 
 #include <cholmod.h>
 #include <dlfcn.h>
+#include <omp.h>
 
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,39 @@
 namespace msfab {
 
 namespace {
+
+// Debian's CHOLMOD 3 (SuiteSparse 5) opens OpenMP regions with a fixed
+// num_threads(4) in the supernodal numeric factorization, whatever the
+// caller's thread count. A single-threaded caller (`--threads 1`, each rank
+// of an MPI fan-out, or a solver asked for one thread) then oversubscribes
+// the cores and spends its time waking threads: 8500 futex calls per
+// Newmark step of a 432-element mesh, a third of the step. With dynamic
+// adjustment on, libgomp caps such a request at omp_get_max_threads(), here
+// set to 1; the OpenMP build of OpenBLAS follows omp_get_max_threads() too.
+// Only for one thread: with more, libgomp would also cap by the load
+// average, and OpenBLAS waits forever for threads it planned for but was
+// not given. Both settings are restored afterwards.
+class CholmodThreadScope {
+ public:
+  explicit CholmodThreadScope(int threads)
+      : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()), single_(threads == 1 || threads_ == 1) {
+    if (!single_) return;
+    omp_set_num_threads(1);
+    omp_set_dynamic(1);
+  }
+  ~CholmodThreadScope() {
+    if (!single_) return;
+    omp_set_dynamic(dynamic_);
+    omp_set_num_threads(threads_);
+  }
+  CholmodThreadScope(const CholmodThreadScope&) = delete;
+  CholmodThreadScope& operator=(const CholmodThreadScope&) = delete;
+
+ private:
+  int threads_;
+  int dynamic_;
+  bool single_;
+};
 
 // A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to
 // read only the lower triangle of the full symmetric matrix.
@@ -193,6 +227,7 @@ bool CholmodSolver::factorize(const SpMat& A, double shift) {
   if (c.n > 0) {
     cholmod_sparse view = lower_triangle_view(A);
     double beta[2] = {shift, 0.0};  // CHOLMOD factors A + beta[0] * I
+    const CholmodThreadScope threads(options_.threads);
     const int ok = cholmod_factorize_p(&view, beta, nullptr, 0, c.factor, &c.common);
     const int status = c.common.status;
     if (status < CHOLMOD_OK || (!ok && status != CHOLMOD_NOT_POSDEF)) {
@@ -223,6 +258,7 @@ VecX CholmodSolver::solve(const VecX& b) {
   VecX x = VecX::Zero(c.n);
   if (c.n > 0) {
     cholmod_dense rhs = dense_view(b.data(), b.size(), 1);
+    const CholmodThreadScope threads(options_.threads);
     if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e,
                         &c.common)) {
       throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
@@ -252,6 +288,7 @@ MatX CholmodSolver::solve_columns(const MatX& B) {
     cholmod_dense rhs = dense_view(B.data(), B.rows(), B.cols());
     // Its own workspace: c.x and c.y are sized for one column.
     cholmod_dense *x = nullptr, *y = nullptr, *e = nullptr;
+    const CholmodThreadScope threads(options_.threads);
     const int ok = cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &x, nullptr, &y, &e, &c.common);
     if (ok) X = Eigen::Map<const MatX>(static_cast<const double*>(x->x), c.n, B.cols());
     cholmod_free_dense(&x, &c.common);
