@@ -13,6 +13,9 @@
 #   make -f Makefile.pipeline design-jump-onto   MPI ranks; docs/design_loop.md): flip to land upright, jump onto
 #   make -f Makefile.pipeline design-jump-over   a platform, over a wall, throw the catapult's cube at a target
 #   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores)
+#   make -f Makefile.pipeline bench-dac-plant    DAC against accurate and convergent meshes on the plant-like
+#   make -f Makefile.pipeline bench-dac-jumper   scene and the flipper jumper (tools/bench_dac_*.sh; minutes;
+#                                                figures in docs/BENCHMARKS.md, "Dynamics")
 #
 # Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots,
 # out/design/*.jump_design.h5.
@@ -55,7 +58,8 @@ $(OUT)/design/jump_onto.jump_design.h5: configs/dynamics/jumper_onto.yaml
 $(OUT)/design/jump_over.jump_design.h5: configs/dynamics/jumper_over.yaml
 $(OUT)/design/catapult.jump_design.h5: configs/dynamics/catapult_param.yaml
 
-.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult dynamics-catapult
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult dynamics-catapult \
+    bench-dac-plant bench-dac-jumper
 dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
 dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
@@ -65,3 +69,7 @@ design-flipper: build $(OUT)/design/flipper.jump_design.h5
 design-jump-onto: build $(OUT)/design/jump_onto.jump_design.h5
 design-jump-over: build $(OUT)/design/jump_over.jump_design.h5
 design-catapult: build $(OUT)/design/catapult.jump_design.h5
+bench-dac-plant: build
+	bash tools/bench_dac_plant.sh $(BIN) $(OUT)/bench/dac_plant
+bench-dac-jumper: build
+	bash tools/bench_dac_jumper.sh $(BIN) $(OUT)/bench/dac_jumper
