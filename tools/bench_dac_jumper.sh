@@ -10,9 +10,10 @@
 #   tools/bench_dac_jumper.sh build/bin out/bench/dac_jumper
 set -euo pipefail
 BIN=$(cd "${1:-build/bin}" && pwd)
-OUT=${2:-out/bench/dac_jumper}
 SRC=$(cd "$(dirname "$0")/.." && pwd)
-mkdir -p "$OUT" && cd "$OUT"
+mkdir -p "${2:-out/bench/dac_jumper}"
+OUT=$(cd "${2:-out/bench/dac_jumper}" && pwd)
+cd "$OUT"
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 SCENE=$SRC/configs/dynamics/flipper_jumper.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > flipper_fine.yaml

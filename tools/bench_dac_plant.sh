@@ -11,9 +11,10 @@
 #   tools/bench_dac_plant.sh build/bin out/bench/dac_plant
 set -euo pipefail
 BIN=$(cd "${1:-build/bin}" && pwd)
-OUT=${2:-out/bench/dac_plant}
 SRC=$(cd "$(dirname "$0")/.." && pwd)
-mkdir -p "$OUT" && cd "$OUT"
+mkdir -p "${2:-out/bench/dac_plant}"
+OUT=$(cd "${2:-out/bench/dac_plant}" && pwd)
+cd "$OUT"
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 SCENE=$SRC/configs/dynamics/plant.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > plant_1mm.yaml
