@@ -18,24 +18,14 @@ export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 SCENE=$SRC/configs/dynamics/flipper_jumper.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > flipper_fine.yaml
 
-# Modes of both meshes with the material's own modulus (the target given
-# here only labels the printout).
-modes() {
-  printf 'scene: %s\nmaterial: rigur\ntarget: {frequency: 100.0, decay: 1.0}\nmodes: 10\n' "$1" > modes.yaml
-  "$BIN/msfab-dac-calibrate" --config modes.yaml --out "$2" | awk '/^  mode/ { print $6 }'
-}
-modes "$OUT/flipper_fine.yaml" modes_fine.h5 > f_fine.txt
-modes "$SCENE" modes_coarse.h5 > f_coarse.txt
+source "$SRC/tools/dac_bench_lib.sh"
+modes "$OUT/flipper_fine.yaml" rigur modes_fine.h5 > f_fine.txt
+modes "$SCENE" rigur modes_coarse.h5 > f_coarse.txt
 f1=$(head -1 f_fine.txt)
-b=$(awk '/name: rigur/ { for (i = 1; i <= NF; ++i) if ($i == "damping_b:") print $(i + 1) }' "$SCENE" | tr -d '}')
-d1=$(awk -v f="$f1" -v b="$b" 'BEGIN { l = (2 * 3.141592653589793 * f)^2; print b * l / 2 }')
-printf 'scene: %s\nmaterial: rigur\ntarget: {frequency: %s, decay: %s}\nmodes: 10\n' "$SCENE" "$f1" "$d1" > dac.yaml
-"$BIN/msfab-dac-calibrate" --config dac.yaml --out flipper.dac_model.h5 > dac.txt
-scale=$(awk '/E_n =/ { for (i = 1; i <= NF; ++i) if ($i ~ /^\(x/) { gsub(/[(x),]/, "", $i); print $i } }' dac.txt)
-paste f_fine.txt f_coarse.txt | awk -v s="$scale" '{ b = ($2 - $1) / $1; a = ($2 * sqrt(s) - $1) / $1;
-  b = b < 0 ? -b : b; a = a < 0 ? -a : a; sb += b; sa += a; if (b > mb) mb = b; if (a > ma) ma = a; n++ }
-  END { printf "first %d modes, mean (max) error: E_m %.1f%% (%.1f%%), DAC %.1f%% (%.1f%%); E_n = %s E_m\n",
-        n, 100 * sb / n, 100 * mb, 100 * sa / n, 100 * ma, s }'
+scale=$(dac_fit "$SCENE" rigur "$f1" flipper.dac_model.h5)
+echo "DAC: E_n = $scale E_m, target f1 $f1 Hz"
+frequency_errors "2 mm, E_m, against 1 mm:" f_fine.txt f_coarse.txt 1
+frequency_errors "2 mm, DAC, against 1 mm:" f_fine.txt f_coarse.txt "$scale"
 sed -e "s|{name: rigur, E: 0.65e9, nu: 0.45, density: 1200, damping_a: 0, damping_b: 1.64e-4}|{name: rigur, dac_model: $OUT/flipper.dac_model.h5, nu: 0.45, density: 1200}|" \
   "$SCENE" > flipper_dac.yaml
 
@@ -45,10 +35,7 @@ sed -e "s|{name: rigur, E: 0.65e9, nu: 0.45, density: 1200, damping_a: 0, dampin
 # scene's 2.5e-5 s would quadruple the elastic steps; docs/dynamics.md).
 run=(--threads 1 --quiet --set simulation.duration=0.16 --set simulation.time_step=1e-4 --set 'press.force=[0,0,-0.8]')
 for m in fine:flipper_fine.yaml coarse:$SCENE dac:flipper_dac.yaml; do
-  name=${m%%:*} scene=${m#*:}
-  /usr/bin/time -f "%M" -o "$name.rss" "$BIN/msfab-dynamics" --config "$scene" --out "$name.h5" "${run[@]}" > "$name.txt"
-  awk -v n="$name" -v r="$(cat "$name.rss")" '/elastic steps/ { ms = $7 } /highest z/ { z = $(NF - 1) }
-    /^  time:/ { t = $(NF - 1) } END { printf "%-6s %s ms per elastic step, %s s in all, %.0f MB, apex %s\n", n, ms, t, r / 1024, z }' "$name.txt"
+  timed_run "${m%%:*}" "${m#*:}" "${run[@]}"
 done
 
 # Samples every 10 ms: centre of mass and rotation about y.

@@ -1,7 +1,7 @@
 #!/bin/bash
 # DAC versus accurate and convergent meshes on the plant-like scene (thesis
 # §4.3, Fig. 4-9/4-11). The plant (configs/dynamics/plant.yaml) at 0.5 mm
-# is the convergent mesh (modes only), at 1 mm the accurate reference that
+# is the finest mesh (modes only), at 1 mm the accurate reference that
 # is simulated; the 2 mm plant runs once with the material's own modulus
 # and once with the DAC modulus and damping fitted to the reference's first
 # frequency and its Rayleigh decay (Eq. 4.16-4.18). Prints the first-10-mode
@@ -9,6 +9,7 @@
 # difference to the reference over the swaying.
 #
 #   tools/bench_dac_plant.sh build/bin out/bench/dac_plant
+#   DURATION=0.005 tools/bench_dac_plant.sh ...   # a quick check of the script
 set -euo pipefail
 BIN=$(cd "${1:-build/bin}" && pwd)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,58 +17,43 @@ mkdir -p "${2:-out/bench/dac_plant}"
 OUT=$(cd "${2:-out/bench/dac_plant}" && pwd)
 cd "$OUT"
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+source "$SRC/tools/dac_bench_lib.sh"
 SCENE=$SRC/configs/dynamics/plant.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > plant_1mm.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.0005/" "$SCENE" > plant_05mm.yaml
 
-modes() {  # scene artifact -> the first 10 frequencies, one per line
-  printf 'scene: %s\nmaterial: dm4825\ntarget: {frequency: 100.0, decay: 1.0}\nmodes: 10\n' "$1" > modes.yaml
-  "$BIN/msfab-dac-calibrate" --config modes.yaml --out "$2" | awk '/^  mode/ { print $6 }'
-}
-errors() {  # label, reference frequencies, frequencies, scale of the eigenvalues
-  paste "$2" "$3" | awk -v l="$1" -v s="$4" '{ e = ($2 * sqrt(s) - $1) / $1; e = e < 0 ? -e : e; se += e; if (e > me) me = e; n++ }
-    END { printf "%-28s mean %.1f%%, max %.1f%% over %d modes\n", l, 100 * se / n, 100 * me, n }'
-}
-modes "$OUT/plant_05mm.yaml" modes_05mm.h5 > f_05mm.txt
-modes "$OUT/plant_1mm.yaml" modes_1mm.h5 > f_1mm.txt
-modes "$SCENE" modes_2mm.h5 > f_2mm.txt
+modes "$OUT/plant_05mm.yaml" dm4825 modes_05mm.h5 > f_05mm.txt
+modes "$OUT/plant_1mm.yaml" dm4825 modes_1mm.h5 > f_1mm.txt
+modes "$SCENE" dm4825 modes_2mm.h5 > f_2mm.txt
 echo "frequencies (Hz): 0.5 mm | 1 mm | 2 mm"
 paste f_05mm.txt f_1mm.txt f_2mm.txt
-errors "1 mm against 0.5 mm:" f_05mm.txt f_1mm.txt 1
+frequency_errors "1 mm against 0.5 mm:" f_05mm.txt f_1mm.txt 1
 
 f1=$(head -1 f_1mm.txt)
-b=$(awk '/name: dm4825/ { for (i = 1; i <= NF; ++i) if ($i == "damping_b:") print $(i + 1) }' "$SCENE" | tr -d '}')
-d1=$(awk -v f="$f1" -v b="$b" 'BEGIN { l = (2 * 3.141592653589793 * f)^2; print b * l / 2 }')
-printf 'scene: %s\nmaterial: dm4825\ntarget: {frequency: %s, decay: %s}\nmodes: 10\n' "$SCENE" "$f1" "$d1" > dac.yaml
-"$BIN/msfab-dac-calibrate" --config dac.yaml --out plant.dac_model.h5 > dac.txt
-scale=$(awk '/E_n =/ { for (i = 1; i <= NF; ++i) if ($i ~ /^\(x/) { gsub(/[(x),]/, "", $i); print $i } }' dac.txt)
-echo "DAC: E_n = $scale E_m, target f1 $f1 Hz, decay $d1 1/s"
-errors "2 mm, E_m, against 1 mm:" f_1mm.txt f_2mm.txt 1
-errors "2 mm, DAC, against 1 mm:" f_1mm.txt f_2mm.txt "$scale"
-errors "2 mm, E_m, against 0.5 mm:" f_05mm.txt f_2mm.txt 1
-errors "2 mm, DAC, against 0.5 mm:" f_05mm.txt f_2mm.txt "$scale"
+scale=$(dac_fit "$SCENE" dm4825 "$f1" plant.dac_model.h5)
+echo "DAC: E_n = $scale E_m, target f1 $f1 Hz"
+frequency_errors "2 mm, E_m, against 1 mm:" f_1mm.txt f_2mm.txt 1
+frequency_errors "2 mm, DAC, against 1 mm:" f_1mm.txt f_2mm.txt "$scale"
+frequency_errors "2 mm, E_m, against 0.5 mm:" f_05mm.txt f_2mm.txt 1
+frequency_errors "2 mm, DAC, against 0.5 mm:" f_05mm.txt f_2mm.txt "$scale"
 sed -e "s|{name: dm4825, E: 1.57e9, nu: 0.45, density: 1170, damping_a: 0, damping_b: 2.55e-4}|{name: dm4825, dac_model: $OUT/plant.dac_model.h5, nu: 0.45, density: 1170}|" \
   "$SCENE" > plant_dac.yaml
 grep -q dac_model plant_dac.yaml || { echo "plant_dac.yaml: material line not replaced" >&2; exit 1; }
 
 # Pluck, release, 0.1 s of swaying; the flower's top centre is tracked.
-run=(--threads 1 --quiet --marker 0.024 0.014 0.070)
+run=(--threads 1 --quiet --marker 0.024 0.014 0.070 --set "simulation.duration=${DURATION:-0.1}")
 for m in fine:plant_1mm.yaml coarse:$SCENE dac:plant_dac.yaml; do
-  name=${m%%:*} scene=${m#*:}
-  /usr/bin/time -f "%M" -o "$name.rss" "$BIN/msfab-dynamics" --config "$scene" --out "$name.h5" \
-    --marker-csv "$name.csv" "${run[@]}" > "$name.txt"
-  awk -v n="$name" -v r="$(cat "$name.rss")" '/elastic steps/ { ms = $7 } /^  time:/ { t = $(NF - 1) }
-    END { printf "%-6s %s ms per step, %s s in all, %.0f MB\n", n, ms, t, r / 1024 }' "$name.txt"
+  timed_run "${m%%:*}" "${m#*:}" "${run[@]}" --marker-csv "${m%%:*}.csv"
 done
 
-# Flower marker: displacement from rest, difference to the reference
+# Flower marker: displacement from its rest position (a node at every
+# resolution), difference to the reference
 # (RMS over the run relative to the reference's RMS displacement, and the
-# largest difference), every 10 ms for a table.
-paste -d, fine.csv dac.csv coarse.csv | awk -F, 'NR == 1 { next }
-  NR == 2 { x0 = $2; y0 = $3; z0 = $4 }
+# largest difference); every 2.5 ms over the first three periods.
+paste -d, fine.csv dac.csv coarse.csv | awk -F, -v x0=0.024 -v y0=0.014 -v z0=0.070 'NR == 1 { next }
   { ux = $2 - x0; uy = $3 - y0; uz = $4 - z0; u2 = ux^2 + uy^2 + uz^2
     dd = ($6 - $2)^2 + ($7 - $3)^2 + ($8 - $4)^2; dc = ($10 - $2)^2 + ($11 - $3)^2 + ($12 - $4)^2
     su += u2; sd += dd; sc += dc; n++; if (dd > md) md = dd; if (dc > mc) mc = dc
-    if ((NR - 2) % 100 == 0) printf "t %.3f s  reference |u| %.3f mm | DAC diff %.3f mm | E_m diff %.3f mm\n", $1, 1e3 * sqrt(u2), 1e3 * sqrt(dd), 1e3 * sqrt(dc) }
+    if ((NR - 2) % 25 == 0 && $1 < 0.0301) printf "t %.4f s  reference |u| %.3f mm | DAC diff %.3f mm | E_m diff %.3f mm\n", $1, 1e3 * sqrt(u2), 1e3 * sqrt(dd), 1e3 * sqrt(dc) }
   END { printf "flower marker, RMS difference / RMS displacement: DAC %.1f%%, E_m %.1f%%; largest difference DAC %.3f mm, E_m %.3f mm\n",
         100 * sqrt(sd / su), 100 * sqrt(sc / su), 1e3 * sqrt(md), 1e3 * sqrt(mc) }'

@@ -1,0 +1,40 @@
+# Shared by the DAC benchmark scripts (tools/bench_dac_*.sh); sourced after
+# BIN, SRC and OUT are set and the script has moved into OUT.
+
+# modes SCENE MATERIAL ARTIFACT: the first 10 frequencies of SCENE with the
+# material's own modulus, one per line (the target given here only labels
+# msfab-dac-calibrate's printout).
+modes() {
+  printf 'scene: %s\nmaterial: %s\ntarget: {frequency: 100.0, decay: 1.0}\nmodes: 10\n' "$1" "$2" > modes.yaml
+  "$BIN/msfab-dac-calibrate" --config modes.yaml --out "$3" | awk '/^  mode/ { print $6 }'
+}
+
+# dac_fit SCENE MATERIAL F1 ARTIFACT: fits E_n and b of MATERIAL in SCENE to
+# the first frequency F1 of a reference mesh and the Rayleigh decay that the
+# scene's own stiffness damping gives it (Eq. 4.16-4.18); prints E_n / E_m.
+dac_fit() {
+  local b d1
+  b=$(awk -v m="name: $2," 'index($0, m) { for (i = 1; i <= NF; ++i) if ($i == "damping_b:") print $(i + 1) }' "$1" | tr -d '}')
+  d1=$(awk -v f="$3" -v b="$b" 'BEGIN { l = (2 * 3.141592653589793 * f)^2; print b * l / 2 }')
+  printf 'scene: %s\nmaterial: %s\ntarget: {frequency: %s, decay: %s}\nmodes: 10\n' "$1" "$2" "$3" "$d1" > dac.yaml
+  "$BIN/msfab-dac-calibrate" --config dac.yaml --out "$4" > dac.txt
+  awk '/E_n =/ { for (i = 1; i <= NF; ++i) if ($i ~ /^\(x/) { gsub(/[(x),]/, "", $i); print $i } }' dac.txt
+}
+
+# frequency_errors LABEL REFERENCE FREQUENCIES SCALE: mean and largest
+# relative error of FREQUENCIES (times sqrt(SCALE), the DAC eigenvalue
+# scaling) against REFERENCE.
+frequency_errors() {
+  paste "$2" "$3" | awk -v l="$1" -v s="$4" '{ e = ($2 * sqrt(s) - $1) / $1; e = e < 0 ? -e : e; se += e; if (e > me) me = e; n++ }
+    END { printf "%-28s mean %.1f%%, max %.1f%% over %d modes\n", l, 100 * se / n, 100 * me, n }'
+}
+
+# timed_run NAME SCENE ARGS...: msfab-dynamics with peak memory; prints
+# time per elastic step, total time and memory.
+timed_run() {
+  local name=$1 scene=$2
+  shift 2
+  /usr/bin/time -f "%M" -o "$name.rss" "$BIN/msfab-dynamics" --config "$scene" --out "$name.h5" "$@" > "$name.txt"
+  awk -v n="$name" -v r="$(cat "$name.rss")" '/elastic steps/ { ms = $7 } /highest z/ { z = $(NF - 1) }
+    /^  time:/ { t = $(NF - 1) } END { printf "%-6s %s ms per elastic step, %s s in all, %.0f MB, highest centre of mass %s m\n", n, ms, t, r / 1024, z }' "$name.txt"
+}
