@@ -106,20 +106,65 @@ class Recorder {
 // Neither preload solver knows contact between or within bodies, so a load
 // too large for the geometry folds a body through itself (a pressed plate
 // through the plate below it) and the dynamics would start from an
-// impossible state. Refused here, with the node that went through.
-void check_preload_not_folded(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
+// impossible state. The boundary nodes of q that ended behind a face by
+// more than 5% of an element.
+std::vector<NodeFaceContact> preload_folds(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
   const HexBoundary boundary = hex_boundary(scene.model.mesh);
   const BoundarySurface surface(boundary, sim.boundary_nodes());
   const double dx = sim.element_size();
-  const auto through = surface.find(scene.initial_positions, q, -0.05 * dx, 0.25 * dx);
+  return surface.find(scene.initial_positions, q, -0.05 * dx, 0.25 * dx);
+}
+
+// Refused, with the node that went through.
+void check_preload_not_folded(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
+  const auto through = preload_folds(scene, sim, q);
   if (through.empty()) return;
   const NodeFaceContact& c = through.front();
   std::ostringstream msg;
   msg << (scene.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
       << through.size() << " boundary nodes end behind a face; node at rest (" << scene.model.mesh.nodes(c.node, 0)
       << ", " << scene.model.mesh.nodes(c.node, 1) << ", " << scene.model.mesh.nodes(c.node, 2) << ") ends "
-      << -c.gap_end * 1e3 << " mm deep); the preload solvers have no self-contact: reduce the force";
+      << -c.gap_end * 1e3 << " mm deep); the preload solvers have no self-contact: reduce the force"
+      << (scene.preload == Preload::kQuasistaticPress ? " or set press.stop_at_touch" : "");
   throw InputError(msg.str());
+}
+
+// The quasistatic press under `scale` times the press load (and gravity),
+// always from the scene's initial state: no-slip contact makes the
+// equilibrium depend on the loading path, so every scale takes the same one.
+QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& load, double scale) {
+  QuasistaticOptions options;
+  options.load_steps = scene.preload_steps;
+  return solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, scale * load + sim.gravity_force(),
+                                   scene.initial_positions, options);
+}
+
+// press.stop_at_touch: the largest fraction of the load whose equilibrium
+// does not fold the body through itself, by bisection to 1% of the load
+// (the pressed part then rests on, or just above, the part below it).
+// Continuous in the geometry, so a design loop sees no plateau where the
+// full load would have been refused.
+QuasistaticResult press_until_touch(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& load,
+                                    double& scale) {
+  QuasistaticResult r = press_at(scene, sim, load, 1.0);
+  scale = 1.0;
+  if (preload_folds(scene, sim, r.x).empty()) return r;
+  double lo = 0, hi = 1;
+  QuasistaticResult best = press_at(scene, sim, load, 0.0);
+  if (!preload_folds(scene, sim, best.x).empty())
+    throw InputError("press: the body folds through itself under gravity alone");
+  while (hi - lo > 0.01) {
+    const double mid = 0.5 * (lo + hi);
+    QuasistaticResult m = press_at(scene, sim, load, mid);
+    if (preload_folds(scene, sim, m.x).empty()) {
+      lo = mid;
+      best = std::move(m);
+    } else {
+      hi = mid;
+    }
+  }
+  scale = lo;
+  return best;
 }
 
 // The preloaded state: the scene's initial positions, or the equilibrium
@@ -152,12 +197,13 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     detail << "static pluck: " << r.iterations << " Newton iterations";
     for (const std::string& n : notes) detail << "; " << n;
   } else {
-    QuasistaticOptions options;
-    options.load_steps = scene.preload_steps;
+    double scale = 1.0;
     const QuasistaticResult r =
-        solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, force, scene.initial_positions, options);
+        scene.stop_at_touch ? press_until_touch(scene, sim, load, scale) : press_at(scene, sim, load, 1.0);
     q = r.x;
     detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
+    if (scale < 1.0)
+      detail << "; stopped at touch: " << 100 * scale << "% of the load (" << scale * scene.load.force.norm() << " N)";
   }
   check_preload_not_folded(scene, sim, q);
   out.seconds_quasistatic = seconds_since(t0);

@@ -294,6 +294,7 @@ DynamicsScene read_dynamics_scene(const Config& c) {
     s.preload = Preload::kQuasistaticPress;
     s.load = read_region_load(c.child("press"));
     s.preload_steps = c.child("press").get_or<int>("steps", s.preload_steps);
+    s.stop_at_touch = c.child("press").get_or<bool>("stop_at_touch", false);
     if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
     if (s.body_names.size() > 1)
       c.fail("press", "the quasistatic press handles one body; a scene with several bodies preloads with a pluck");

@@ -53,6 +53,11 @@ struct DynamicsScene {
   Preload preload = Preload::kNone;
   RegionLoad load;
   int preload_steps = 4;
+  // Press only: when the full load would fold the body through itself (the
+  // press solver has no self-contact), stop at the largest load that does
+  // not, i.e. when the pressed part touches the part below it, instead of
+  // refusing the scene (`press.stop_at_touch`).
+  bool stop_at_touch = false;
   RigidFlightSettings rigid;
 };
 

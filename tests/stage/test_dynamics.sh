@@ -60,6 +60,14 @@ check "no body penetrates beyond 1e-3 voxel" -- awk '/deepest penetration/ { exi
 # Bad input.
 expect_exit 2 "press: the preload folds the body through itself" -- "$BIN/msfab-dynamics" \
   --config $S/flipper_jumper.yaml --out "$WORK/x.h5" --set 'press.force=[0,0,-3]'
+# The same press with stop_at_touch stops where the top plate meets the
+# base, short of the full load, and the run goes on from there.
+"$BIN/msfab-dynamics" --quiet --config $S/flipper_jumper.yaml --out "$WORK/touch.h5" --set 'press.force=[0,0,-3]' \
+  --set press.stop_at_touch=true --set simulation.duration=0.0005 > "$WORK/touch.txt"
+share=$(awk '/stopped at touch/ { for (i = 1; i <= NF; ++i) if ($i ~ /%$/) print $i + 0 }' "$WORK/touch.txt")
+echo "press with stop_at_touch: stopped at ${share}% of 3 N"
+check "press.stop_at_touch stops short of a load that folds" -- awk -v s="$share" 'BEGIN { exit !(s > 10 && s < 100) }'
+check "press.stop_at_touch: the run continues" -- test -s "$WORK/touch.h5"
 expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml \
   --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
