@@ -9,16 +9,11 @@
 #
 #   tools/bench_dac_jumper.sh build/bin out/bench/dac_jumper
 set -euo pipefail
-BIN=$(cd "${1:-build/bin}" && pwd)
-SRC=$(cd "$(dirname "$0")/.." && pwd)
-mkdir -p "${2:-out/bench/dac_jumper}"
-OUT=$(cd "${2:-out/bench/dac_jumper}" && pwd)
-cd "$OUT"
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+source "$(dirname "$0")/dac_bench_lib.sh"
+bench_folders "${1:-build/bin}" "${2:-out/bench/dac_jumper}"
 SCENE=$SRC/configs/dynamics/flipper_jumper.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > flipper_fine.yaml
 
-source "$SRC/tools/dac_bench_lib.sh"
 modes "$OUT/flipper_fine.yaml" rigur modes_fine.h5 > f_fine.txt
 modes "$SCENE" rigur modes_coarse.h5 > f_coarse.txt
 f1=$(head -1 f_fine.txt)

@@ -11,13 +11,8 @@
 #   tools/bench_dac_plant.sh build/bin out/bench/dac_plant
 #   DURATION=0.005 tools/bench_dac_plant.sh ...   # a quick check of the script
 set -euo pipefail
-BIN=$(cd "${1:-build/bin}" && pwd)
-SRC=$(cd "$(dirname "$0")/.." && pwd)
-mkdir -p "${2:-out/bench/dac_plant}"
-OUT=$(cd "${2:-out/bench/dac_plant}" && pwd)
-cd "$OUT"
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-source "$SRC/tools/dac_bench_lib.sh"
+source "$(dirname "$0")/dac_bench_lib.sh"
+bench_folders "${1:-build/bin}" "${2:-out/bench/dac_plant}"
 SCENE=$SRC/configs/dynamics/plant.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > plant_1mm.yaml
 sed "s/voxel_size: 0.002/voxel_size: 0.0005/" "$SCENE" > plant_05mm.yaml

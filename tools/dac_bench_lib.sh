@@ -1,5 +1,15 @@
-# Shared by the DAC benchmark scripts (tools/bench_dac_*.sh); sourced after
-# BIN, SRC and OUT are set and the script has moved into OUT.
+# Shared by the DAC benchmark scripts (tools/bench_dac_*.sh), sourced first.
+
+# bench_folders BIN OUT: sets BIN (the stage binaries) and OUT (created) as
+# absolute paths and SRC (the source tree), moves into OUT, one thread.
+bench_folders() {
+  BIN=$(cd "$1" && pwd)
+  SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+  mkdir -p "$2"
+  OUT=$(cd "$2" && pwd)
+  cd "$OUT"
+  export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+}
 
 # modes SCENE MATERIAL ARTIFACT: the first 10 frequencies of SCENE with the
 # material's own modulus, one per line (the target given here only labels
