@@ -135,6 +135,7 @@ void check_preload_not_folded(const DynamicsScene& scene, const NewmarkIntegrato
 QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& load, double scale) {
   QuasistaticOptions options;
   options.load_steps = scene.preload_steps;
+  options.threads = 1;  // as the Newmark factorization: same bits for any --threads
   return solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, scale * load + sim.gravity_force(),
                                    scene.initial_positions, options);
 }
@@ -190,6 +191,7 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
     newton.relative_tolerance = 1e-5;
     newton.load_steps = scene.preload_steps;
     newton.linear_solver = "cholmod";
+    newton.linear.threads = 1;  // as the Newmark factorization: same bits for any --threads
     const NewtonResult r = solve_static(sim.assembler(), bc, force, newton, scene.initial_positions);
     if (!r.converged) throw NumericalError("pluck preload: " + r.failure + "\n" + format_history(r.history));
     std::vector<std::string> notes;
