@@ -106,28 +106,40 @@ class Recorder {
 // Neither preload solver knows contact between or within bodies, so a load
 // too large for the geometry folds a body through itself (a pressed plate
 // through the plate below it) and the dynamics would start from an
-// impossible state. The boundary nodes of q that ended behind a face by
-// more than 5% of an element.
-std::vector<NodeFaceContact> preload_folds(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
-  const HexBoundary boundary = hex_boundary(scene.model.mesh);
-  const BoundarySurface surface(boundary, sim.boundary_nodes());
-  const double dx = sim.element_size();
-  return surface.find(scene.initial_positions, q, -0.05 * dx, 0.25 * dx);
-}
+// impossible state. The boundary surface is built once per preload: the
+// press that stops at touch asks about a dozen trial states.
+class PreloadFoldCheck {
+ public:
+  PreloadFoldCheck(const DynamicsScene& scene, const NewmarkIntegrator& sim)
+      : scene_(scene), surface_(hex_boundary(scene.model.mesh), sim.boundary_nodes()), dx_(sim.element_size()) {}
 
-// Refused, with the node that went through.
-void check_preload_not_folded(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& q) {
-  const auto through = preload_folds(scene, sim, q);
-  if (through.empty()) return;
-  const NodeFaceContact& c = through.front();
-  std::ostringstream msg;
-  msg << (scene.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
-      << through.size() << " boundary nodes end behind a face; node at rest (" << scene.model.mesh.nodes(c.node, 0)
-      << ", " << scene.model.mesh.nodes(c.node, 1) << ", " << scene.model.mesh.nodes(c.node, 2) << ") ends "
-      << -c.gap_end * 1e3 << " mm deep); the preload solvers have no self-contact: reduce the force"
-      << (scene.preload == Preload::kQuasistaticPress ? " or set press.stop_at_touch" : "");
-  throw InputError(msg.str());
-}
+  // The boundary nodes of q that ended behind a face by more than 5% of an
+  // element.
+  std::vector<NodeFaceContact> folds(const VecX& q) const {
+    return surface_.find(scene_.initial_positions, q, -0.05 * dx_, 0.25 * dx_);
+  }
+  bool folded(const VecX& q) const { return !folds(q).empty(); }
+
+  // Refused, with the node that went through.
+  void check(const VecX& q) const {
+    const auto through = folds(q);
+    if (through.empty()) return;
+    const NodeFaceContact& c = through.front();
+    const HexMesh& mesh = scene_.model.mesh;
+    std::ostringstream msg;
+    msg << (scene_.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
+        << through.size() << " boundary nodes end behind a face; node at rest (" << mesh.nodes(c.node, 0) << ", "
+        << mesh.nodes(c.node, 1) << ", " << mesh.nodes(c.node, 2) << ") ends " << -c.gap_end * 1e3
+        << " mm deep); the preload solvers have no self-contact: reduce the force"
+        << (scene_.preload == Preload::kQuasistaticPress ? " or set press.stop_at_touch" : "");
+    throw InputError(msg.str());
+  }
+
+ private:
+  const DynamicsScene& scene_;
+  BoundarySurface surface_;
+  double dx_;
+};
 
 // The quasistatic press under `scale` times the press load (and gravity),
 // always from the scene's initial state: no-slip contact makes the
@@ -145,19 +157,19 @@ QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& 
 // (the pressed part then rests on, or just above, the part below it).
 // Continuous in the geometry, so a design loop sees no plateau where the
 // full load would have been refused.
-QuasistaticResult press_until_touch(const DynamicsScene& scene, const NewmarkIntegrator& sim, const VecX& load,
-                                    double& scale) {
+QuasistaticResult press_until_touch(const DynamicsScene& scene, const NewmarkIntegrator& sim,
+                                    const PreloadFoldCheck& fold, const VecX& load, double& scale) {
   QuasistaticResult r = press_at(scene, sim, load, 1.0);
   scale = 1.0;
-  if (preload_folds(scene, sim, r.x).empty()) return r;
+  if (!fold.folded(r.x)) return r;
   double lo = 0, hi = 1;
   QuasistaticResult best = press_at(scene, sim, load, 0.0);
-  if (!preload_folds(scene, sim, best.x).empty())
+  if (fold.folded(best.x))
     throw InputError("press: the body folds through itself under gravity alone");
   while (hi - lo > 0.01) {
     const double mid = 0.5 * (lo + hi);
     QuasistaticResult m = press_at(scene, sim, load, mid);
-    if (preload_folds(scene, sim, m.x).empty()) {
+    if (!fold.folded(m.x)) {
       lo = mid;
       best = std::move(m);
     } else {
@@ -174,10 +186,11 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
   if (scene.preload == Preload::kNone) return scene.initial_positions;
   const auto t0 = std::chrono::steady_clock::now();
   const VecX load = region_force(scene, scene.load, scene.preload == Preload::kStaticPluck ? "pluck" : "press");
-  const VecX force = load + sim.gravity_force();
+  const PreloadFoldCheck fold(scene, sim);
   VecX q;
   std::ostringstream detail;
   if (scene.preload == Preload::kStaticPluck) {
+    const VecX force = load + sim.gravity_force();
     DirichletConditions bc = DirichletConditions::none(sim.model().mesh.num_dofs());
     bc.fixed = sim.model().fixed;
     if (bc.fixed.empty()) bc.fixed.assign(sim.model().mesh.num_dofs(), 0);
@@ -201,13 +214,13 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
   } else {
     double scale = 1.0;
     const QuasistaticResult r =
-        scene.stop_at_touch ? press_until_touch(scene, sim, load, scale) : press_at(scene, sim, load, 1.0);
+        scene.stop_at_touch ? press_until_touch(scene, sim, fold, load, scale) : press_at(scene, sim, load, 1.0);
     q = r.x;
     detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
     if (scale < 1.0)
       detail << "; stopped at touch: " << 100 * scale << "% of the load (" << scale * scene.load.force.norm() << " N)";
   }
-  check_preload_not_folded(scene, sim, q);
+  fold.check(q);
   out.seconds_quasistatic = seconds_since(t0);
   rec.event(0.0, "preload", detail.str());
   StepReport none;
