@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "ddfem/nnls.hpp"
+#include "ddfem/periodic_samples.hpp"
 #include "material/anisotropic_spring.hpp"
 #include "material/material_sum.hpp"
 #include "material/neo_hookean.hpp"
@@ -92,8 +93,8 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.mu0[k] = block.point_mu0[k];
     fit.lambda0[k] = block.point_lambda0[k];
   }
-  if (!block.has_all_corners()) {
-    fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
+  if (!block.all_children_solid() || !block.has_all_corners()) {
+    fit.not_fitted_reason = "a child of the block is void";
     return fit;
   }
 
@@ -222,14 +223,16 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 }
 
 CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options) {
-  if (!block.has_all_corners()) {
+  if (!block.all_children_solid() || !block.has_all_corners()) {
     CoarseMaterialFit fit(block.coarse_points());
     fit.material_ids = block.material_ids;
-    fit.not_fitted_reason = "a child of the block is void, so a coarse corner has no fine node";
+    fit.not_fitted_reason = "a child of the block is void";
     return fit;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const ForceSampleSet samples = sample_force_space(block, options.sampling);
+  const bool periodic = options.sampling.mode == ForceSamplingOptions::Mode::periodic;
+  const ForceSampleSet samples =
+      periodic ? sample_periodic(block, options.sampling) : sample_force_space(block, options.sampling);
   std::vector<Vec3> directions(block.coarse_points(), Vec3::UnitX());
   if (options.anisotropic) directions = estimate_anisotropy(block, options.anisotropy).direction;
   CoarseMaterialFit fit = fit_from_samples(block, samples, directions, options);

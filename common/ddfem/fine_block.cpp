@@ -13,6 +13,21 @@ bool FineBlock::has_all_corners() const {
   return true;
 }
 
+bool FineBlock::all_children_solid() const {
+  for (int id : material_ids)
+    if (id == 0) return false;
+  return true;
+}
+
+int FineBlock::child_of_element(int e) const {
+  const int n = 2 + 2 * context;
+  const int v = voxels.element_voxel[e];  // x fastest
+  const int i = v % n, j = (v / n) % n, k = v / (n * n);
+  // Periodic copy: voxel i of the patch is child (i - context) mod 2.
+  auto child = [&](int a) { return ((a - context) % 2 + 2) % 2; };
+  return 4 * child(i) + 2 * child(j) + child(k);
+}
+
 hex8::NodeMatrix FineBlock::coarse_rest_positions() const {
   hex8::NodeMatrix X;
   for (int c = 0; c < 8; ++c)
@@ -35,11 +50,17 @@ int FineBlock::child_of_coarse_point(int q) {
 }
 
 int FineBlock::lattice_node(int i, int j, int k) const {
-  return voxels.lattice_node[size_t(i) + 3 * (size_t(j) + 3 * size_t(k))];
+  const size_t n = 3 + 2 * size_t(context);
+  return voxels.lattice_node[size_t(i + context) + n * (size_t(j + context) + n * size_t(k + context))];
 }
 
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size, int coarse_points_per_axis) {
+                          double voxel_size, int coarse_points_per_axis, int context) {
+  if (context < 0 || context > 4) {
+    std::ostringstream os;
+    os << "fine block: context must be 0 (isolated) to 4 voxels, got " << context;
+    throw InputError(os.str());
+  }
   if (coarse_points_per_axis != 2 && coarse_points_per_axis != 4)
     throw InputError("fine block: the coarse element takes 2 or 4 Gauss points per axis");
   if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
@@ -51,8 +72,11 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
   block.voxel_size = voxel_size;
   block.coarse_points_per_axis = coarse_points_per_axis;
   block.material_ids = ids;
+  block.context = context;
   block.child_material.assign(8, nullptr);
-  VoxelGrid grid(2, 2, 2, voxel_size, 0);
+  const int n = 2 + 2 * context;
+  VoxelGrid grid(n, n, n, voxel_size, 0);
+  grid.origin = Vec3::Constant(-context * voxel_size);
   bool any_solid = false;
   for (int c = 0; c < 8; ++c) {
     const int id = ids[c];
@@ -70,10 +94,20 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
     }
     any_solid = true;
     block.child_material[c] = palette[id];
-    grid.at(c >> 2 & 1, c >> 1 & 1, c & 1) = id;
   }
   if (!any_solid) throw InputError("fine block: all eight children are void");
+  auto child = [&](int a) { return ((a - context) % 2 + 2) % 2; };
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) grid.at(i, j, k) = ids[4 * child(i) + 2 * child(j) + child(k)];
   block.voxels = build_voxel_mesh(grid, palette);
+  const HexMesh& mesh = block.voxels.mesh;
+  block.core_element.assign(mesh.num_elements(), 0);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int v = block.voxels.element_voxel[e];
+    const int i = v % n - context, j = (v / n) % n - context, k = v / (n * n) - context;
+    block.core_element[e] = i >= 0 && i < 2 && j >= 0 && j < 2 && k >= 0 && k < 2;
+  }
   for (int c = 0; c < 8; ++c)
     block.corner_nodes[c] = block.lattice_node(2 * (c >> 2 & 1), 2 * (c >> 1 & 1), 2 * (c & 1));
   for (int q = 0; q < block.coarse_points(); ++q) {

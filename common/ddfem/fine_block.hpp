@@ -17,9 +17,18 @@ struct FineBlock {
   double voxel_size = 1.0;           // fine edge h; the coarse element has edge 2h
   BlockMaterials material_ids{};     // palette ids per child, 0 = void
   std::vector<MaterialPtr> child_material;  // per child, null for void
-  VoxelMesh voxels;                  // mesh of the non-void children, origin at 0
-  // Fine mesh node at coarse corner c (hex8 order), -1 where only void
-  // children touch that corner.
+  // Voxels of context around the block on every side (in-situ sampling,
+  // docs/ddfem.md): 0 is the isolated block; r > 0 surrounds it with r
+  // layers of its own periodic copies, so the mesh covers (2 + 2r)^3 voxels
+  // and a fibre or layer that crosses the block continues through its faces
+  // as it does in a body. The block itself always spans [0, 2h]^3.
+  int context = 0;
+  VoxelMesh voxels;                  // mesh of the non-void voxels (block and context)
+  // Elements inside the block (1) or in its context (0): a sample's energy
+  // is the energy of the block's own elements.
+  std::vector<char> core_element;
+  // Fine mesh node at coarse corner c (hex8 order), -1 where no solid voxel
+  // touches that corner.
   std::array<int, 8> corner_nodes{};
   // The coarse element's Gauss rule: 2 points per axis at level 1 (one per
   // child), 4 for a 64-point element. Eq. 2.9's p^0 at each coarse point:
@@ -28,9 +37,13 @@ struct FineBlock {
   std::vector<double> point_mu0, point_lambda0;
 
   const HexMesh& mesh() const { return voxels.mesh; }
-  // Each coarse corner belongs to exactly one child, so this holds exactly
-  // when no child is void. Only such blocks are fitted (see docs/ddfem.md).
+  // Every coarse corner has a fine node (needed to sample the block).
   bool has_all_corners() const;
+  // No child is void. Only such blocks are fitted (see docs/ddfem.md).
+  bool all_children_solid() const;
+  // The child of the block whose copy element e is (the element's own child
+  // inside the block).
+  int child_of_element(int e) const;
   // Rest positions of the coarse element's corners (edge 2h, origin at 0).
   hex8::NodeMatrix coarse_rest_positions() const;
   // The coarse element's Gauss geometry (its quadrature points k of
@@ -39,14 +52,16 @@ struct FineBlock {
   int coarse_points() const { return coarse_points_per_axis * coarse_points_per_axis * coarse_points_per_axis; }
   int child_of_point(int q) const;
   static int child_of_coarse_point(int q);  // the 2-point rule
-  // Mesh node at lattice position (i, j, k), i, j, k in {0, 1, 2}; -1 if absent.
+  // Mesh node at block lattice position (i, j, k), i, j, k in {0, 1, 2}
+  // (offset by the context); -1 if absent.
   int lattice_node(int i, int j, int k) const;
 };
 
-// Builds the block for material ids (palette[id], id 0 = void). Throws
-// InputError if h is not positive, an id is out of range, a non-void id has
-// no material, or every child is void.
+// Builds the block for material ids (palette[id], id 0 = void), with
+// `context` layers of periodic copies around it. Throws InputError if h is
+// not positive, an id is out of range, a non-void id has no material, every
+// child is void, or context is outside [0, 4].
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size, int coarse_points_per_axis = 2);
+                          double voxel_size, int coarse_points_per_axis = 2, int context = 0);
 
 }  // namespace msfab

@@ -1,10 +1,13 @@
 #include "ddfem/force_samples.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <stdexcept>
+
+#include <Eigen/SparseCholesky>
 
 #include "core/errors.hpp"
 
@@ -46,6 +49,22 @@ std::string force_kind_name(ForceKind kind) {
     case ForceKind::pinch: return "pinch";
   }
   return "unknown";
+}
+
+std::string sampling_mode_name(ForceSamplingOptions::Mode mode) {
+  switch (mode) {
+    case ForceSamplingOptions::Mode::isolated: return "isolated";
+    case ForceSamplingOptions::Mode::patch: return "patch";
+    case ForceSamplingOptions::Mode::periodic: return "periodic";
+  }
+  return "unknown";
+}
+
+ForceSamplingOptions::Mode parse_sampling_mode(const std::string& name) {
+  for (auto m : {ForceSamplingOptions::Mode::isolated, ForceSamplingOptions::Mode::patch,
+                 ForceSamplingOptions::Mode::periodic})
+    if (sampling_mode_name(m) == name) return m;
+  throw InputError("unknown sampling mode '" + name + "' (isolated, patch or periodic)");
 }
 
 std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed) {
@@ -92,20 +111,76 @@ VecX self_equilibrate(const HexMesh& mesh, const VecX& force) {
   return out;
 }
 
+namespace {
+
+// Consistent nodal loads of the traction sigma(r) n on the outer faces of a
+// block in context (the faces on the bounding box of its mesh), r the
+// position from the block centre in voxels. 2 x 2 Gauss points per face are
+// exact for the at most linear stress fields used here. Faces of void
+// voxels are absent, as in a body; interior surfaces next to void are free.
+template <typename StressField>
+VecX outer_face_loads(const FineBlock& block, const Vec3& center, StressField sigma) {
+  const HexMesh& mesh = block.mesh();
+  const double h = block.voxel_size;
+  const Vec3 lo = mesh.bbox_min(), hi = mesh.bbox_max();
+  const double gauss = 1.0 / std::sqrt(3.0);
+  VecX f = VecX::Zero(mesh.num_dofs());
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const hex8::NodeMatrix X = mesh.element_rest_positions(e);
+    const Vec3 mid = 0.5 * (X.row(0) + X.row(7)).transpose();
+    for (int axis = 0; axis < 3; ++axis)
+      for (int side = 0; side < 2; ++side) {
+        const double plane = side ? hi[axis] : lo[axis];
+        if (std::abs(mid[axis] + (side ? 0.5 : -0.5) * h - plane) > 1e-9 * h) continue;
+        const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+        const Vec3 normal = (side ? 1.0 : -1.0) * Vec3::Unit(axis);
+        for (int gb = 0; gb < 2; ++gb)
+          for (int gc = 0; gc < 2; ++gc) {
+            const double xb = gb ? gauss : -gauss, xc = gc ? gauss : -gauss;
+            Vec3 point = mid;
+            point[axis] = plane;
+            point[b] += 0.5 * h * xb, point[c] += 0.5 * h * xc;
+            const Vec3 traction = sigma((point - center) / h) * normal;
+            const double area = 0.25 * h * h;  // Gauss weight 1 times the Jacobian (h/2)^2
+            for (int node = 0; node < 8; ++node) {
+              const int bits[3] = {node >> 2 & 1, node >> 1 & 1, node & 1};  // x, y, z
+              if (bits[axis] != side) continue;
+              const double N = 0.25 * (1 + (bits[b] ? xb : -xb)) * (1 + (bits[c] ? xc : -xc));
+              f.segment<3>(3 * mesh.elements[e][node]) += area * N * traction;
+            }
+          }
+      }
+  }
+  return f;
+}
+
+Mat3 outer(const Vec3& a, const Vec3& b) { return a * b.transpose(); }
+
+}  // namespace
+
 std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const ForceSamplingOptions& options) {
   const HexMesh& mesh = block.mesh();
   const int n = mesh.num_nodes();
   const double h = block.voxel_size;
   const Vec3 center = Vec3::Constant(h);
-  // Each node carries the field times its lumped volume (an eighth of every
-  // incident element). For a field linear in position this is the consistent
-  // load of a surface traction, so a homogeneous block deforms smoothly, as
-  // it would inside a larger body; equal nodal weights would overload the
-  // corners, whose displacements are exactly what the coarse element sees.
+  // Isolated block: each node carries the field times its lumped volume (an
+  // eighth of every incident element). For a field linear in position this
+  // is the consistent load of a surface traction, so a homogeneous block
+  // deforms smoothly, as it would inside a larger body; equal nodal weights
+  // would overload the corners, whose displacements are exactly what the
+  // coarse element sees.
   std::vector<double> lumped(n, 0.0);
   for (const auto& element : mesh.elements)
     for (int node : element) lumped[node] += 0.125;
   std::vector<ForcePattern> patterns;
+  auto keep = [&](ForcePattern p) {
+    p.force = self_equilibrate(mesh, p.force);
+    const double norm = p.force.norm();
+    if (norm > 0) {
+      p.force /= norm;
+      patterns.push_back(std::move(p));
+    }
+  };
   auto add = [&](ForceKind kind, const Vec3& d, const Vec3& t, auto field) {
     ForcePattern p;
     p.kind = kind;
@@ -114,15 +189,35 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
     p.force.setZero(3 * n);
     for (int i = 0; i < n; ++i)
       p.force.segment<3>(3 * i) = lumped[i] * field((mesh.nodes.row(i).transpose() - center) / h);
-    p.force = self_equilibrate(mesh, p.force);
-    const double norm = p.force.norm();
-    if (norm > 0) {
-      p.force /= norm;
-      patterns.push_back(std::move(p));
-    }
+    keep(std::move(p));
+  };
+  // Block in context: each kind is a divergence-free stress field whose
+  // tractions load the outer faces of the patch, as a body is loaded at its
+  // surface; nothing acts inside. Under the constant fields (stretch,
+  // shear) a homogeneous patch deforms affinely, so its block is exactly a
+  // coarse element under that deformation.
+  auto add_stress = [&](ForceKind kind, const Vec3& d, const Vec3& t, auto sigma) {
+    ForcePattern p;
+    p.kind = kind;
+    p.direction = d;
+    p.second = t;
+    p.force = outer_face_loads(block, center, sigma);
+    keep(std::move(p));
   };
   for (const Vec3& d : sampling_directions(options.include_axes, options.sphere_directions, options.seed)) {
     const Vec3 t = transverse(d);
+    if (block.context > 0) {
+      add_stress(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3&) -> Mat3 { return outer(d, d); });
+      add_stress(ForceKind::shear, d, t, [&](const Vec3&) -> Mat3 { return outer(d, t) + outer(t, d); });
+      // Pure bending: axial stress linear across the neutral plane t.r = 0.
+      add_stress(ForceKind::bend, d, t, [&](const Vec3& r) -> Mat3 { return t.dot(r) * outer(d, d); });
+      // Torsion about d: shear stress growing with the distance from the axis.
+      add_stress(ForceKind::twist, d, Vec3::Zero(), [&](const Vec3& r) -> Mat3 {
+        const Vec3 w = d.cross(r);
+        return outer(w, d) + outer(d, w);
+      });
+      continue;
+    }
     // Stretch: traction along d growing linearly towards the two ends.
     add(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d * d.dot(r); });
     // Simple shear (symmetric, so it carries no net moment).
@@ -153,7 +248,62 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
 namespace {
 // Dense copy of a sparse Hessian projected on the null space: Z^T K Z.
 MatX project(const SpMat& K, const MatX& Z) { return Z.transpose() * (K * Z); }
+
+// Above this many DOFs the Newton steps use the sparse KKT path; the
+// isolated block has 81.
+constexpr int kDenseDofLimit = 120;
+// The identity shift that makes K's rigid modes invertible on the sparse
+// path, relative to the largest diagonal entry of the rest stiffness. It
+// perturbs the Newton step by about this relative amount (a Newton
+// iteration then contracts the error by ~1e-8 near the solution) and
+// amplifies the rigid components of the back-solves by its inverse, which
+// the Schur correction removes.
+constexpr double kRigidShift = 1e-8;
 }  // namespace
+
+// K + sigma I factored once per Newton iteration (symbolic analysis once),
+// with the Schur complement S = G (K + sigma I)^{-1} G^T of the six
+// constraints.
+struct BlockSolver::SparseKkt {
+  Eigen::SimplicialLDLT<SpMat> ldlt;
+  MatX Gt;                         // G^T
+  Eigen::LDLT<MatX> gram;          // G G^T, for the exact projection on G d = 0
+  MatX Y;                          // (K + sigma I)^{-1} G^T
+  Eigen::LDLT<MatX> schur;
+  bool positive_on_null_space = false;
+
+  // Factors K + shift I; false if the factorization failed.
+  bool factor(const SpMat& K, double shift) {
+    SpMat A = K;
+    for (int i = 0; i < A.rows(); ++i) A.coeffRef(i, i) += shift;
+    ldlt.factorize(A);
+    if (ldlt.info() != Eigen::Success) return false;
+    Y = ldlt.solve(Gt);
+    const MatX S = Gt.transpose() * Y;
+    schur.compute(S);
+    // Haynsworth: inertia [A G^T; G 0] = inertia(A) + inertia(-S); the
+    // reduced Hessian Z^T A Z is positive definite exactly when the KKT
+    // matrix has n positive eigenvalues, i.e. when S has as many negative
+    // eigenvalues as A.
+    int negative_A = 0;
+    for (int i = 0; i < ldlt.vectorD().size(); ++i) negative_A += ldlt.vectorD()[i] < 0;
+    const VecX s_eig = Eigen::SelfAdjointEigenSolver<MatX>(S, Eigen::EigenvaluesOnly).eigenvalues();
+    int negative_S = 0;
+    for (int i = 0; i < s_eig.size(); ++i) negative_S += s_eig[i] < 0;
+    positive_on_null_space = Y.allFinite() && negative_A == negative_S && negative_A <= 6;
+    return positive_on_null_space;
+  }
+  // argmin 1/2 d^T A d + r^T d subject to G d = 0.
+  VecX solve(const VecX& r) const {
+    const VecX z = ldlt.solve(r);
+    const VecX mu = schur.solve(Gt.transpose() * z);
+    VecX d = -(z - Y * mu);
+    d -= Gt * gram.solve(Gt.transpose() * d);  // round-off in the rigid components
+    return d;
+  }
+};
+
+BlockSolver::~BlockSolver() = default;
 
 BlockSolver::BlockSolver(const FineBlock& block, double newton_tolerance)
     : block_(block), assembler_(block.mesh()), tolerance_(newton_tolerance) {
@@ -172,22 +322,59 @@ BlockSolver::BlockSolver(const FineBlock& block, double newton_tolerance)
     // (r x u) = [r]_x u
     G_.block<3, 3>(3, 3 * i) << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
   }
-  // Null space from the full QR of G^T: the last n - 6 columns of Q.
-  Eigen::HouseholderQR<MatX> qr(G_.transpose());
-  const MatX Q = qr.householderQ() * MatX::Identity(n, n);
-  Z_ = Q.rightCols(n - 6);
+  if (static_cast<int>(block.core_element.size()) == mesh.num_elements() &&
+      std::find(block.core_element.begin(), block.core_element.end(), 0) != block.core_element.end()) {
+    core_mesh_ = mesh;
+    core_mesh_.elements.clear(), core_mesh_.element_geometry.clear();
+    core_mesh_.element_material.clear(), core_mesh_.element_tag.clear();
+    for (int e = 0; e < mesh.num_elements(); ++e)
+      if (block.core_element[e]) {
+        core_mesh_.elements.push_back(mesh.elements[e]);
+        core_mesh_.element_geometry.push_back(mesh.element_geometry[e]);
+        core_mesh_.element_material.push_back(mesh.element_material[e]);
+        core_mesh_.element_tag.push_back(mesh.element_tag[e]);
+      }
+    core_mesh_.colors = greedy_element_coloring(core_mesh_);
+    core_assembler_ = std::make_unique<ElasticAssembler>(core_mesh_);
+  }
   SpMat K = assembler_.pattern();
   assembler_.evaluate(rest_, nullptr, &K);
-  const MatX K0 = project(K, Z_);
-  stiffness_scale_ = K0.diagonal().cwiseAbs().maxCoeff();
-  rest_stiffness_.compute(K0);
+  if (n <= kDenseDofLimit) {
+    // Null space from the full QR of G^T: the last n - 6 columns of Q.
+    Eigen::HouseholderQR<MatX> qr(G_.transpose());
+    const MatX Q = qr.householderQ() * MatX::Identity(n, n);
+    Z_ = Q.rightCols(n - 6);
+    const MatX K0 = project(K, Z_);
+    stiffness_scale_ = K0.diagonal().cwiseAbs().maxCoeff();
+    rest_stiffness_.compute(K0);
+    return;
+  }
+  stiffness_scale_ = K.diagonal().cwiseAbs().maxCoeff();
+  for (auto* kkt : {&sparse_, &sparse_rest_}) {
+    *kkt = std::make_unique<SparseKkt>();
+    (*kkt)->Gt = G_.transpose();
+    (*kkt)->gram.compute(G_ * G_.transpose());
+    (*kkt)->ldlt.analyzePattern(K);
+  }
+  if (!sparse_rest_->factor(K, kRigidShift * stiffness_scale_))
+    throw NumericalError("BlockSolver: the rest stiffness of the block in context is not positive definite");
+}
+
+double BlockSolver::block_energy(const VecX& x) const {
+  return core_assembler_ ? core_assembler_->energy(x) : assembler_.energy(x);
 }
 
 double BlockSolver::linear_peak_strain(const VecX& force) const {
-  const VecX u = Z_ * rest_stiffness_.solve(Z_.transpose() * force);
+  VecX u;
+  if (sparse_)
+    u = sparse_rest_->solve(-force);
+  else
+    u = Z_ * rest_stiffness_.solve(Z_.transpose() * force);
   const HexMesh& mesh = block_.mesh();
+  const bool all = block_.core_element.size() != static_cast<size_t>(mesh.num_elements());
   double peak = 0;
   for (int e = 0; e < mesh.num_elements(); ++e) {
+    if (!all && !block_.core_element[e]) continue;
     hex8::NodeMatrix ue;
     for (int c = 0; c < 8; ++c) ue.row(c) = u.segment<3>(3 * mesh.elements[e][c]).transpose();
     const auto& geo = mesh.geometries[mesh.element_geometry[e]];
@@ -200,13 +387,46 @@ double BlockSolver::linear_peak_strain(const VecX& force) const {
   return peak;
 }
 
-// A dense Newton in the null-space coordinates: at ~80 unknowns a dense
-// LDLT costs microseconds, whereas a sparse factorization's analysis and
-// allocations would dominate. Thousands of these solves make a database.
+bool BlockSolver::newton_step(const SpMat& K, const VecX& r, VecX& step) const {
+  // Shift towards a descent direction where the tangent is indefinite.
+  if (!sparse_) {
+    const VecX gz = Z_.transpose() * r;
+    const MatX H = project(K, Z_);
+    const int m = static_cast<int>(Z_.cols());
+    double shift = 0;
+    const double diag = H.diagonal().cwiseAbs().maxCoeff();
+    for (int attempt = 0; attempt < 12; ++attempt) {
+      Eigen::LDLT<MatX> ldlt(H + shift * MatX::Identity(m, m));
+      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+        const VecX y = -ldlt.solve(gz);
+        if (y.allFinite() && y.dot(gz) < 0) {
+          step = Z_ * y;
+          return true;
+        }
+      }
+      shift = shift == 0 ? 1e-8 * diag : shift * 10;
+    }
+    return false;
+  }
+  const double base = kRigidShift * stiffness_scale_;
+  double shift = 0;
+  for (int attempt = 0; attempt < 12; ++attempt) {
+    if (sparse_->factor(K, base + shift)) {
+      step = sparse_->solve(r);
+      if (step.allFinite() && step.dot(r) < 0) return true;
+    }
+    shift = shift == 0 ? 1e-8 * stiffness_scale_ : shift * 10;
+  }
+  return false;
+}
+
+// A dense Newton in the null-space coordinates for the isolated block: at
+// ~80 unknowns a dense LDLT costs microseconds, whereas a sparse
+// factorization's analysis and allocations would dominate. Thousands of
+// these solves make a database. A block in context takes the sparse path.
 BlockSolver::Solution BlockSolver::solve(const VecX& force, const VecX& x0) const {
   Solution s;
   const int n = static_cast<int>(force.size());
-  const int m = static_cast<int>(Z_.cols());
   VecX x = x0.size() == n ? x0 : rest_;
   auto potential = [&](const VecX& y) { return assembler_.energy(y) - force.dot(y - rest_); };
   // Below this the residual is round-off: forces of the stiffest element
@@ -219,36 +439,24 @@ BlockSolver::Solution BlockSolver::solve(const VecX& force, const VecX& x0) cons
     phi = potential(x);
   }
   SpMat K = assembler_.pattern();
-  VecX g(n), step(m);
+  VecX g(n), dx(n);
   for (int it = 0; it < max_iterations_; ++it) {
     assembler_.evaluate(x, &g, &K);
-    const VecX gz = Z_.transpose() * (g - force);
-    if (gz.norm() <= target) {
+    const VecX r = g - force;
+    // |Z^T r| = |P r| with P the projection on the constraints' null space.
+    const double residual =
+        sparse_ ? (r - sparse_->Gt * sparse_->gram.solve(G_ * r)).norm() : (Z_.transpose() * r).norm();
+    if (residual <= target) {
       s.converged = true;
       break;
     }
-    const MatX H = project(K, Z_);
-    // Shift towards a descent direction where the tangent is indefinite.
-    double shift = 0;
-    const double diag = H.diagonal().cwiseAbs().maxCoeff();
-    step.setZero();
-    for (int attempt = 0; attempt < 12; ++attempt) {
-      Eigen::LDLT<MatX> ldlt(H + shift * MatX::Identity(m, m));
-      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-        step = -ldlt.solve(gz);
-        if (step.allFinite() && step.dot(gz) < 0) break;
-      }
-      shift = shift == 0 ? 1e-8 * diag : shift * 10;
-      step.setZero();
-    }
-    if (step.squaredNorm() == 0) break;
-    const VecX dx = Z_ * step;
+    if (!newton_step(K, r, dx)) break;
     // Cap the largest nodal move of one step at a quarter voxel: the energy
     // is +inf on inverted elements, and a long step could leap across that
     // barrier into a reflected state.
     const double largest = dx.cwiseAbs().maxCoeff();
     double alpha = std::min(1.0, 0.25 * block_.voxel_size / largest);
-    const double slope = step.dot(gz);
+    const double slope = dx.dot(r);
     bool accepted = false;
     VecX trial;
     for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
@@ -269,7 +477,7 @@ BlockSolver::Solution BlockSolver::solve(const VecX& force, const VecX& x0) cons
     s.iterations = it + 1;
   }
   s.x = x;
-  s.energy = s.converged ? assembler_.energy(x) : kInfiniteEnergy;
+  s.energy = s.converged ? block_energy(x) : kInfiniteEnergy;
   if (!std::isfinite(s.energy)) s.converged = false;
   return s;
 }

@@ -6,6 +6,7 @@
 // problem. A sample is the displacement of the eight block corners (the
 // coarse element's u^1 = r(u^0) of Eq. 2.8) and the fine elastic energy V^0.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,23 @@ struct ForceSamplingOptions {
   double max_strain = 0.15;    // small-strain estimate of the largest local strain at the largest magnitude
   std::uint64_t seed = 1;
   double newton_tolerance = 1e-9;
+  // Where the block is while it is sampled (docs/ddfem.md, "In-situ
+  // sampling"):
+  //  isolated: alone, loaded by the force patterns (thesis §2.3.2);
+  //  patch:    surrounded by `context` layers of its own periodic copies,
+  //            loaded by stress fields on the patch's outer faces (the
+  //            builder makes such blocks with make_fine_block(..., context));
+  //  periodic: among infinitely many periodic copies, corner displacements
+  //            prescribed and the periodic fluctuation relaxed
+  //            (periodic_samples.hpp).
+  enum class Mode { isolated, patch, periodic };
+  Mode mode = Mode::isolated;
+  int context = 1;  // patch mode: voxels of periodic copies on each side
 };
+// "isolated", "patch", "periodic"; parse_sampling_mode throws InputError on
+// anything else.
+std::string sampling_mode_name(ForceSamplingOptions::Mode mode);
+ForceSamplingOptions::Mode parse_sampling_mode(const std::string& name);
 
 // A unit-norm, self-equilibrated nodal force set on the block's mesh.
 struct ForcePattern {
@@ -56,8 +73,7 @@ struct ForceSampleSet {
 // The fine block's static problem with rigid motion removed by six linear
 // constraints on the displacement u: zero mean translation, sum_i u_i = 0,
 // and zero mean infinitesimal rotation, sum_i (X_i - c) x u_i = 0 (c the
-// node centroid). Unknowns live in an orthonormal basis Z of the
-// constraints' null space, x = X + Z y.
+// node centroid), over every node of the mesh (the block and its context).
 //
 // Why not three pinned corners (a 3-2-1 support): with dead loads a
 // compressive or shearing pattern makes the block rotate about the pinned
@@ -67,9 +83,19 @@ struct ForceSampleSet {
 // averaged rotation constraint acts on all nodes, like the rest of the body
 // around a coarse element would. Requires all eight corners
 // (std::invalid_argument otherwise). The block must outlive the solver.
+//
+// Two linear algebra paths, chosen by size. The isolated block (75
+// unknowns) runs a dense Newton in an orthonormal basis Z of the
+// constraints' null space, x = X + Z y. A block in context (hundreds to
+// thousands of unknowns) solves each Newton step's KKT system with a sparse
+// LDL^T of K + sigma I (sigma tiny, only to make K's rigid modes
+// invertible) and a 6 x 6 Schur complement on the constraints; the inertia
+// of the two factors tells whether K is positive definite on the
+// constraints' null space, as the dense path's LDL^T of Z^T K Z does.
 class BlockSolver {
  public:
   explicit BlockSolver(const FineBlock& block, double newton_tolerance = 1e-9);
+  ~BlockSolver();
 
   const FineBlock& block() const { return block_; }
   const ElasticAssembler& assembler() const { return assembler_; }
@@ -77,36 +103,50 @@ class BlockSolver {
   // translation and rotation modes, so G f is the net force and moment of
   // a nodal force set f.
   const MatX& constraint_matrix() const { return G_; }
-  // Orthonormal null-space basis Z (DOFs x (DOFs - 6)).
+  // Orthonormal null-space basis Z (DOFs x (DOFs - 6)); empty on the
+  // sparse path.
   const MatX& null_space() const { return Z_; }
+  bool sparse() const { return sparse_ != nullptr; }
 
   // Largest local small strain (largest |eigenvalue| of sym grad u over the
-  // fine quadrature points) of the linearized response to `force`.
+  // block's own fine quadrature points) of the linearized response to `force`.
   double linear_peak_strain(const VecX& force) const;
 
   struct Solution {
     bool converged = false;
     VecX x;             // deformed positions
-    double energy = 0;  // fine elastic energy
+    double energy = 0;  // fine elastic energy of the block's own elements
     int iterations = 0;
   };
-  // Nonlinear solve under `force` by a dense Newton with backtracking line
-  // search, starting from x0 (rest if empty; x0 must satisfy the
-  // constraints, as every returned x does).
+  // Nonlinear solve under `force` by Newton with backtracking line search,
+  // starting from x0 (rest if empty; x0 must satisfy the constraints, as
+  // every returned x does).
   Solution solve(const VecX& force, const VecX& x0 = VecX()) const;
 
   // Corner displacements (24) of a deformed configuration.
   Vec24 corner_displacements(const VecX& x) const;
 
  private:
+  struct SparseKkt;
+  // The constrained Newton step for Hessian K and residual r (= g - f):
+  // minimizes 1/2 d^T K d + r^T d over G d = 0, shifting K by multiples of
+  // the identity until it is positive definite on the null space. Returns
+  // false if no shift gave a descent direction.
+  bool newton_step(const SpMat& K, const VecX& r, VecX& step) const;
+  double block_energy(const VecX& x) const;
+
   const FineBlock& block_;
   ElasticAssembler assembler_;
+  HexMesh core_mesh_;                   // the block's own elements (all nodes); empty when isolated
+  std::unique_ptr<ElasticAssembler> core_assembler_;
   double tolerance_;
   int max_iterations_ = 200;  // slow cases: a soft corner next to stiff children
   MatX G_, Z_;
   VecX rest_;
-  double stiffness_scale_ = 0;        // largest diagonal entry of Z^T K(X) Z
-  Eigen::LDLT<MatX> rest_stiffness_;  // Z^T K(X) Z
+  double stiffness_scale_ = 0;        // largest diagonal entry of the rest stiffness (projected when dense)
+  Eigen::LDLT<MatX> rest_stiffness_;  // dense path: Z^T K(X) Z
+  std::unique_ptr<SparseKkt> sparse_;       // Newton iterations (refactored each step)
+  std::unique_ptr<SparseKkt> sparse_rest_;  // the rest state, for linear_peak_strain
 };
 
 // Removes the net force and net moment (about the node centroid) of a nodal

@@ -22,7 +22,7 @@ int level1_point_of(int q, int* child) {
 }
 
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
-                                         const BlockMaterials& ids, double child_size) {
+                                         const BlockMaterials& ids, double child_size, int context) {
   for (int c = 0; c < 8; ++c) {
     if (!children[c] || !children[c]->fitted || children[c]->points() != 8) {
       std::ostringstream os;
@@ -33,17 +33,16 @@ FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFi
   // Geometry and topology of a 2 x 2 x 2 voxel block; the materials are
   // replaced by the children's fitted ones below.
   const std::vector<MaterialPtr> shape_only = {nullptr, std::make_shared<NeoHookean>(1.0, 0.3)};
-  FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, shape_only, child_size, 4);
+  FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, shape_only, child_size, 4, context);
   block.material_ids = ids;
   block.child_material.assign(8, nullptr);
   HexMesh& mesh = block.voxels.mesh;
   mesh.materials.clear();
   for (int c = 0; c < 8; ++c) mesh.materials.push_back(coarse_quadrature_materials(*children[c]));
   for (int e = 0; e < mesh.num_elements(); ++e) {
-    const int v = block.voxels.element_voxel[e];  // x fastest in a 2 x 2 x 2 grid
-    const int i = v & 1, j = (v >> 1) & 1, k = (v >> 2) & 1;
-    mesh.element_material[e] = 4 * i + 2 * j + k;
-    mesh.element_tag[e] = ids[4 * i + 2 * j + k];
+    const int c = block.child_of_element(e);
+    mesh.element_material[e] = c;
+    mesh.element_tag[e] = ids[c];
   }
   for (int q = 0; q < block.coarse_points(); ++q) {
     int c = 0;

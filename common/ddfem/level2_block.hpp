@@ -19,9 +19,10 @@ namespace msfab {
 // voxel), not the child's fitted parameters, which are a poor prior: a
 // level-1 fit often moves its stiffness between points and parameters
 // (docs/ddfem.md, "Level 2"). Throws InputError on an unfitted
-// child or a child with another point count.
+// child or a child with another point count. `context`: layers of periodic
+// copies around the block, in level-1 elements (see make_fine_block).
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
-                                         const BlockMaterials& ids, double child_size);
+                                         const BlockMaterials& ids, double child_size, int context = 0);
 
 // Level-1 point of child `child` that lies in the same fine voxel as point
 // q of the 4-point rule (both in hex8 bit order).

@@ -1,6 +1,7 @@
 #include "fem/voxel_shapes.hpp"
 
 #include <cmath>
+#include <random>
 
 #include "core/errors.hpp"
 
@@ -86,6 +87,27 @@ void paint_helical_fibers(VoxelGrid& grid, int axis, const Vec3& center, double 
     }
     return false;
   });
+}
+
+void paint_checker(VoxelGrid& grid, double cell, const std::vector<int>& ids) {
+  if (!(cell > 0) || !std::isfinite(cell)) throw InputError("checker cell size must be positive and finite");
+  if (ids.empty()) throw InputError("a checkerboard needs at least one id");
+  const long n = static_cast<long>(ids.size());
+  for (int k = 0; k < grid.nz; ++k)
+    for (int j = 0; j < grid.ny; ++j)
+      for (int i = 0; i < grid.nx; ++i) {
+        const Vec3 s = (grid.voxel_center(i, j, k) - grid.origin) / cell;
+        const long parity = static_cast<long>(std::floor(s[0])) + static_cast<long>(std::floor(s[1])) +
+                            static_cast<long>(std::floor(s[2]));
+        grid.at(i, j, k) = ids[((parity % n) + n) % n];
+      }
+}
+
+void paint_random_field(VoxelGrid& grid, const std::vector<int>& ids, std::uint64_t seed) {
+  if (ids.empty()) throw InputError("a random field needs at least one id");
+  std::mt19937_64 rng(seed);
+  const std::uint64_t n = ids.size();
+  for (int& id : grid.ids) id = ids[rng() % n];  // storage order: x fastest
 }
 
 }  // namespace msfab

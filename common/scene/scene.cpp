@@ -95,6 +95,14 @@ std::vector<PaletteEntry> read_materials(const Config& config, std::vector<Mater
 }
 
 void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
+  // The `ids` list of a pattern item: each a palette id or 0 (void).
+  auto id_list_of = [&](const Config& c) {
+    const std::vector<int> ids = c.get<std::vector<int>>("ids");
+    for (int id : ids)
+      if (id < 0 || id >= static_cast<int>(material_by_id.size()) || (id > 0 && !material_by_id[id]))
+        c.fail("ids", "material id " + std::to_string(id) + " is not in the palette");
+    return ids;
+  };
   for (const Config& item : config.children("layout")) {
     auto id_of = [&](const std::string& key) {
       const int id = item.get<int>(key);
@@ -110,12 +118,8 @@ void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<Mater
     } else if (item.has("layers")) {
       const Config l = item.child("layers");
       const auto t = l.get<std::vector<double>>("thickness");
-      std::vector<int> ids = l.get<std::vector<int>>("ids");
+      const std::vector<int> ids = id_list_of(l);
       if (t.size() != ids.size() || t.empty()) l.fail("ids", "need one id per thickness");
-      for (size_t k = 0; k < ids.size(); ++k)
-        if (ids[k] < 0 || ids[k] >= static_cast<int>(material_by_id.size()) ||
-            (ids[k] > 0 && !material_by_id[ids[k]]))
-          l.fail("ids", "material id " + std::to_string(ids[k]) + " is not in the palette");
       for (double x : t)
         if (!(x > 0)) l.fail("thickness", "layer thicknesses must be positive");
       paint_layers(grid, read_axis(l, "axis"), t, ids);
@@ -129,8 +133,18 @@ void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<Mater
       paint_helical_fibers(grid, read_axis(c, "axis"), read_vec3(c, "center"), c.require_positive("helix_radius"),
                            c.require_positive("pitch"), c.require_positive("fiber_radius"),
                            c.require_positive<int>("count"), id_of("id"));
+    } else if (item.has("checker")) {
+      const Config c = item.child("checker");
+      const std::vector<int> ids = id_list_of(c);
+      if (ids.size() < 2) c.fail("ids", "a checkerboard needs at least two ids");
+      paint_checker(grid, c.require_positive("cell", "checker cell size"), ids);
+    } else if (item.has("random_field")) {
+      const Config c = item.child("random_field");
+      const std::vector<int> ids = id_list_of(c);
+      if (ids.empty()) c.fail("ids", "a random field needs at least one id");
+      paint_random_field(grid, ids, c.get<std::uint64_t>("seed"));
     } else {
-      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers");
+      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field");
     }
   }
 }

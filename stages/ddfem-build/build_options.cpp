@@ -61,6 +61,12 @@ BuildOptions read_build_options(const Config& config) {
     f.seed = s.get_or<std::uint64_t>("seed", f.seed);
     f.newton_tolerance = s.get_or<double>("newton_tolerance", f.newton_tolerance);
     if (!(f.newton_tolerance > 0)) s.fail("newton_tolerance", "must be > 0");
+    const std::string mode = s.get_or<std::string>("mode", sampling_mode_name(f.mode));
+    if (mode != "isolated" && mode != "patch" && mode != "periodic")
+      s.fail("mode", "must be isolated, patch or periodic, got '" + mode + "'");
+    f.mode = parse_sampling_mode(mode);
+    f.context = s.get_or<int>("context", f.context);
+    if (f.context < 1 || f.context > 4) s.fail("context", "must be 1 to 4 voxels of periodic copies");
     s.check_no_unknown_keys();
   }
   if (config.has("anisotropy")) {

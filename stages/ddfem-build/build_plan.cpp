@@ -25,6 +25,12 @@ std::string file_fingerprint(const std::string& path) {
   return text;
 }
 
+// Layers of periodic copies the blocks are built with (patch sampling only).
+int patch_context(const BuildOptions& options) {
+  const ForceSamplingOptions& s = options.fit.sampling;
+  return s.mode == ForceSamplingOptions::Mode::patch ? s.context : 0;
+}
+
 }  // namespace
 
 BuildPlan plan_level1(const BuildOptions& options) {
@@ -45,8 +51,8 @@ BuildPlan plan_level1(const BuildOptions& options) {
   const auto palette = plan.db.palette();
   CoarseDatabase codes;  // only the palette size matters for decoding
   codes.materials = plan.db.materials;
-  plan.block = [palette, codes, h = options.voxel_size](std::int64_t code) {
-    return make_fine_block(codes.combination_ids(code), palette, h);
+  plan.block = [palette, codes, h = options.voxel_size, context = patch_context(options)](std::int64_t code) {
+    return make_fine_block(codes.combination_ids(code), palette, h, 2, context);
   };
   return plan;
 }
@@ -79,12 +85,13 @@ BuildPlan plan_level2(const BuildOptions& options) {
   for (int r = 0; r < plan.db.hierarchy.num_final(); ++r) plan.items.push_back(r);
   plan.points = 64;
   plan.fingerprint = "base_database " + file_fingerprint(options.base_database);
-  plan.block = [base, hierarchy = plan.db.hierarchy, h = options.voxel_size](std::int64_t r) {
+  plan.block = [base, hierarchy = plan.db.hierarchy, h = options.voxel_size,
+                context = patch_context(options)](std::int64_t r) {
     const Arrangement arr = hierarchy.arrangement(2, static_cast<int>(r));
     std::array<const CoarseMaterialFit*, 8> children;
     BlockMaterials ids;
     for (int c = 0; c < 8; ++c) children[c] = &base->entries[arr[c]], ids[c] = arr[c] + 1;
-    return make_block_of_coarse_materials(children, ids, 2 * h);
+    return make_block_of_coarse_materials(children, ids, 2 * h, context);
   };
   return plan;
 }

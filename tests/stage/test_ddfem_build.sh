@@ -20,6 +20,14 @@ check "no checkpoint left" -- test ! -e "$WORK/one.h5.checkpoint.h5"
 check "three-rank build" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$TINY" --out "$WORK/three.h5" --quiet
 check "1 and 3 ranks give the same database" -- same_db "$WORK/one.h5" "$WORK/three.h5"
 
+# In-situ (periodic) sampling: also independent of the rank count, and not
+# the isolated database.
+check "periodic sampling, one rank" -- "$BUILD" --config "$TINY" --set sampling.mode=periodic --out "$WORK/p1.h5" --quiet
+check "periodic sampling, three ranks" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$TINY" \
+  --set sampling.mode=periodic --out "$WORK/p3.h5" --quiet
+check "1 and 3 ranks give the same periodic database" -- same_db "$WORK/p1.h5" "$WORK/p3.h5"
+check "periodic and isolated databases differ" -- bash -c "! h5diff -q '$WORK/one.h5' '$WORK/p1.h5' /fit/mu /fit/mu"
+
 # Stop after two rounds (a batch job's time limit), then resume.
 expect_exit 0 "stopped after 2 rounds" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --max-rounds 2
 check "checkpoint kept" -- test -e "$WORK/part.h5.checkpoint.h5"
@@ -68,5 +76,8 @@ sed 's/E: 1.0e5/E: -3/' "$TINY" > "$WORK/negE.yaml"
 expect_exit 2 "palette\[0\]\.E" -- "$BUILD" --config "$WORK/negE.yaml" --out "$WORK/bad.h5"
 expect_exit 2 "unknown key 'magnitude'" -- "$BUILD" --config "$TINY" --set sampling.magnitude=2 --out "$WORK/bad.h5"
 expect_exit 2 "folder does not exist" -- "$BUILD" --config "$TINY" --out "$WORK/nowhere/db.h5"
+expect_exit 2 "sampling.mode.*isolated, patch or periodic" -- "$BUILD" --config "$TINY" --set sampling.mode=situ --out "$WORK/bad.h5"
+expect_exit 2 "sampling.context.*1 to 4" -- "$BUILD" --config "$TINY" --set sampling.mode=patch --set sampling.context=9 \
+  --out "$WORK/bad.h5"
 check "nothing written on bad input" -- test ! -e "$WORK/bad.h5"
 finish

@@ -1,0 +1,206 @@
+#include "ddfem/periodic_samples.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/errors.hpp"
+#include "ddfem/anisotropy.hpp"
+
+namespace msfab {
+namespace {
+
+constexpr int kFree = 21;  // 7 periodic node classes x 3 (the corners' class is prescribed)
+
+// Largest |eigenvalue| of the small strain of the coarse element over its
+// Gauss points for corner displacements u.
+double coarse_peak_strain(const FineBlock& block, const Vec24& u) {
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  double peak = 0;
+  for (int q = 0; q < geo.size(); ++q) {
+    Mat3 G = Mat3::Zero();
+    for (int c = 0; c < 8; ++c) G += u.segment<3>(3 * c) * geo.dNdX[q].row(c);
+    const Mat3 eps = 0.5 * (G + G.transpose());
+    peak = std::max(peak, Eigen::SelfAdjointEigenSolver<Mat3>(eps).eigenvalues().cwiseAbs().maxCoeff());
+  }
+  return peak;
+}
+
+Vec3 transverse_of(const Vec3& d) {
+  for (int a = 0; a < 3; ++a)
+    if (std::abs(std::abs(d[a]) - 1.0) < 1e-12) return Vec3::Unit((a + 1) % 3);
+  const Vec3 trial = std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return (trial - trial.dot(d) * d).normalized();
+}
+
+}  // namespace
+
+std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& block,
+                                                            const ForceSamplingOptions& options) {
+  const double h = block.voxel_size;
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const Vec3 center = Vec3::Constant(h);
+  std::vector<ForcePattern> patterns;
+  auto add = [&](ForceKind kind, const Vec3& d, const Vec3& t, auto field) {
+    ForcePattern p;
+    p.kind = kind, p.direction = d, p.second = t;
+    Vec24 u;
+    for (int c = 0; c < 8; ++c) u.segment<3>(3 * c) = h * field((X.row(c).transpose() - center) / h);
+    const double peak = coarse_peak_strain(block, u);
+    if (!(peak > 0)) return;
+    p.force = u / peak;
+    patterns.push_back(std::move(p));
+  };
+  for (const Vec3& d : sampling_directions(options.include_axes, options.sphere_directions, options.seed)) {
+    const Vec3 t = transverse_of(d);
+    add(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d * d.dot(r); });
+    add(ForceKind::shear, d, t, [&](const Vec3& r) -> Vec3 { return d * t.dot(r) + t * d.dot(r); });
+    add(ForceKind::bend, d, t, [&](const Vec3& r) -> Vec3 { return d * (d.dot(r) * t.dot(r)); });
+    add(ForceKind::twist, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d.cross(r) * d.dot(r); });
+  }
+  for (int a = 0; a < 8; ++a)
+    for (int bit = 0; bit < 3; ++bit) {
+      const int b = a | (1 << bit);
+      if (b == a) continue;
+      const Vec3 e = Vec3::Unit(2 - bit);  // bit 2 is x, bit 0 is z
+      add(ForceKind::pinch, e, X.row(a).transpose(), [&](const Vec3& r) -> Vec3 {
+        const Vec3 at = center + h * r;
+        if ((at - X.row(a).transpose()).norm() < 1e-9 * h) return e;
+        if ((at - X.row(b).transpose()).norm() < 1e-9 * h) return -e;
+        return Vec3::Zero();
+      });
+    }
+  return patterns;
+}
+
+PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_tolerance)
+    : block_(block), assembler_(block.mesh()), tolerance_(newton_tolerance) {
+  if (block.context != 0) throw std::invalid_argument("PeriodicBlockSolver: takes the isolated block (context 0)");
+  if (!block.all_children_solid())
+    throw std::invalid_argument("PeriodicBlockSolver: a child of the block is void");
+  const HexMesh& mesh = block.mesh();
+  rest_ = assembler_.rest_positions();
+  node_class_.assign(mesh.num_nodes(), -1);
+  node_weights_.resize(mesh.num_nodes());
+  const double h = block.voxel_size;
+  for (int n = 0; n < mesh.num_nodes(); ++n) {
+    const Vec3 s = mesh.nodes.row(n).transpose() / (2 * h);  // in [0, 1]^3
+    int lattice[3];
+    for (int a = 0; a < 3; ++a) lattice[a] = static_cast<int>(std::lround(2 * s[a]));
+    node_class_[n] = 4 * (lattice[0] % 2) + 2 * (lattice[1] % 2) + (lattice[2] % 2);
+    for (int c = 0; c < 8; ++c) {
+      const double wx = (c >> 2 & 1) ? s.x() : 1 - s.x(), wy = (c >> 1 & 1) ? s.y() : 1 - s.y(),
+                   wz = (c & 1) ? s.z() : 1 - s.z();
+      node_weights_[n][c] = wx * wy * wz;
+    }
+  }
+}
+
+VecX PeriodicBlockSolver::positions(const Vec24& u1, const VecX& w) const {
+  VecX x = rest_;
+  for (int n = 0; n < static_cast<int>(node_class_.size()); ++n) {
+    Vec3 u = Vec3::Zero();
+    for (int c = 0; c < 8; ++c) u += node_weights_[n][c] * u1.segment<3>(3 * c);
+    if (node_class_[n] > 0) u += w.segment<3>(3 * (node_class_[n] - 1));
+    x.segment<3>(3 * n) += u;
+  }
+  return x;
+}
+
+double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) const {
+  if (w.size() != kFree) w = VecX::Zero(kFree);
+  const int nodes = static_cast<int>(node_class_.size());
+  SpMat K = assembler_.pattern();
+  VecX g(3 * nodes);
+  // Reduction to the periodic unknowns: sum over each class's nodes.
+  MatX P = MatX::Zero(3 * nodes, kFree);
+  for (int n = 0; n < nodes; ++n)
+    if (node_class_[n] > 0) P.block<3, 3>(3 * n, 3 * (node_class_[n] - 1)).setIdentity();
+  double E = assembler_.energy(positions(u1, w));
+  if (!std::isfinite(E)) {
+    w.setZero();
+    E = assembler_.energy(positions(u1, w));
+    if (!std::isfinite(E)) return kInfiniteEnergy;  // the trilinear field itself inverts a fine element
+  }
+  const double h = block_.voxel_size;
+  for (int it = 0; it < 100; ++it) {
+    assembler_.evaluate(positions(u1, w), &g, &K);
+    const VecX gw = P.transpose() * g;
+    // Converged when the fluctuation's forces are a small fraction of the
+    // forces the block carries (the corner reactions), or at round-off.
+    const double scale = g.norm();
+    if (gw.norm() <= std::max(tolerance_ * scale, 1e3 * std::numeric_limits<double>::epsilon() * scale) ||
+        scale == 0.0) {
+      if (iterations) *iterations = it;
+      return E;
+    }
+    const MatX H = P.transpose() * (K * P);
+    const double diag = H.diagonal().cwiseAbs().maxCoeff();
+    VecX step;
+    double shift = 0;
+    for (int attempt = 0; attempt < 12; ++attempt) {
+      Eigen::LDLT<MatX> ldlt(H + shift * MatX::Identity(kFree, kFree));
+      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
+        step = -ldlt.solve(gw);
+        if (step.allFinite() && step.dot(gw) < 0) break;
+      }
+      step.resize(0);
+      shift = shift == 0 ? 1e-8 * diag : shift * 10;
+    }
+    if (step.size() == 0) return kInfiniteEnergy;
+    // A quarter voxel at most per step (inverted elements are +inf).
+    double alpha = std::min(1.0, 0.25 * h / step.cwiseAbs().maxCoeff());
+    const double slope = step.dot(gw);
+    bool accepted = false;
+    for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
+      const VecX trial = w + alpha * step;
+      const double E_trial = assembler_.energy(positions(u1, trial));
+      if (std::isfinite(E_trial) && (E_trial <= E + 1e-4 * alpha * slope ||
+                                     (ls == 0 && std::abs(E_trial - E) <= 1e-13 * std::max(1.0, std::abs(E))))) {
+        w = trial, E = E_trial, accepted = true;
+        break;
+      }
+    }
+    if (!accepted) return kInfiniteEnergy;
+  }
+  return kInfiniteEnergy;
+}
+
+ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOptions& options) {
+  if (options.magnitudes < 1) throw InputError("force sampling: magnitudes must be >= 1");
+  if (!(options.max_strain > 0.0)) throw InputError("force sampling: max_strain must be > 0");
+  const auto t0 = std::chrono::steady_clock::now();
+  ForceSampleSet set;
+  set.patterns = make_corner_displacement_patterns(block, options);
+  const PeriodicBlockSolver solver(block, options.newton_tolerance);
+  for (int p = 0; p < static_cast<int>(set.patterns.size()); ++p) {
+    const Vec24 unit = set.patterns[p].force;
+    for (int sign : {1, -1}) {
+      VecX w;  // continuation in the magnitude
+      for (int m = 1; m <= options.magnitudes; ++m) {
+        const double load = sign * options.max_strain * m / options.magnitudes;
+        ++set.attempted;
+        VecX trial = w;
+        int its = 0;
+        const double E = solver.relax(load * unit, trial, &its);
+        if (!std::isfinite(E) || !(E > 0)) {
+          ++set.dropped;
+          continue;
+        }
+        w = trial;
+        ForceSample s;
+        s.pattern = p;
+        s.load = load;
+        s.corner_displacement = load * unit;
+        s.energy = E;
+        s.newton_iterations = its;
+        set.samples.push_back(s);
+      }
+    }
+  }
+  set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return set;
+}
+
+}  // namespace msfab

@@ -1,0 +1,53 @@
+#pragma once
+// Kinematic in-situ sampling of a block (docs/ddfem.md, "In-situ
+// sampling"): the block among infinitely many periodic copies of itself.
+//
+// A sample prescribes the coarse element's corner displacements u1 (the
+// same stretch, shear, bend, twist and pinch families as the force-space
+// sampling, as displacement fields evaluated at the corners) and relaxes
+// the block: x = X + U(X) + w(X), U the trilinear interpolation of u1 and w
+// a fluctuation periodic on the block, zero at the corners. The sample's
+// energy is min_w of the fine energy. For an affine u1 this is periodic
+// homogenization of the block (a fibre or a layer continues through the
+// block's faces, as in a body); for a homogeneous block it is then exactly
+// the coarse element's energy. Isolated, force-loaded sampling instead lets
+// a stiff fibre segment carry load only through the soft matrix around it.
+#include "ddfem/force_samples.hpp"
+
+namespace msfab {
+
+// The unit corner-displacement patterns (24 values in ForcePattern::force,
+// node-major) of the families: stretch d (d.r), shear d (t.r) + t (d.r),
+// bend d (d.r)(t.r), twist (d x r)(d.r) with r the corner's position from
+// the block centre in voxels, plus the two corners of each cube edge moved
+// towards each other. Each is scaled so the coarse element's largest
+// small-strain eigenvalue over its Gauss points is 1.
+std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& block,
+                                                            const ForceSamplingOptions& options);
+
+// The relaxed fine energy min_w E(X + U + w) for corner displacements u1.
+// `w` carries the periodic fluctuation in (a warm start) and out, one Vec3
+// per periodic node class of the 3 x 3 x 3 lattice (8 classes, the corners'
+// class held at zero). Returns +inf if Newton does not converge.
+class PeriodicBlockSolver {
+ public:
+  explicit PeriodicBlockSolver(const FineBlock& block, double newton_tolerance = 1e-9);
+  double relax(const Vec24& u1, VecX& w, int* iterations = nullptr) const;
+  // Deformed positions for corner displacements u1 and fluctuation w.
+  VecX positions(const Vec24& u1, const VecX& w) const;
+
+ private:
+  const FineBlock& block_;
+  ElasticAssembler assembler_;
+  double tolerance_;
+  VecX rest_;
+  std::vector<int> node_class_;        // mesh node -> periodic class 0..7 (0: corners)
+  std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node
+};
+
+// Every pattern at options.magnitudes magnitudes in both signs, peak coarse
+// strain options.max_strain at the largest, each magnitude started from the
+// previous one's fluctuation. Requires a block without void children.
+ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOptions& options);
+
+}  // namespace msfab
