@@ -29,16 +29,15 @@ Mat3 seeded_rotation(std::uint64_t seed) {
   return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
 }
 
-// A unit vector orthogonal to d, chosen deterministically.
-Vec3 transverse(const Vec3& d) {
+}  // namespace
+
+Vec3 sampling_transverse(const Vec3& d) {
   const Vec3 trial = std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   // Axes map to the next axis (x -> y, y -> z, z -> x) so axis shears are the classic ones.
   for (int a = 0; a < 3; ++a)
     if (std::abs(std::abs(d[a]) - 1.0) < 1e-12) return Vec3::Unit((a + 1) % 3);
   return (trial - trial.dot(d) * d).normalized();
 }
-
-}  // namespace
 
 std::string force_kind_name(ForceKind kind) {
   switch (kind) {
@@ -205,7 +204,7 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
     keep(std::move(p));
   };
   for (const Vec3& d : sampling_directions(options.include_axes, options.sphere_directions, options.seed)) {
-    const Vec3 t = transverse(d);
+    const Vec3 t = sampling_transverse(d);
     if (block.context > 0) {
       add_stress(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3&) -> Mat3 { return outer(d, d); });
       add_stress(ForceKind::shear, d, t, [&](const Vec3&) -> Mat3 { return outer(d, t) + outer(t, d); });

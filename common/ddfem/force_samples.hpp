@@ -155,6 +155,9 @@ VecX self_equilibrate(const HexMesh& mesh, const VecX& force);
 
 // The unit force patterns for a block (deterministic for given options).
 std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const ForceSamplingOptions& options);
+// The transverse direction t of the shear and bend patterns along d: a unit
+// vector orthogonal to d, the next axis for an axis (x -> y -> z -> x).
+Vec3 sampling_transverse(const Vec3& d);
 // Sampling directions: axes then the seeded Fibonacci hemisphere.
 std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed);
 

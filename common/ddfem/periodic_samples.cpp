@@ -27,13 +27,6 @@ double coarse_peak_strain(const FineBlock& block, const Vec24& u) {
   return peak;
 }
 
-Vec3 transverse_of(const Vec3& d) {
-  for (int a = 0; a < 3; ++a)
-    if (std::abs(std::abs(d[a]) - 1.0) < 1e-12) return Vec3::Unit((a + 1) % 3);
-  const Vec3 trial = std::abs(d.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  return (trial - trial.dot(d) * d).normalized();
-}
-
 }  // namespace
 
 std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& block,
@@ -53,7 +46,7 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
     patterns.push_back(std::move(p));
   };
   for (const Vec3& d : sampling_directions(options.include_axes, options.sphere_directions, options.seed)) {
-    const Vec3 t = transverse_of(d);
+    const Vec3 t = sampling_transverse(d);
     add(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d * d.dot(r); });
     add(ForceKind::shear, d, t, [&](const Vec3& r) -> Vec3 { return d * t.dot(r) + t * d.dot(r); });
     add(ForceKind::bend, d, t, [&](const Vec3& r) -> Vec3 { return d * (d.dot(r) * t.dot(r)); });
