@@ -9,7 +9,8 @@
 # DATABASE: a level-1 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
 # nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`;
 # DATABASE2 (environment, optional): a level-2 coarse_db of the same palette
-# (`ddfem-db-level2`), without it level 2 has only the baselines. A run that
+# (`ddfem-db-level2`), without it level 2 has only the baselines. BENCH_SECTION
+# (environment, default ddfem) names the section of BENCHMARKS.md written. A run that
 # does not converge within BENCH_RUN_LIMIT seconds (default 900) is "failed".
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
@@ -127,5 +128,5 @@ Jacobi-preconditioned CG iterations per Newton iteration (Figure 2-13):
 | scene | fine | DDFEM level 1 |
 |---|---|---|
 ${cg_rows}"
-python3 "$SRC/tools/replace_bench_section.py" "$DOC" ddfem "$table"
+python3 "$SRC/tools/replace_bench_section.py" "$DOC" "${BENCH_SECTION:-ddfem}" "$table"
 echo "bench: table written to $DOC" >&2
