@@ -11,6 +11,7 @@
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
+#include "ddfem/level2_block.hpp"
 #include "ddfem/periodic_samples.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
@@ -282,6 +283,48 @@ TEST(DdfemPeriodic, FiberBlockCarriesLoadAlongTheFiber) {
               E_alone / voigt, E_periodic / voigt);
   EXPECT_GT(E_periodic, 2.0 * E_alone);
   EXPECT_LT(E_periodic, 1.05 * voigt);
+}
+
+// Level 2: a block of eight level-1 coarse materials, here eight copies of
+// one exactly Neo-Hookean material. In a patch each context element takes
+// its child's material, and both in-situ modes reproduce the material on
+// the affine families to round-off (the 64-point coarse element of a
+// homogeneous block under a uniform deformation).
+TEST(DdfemContext, Level2BlockInContextAndPeriodic) {
+  const double mu = 4e5, lambda = 9e5;
+  CoarseMaterialFit l1;
+  l1.fitted = true;
+  for (int k = 0; k < 8; ++k) l1.mu[k] = l1.mu0[k] = mu, l1.lambda[k] = l1.lambda0[k] = lambda;
+  std::array<const CoarseMaterialFit*, 8> children;
+  children.fill(&l1);
+  const FineBlock patch = make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel, 1);
+  ASSERT_EQ(patch.mesh().num_elements(), 64);
+  for (int e = 0; e < 64; ++e) {
+    EXPECT_EQ(patch.mesh().element_material[e], patch.child_of_element(e));
+    EXPECT_EQ(patch.mesh().element_tag[e], patch.child_of_element(e) + 1);
+  }
+  const FineBlock alone = make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel);
+  CoarseMaterialFit exact(64);
+  exact.fitted = true;
+  for (int k = 0; k < 64; ++k) exact.mu[k] = mu, exact.lambda[k] = lambda;
+  ForceSamplingOptions o;
+  o.sphere_directions = 1;
+  o.magnitudes = 2;
+  for (const FineBlock* b : {&patch, &alone}) {
+    const ForceSampleSet set = b == &patch ? sample_force_space(*b, o) : sample_periodic(*b, o);
+    EXPECT_EQ(set.dropped, 0);
+    double worst = 0;
+    int checked = 0;
+    for (const ForceSample& s : set.samples) {
+      const ForceKind kind = set.patterns[s.pattern].kind;
+      if (kind != ForceKind::stretch && kind != ForceKind::shear) continue;
+      const double V1 = coarse_energy(exact, b->coarse_geometry(), b->coarse_rest_positions(), s.corner_displacement);
+      worst = std::max(worst, std::abs(V1 - s.energy) / s.energy);
+      ++checked;
+    }
+    EXPECT_EQ(checked, 2 * 2 * 2 * 4);
+    EXPECT_LT(worst, 1e-8) << (b == &patch ? "patch" : "periodic");
+  }
 }
 
 }  // namespace
