@@ -10,6 +10,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "core/errors.hpp"
+#include "ddfem/block_newton.hpp"
 
 namespace msfab {
 namespace {
@@ -321,8 +322,9 @@ BlockSolver::BlockSolver(const FineBlock& block, double newton_tolerance)
     // (r x u) = [r]_x u
     G_.block<3, 3>(3, 3 * i) << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
   }
-  if (static_cast<int>(block.core_element.size()) == mesh.num_elements() &&
-      std::find(block.core_element.begin(), block.core_element.end(), 0) != block.core_element.end()) {
+  if (static_cast<int>(block.core_element.size()) != mesh.num_elements())
+    throw std::invalid_argument("BlockSolver: the block has no core-element mask (use make_fine_block)");
+  if (std::find(block.core_element.begin(), block.core_element.end(), 0) != block.core_element.end()) {
     core_mesh_ = mesh;
     core_mesh_.elements.clear(), core_mesh_.element_geometry.clear();
     core_mesh_.element_material.clear(), core_mesh_.element_tag.clear();
@@ -370,18 +372,14 @@ double BlockSolver::linear_peak_strain(const VecX& force) const {
   else
     u = Z_ * rest_stiffness_.solve(Z_.transpose() * force);
   const HexMesh& mesh = block_.mesh();
-  const bool all = block_.core_element.size() != static_cast<size_t>(mesh.num_elements());
   double peak = 0;
   for (int e = 0; e < mesh.num_elements(); ++e) {
-    if (!all && !block_.core_element[e]) continue;
+    if (!block_.core_element[e]) continue;
     hex8::NodeMatrix ue;
     for (int c = 0; c < 8; ++c) ue.row(c) = u.segment<3>(3 * mesh.elements[e][c]).transpose();
     const auto& geo = mesh.geometries[mesh.element_geometry[e]];
-    for (int q = 0; q < geo.size(); ++q) {
-      const Mat3 G = hex8::deformation_gradient(ue, geo.dNdX[q]);
-      const Mat3 eps = 0.5 * (G + G.transpose());
-      peak = std::max(peak, Eigen::SelfAdjointEigenSolver<Mat3>(eps).eigenvalues().cwiseAbs().maxCoeff());
-    }
+    for (int q = 0; q < geo.size(); ++q)
+      peak = std::max(peak, largest_small_strain(hex8::deformation_gradient(ue, geo.dNdX[q])));
   }
   return peak;
 }
@@ -389,23 +387,10 @@ double BlockSolver::linear_peak_strain(const VecX& force) const {
 bool BlockSolver::newton_step(const SpMat& K, const VecX& r, VecX& step) const {
   // Shift towards a descent direction where the tangent is indefinite.
   if (!sparse_) {
-    const VecX gz = Z_.transpose() * r;
-    const MatX H = project(K, Z_);
-    const int m = static_cast<int>(Z_.cols());
-    double shift = 0;
-    const double diag = H.diagonal().cwiseAbs().maxCoeff();
-    for (int attempt = 0; attempt < 12; ++attempt) {
-      Eigen::LDLT<MatX> ldlt(H + shift * MatX::Identity(m, m));
-      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-        const VecX y = -ldlt.solve(gz);
-        if (y.allFinite() && y.dot(gz) < 0) {
-          step = Z_ * y;
-          return true;
-        }
-      }
-      shift = shift == 0 ? 1e-8 * diag : shift * 10;
-    }
-    return false;
+    VecX y;
+    if (!shifted_descent_step(project(K, Z_), Z_.transpose() * r, y)) return false;
+    step = Z_ * y;
+    return true;
   }
   const double base = kRigidShift * stiffness_scale_;
   double shift = 0;
@@ -461,11 +446,7 @@ BlockSolver::Solution BlockSolver::solve(const VecX& force, const VecX& x0) cons
     for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
       trial = x + alpha * dx;
       const double phi_trial = potential(trial);
-      // Near convergence the decrease drowns in round-off; accept a first
-      // trial whose energy is unchanged to machine precision.
-      if (std::isfinite(phi_trial) &&
-          (phi_trial <= phi + 1e-4 * alpha * slope ||
-           (ls == 0 && std::abs(phi_trial - phi) <= 1e-13 * std::max(1.0, std::abs(phi))))) {
+      if (energy_step_accepted(phi_trial, phi, alpha, slope, ls == 0)) {
         accepted = true;
         phi = phi_trial;
         break;
@@ -490,9 +471,13 @@ Vec24 BlockSolver::corner_displacements(const VecX& x) const {
   return u;
 }
 
-ForceSampleSet sample_force_space(const FineBlock& block, const ForceSamplingOptions& options) {
+void check_sampling_options(const ForceSamplingOptions& options) {
   if (options.magnitudes < 1) throw InputError("force sampling: magnitudes must be >= 1");
   if (!(options.max_strain > 0.0)) throw InputError("force sampling: max_strain must be > 0");
+}
+
+ForceSampleSet sample_force_space(const FineBlock& block, const ForceSamplingOptions& options) {
+  check_sampling_options(options);
   const auto t0 = std::chrono::steady_clock::now();
   ForceSampleSet set;
   set.patterns = make_force_patterns(block, options);

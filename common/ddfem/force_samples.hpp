@@ -161,6 +161,9 @@ Vec3 sampling_transverse(const Vec3& d);
 // Sampling directions: axes then the seeded Fibonacci hemisphere.
 std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed);
 
+// InputError unless magnitudes >= 1 and max_strain > 0.
+void check_sampling_options(const ForceSamplingOptions& options);
+
 // Runs every pattern at options.magnitudes magnitudes in both signs. Each
 // pattern's largest load is scaled so its linear response peaks at
 // options.max_strain, so soft and stiff blocks deform comparably.

@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "ddfem/anisotropy.hpp"
+#include "ddfem/block_newton.hpp"
 
 namespace msfab {
 namespace {
@@ -21,8 +22,7 @@ double coarse_peak_strain(const FineBlock& block, const Vec24& u) {
   for (int q = 0; q < geo.size(); ++q) {
     Mat3 G = Mat3::Zero();
     for (int c = 0; c < 8; ++c) G += u.segment<3>(3 * c) * geo.dNdX[q].row(c);
-    const Mat3 eps = 0.5 * (G + G.transpose());
-    peak = std::max(peak, Eigen::SelfAdjointEigenSolver<Mat3>(eps).eigenvalues().cwiseAbs().maxCoeff());
+    peak = std::max(peak, largest_small_strain(G));
   }
   return peak;
 }
@@ -88,6 +88,10 @@ PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_t
       node_weights_[n][c] = wx * wy * wz;
     }
   }
+  // Reduction to the periodic unknowns: sum over each class's nodes.
+  reduce_ = MatX::Zero(3 * mesh.num_nodes(), kFree);
+  for (int n = 0; n < mesh.num_nodes(); ++n)
+    if (node_class_[n] > 0) reduce_.block<3, 3>(3 * n, 3 * (node_class_[n] - 1)).setIdentity();
 }
 
 VecX PeriodicBlockSolver::positions(const Vec24& u1, const VecX& w) const {
@@ -106,10 +110,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
   const int nodes = static_cast<int>(node_class_.size());
   SpMat K = assembler_.pattern();
   VecX g(3 * nodes);
-  // Reduction to the periodic unknowns: sum over each class's nodes.
-  MatX P = MatX::Zero(3 * nodes, kFree);
-  for (int n = 0; n < nodes; ++n)
-    if (node_class_[n] > 0) P.block<3, 3>(3 * n, 3 * (node_class_[n] - 1)).setIdentity();
+  const MatX& P = reduce_;
   double E = assembler_.energy(positions(u1, w));
   if (!std::isfinite(E)) {
     w.setZero();
@@ -128,20 +129,8 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
       if (iterations) *iterations = it;
       return E;
     }
-    const MatX H = P.transpose() * (K * P);
-    const double diag = H.diagonal().cwiseAbs().maxCoeff();
     VecX step;
-    double shift = 0;
-    for (int attempt = 0; attempt < 12; ++attempt) {
-      Eigen::LDLT<MatX> ldlt(H + shift * MatX::Identity(kFree, kFree));
-      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-        step = -ldlt.solve(gw);
-        if (step.allFinite() && step.dot(gw) < 0) break;
-      }
-      step.resize(0);
-      shift = shift == 0 ? 1e-8 * diag : shift * 10;
-    }
-    if (step.size() == 0) return kInfiniteEnergy;
+    if (!shifted_descent_step(P.transpose() * (K * P), gw, step)) return kInfiniteEnergy;
     // A quarter voxel at most per step (inverted elements are +inf).
     double alpha = std::min(1.0, 0.25 * h / step.cwiseAbs().maxCoeff());
     const double slope = step.dot(gw);
@@ -149,8 +138,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
     for (int ls = 0; ls < 40; ++ls, alpha *= 0.5) {
       const VecX trial = w + alpha * step;
       const double E_trial = assembler_.energy(positions(u1, trial));
-      if (std::isfinite(E_trial) && (E_trial <= E + 1e-4 * alpha * slope ||
-                                     (ls == 0 && std::abs(E_trial - E) <= 1e-13 * std::max(1.0, std::abs(E))))) {
+      if (energy_step_accepted(E_trial, E, alpha, slope, ls == 0)) {
         w = trial, E = E_trial, accepted = true;
         break;
       }
@@ -161,8 +149,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
 }
 
 ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOptions& options) {
-  if (options.magnitudes < 1) throw InputError("force sampling: magnitudes must be >= 1");
-  if (!(options.max_strain > 0.0)) throw InputError("force sampling: max_strain must be > 0");
+  check_sampling_options(options);
   const auto t0 = std::chrono::steady_clock::now();
   ForceSampleSet set;
   set.patterns = make_corner_displacement_patterns(block, options);

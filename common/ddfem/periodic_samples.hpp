@@ -43,6 +43,7 @@ class PeriodicBlockSolver {
   VecX rest_;
   std::vector<int> node_class_;        // mesh node -> periodic class 0..7 (0: corners)
   std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node
+  MatX reduce_;                         // DOFs x 21: sums nodal forces over each free periodic class
 };
 
 // Every pattern at options.magnitudes magnitudes in both signs, peak coarse

@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "ddfem/anisotropy.hpp"
 #include "ddfem/coarse_fit.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
 #include "ddfem/level2_block.hpp"
@@ -19,26 +20,34 @@
 namespace msfab {
 namespace {
 
-constexpr double kVoxel = 1e-3;
+using ddfem_test::kVoxel;
+using ddfem_test::layered_ids;
+using ddfem_test::two_materials;
 
-std::vector<MaterialPtr> two_materials(double E_soft, double E_stiff) {
-  return {nullptr, std::make_shared<NeoHookean>(E_soft, 0.3), std::make_shared<NeoHookean>(E_stiff, 0.3)};
+// Worst relative difference, over the stretch and shear samples of a set,
+// between the sample's energy and the coarse energy of `exact` at its
+// corner displacements; *checked counts them.
+double worst_affine_energy_error(const ForceSampleSet& set, const CoarseMaterialFit& exact, const FineBlock& b,
+                                 int* checked) {
+  double worst = 0;
+  *checked = 0;
+  for (const ForceSample& s : set.samples) {
+    const ForceKind kind = set.patterns[s.pattern].kind;
+    if (kind != ForceKind::stretch && kind != ForceKind::shear) continue;
+    const double V1 = coarse_energy(exact, b.coarse_geometry(), b.coarse_rest_positions(), s.corner_displacement);
+    worst = std::max(worst, std::abs(V1 - s.energy) / s.energy);
+    ++*checked;
+  }
+  return worst;
 }
 
-// Soft children below z = h, stiff above: in periodic context, 1-voxel
-// layers normal to z.
-BlockMaterials layered_ids() {
-  BlockMaterials ids;
-  for (int c = 0; c < 8; ++c) ids[c] = (c & 1) ? 2 : 1;
-  return ids;
-}
-
-CoarseFitOptions small_options() {
-  CoarseFitOptions o;
-  o.sampling.sphere_directions = 1;
-  o.sampling.magnitudes = 2;
-  o.anisotropy.directions = 10;
-  return o;
+// The coarse material of a homogeneous Neo-Hookean block: (mu, lambda) at
+// every point, no springs.
+CoarseMaterialFit homogeneous_fit(int points, double mu, double lambda) {
+  CoarseMaterialFit fit(points);
+  fit.fitted = true;
+  for (int k = 0; k < points; ++k) fit.mu[k] = mu, fit.lambda[k] = lambda;
+  return fit;
 }
 
 TEST(DdfemContext, PatchOfPeriodicCopies) {
@@ -133,20 +142,9 @@ TEST(DdfemContext, HomogeneousBlockIsReproducedExactly) {
   o.magnitudes = 3;
   const ForceSampleSet set = sample_force_space(b, o);
   EXPECT_EQ(set.dropped, 0);
-  CoarseMaterialFit exact(8);
-  exact.fitted = true;
-  for (int k = 0; k < 8; ++k) exact.mu[k] = pal[2]->shear_modulus(), exact.lambda[k] = pal[2]->lame_lambda();
-  const auto coarse = b.coarse_geometry();
-  const auto X = b.coarse_rest_positions();
   int checked = 0;
-  double worst = 0;
-  for (const ForceSample& s : set.samples) {
-    const ForceKind kind = set.patterns[s.pattern].kind;
-    if (kind != ForceKind::stretch && kind != ForceKind::shear) continue;
-    const double V1 = coarse_energy(exact, coarse, X, s.corner_displacement);
-    worst = std::max(worst, std::abs(V1 - s.energy) / s.energy);
-    ++checked;
-  }
+  const double worst = worst_affine_energy_error(
+      set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b, &checked);
   std::printf("[ddfem-context] homogeneous block: %d stretch/shear samples, worst relative energy difference %.2e\n",
               checked, worst);
   EXPECT_EQ(checked, 2 * 2 * 3 * 6);  // 2 kinds x 2 signs x 3 magnitudes x 6 directions
@@ -177,7 +175,7 @@ TEST(DdfemContext, LayeredBlockMovesTowardVoigtAlongTheLayers) {
   const double M_soft = pal[1]->lame_lambda() + 2 * pal[1]->shear_modulus();
   const double M_stiff = pal[2]->lame_lambda() + 2 * pal[2]->shear_modulus();
   const double voigt = 0.5 * (M_soft + M_stiff), reuss = 2.0 / (1.0 / M_soft + 1.0 / M_stiff);
-  CoarseFitOptions options = small_options();
+  CoarseFitOptions options = ddfem_test::small_fit_options();
   const FineBlock alone = make_fine_block(layered_ids(), pal, kVoxel);
   const FineBlock in_context = make_fine_block(layered_ids(), pal, kVoxel, 2, 1);
   const CoarseMaterialFit fit_alone = fit_coarse_material(alone, options);
@@ -219,18 +217,10 @@ TEST(DdfemPeriodic, HomogeneousBlockIsExactAndTheFluctuationMinimizes) {
   const ForceSampleSet set = sample_periodic(b, o);
   EXPECT_EQ(set.dropped, 0);
   EXPECT_EQ(set.attempted, (6 * 4 + 12) * 2 * 3);
-  CoarseMaterialFit exact(8);
-  exact.fitted = true;
-  for (int k = 0; k < 8; ++k) exact.mu[k] = pal[2]->shear_modulus(), exact.lambda[k] = pal[2]->lame_lambda();
-  const auto coarse = b.coarse_geometry();
-  const auto X = b.coarse_rest_positions();
-  double worst = 0;
-  for (const ForceSample& s : set.samples) {
-    const ForceKind kind = set.patterns[s.pattern].kind;
-    if (kind != ForceKind::stretch && kind != ForceKind::shear) continue;
-    worst = std::max(worst, std::abs(coarse_energy(exact, coarse, X, s.corner_displacement) - s.energy) / s.energy);
-  }
-  EXPECT_LT(worst, 1e-12);
+  int checked = 0;
+  EXPECT_LT(worst_affine_energy_error(set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b,
+                                      &checked),
+            1e-12);
   // Relaxed bending: below the unrelaxed (w = 0) energy, and a minimum.
   const PeriodicBlockSolver solver(b, 1e-12);
   const ElasticAssembler assembler(b.mesh());
@@ -271,7 +261,7 @@ TEST(DdfemPeriodic, FiberBlockCarriesLoadAlongTheFiber) {
   BlockMaterials ids;
   for (int c = 0; c < 8; ++c) ids[c] = ((c >> 2 & 1) == 0 && (c & 1) == 0) ? 2 : 1;  // x = 0, z = 0: one column
   const FineBlock b = make_fine_block(ids, pal, kVoxel);
-  CoarseFitOptions options = small_options();
+  CoarseFitOptions options = ddfem_test::small_fit_options();
   const CoarseMaterialFit alone = fit_coarse_material(b, options);
   options.sampling.mode = ForceSamplingOptions::Mode::periodic;
   const CoarseMaterialFit periodic = fit_coarse_material(b, options);
@@ -304,24 +294,14 @@ TEST(DdfemContext, Level2BlockInContextAndPeriodic) {
     EXPECT_EQ(patch.mesh().element_tag[e], patch.child_of_element(e) + 1);
   }
   const FineBlock alone = make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel);
-  CoarseMaterialFit exact(64);
-  exact.fitted = true;
-  for (int k = 0; k < 64; ++k) exact.mu[k] = mu, exact.lambda[k] = lambda;
   ForceSamplingOptions o;
   o.sphere_directions = 1;
   o.magnitudes = 2;
   for (const FineBlock* b : {&patch, &alone}) {
     const ForceSampleSet set = b == &patch ? sample_force_space(*b, o) : sample_periodic(*b, o);
     EXPECT_EQ(set.dropped, 0);
-    double worst = 0;
     int checked = 0;
-    for (const ForceSample& s : set.samples) {
-      const ForceKind kind = set.patterns[s.pattern].kind;
-      if (kind != ForceKind::stretch && kind != ForceKind::shear) continue;
-      const double V1 = coarse_energy(exact, b->coarse_geometry(), b->coarse_rest_positions(), s.corner_displacement);
-      worst = std::max(worst, std::abs(V1 - s.energy) / s.energy);
-      ++checked;
-    }
+    const double worst = worst_affine_energy_error(set, homogeneous_fit(64, mu, lambda), *b, &checked);
     EXPECT_EQ(checked, 2 * 2 * 2 * 4);
     EXPECT_LT(worst, 1e-8) << (b == &patch ? "patch" : "periodic");
   }
