@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "fem/voxel_shapes.hpp"
@@ -191,22 +192,19 @@ TEST(Scene, BadCheckerOrRandomFieldNamesTheField) {
     return std::string("no error");
   };
   auto contains = [](const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; };
-  std::string m = message("[{checker: {cell: 0.5, ids: [1, 2]}}]");
-  EXPECT_TRUE(contains(m, "layout[0].checker.ids")) << m;  // id 2 is not in the palette
-  m = message("[{checker: {cell: 0.5, ids: [1]}}]");
-  EXPECT_TRUE(contains(m, "layout[0].checker.ids")) << m;
-  m = message("[{checker: {cell: -0.5, ids: [1, 0]}}]");
-  EXPECT_TRUE(contains(m, "layout[0].checker.cell")) << m;
-  m = message("[{checker: {ids: [1, 0]}}]");
-  EXPECT_TRUE(contains(m, "layout[0].checker.cell")) << m;
-  m = message("[{random_field: {ids: [1], seed: -3}}]");
-  EXPECT_TRUE(contains(m, "layout[0].random_field.seed")) << m;
-  m = message("[{random_field: {ids: [1]}}]");
-  EXPECT_TRUE(contains(m, "layout[0].random_field.seed")) << m;
-  m = message("[{random_field: {ids: [], seed: 1}}]");
-  EXPECT_TRUE(contains(m, "layout[0].random_field.ids")) << m;
-  m = message("[{random_field: {ids: [1, 9], seed: 1}}]");
-  EXPECT_TRUE(contains(m, "layout[0].random_field.ids")) << m;
-  m = message("[{random_field: {ids: [1], seed: 1, sed: 2}}]");
-  EXPECT_TRUE(contains(m, "sed")) << m;
+  const std::pair<const char*, const char*> cases[] = {
+      {"[{checker: {cell: 0.5, ids: [1, 2]}}]", "layout[0].checker.ids"},  // id 2 is not in the palette
+      {"[{checker: {cell: 0.5, ids: [1]}}]", "layout[0].checker.ids"},
+      {"[{checker: {cell: -0.5, ids: [1, 0]}}]", "layout[0].checker.cell"},
+      {"[{checker: {ids: [1, 0]}}]", "layout[0].checker.cell"},
+      {"[{random_field: {ids: [1], seed: -3}}]", "layout[0].random_field.seed"},
+      {"[{random_field: {ids: [1]}}]", "layout[0].random_field.seed"},
+      {"[{random_field: {ids: [], seed: 1}}]", "layout[0].random_field.ids"},
+      {"[{random_field: {ids: [1, 9], seed: 1}}]", "layout[0].random_field.ids"},
+      {"[{random_field: {ids: [1], seed: 1, sed: 2}}]", "sed"},
+  };
+  for (const auto& [layout, field] : cases) {
+    const std::string m = message(layout);
+    EXPECT_TRUE(contains(m, field)) << layout << ": " << m;
+  }
 }
