@@ -80,6 +80,7 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
   const int P = K > 0 ? entries[0].points() : 8;
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> entry_ids(K, 8);
   MatX mu(K, P), lambda(K, P), C(K, P), v(K, 3 * P);
+  MatX centre(K, 2);
   VecX residual(K), heldout(K), heldout_energy(K), seconds(K);
   std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
   for (std::int64_t e = 0; e < K; ++e) {
@@ -90,6 +91,7 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
       mu(e, k) = fit.mu[k], lambda(e, k) = fit.lambda[k], C(e, k) = fit.C[k];
       v.block<1, 3>(e, 3 * k) = fit.v[k].transpose();
     }
+    centre(e, 0) = fit.mu_centre, centre(e, 1) = fit.lambda_centre;
     residual[e] = fit.residual, heldout[e] = fit.heldout_error, heldout_energy[e] = fit.heldout_energy_error;
     seconds[e] = fit.seconds;
     fitted[e] = fit.fitted;
@@ -103,7 +105,12 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
   f.write_matrix(g + "/lambda", lambda);
   f.write_matrix(g + "/C", C);
   f.write_matrix(g + "/v", v);
-  f.write_attribute(g, "units", "mu, lambda, C: Pa (energy densities, Eq. 2.7 per quadrature point); v: unit");
+  // Only databases fitted with the centre point carry it; without the
+  // dataset mu_c = lambda_c = 0, so older databases read unchanged.
+  if (centre.size() > 0 && centre.maxCoeff() > 0.0) f.write_matrix(g + "/centre", centre);
+  f.write_attribute(g, "units",
+                    "mu, lambda, C: Pa (energy densities, Eq. 2.7 per quadrature point); v: unit; "
+                    "centre: mu_c, lambda_c in Pa (Neo-Hookean term at the element centre)");
   f.write_attribute(g, "points", P);
   f.write_vector(g + "/residual", residual);
   f.write_vector(g + "/heldout_error", heldout);
@@ -222,6 +229,11 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
   const auto heldout_energy = f.read_vector<double>(g + "/heldout_energy_error");
   const auto train = f.read_vector<int>(g + "/samples_train");
   const auto held = f.read_vector<int>(g + "/samples_heldout");
+  MatX centre = MatX::Zero(K, 2);
+  if (f.exists(g + "/centre")) {
+    centre = f.read_matrix<double>(g + "/centre");
+    shape_ok(path, g + "/centre", centre.rows(), centre.cols(), K, 2);
+  }
   if (K < 1 || K > max_rows) bad(path, g + "/ids must have between 1 and " + std::to_string(max_rows) + " rows");
   shape_ok(path, g + "/ids", K, entry_ids.cols(), K, 8);
   shape_ok(path, g + "/fitted", fitted.size(), 1, K, 1);
@@ -252,6 +264,10 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
         bad(path, g + " row " + std::to_string(e) + " point " + std::to_string(k) +
                       ": parameters must be >= 0 and v a unit vector");
     }
+    fit.mu_centre = centre(e, 0), fit.lambda_centre = centre(e, 1);
+    if (!(fit.mu_centre >= 0.0) || !std::isfinite(fit.mu_centre) || !(fit.lambda_centre >= 0.0) ||
+        !std::isfinite(fit.lambda_centre))
+      bad(path, g + "/centre row " + std::to_string(e) + " must be finite and >= 0");
     fit.residual = residual[e], fit.heldout_error = heldout[e], fit.heldout_energy_error = heldout_energy[e];
     fit.samples_train = train[e], fit.samples_heldout = held[e];
   }

@@ -61,6 +61,15 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
     const double l = (F[k] * v[k]).norm();
     out.s[k] = w * (l - 1.0) * (l - 1.0);
   }
+  const hex8::ElementGeometry centre = hex8::element_geometry(X, hex8::gauss_rule(1));
+  hex8::NodeMatrix x = X;
+  for (int n = 0; n < 8; ++n) x.row(n) += u.segment<3>(3 * n).transpose();
+  const Mat3 Fc = hex8::deformation_gradient(x, centre.dNdX[0]);
+  const double Jc = Fc.determinant();
+  if (!(Jc > 0.0)) return false;
+  const double logJc = std::log(Jc);
+  out.a_centre = centre.weight[0] * (0.5 * (Fc.squaredNorm() - 3.0) - logJc);
+  out.b_centre = centre.weight[0] * 0.5 * logJc * logJc;
   return true;
 }
 
@@ -72,7 +81,7 @@ double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& 
   if (!coarse_energy_basis(coarse, X, u, fit.v, e)) return kInfiniteEnergy;
   double V = 0;
   for (int k = 0; k < fit.points(); ++k) V += fit.mu[k] * e.a[k] + fit.lambda[k] * e.b[k] + fit.C[k] * e.s[k];
-  return V;
+  return V + fit.mu_centre * e.a_centre + fit.lambda_centre * e.b_centre;
 }
 
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
@@ -129,7 +138,8 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   // would forbid a soft point from stiffening, yet in a layered block the
   // soft children's points must carry the stiff layer's in-plane stiffness.
   const int per_point = options.anisotropic ? 3 : 2;
-  const int np = points * per_point;
+  const int centre = points * per_point;  // mu_c's column, then lambda_c's, if fitted
+  const int np = centre + (options.centre_point ? 2 : 0);
   double mu_mean = 0, lambda_mean = 0;
   for (int k = 0; k < points; ++k) mu_mean += fit.mu0[k] / points, lambda_mean += fit.lambda0[k] / points;
   if (!(lambda_mean > 1e-6 * mu_mean)) lambda_mean = mu_mean;
@@ -143,6 +153,13 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
       scale[per_point * k + 2] = mu_mean;
       target[per_point * k + 2] = 0.0;
     }
+  }
+  // The centre starts from nothing: the fine block's material is at the
+  // Gauss points (p^0), and the data move stiffness to the centre where
+  // bending samples ask for it.
+  if (options.centre_point) {
+    scale[centre] = mu_mean, target[centre] = 0.0;
+    scale[centre + 1] = lambda_mean, target[centre + 1] = 0.0;
   }
   // Sample weights: kind weight / samples of that kind in the same split,
   // normalized per split, so the data term is a weighted mean squared
@@ -178,6 +195,10 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
       A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
       if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
     }
+    if (options.centre_point) {
+      A(r, centre) = w * basis[s].a_centre * scale[centre];
+      A(r, centre + 1) = w * basis[s].b_centre * scale[centre + 1];
+    }
     b[r] = w * V0[s];
     ++r;
   }
@@ -199,13 +220,17 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.lambda[k] = sol.x[per_point * k + 1] * scale[per_point * k + 1];
     fit.C[k] = options.anisotropic ? sol.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
   }
+  if (options.centre_point) {
+    fit.mu_centre = sol.x[centre] * scale[centre];
+    fit.lambda_centre = sol.x[centre + 1] * scale[centre + 1];
+  }
   fit.fitted = true;
   fit.objective = sol.residual * sol.residual;
 
   std::vector<double> rel_train, rel_held, w_train, w_held;
   double abs_held = 0, sum_held = 0;
   for (int s = 0; s < ns; ++s) {
-    double V1 = 0;
+    double V1 = fit.mu_centre * basis[s].a_centre + fit.lambda_centre * basis[s].b_centre;
     for (int k = 0; k < points; ++k)
       V1 += fit.mu[k] * basis[s].a[k] + fit.lambda[k] * basis[s].b[k] + fit.C[k] * basis[s].s[k];
     (held[s] ? rel_held : rel_train).push_back((V1 - V0[s]) / V0[s]);
@@ -251,7 +276,16 @@ QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit) {
     else
       q.at_point.push_back(nh);
   }
+  if (fit.mu_centre > 0.0 || fit.lambda_centre > 0.0)
+    q.at_point.push_back(NeoHookean::from_lame(fit.mu_centre, fit.lambda_centre));
   return q;
+}
+
+hex8::ElementGeometry coarse_element_geometry(const hex8::ElementGeometry& gauss, const hex8::NodeMatrix& X,
+                                              const QuadratureMaterials& materials) {
+  const int n = static_cast<int>(materials.at_point.size());
+  if (n == gauss.size() + 1) return hex8::with_centre_point(gauss, X);
+  return gauss;
 }
 
 }  // namespace msfab

@@ -14,6 +14,16 @@
 //                               + C_k (||F_k v_k|| - 1)^2],
 // so Eq. 2.9 is a regularized linear least-squares problem with p >= 0,
 // solved by NNLS in scaled variables (see docs/ddfem.md, "Fitting").
+//
+// Optionally (CoarseFitOptions::centre_point) a Neo-Hookean term at the
+// element centre,
+//   + V_e [mu_c ((I1_c - 3)/2 - log J_c) + lambda_c (log J_c)^2 / 2],
+// F_c the deformation gradient at chi = 0: the one-point element of reduced
+// integration, with the 8 Gauss-point terms as its fitted hourglass control.
+// A bent trilinear element shears parasitically and changes volume at its
+// Gauss points but not at its centre, so the fit can move stiffness there
+// instead of softening every point to offset locking (docs/ddfem.md,
+// "Centre point").
 #include <array>
 #include <cstdint>
 #include <string>
@@ -28,6 +38,7 @@ struct CoarseFitOptions {
   ForceSamplingOptions sampling;
   AnisotropyOptions anisotropy;
   bool anisotropic = true;        // fit C_k (else C_k = 0 and no direction solves)
+  bool centre_point = false;      // fit mu_c, lambda_c (else both 0)
   double regularization = 0.02;   // lambda of Eq. 2.9, on the scaled problem, per 8 points
   double heldout_fraction = 0.2;  // samples kept out of the fit for validation
   // Weight of each force kind in the fit, indexed by ForceKind (stretch,
@@ -46,6 +57,7 @@ struct CoarseMaterialFit {
   // 64 for a 4-point rule.
   std::vector<double> mu, lambda, C;
   std::vector<Vec3> v;                        // spring directions (unit)
+  double mu_centre = 0, lambda_centre = 0;    // mu_c, lambda_c (energy densities), 0 without the centre point
   std::vector<double> mu0, lambda0;           // fine parameters at each point (Eq. 2.9's p^0)
   // Relative energy errors (V1 - V0) / V0, RMS with the fit's kind weights.
   double residual = 0;             // over the training samples
@@ -65,10 +77,12 @@ struct CoarseMaterialFit {
 };
 
 // The per-point basis energies of V^1 for corner displacements u: a_k, b_k,
-// s_k already multiplied by w_k det J_k. Returns false if the coarse element
-// is inverted at a point.
+// s_k already multiplied by w_k det J_k, and the centre's a_c, b_c
+// multiplied by V_e. Returns false if the coarse element is inverted at a
+// point or at its centre.
 struct CoarseEnergyBasis {
   std::vector<double> a, b, s;
+  double a_centre = 0, b_centre = 0;
 };
 bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
                          const std::vector<Vec3>& v, CoarseEnergyBasis& out);
@@ -89,7 +103,15 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 
 // Materials for a coarse element using the fit: per point MaterialSum of
 // NeoHookean(mu_k, lambda_k) and AnisotropicSpring(C_k, v_k) (the spring is
-// omitted where C_k = 0). Throws std::invalid_argument if !fit.fitted.
+// omitted where C_k = 0); where mu_c or lambda_c > 0, one more material,
+// NeoHookean(mu_c, lambda_c), for the element centre (pair it with
+// coarse_element_geometry). Throws std::invalid_argument if !fit.fitted.
 QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit);
+
+// The geometry that goes with `materials`: `gauss` itself, or `gauss` with
+// the centre point of the element X when there is one material more than
+// Gauss points.
+hex8::ElementGeometry coarse_element_geometry(const hex8::ElementGeometry& gauss, const hex8::NodeMatrix& X,
+                                              const QuadratureMaterials& materials);
 
 }  // namespace msfab

@@ -119,21 +119,28 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   for (size_t c = 0; c < grid.combinations.size(); ++c) {
     QuadratureMaterials m = lookup(grid.combinations[c]);
     const int n = static_cast<int>(m.at_point.size());
-    if (n != 1 && n != rule.size()) {
+    if (n != 1 && n != rule.size() && n != rule.size() + 1) {
       std::ostringstream msg;
       msg << "coarse mesh: the material lookup returned " << n << " materials for combination " << c
-          << "; expected 1 or " << rule.size() << " (one per quadrature point)";
+          << "; expected 1, " << rule.size() << " (one per quadrature point) or " << rule.size() + 1
+          << " (and one at the centre)";
       throw InputError(msg.str());
     }
     for (const MaterialPtr& p : m.at_point)
       if (!p) throw InputError("coarse mesh: the material lookup returned a null material for combination " + std::to_string(c));
     mesh.materials.push_back(std::move(m));
   }
-  for (int e = 0; e < mesh.num_elements(); ++e) mesh.element_material[e] = mesh.element_tag[e] - 1;
-
   hex8::NodeMatrix cube;
   for (int c = 0; c < 8; ++c) cube.row(c) = grid.cell_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
+  // Geometry 0: the Gauss rule; geometry 1: the rule and the element centre,
+  // for materials with a centre term (ddfem/coarse_fit.hpp).
   mesh.geometries.assign(1, hex8::element_geometry(cube, rule));
+  mesh.geometries.push_back(hex8::with_centre_point(mesh.geometries[0], cube));
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const int m = mesh.element_tag[e] - 1;
+    mesh.element_material[e] = m;
+    mesh.element_geometry[e] = static_cast<int>(mesh.materials[m].at_point.size()) == rule.size() + 1 ? 1 : 0;
+  }
 
   if (stats) {
     stats->elements = mesh.num_elements();

@@ -50,7 +50,8 @@ std::vector<Mat24> level1_rest_stiffness(const std::vector<CoarseMaterialFit>& l
   const hex8::NodeMatrix X = element.coarse_rest_positions();
   std::vector<Mat24> K(level1.size());
   for (std::size_t e = 0; e < level1.size(); ++e) {
-    hex_evaluate(geo, coarse_quadrature_materials(level1[e]), X, nullptr, &K[e]);
+    const QuadratureMaterials m = coarse_quadrature_materials(level1[e]);
+    hex_evaluate(coarse_element_geometry(geo, X, m), m, X, nullptr, &K[e]);
     if (!K[e].allFinite()) throw InputError("level 2: level-1 coarse material " + std::to_string(e) + " has a non-finite stiffness");
   }
   return K;

@@ -39,10 +39,15 @@ FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFi
   HexMesh& mesh = block.voxels.mesh;
   mesh.materials.clear();
   for (int c = 0; c < 8; ++c) mesh.materials.push_back(coarse_quadrature_materials(*children[c]));
+  // Children fitted with a centre term need the element centre as a ninth
+  // point: geometry 1 (all elements are the same cube).
+  const hex8::ElementGeometry gauss = mesh.geometries.at(0);
+  mesh.geometries.push_back(hex8::with_centre_point(gauss, mesh.element_rest_positions(0)));
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int c = block.child_of_element(e);
     mesh.element_material[e] = c;
     mesh.element_tag[e] = ids[c];
+    mesh.element_geometry[e] = mesh.materials[c].at_point.size() == gauss.weight.size() ? 0 : 1;
   }
   for (int q = 0; q < block.coarse_points(); ++q) {
     int c = 0;

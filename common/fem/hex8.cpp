@@ -90,4 +90,12 @@ ElementGeometry element_geometry(const NodeMatrix& X, const QuadratureRule& rule
   return g;
 }
 
+ElementGeometry with_centre_point(const ElementGeometry& geo, const NodeMatrix& X) {
+  const ElementGeometry centre = element_geometry(X, gauss_rule(1));
+  ElementGeometry g = geo;
+  g.dNdX.push_back(centre.dNdX[0]);
+  g.weight.push_back(centre.weight[0]);
+  return g;
+}
+
 }  // namespace msfab::hex8

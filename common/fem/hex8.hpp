@@ -44,6 +44,11 @@ struct ElementGeometry {
   int size() const { return static_cast<int>(weight.size()); }
 };
 ElementGeometry element_geometry(const NodeMatrix& X, const QuadratureRule& rule);
+// `geo` with one more point: the element centre, weighted by the element's
+// volume. A material placed there sees the centre's deformation gradient, as
+// the volumetric point of selective reduced integration does; DDFEM coarse
+// materials may carry a fitted volumetric term there (ddfem/coarse_fit.hpp).
+ElementGeometry with_centre_point(const ElementGeometry& geo, const NodeMatrix& X);
 
 // F = sum_i x_i (dN_i/dX)^T (Eq. 2.4 written for positions x = X + u).
 inline Mat3 deformation_gradient(const NodeMatrix& x, const NodeMatrix& dNdX) {

@@ -87,6 +87,7 @@ BuildOptions read_build_options(const Config& config) {
     if (!(o.fit.heldout_fraction >= 0 && o.fit.heldout_fraction < 1)) f.fail("heldout_fraction", "must be in [0, 1)");
     o.fit.split_seed = f.get_or<std::uint64_t>("split_seed", o.fit.split_seed);
     o.fit.anisotropic = f.get_or<bool>("anisotropic", o.fit.anisotropic);
+    o.fit.centre_point = f.get_or<bool>("centre_point", o.fit.centre_point);
     o.fit.kind_weight[int(ForceKind::pinch)] = f.get_or<double>("pinch_weight", o.fit.kind_weight[4]);
     if (!(o.fit.kind_weight[4] >= 0)) f.fail("pinch_weight", "must be >= 0");
     for (ForceKind kind : {ForceKind::stretch, ForceKind::shear, ForceKind::bend, ForceKind::twist}) {

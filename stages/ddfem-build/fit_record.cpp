@@ -21,8 +21,8 @@ void pack_fit(const CoarseMaterialFit& fit, double* row) {
   *p++ = fit.samples_train;
   *p++ = fit.samples_heldout;
   *p++ = fit.seconds;
-  *p++ = 0;
-  *p++ = 0;
+  *p++ = fit.mu_centre;
+  *p++ = fit.lambda_centre;
 }
 
 CoarseMaterialFit unpack_fit(const double* row, int points) {
@@ -44,6 +44,8 @@ CoarseMaterialFit unpack_fit(const double* row, int points) {
   fit.samples_train = static_cast<int>(*p++);
   fit.samples_heldout = static_cast<int>(*p++);
   fit.seconds = *p++;
+  fit.mu_centre = *p++;
+  fit.lambda_centre = *p++;
   return fit;
 }
 

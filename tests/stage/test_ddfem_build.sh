@@ -28,6 +28,19 @@ check "periodic sampling, three ranks" -- mpirun -np 3 --oversubscribe -x OMP_NU
 check "1 and 3 ranks give the same periodic database" -- same_db "$WORK/p1.h5" "$WORK/p3.h5"
 check "periodic and isolated databases differ" -- bash -c "! h5diff -q '$WORK/one.h5' '$WORK/p1.h5' /fit/mu /fit/mu"
 
+# The centre point (docs/ddfem.md): stored, carried through the MPI records
+# unchanged, and used by the simulator.
+check "centre point, one rank" -- "$BUILD" --config "$TINY" --set sampling.mode=periodic --set fit.centre_point=true \
+  --out "$WORK/c1.h5" --quiet
+check "centre point, three ranks" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$TINY" \
+  --set sampling.mode=periodic --set fit.centre_point=true --out "$WORK/c3.h5" --quiet
+check "1 and 3 ranks give the same centre-point database" -- bash -c \
+  "h5diff -q '$WORK/c1.h5' '$WORK/c3.h5' /fit/centre /fit/centre && $(declare -f same_db); DATASETS='$DATASETS' same_db '$WORK/c1.h5' '$WORK/c3.h5'"
+check "centre-point database stores /fit/centre" -- bash -c "h5dump -H -d /fit/centre '$WORK/c1.h5' | grep -q '( 256, 2 )'"
+check "databases without the centre point store none" -- bash -c "! h5dump -H -d /fit/centre '$WORK/p1.h5' >/dev/null 2>&1"
+check "the simulator runs on a centre-point database" -- "$BIN/msfab-simulate" --config "$SRC/configs/scenes/demo_bar.yaml" \
+  --coarsen 1 --database "$WORK/c1.h5" --out "$WORK/c1run.h5" --quiet
+
 # Stop after two rounds (a batch job's time limit), then resume.
 expect_exit 0 "stopped after 2 rounds" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --max-rounds 2
 check "checkpoint kept" -- test -e "$WORK/part.h5.checkpoint.h5"

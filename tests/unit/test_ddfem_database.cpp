@@ -27,6 +27,7 @@ CoarseMaterialFit random_fit(std::mt19937_64& rng, const BlockMaterials& ids) {
     f.C[k] = 2e5 * u01();
     f.v[k] = Vec3(u01() - 0.5, u01() - 0.5, u01() - 0.5).normalized();
   }
+  f.lambda_centre = u01() < 0.5 ? 0.0 : 3e5 * u01();
   f.heldout_error = u01();
   return f;
 }
@@ -97,6 +98,7 @@ TEST(DdfemDatabase, CombinationCodesRoundTripAndArtifactReadsBack) {
   for (std::size_t e = 0; e < db.entries.size(); ++e) {
     EXPECT_EQ(back.entries[e].mu, db.entries[e].mu);
     EXPECT_EQ(back.entries[e].C, db.entries[e].C);
+    EXPECT_EQ(back.entries[e].lambda_centre, db.entries[e].lambda_centre);
     for (int k = 0; k < 8; ++k) EXPECT_EQ(back.entries[e].v[k], db.entries[e].v[k]);
     EXPECT_EQ(back.orbit[e], db.orbit[e]);
   }
