@@ -132,14 +132,17 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   }
   hex8::NodeMatrix cube;
   for (int c = 0; c < 8; ++c) cube.row(c) = grid.cell_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
-  // Geometry 0: the Gauss rule; geometry 1: the rule and the element centre,
-  // for materials with a centre term (ddfem/coarse_fit.hpp).
+  // Geometry 0: the Gauss rule; geometry 1, where a material has a centre
+  // point (ddfem/coarse_fit.hpp): the rule and the element centre.
   mesh.geometries.assign(1, hex8::element_geometry(cube, rule));
-  mesh.geometries.push_back(hex8::with_centre_point(mesh.geometries[0], cube));
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int m = mesh.element_tag[e] - 1;
     mesh.element_material[e] = m;
-    mesh.element_geometry[e] = static_cast<int>(mesh.materials[m].at_point.size()) == rule.size() + 1 ? 1 : 0;
+    mesh.element_geometry[e] = 0;
+    if (static_cast<int>(mesh.materials[m].at_point.size()) == rule.size() + 1) {
+      if (mesh.geometries.size() == 1) mesh.geometries.push_back(hex8::with_centre_point(mesh.geometries[0], cube));
+      mesh.element_geometry[e] = 1;
+    }
   }
 
   if (stats) {
