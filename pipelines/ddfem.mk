@@ -5,6 +5,7 @@
 #   make -f Makefile.pipeline ddfem-db-level2    level 2 over level 1 compressed to 400 materials, minutes
 #   make -f Makefile.pipeline ddfem-table        regenerate the Table 2.2 analogue in docs/BENCHMARKS.md
 #   make -f Makefile.pipeline ddfem-table-periodic  the same with in-situ (periodic) sampling, its own section
+#   make -f Makefile.pipeline ddfem-table-centre    periodic sampling and a fitted centre point, its own section
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -26,7 +27,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
-.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic
+.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -40,3 +41,10 @@ ddfem-table-periodic: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/d
 	BENCH_SECTION=ddfem-periodic DATABASE2=$(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-periodic docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic.coarse_db.h5
+
+# The centre point (docs/ddfem.md, "Centre point") on periodic databases.
+ddfem-table-centre: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
+                    $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
+	BENCH_SECTION=ddfem-centre DATABASE2=$(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5 \
+	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-centre docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5
