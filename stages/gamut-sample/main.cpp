@@ -25,13 +25,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <optional>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "gamut_plots.hpp"
+#include "io/atomic_file.hpp"
 #include "parallel/fan_out.hpp"
 #include "sampler.hpp"
 #include "sampler_checkpoint.hpp"
@@ -53,15 +54,12 @@ void log_step(const char* name, const StepReport& r) {
 }
 
 void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
-    for (const GamutCycle& c : history)
-      f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
-        << ',' << c.seconds << '\n';
-  }
-  std::filesystem::rename(tmp, path);
+  std::ostringstream f;
+  f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
+  for (const GamutCycle& c : history)
+    f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
+      << ',' << c.seconds << '\n';
+  write_file_atomically(path, f.str());
 }
 
 }  // namespace
