@@ -25,8 +25,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <sstream>
 #include <optional>
+#include <sstream>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
@@ -94,7 +94,23 @@ int main(int argc, char** argv) {
     ctx.check_out_folder();
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
     if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
-    if (rank == 0) std::filesystem::create_directories(plots_dir);
+    // The second artifact and the plots folder are checked before any work,
+    // on every rank (a rank that threw alone would leave the others waiting).
+    try {
+      AtomicFile probe(structures_path);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--structures ") + e.what());
+    }
+    {
+      std::error_code ec;
+      if (std::filesystem::exists(plots_dir, ec) && !std::filesystem::is_directory(plots_dir, ec))
+        throw InputError("--plots " + plots_dir + ": is a file, expected a folder for the plots");
+    }
+    if (rank == 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(plots_dir, ec);
+      if (ec) throw InputError("--plots " + plots_dir + ": cannot create the plots folder (" + ec.message() + ")");
+    }
     const std::string run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
     const GamutSampler sampler(options, ctx.options.seed);
     if (rank == 0)
