@@ -10,7 +10,8 @@
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
-
+#include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 namespace {
@@ -33,6 +34,32 @@ CLI::Validator integer_validator(bool positive) {
         return std::string("expected a ") + (positive ? "positive" : "non-negative") + " integer, found '" + text + "'";
       },
       "");
+}
+
+// Refuses, before any work, an --out the run could not write or that would
+// destroy one of its inputs: an --out naming the same file as another
+// option's value (the config, an input artifact, --structures: by device and
+// inode when both exist, else by path), an existing folder, or a path in a
+// folder that is missing or not writable. The folder is checked by creating
+// and removing an exclusive temporary there, exactly as the writer will.
+void check_output_path(const CLI::App& cli, const std::string& out) {
+  for (const CLI::Option* option : cli.get_options()) {
+    if (option->check_name("--out") || option->check_name("--set") || option->check_name("--log-level")) continue;
+    if (option->get_items_expected_max() == 0) continue;  // a flag
+    const std::string type = option->get_type_name();
+    const std::string base = type.substr(0, type.find(':'));
+    if (base != "TEXT" && base != "FILE" && base != "PATH" && base != "DIR") continue;  // numbers
+    for (const std::string& value : option->results())
+      if (!value.empty() && same_file(value, out))
+        throw InputError(option->get_name() + " '" + value + "' and --out '" + out +
+                         "' name the same file; the run would overwrite its own input");
+  }
+  try {
+    AtomicFile probe(out);
+    probe.discard();
+  } catch (const InputError& e) {
+    throw InputError(std::string("--out ") + e.what());
+  }
 }
 
 }  // namespace
@@ -105,6 +132,7 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
     if (options_.threads > 0) omp_set_num_threads(options_.threads);
 
     StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};
+    if (!options_.out.empty()) check_output_path(cli_, options_.out);
     spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, version(), git_revision(),
                   omp_get_max_threads(), options_.seed);
     spdlog::debug("command line: {}", ctx.command_line);

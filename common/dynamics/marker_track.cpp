@@ -6,10 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
+#include <sstream>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 namespace {
@@ -54,8 +55,7 @@ MarkerTrack read_marker_track(const std::string& path, const std::string& column
   if (options.min_samples < 2 || !(options.uniform_tolerance > 0.0))
     throw InputError(path + ": marker track options: min_samples = " + std::to_string(options.min_samples) +
                      " must be >= 2 and uniform_tolerance = " + num(options.uniform_tolerance) + " positive");
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open marker track file");
+  std::istringstream in(read_text_file(path, kMaxTextInputBytes));
   auto error = [&](int line, const std::string& what) {
     return InputError(path + (line > 0 ? ": line " + std::to_string(line) : std::string()) + ": " + what);
   };

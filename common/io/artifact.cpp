@@ -1,18 +1,15 @@
 #include "io/artifact.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
 #include "core/errors.hpp"
 #include "core/version.hpp"
+#include "io/input_file.hpp"
 #include "io/sha256.hpp"
 
 namespace msfab {
@@ -31,29 +28,6 @@ std::vector<std::string> parse_name_list(const std::string& text) {
 }
 
 namespace {
-
-namespace fs = std::filesystem;
-
-// Pushes a file's (or directory's) data to the disk, so that after a power
-// loss the renamed artifact is either complete or absent.
-void sync_to_disk(const std::string& path, bool directory) {
-  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
-  if (fd < 0) {
-    if (directory) return;  // some file systems do not allow opening directories
-    throw std::runtime_error(path + ": cannot open to sync (" + std::strerror(errno) + ")");
-  }
-  const int status = ::fsync(fd);
-  const int err = errno;
-  ::close(fd);
-  if (status != 0 && !directory) {
-    throw std::runtime_error(path + ": fsync failed (" + std::strerror(err) + ")");
-  }
-}
-
-std::string parent_directory(const std::string& path) {
-  const fs::path parent = fs::path(path).parent_path();
-  return parent.empty() ? std::string(".") : parent.string();
-}
 
 std::string versions_text(int min_version, int max_version) {
   if (min_version == max_version) return "version " + std::to_string(min_version);
@@ -103,17 +77,16 @@ std::vector<ArtifactInput> parse_inputs(const std::string& text) {
 ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
                                const std::string& executable, const std::string& config_text,
                                const std::vector<std::string>& input_paths, std::uint64_t seed)
-    : path_(std::move(path)), tmp_path_(path_ + ".tmp") {
+    : path_(std::move(path)) {
   std::vector<ArtifactInput> inputs;
-  for (const std::string& input : input_paths) inputs.push_back({input, sha256_file_hex(input)});
-
-  const std::string directory = parent_directory(path_);
-  std::error_code ec;
-  if (!fs::is_directory(directory, ec)) {
-    throw InputError(path_ + ": output directory '" + directory + "' does not exist");
+  for (const std::string& input : input_paths) {
+    if (same_file(input, path_))
+      throw InputError(path_ + ": the output is also an input of this run; writing it would destroy the input");
+    inputs.push_back({input, sha256_file_hex(input)});
   }
-  file_.emplace(H5File::create(tmp_path_));
+  tmp_ = std::make_unique<AtomicFile>(path_);
   try {
+    file_.emplace(H5File::create_in(*tmp_));
     H5File& out = *file_;
     out.write_attribute("/", "schema", schema);
     out.write_attribute("/", "schema_version", std::int32_t(schema_version));
@@ -128,10 +101,11 @@ ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_
   }
 }
 
+const std::string& ArtifactWriter::tmp_path() const { return tmp_->tmp_path(); }
+
 void ArtifactWriter::discard() noexcept {
   file_.reset();  // closes quietly
-  std::error_code ignored;
-  fs::remove(tmp_path_, ignored);
+  tmp_.reset();   // removes the temporary
 }
 
 ArtifactWriter::~ArtifactWriter() {
@@ -147,15 +121,8 @@ void ArtifactWriter::commit() {
   if (committed_) throw std::logic_error(path_ + ": commit() called twice");
   file_->flush();
   file_->close();
-  sync_to_disk(tmp_path_, false);
-  std::error_code ec;
-  fs::rename(tmp_path_, path_, ec);
-  if (ec) {
-    throw std::runtime_error("cannot rename " + tmp_path_ + " to " + path_ + " (" + ec.message() +
-                             ")");
-  }
+  tmp_->commit();
   committed_ = true;
-  sync_to_disk(parent_directory(path_), true);
 }
 
 // ---------------------------------------------------------------------------

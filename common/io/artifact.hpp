@@ -3,10 +3,12 @@
 // provenance as root attributes and written atomically. docs/artifacts.md
 // describes the conventions.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "io/atomic_file.hpp"
 #include "io/hdf5_file.hpp"
 
 namespace msfab {
@@ -30,9 +32,10 @@ std::vector<ArtifactInput> parse_inputs(const std::string& text);
 std::string format_name_list(const std::vector<std::string>& names);
 std::vector<std::string> parse_name_list(const std::string& text);
 
-// Writes "<path>.tmp"; commit() flushes, closes and renames it over <path>.
-// Destroyed without commit() (an exception, an early return), it deletes
-// the tmp file and leaves whatever was at <path> untouched.
+// Writes an exclusive temporary "<path>.<random>.tmp" (io/atomic_file.hpp);
+// commit() flushes, closes, syncs and renames it over <path>. Destroyed
+// without commit() (an exception, an early return), it deletes the
+// temporary and leaves whatever was at <path> untouched.
 //
 //   ArtifactWriter out(path, "msfab.result", 1, "msfab-simulate", config_text,
 //                      {mesh_path}, seed);
@@ -41,9 +44,10 @@ std::vector<std::string> parse_name_list(const std::string& text);
 //   out.commit();
 class ArtifactWriter {
  public:
-  // Hashes every input (InputError if one is missing), checks that the
-  // output directory exists (InputError), creates the tmp file and writes
-  // the root attributes. `executable` is the program name; the version and
+  // Hashes every input (InputError if one is missing or is the output
+  // itself), creates the temporary (InputError if the output folder is
+  // missing or not writable, or the path is a folder) and writes the root
+  // attributes. `executable` is the program name; the version and
   // git revision are added here.
   ArtifactWriter(std::string path, std::string schema, int schema_version,
                  const std::string& executable, const std::string& config_text,
@@ -54,7 +58,7 @@ class ArtifactWriter {
 
   H5File& file();
   const std::string& path() const { return path_; }
-  const std::string& tmp_path() const { return tmp_path_; }
+  const std::string& tmp_path() const;
   bool committed() const { return committed_; }
 
   // Throws std::runtime_error if the data cannot be made durable; the final
@@ -65,7 +69,7 @@ class ArtifactWriter {
   void discard() noexcept;
 
   std::string path_;
-  std::string tmp_path_;
+  std::unique_ptr<AtomicFile> tmp_;
   std::optional<H5File> file_;
   bool committed_ = false;
 };

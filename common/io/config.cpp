@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -16,6 +15,7 @@
 #include <type_traits>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 
@@ -290,9 +290,43 @@ struct Reader<std::vector<std::string>> {
   }
 };
 
+// yaml-cpp shares the node of an anchor between all its aliases, so a few
+// hundred bytes of nested anchors ("a billion laughs") stand for a tree of
+// billions of nodes, and every walk over the tree (this check, the unknown-
+// key check, resolved_text()) would take forever. The document is therefore
+// walked once, as expanded, against a budget: each node costs 1 plus the
+// length of its text. A document without aliases costs at most about twice
+// its size, so the budget of 4 x its size + 1,000,000 only ever stops
+// alias expansion, and every later walk is bounded by it too. Nesting is
+// bounded as well (an anchor may hold an alias of itself).
+struct ExpansionBudget {
+  std::string source;
+  std::uint64_t limit = 0, left = 0;
+  int depth = 0;
+  static constexpr int kMaxDepth = 256;
+
+  ExpansionBudget(std::string source_name, std::size_t text_size)
+      : source(std::move(source_name)), limit(4 * std::uint64_t(text_size) + 1000000), left(limit) {}
+
+  void spend(const YAML::Node& node) {
+    const std::uint64_t cost = 1 + (node.IsScalar() ? node.Scalar().size() : 0);
+    if (cost > left)
+      throw InputError(source + ": YAML aliases expand the document to more than " +
+                       std::to_string(limit) +
+                       " nodes and characters; refusing it (nested anchors and aliases, an 'alias bomb'?)");
+    left -= cost;
+  }
+};
+
 // yaml-cpp keeps the first of two equal keys and drops the other without a
 // word; a strict config refuses them, and keys that are not plain scalars.
-void check_keys_are_unique(const YAML::Node& node, const std::string& path, const std::string& source) {
+void check_keys_are_unique(const YAML::Node& node, const std::string& path, ExpansionBudget& budget) {
+  const std::string& source = budget.source;
+  budget.spend(node);
+  if (!node.IsMap() && !node.IsSequence()) return;
+  if (++budget.depth > ExpansionBudget::kMaxDepth)
+    throw InputError(source + ": " + (path.empty() ? std::string("the document") : "'" + path + "'") +
+                     " is nested more than " + std::to_string(ExpansionBudget::kMaxDepth) + " levels deep");
   if (node.IsMap()) {
     std::set<std::string> seen;
     for (auto it = node.begin(); it != node.end(); ++it) {
@@ -303,12 +337,19 @@ void check_keys_are_unique(const YAML::Node& node, const std::string& path, cons
       if (!seen.insert(key.Scalar()).second)
         throw InputError(source + ": line " + std::to_string(key.Mark().line + 1) + ": duplicate key '" +
                          join(path, key.Scalar()) + "'");
-      check_keys_are_unique(it->second, join(path, key.Scalar()), source);
+      budget.spend(key);
+      check_keys_are_unique(it->second, join(path, key.Scalar()), budget);
     }
-  } else if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i)
-      check_keys_are_unique(node[i], path + "[" + std::to_string(i) + "]", source);
+  } else {
+    std::size_t i = 0;
+    for (auto it = node.begin(); it != node.end(); ++it, ++i) {
+      if (it->IsMap() || it->IsSequence())
+        check_keys_are_unique(*it, path + "[" + std::to_string(i) + "]", budget);
+      else
+        budget.spend(*it);
+    }
   }
+  --budget.depth;
 }
 
 std::string trim(const std::string& s) {
@@ -374,20 +415,13 @@ Config Config::from_string(const std::string& yaml_text, const std::string& disp
   if (!doc->root.IsMap())
     throw InputError(display_name + ": expected a mapping of keys to values at top level, found " +
                      describe(doc->root));
-  check_keys_are_unique(doc->root, "", display_name);
+  ExpansionBudget budget(display_name, yaml_text.size());
+  check_keys_are_unique(doc->root, "", budget);
   return Config(doc, doc->root, "");
 }
 
 Config Config::load_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, expected a YAML file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": read error");
-  Config config = from_string(text.str(), path);
+  Config config = from_string(read_text_file(path, kMaxConfigBytes), path);
   config.doc_->from_file = true;
   return config;
 }
@@ -410,7 +444,8 @@ void Config::apply_override(const std::string& assignment) {
   } catch (const YAML::Exception& e) {
     throw bad("cannot parse value '" + value_text + "': " + e.msg);
   }
-  check_keys_are_unique(value, path, "--set '" + assignment + "'");
+  ExpansionBudget budget("--set '" + assignment + "'", value_text.size());
+  check_keys_are_unique(value, path, budget);
 
   // Walk down from the document root, creating mappings that do not exist.
   // reset() rebinds the handle; operator= would overwrite the node in place.

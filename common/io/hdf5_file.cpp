@@ -4,11 +4,12 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <utility>
 
 #include "core/errors.hpp"
+#include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 namespace {
@@ -190,15 +191,27 @@ H5File H5File::create(const std::string& path) {
   return H5File(path, std::move(file));
 }
 
+H5File H5File::create_in(const AtomicFile& tmp) {
+  // HDF5 opens files by name. Through /proc/self/fd it reopens the inode the
+  // temporary's descriptor holds, so a file or symlink swapped in under the
+  // temporary's name meanwhile is never opened, let alone truncated; where
+  // /proc is missing the name is used and the check below catches a swap.
+  const std::string by_descriptor = "/proc/self/fd/" + std::to_string(tmp.fd());
+  std::error_code ec;
+  const bool proc = std::filesystem::exists(by_descriptor, ec);
+  H5File created = create(proc ? by_descriptor : tmp.tmp_path());
+  created.path_ = tmp.tmp_path();
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(created.id(), H5P_DEFAULT, &handle) < 0 || handle == nullptr) {
+    throw std::runtime_error(tmp.tmp_path() + ": cannot reach the file HDF5 opened (" + hdf5_error_detail() + ")");
+  }
+  tmp.check_is_this_file(*static_cast<int*>(handle));
+  return created;
+}
+
 H5File H5File::open(const std::string& path, Mode mode) {
   silence_hdf5_errors();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a file");
-  {
-    std::ifstream probe(path, std::ios::binary);
-    if (!probe) throw InputError(path + ": cannot open for reading (" + std::strerror(errno) + ")");
-  }
+  require_regular_file(path);  // a FIFO or a device would block or read forever
   if (H5Fis_hdf5(path.c_str()) <= 0) {
     H5Eclear2(H5E_DEFAULT);
     throw InputError(path + ": not a valid HDF5 file (truncated or corrupt: no HDF5 signature)");

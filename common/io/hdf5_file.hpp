@@ -22,6 +22,8 @@
 
 namespace msfab {
 
+class AtomicFile;
+
 // The element types a dataset or numeric attribute may have.
 enum class H5Dtype { kFloat64, kInt32, kInt64, kUInt8, kUInt64 };
 
@@ -77,6 +79,9 @@ class H5File {
 
   // Creates (or truncates) a file. Throws std::runtime_error.
   static H5File create(const std::string& path);
+  // Creates the file inside `tmp`'s temporary (io/atomic_file.hpp) and checks
+  // that HDF5 opened that very file; close() it, then tmp.commit().
+  static H5File create_in(const AtomicFile& tmp);
   // Opens an existing file. Throws InputError "<path>: no such file" or
   // "<path>: not a valid HDF5 file (truncated or corrupt): <detail>".
   static H5File open(const std::string& path, Mode mode = Mode::kRead);

@@ -6,9 +6,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <stdexcept>
+
+#include "io/atomic_file.hpp"
 
 namespace msfab {
 namespace {
@@ -144,13 +144,9 @@ void PngImage::write_png(const std::string& path) const {
   chunk(out, "IHDR", header);
   chunk(out, "IDAT", packed);
   chunk(out, "IEND", {});
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(reinterpret_cast<const char*>(out.data()), static_cast<std::streamsize>(out.size()));
-    if (!f) throw std::runtime_error(path + ": cannot write the PNG file");
-  }
-  std::filesystem::rename(tmp, path);
+  AtomicFile file(path);
+  file.write(out.data(), out.size());
+  file.commit();
 }
 
 }  // namespace msfab

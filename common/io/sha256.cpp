@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 namespace {
@@ -125,6 +126,7 @@ std::string sha256_hex(std::string_view data) {
 }
 
 std::string sha256_file_hex(const std::string& path) {
+  require_regular_file(path);  // a FIFO or a device would block or read forever
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int err = errno;

@@ -2,9 +2,9 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
+
+#include "io/atomic_file.hpp"
 
 namespace msfab {
 
@@ -111,26 +111,6 @@ void uniform_grid(std::ostream& out, const std::string& indent, const std::strin
   out << indent << "</Grid>\n";
 }
 
-void write_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw std::runtime_error(path + ": cannot write XDMF file (writing " + tmp + " failed)");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error("cannot rename " + tmp + " to " + path);
-  }
-}
-
 const char* kHeader =
     "<?xml version=\"1.0\" ?>\n"
     "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
@@ -149,7 +129,7 @@ void write_hex_mesh_xdmf(const std::string& xmf_path, const XdmfHexMesh& mesh,
   out << kHeader;
   uniform_grid(out, "    ", "mesh", mesh, nullptr, node_fields, cell_fields);
   out << kFooter;
-  write_atomically(xmf_path, out.str());
+  write_file_atomically(xmf_path, out.str());
 }
 
 void write_hex_mesh_time_series_xdmf(const std::string& xmf_path, const XdmfHexMesh& mesh,
@@ -163,7 +143,7 @@ void write_hex_mesh_time_series_xdmf(const std::string& xmf_path, const XdmfHexM
   }
   out << "    </Grid>\n";
   out << kFooter;
-  write_atomically(xmf_path, out.str());
+  write_file_atomically(xmf_path, out.str());
 }
 
 }  // namespace msfab

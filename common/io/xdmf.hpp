@@ -56,7 +56,7 @@ struct XdmfHexMesh {
 };
 
 // One grid with the given node and cell fields. Written atomically
-// (tmp + rename); throws std::runtime_error on I/O failure and
+// (io/atomic_file.hpp); throws std::runtime_error on I/O failure and
 // std::invalid_argument for an unsupported component count.
 void write_hex_mesh_xdmf(const std::string& xmf_path, const XdmfHexMesh& mesh,
                          const std::vector<XdmfField>& node_fields,

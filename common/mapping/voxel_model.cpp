@@ -7,12 +7,12 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
+#include "io/atomic_file.hpp"
 
 namespace msfab {
 namespace fs = std::filesystem;
@@ -141,28 +141,20 @@ std::vector<int> VoxelsReader::layer(std::int64_t z) const {
 
 namespace {
 
-// A binary STL written through "<path>.tmp": header, a triangle count
-// patched at the end, 50 bytes per triangle; renamed over <path> by finish().
+// A binary STL written through an AtomicFile (io/atomic_file.hpp): header,
+// a triangle count patched at the end, 50 bytes per triangle; committed over
+// <path> by finish().
 class StlFile {
  public:
-  explicit StlFile(std::string path) : path_(std::move(path)), tmp_(path_ + ".tmp") {
-    out_.open(tmp_, std::ios::binary | std::ios::trunc);
-    if (!out_) throw std::runtime_error(tmp_ + ": cannot open for writing");
+  explicit StlFile(std::string path) : out_(std::move(path)) {
     char header[80] = {};
     std::snprintf(header, sizeof header, "msfab-map voxel surface");
     out_.write(header, 80);
     const std::uint32_t zero = 0;
-    out_.write(reinterpret_cast<const char*>(&zero), 4);
+    out_.write(&zero, 4);
   }
   StlFile(const StlFile&) = delete;
   StlFile& operator=(const StlFile&) = delete;
-  ~StlFile() {
-    if (!finished_) {
-      out_.close();
-      std::error_code ec;
-      fs::remove(tmp_, ec);
-    }
-  }
 
   // The unit square of the face of voxel p on `axis` (side 1: the upper
   // one), counter-clockwise seen from outside, as two triangles.
@@ -184,18 +176,15 @@ class StlFile {
   }
 
   std::int64_t triangles() const { return count_; }
-  const std::string& path() const { return path_; }
+  const std::string& path() const { return out_.path(); }
 
   void finish() {
     flush();
-    if (count_ > std::int64_t(UINT32_MAX)) throw std::runtime_error(path_ + ": more triangles than STL can count");
+    if (count_ > std::int64_t(UINT32_MAX))
+      throw std::runtime_error(out_.path() + ": more triangles than STL can count");
     const std::uint32_t count = std::uint32_t(count_);
-    out_.seekp(80);
-    out_.write(reinterpret_cast<const char*>(&count), 4);
-    out_.close();
-    if (!out_) throw std::runtime_error(tmp_ + ": writing failed");
-    fs::rename(tmp_, path_);
-    finished_ = true;
+    out_.write_at(80, &count, 4);
+    out_.commit();
   }
 
  private:
@@ -210,15 +199,13 @@ class StlFile {
     if (buffer_.size() >= (std::size_t(1) << 20)) flush();
   }
   void flush() {
-    out_.write(buffer_.data(), std::streamsize(buffer_.size()));
+    out_.write(buffer_.data(), buffer_.size());
     buffer_.clear();
   }
 
-  std::string path_, tmp_;
-  std::ofstream out_;
+  AtomicFile out_;
   std::vector<char> buffer_;
   std::int64_t count_ = 0;
-  bool finished_ = false;
 };
 
 }  // namespace

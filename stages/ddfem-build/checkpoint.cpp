@@ -1,11 +1,11 @@
 #include "checkpoint.hpp"
 
 #include <cstdio>
-#include <filesystem>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "fit_record.hpp"
+#include "io/atomic_file.hpp"
 #include "io/hdf5_file.hpp"
 
 namespace msfab {
@@ -14,9 +14,9 @@ std::string checkpoint_path(const std::string& out) { return out + ".checkpoint.
 
 void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done, int points) {
   const int size = fit_record_size(points);
-  const std::string tmp = path + ".tmp";
+  AtomicFile tmp(path);
   {
-    H5File f = H5File::create(tmp);
+    H5File f = H5File::create_in(tmp);
     f.write_attribute("/", "schema", "msfab.coarse_db.checkpoint");
     f.write_attribute("/", "config", config_text);
     MatX rows(done.size(), 1 + size);
@@ -31,7 +31,7 @@ void write_checkpoint(const std::string& path, const std::string& config_text, c
     f.write_matrix("/orbits", rows);
     f.close();
   }
-  std::filesystem::rename(tmp, path);
+  tmp.commit();
 }
 
 FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text, int points) {

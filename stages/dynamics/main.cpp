@@ -25,6 +25,7 @@
 #include "dynamics/dynamics_run.hpp"
 #include "dynamics/dynamics_scene.hpp"
 #include "dynamics/trajectory.hpp"
+#include "io/atomic_file.hpp"
 
 using namespace msfab;
 
@@ -53,19 +54,16 @@ int nearest_rest_node(const DynamicsScene& scene, const Vec3& x) {
   return best;
 }
 
-// Written to "<path>.tmp" and renamed, so an existing file survives a failure.
+// Written atomically (io/atomic_file.hpp), so an existing file survives a failure.
 void write_marker_csv(const std::string& path, const MarkerTrace& trace) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "w");
-  if (!f) throw InputError(path + ": cannot write the marker CSV");
-  std::fprintf(f, "t,x,y,z\n");
-  for (size_t i = 0; i < trace.time.size(); ++i)
-    std::fprintf(f, "%.10g,%.12g,%.12g,%.12g\n", trace.time[i], trace.position[i].x(), trace.position[i].y(),
-                 trace.position[i].z());
-  if (std::fclose(f) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw InputError(path + ": cannot write the marker CSV");
+  std::string text = "t,x,y,z\n";
+  char line[128];
+  for (size_t i = 0; i < trace.time.size(); ++i) {
+    std::snprintf(line, sizeof line, "%.10g,%.12g,%.12g,%.12g\n", trace.time[i], trace.position[i].x(),
+                  trace.position[i].y(), trace.position[i].z());
+    text += line;
   }
+  write_file_atomically(path, text);
 }
 
 void print_summary(const DynamicsScene& scene, const Trajectory& t) {

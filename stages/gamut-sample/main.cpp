@@ -25,13 +25,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
+#include <sstream>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "gamut_plots.hpp"
+#include "io/atomic_file.hpp"
 #include "parallel/fan_out.hpp"
 #include "sampler.hpp"
 #include "sampler_checkpoint.hpp"
@@ -53,15 +54,12 @@ void log_step(const char* name, const StepReport& r) {
 }
 
 void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
-    for (const GamutCycle& c : history)
-      f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
-        << ',' << c.seconds << '\n';
-  }
-  std::filesystem::rename(tmp, path);
+  std::ostringstream f;
+  f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
+  for (const GamutCycle& c : history)
+    f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
+      << ',' << c.seconds << '\n';
+  write_file_atomically(path, f.str());
 }
 
 }  // namespace
@@ -96,7 +94,23 @@ int main(int argc, char** argv) {
     ctx.check_out_folder();
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
     if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
-    if (rank == 0) std::filesystem::create_directories(plots_dir);
+    // The second artifact and the plots folder are checked before any work,
+    // on every rank (a rank that threw alone would leave the others waiting).
+    try {
+      AtomicFile probe(structures_path);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--structures ") + e.what());
+    }
+    {
+      std::error_code ec;
+      if (std::filesystem::exists(plots_dir, ec) && !std::filesystem::is_directory(plots_dir, ec))
+        throw InputError("--plots " + plots_dir + ": is a file, expected a folder for the plots");
+    }
+    if (rank == 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(plots_dir, ec);
+      if (ec) throw InputError("--plots " + plots_dir + ": cannot create the plots folder (" + ec.message() + ")");
+    }
     const std::string run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
     const GamutSampler sampler(options, ctx.options.seed);
     if (rank == 0)

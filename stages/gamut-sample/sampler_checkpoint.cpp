@@ -1,8 +1,8 @@
 #include "sampler_checkpoint.hpp"
 
-#include <filesystem>
 
 #include "core/errors.hpp"
+#include "io/atomic_file.hpp"
 #include "io/hdf5_file.hpp"
 
 namespace msfab {
@@ -10,9 +10,9 @@ namespace msfab {
 std::string sampler_checkpoint_path(const std::string& out) { return out + ".checkpoint.h5"; }
 
 void write_sampler_checkpoint(const std::string& path, const std::string& run_text, const SamplerState& s) {
-  const std::string tmp = path + ".tmp";
+  AtomicFile tmp(path);
   {
-    H5File f = H5File::create(tmp);
+    H5File f = H5File::create_in(tmp);
     f.write_attribute("/", "schema", "msfab.gamut.checkpoint");
     f.write_attribute("/", "config", run_text);
     f.write_attribute("/", "cycles_done", static_cast<std::int32_t>(s.cycles_done));
@@ -26,7 +26,7 @@ void write_sampler_checkpoint(const std::string& path, const std::string& run_te
     f.write_dataset("/history", rows, {hsize_t(s.history.size()), 6});
     f.close();
   }
-  std::filesystem::rename(tmp, path);
+  tmp.commit();
 }
 
 SamplerState read_sampler_checkpoint(const std::string& path, const std::string& run_text) {

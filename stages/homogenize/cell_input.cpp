@@ -1,15 +1,14 @@
 #include "cell_input.hpp"
 
-#include <fstream>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 
 VoxelGrid read_voxel_text(const std::string& path, double voxel_size) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the voxel file");
+  std::istringstream in(read_text_file(path, kMaxTextInputBytes));
   std::vector<long long> numbers;
   std::string line;
   for (int line_no = 1; std::getline(in, line); ++line_no) {

@@ -42,8 +42,13 @@ check "the simulator runs on a centre-point database" -- "$BIN/msfab-simulate" -
   --coarsen 1 --database "$WORK/c1.h5" --out "$WORK/c1run.h5" --quiet
 
 # Stop after two rounds (a batch job's time limit), then resume.
+# A symlink planted under the checkpoint's old fixed temporary name is not followed.
+echo "victim" > "$WORK/victim.txt"
+ln -s "$WORK/victim.txt" "$WORK/part.h5.checkpoint.h5.tmp"
 expect_exit 0 "stopped after 2 rounds" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --max-rounds 2
 check "checkpoint kept" -- test -e "$WORK/part.h5.checkpoint.h5"
+check "checkpoint is a regular file, the planted symlink not followed" -- \
+  bash -c "[ ! -L '$WORK/part.h5.checkpoint.h5' ] && [ \"\$(cat '$WORK/victim.txt')\" = victim ]"
 check "no artifact before the end" -- test ! -e "$WORK/part.h5"
 expect_exit 2 "different configuration" -- "$BUILD" --config "$TINY" --set fit.regularization=0.5 --out "$WORK/part.h5" --resume
 expect_exit 0 "resuming: 8 of 22" -- "$BUILD" --config "$TINY" --out "$WORK/part.h5" --resume

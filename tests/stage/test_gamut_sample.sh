@@ -35,7 +35,12 @@ check "another seed" -- "$SAMPLE" --config "$TINY" --seed 8 --out "$WORK/s8.gamu
 check "another seed gives other structures" -- bash -c "[ \"\$(h5dump -d /voxels '$WORK/one.microstructures.h5' | md5sum)\" != \"\$(h5dump -d /voxels '$WORK/s8.microstructures.h5' | md5sum)\" ]"
 
 # Stop after one cycle (a batch job's time limit), then resume.
+# A symlink planted under the checkpoint's old fixed temporary name is not followed.
+echo "victim" > "$WORK/victim.txt"
+ln -s "$WORK/victim.txt" "$WORK/part.gamut.h5.checkpoint.h5.tmp"
 expect_exit 0 "stopped after cycle 1 of 3" -- "$SAMPLE" --config "$TINY" --seed 7 --out "$WORK/part.gamut.h5" --max-cycles 1
+check "checkpoint is a regular file, the planted symlink not followed" -- \
+  bash -c "[ ! -L '$WORK/part.gamut.h5.checkpoint.h5' ] && [ \"\$(cat '$WORK/victim.txt')\" = victim ]"
 check "checkpoint kept" -- test -e "$WORK/part.gamut.h5.checkpoint.h5"
 check "no artifact before the end" -- test ! -e "$WORK/part.gamut.h5"
 expect_exit 2 "different configuration or seed" -- "$SAMPLE" --config "$TINY" --seed 9 --out "$WORK/part.gamut.h5" --resume

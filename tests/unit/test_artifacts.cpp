@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "core/version.hpp"
 #include "io/artifact.hpp"
+#include "io/atomic_file.hpp"
 #include "io/hdf5_file.hpp"
 #include "io/sha256.hpp"
 #include "io/xdmf.hpp"
@@ -39,6 +40,13 @@ class ScratchDir : public ::testing::Test {
     fs::remove_all(dir_, ignored);
   }
   std::string file(const std::string& name) const { return (dir_ / name).string(); }
+  // Names of the temporaries ("*.tmp") left in the folder.
+  std::vector<std::string> temporaries() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir_))
+      if (entry.path().extension() == ".tmp") names.push_back(entry.path().filename().string());
+    return names;
+  }
 
   fs::path dir_;
 };
@@ -273,12 +281,14 @@ TEST_F(ArtifactWriterTest, RecordsProvenanceAsRootAttributes) {
   {
     ArtifactWriter out(path, "msfab.result", 3, "msfab-simulate", config, {input}, 123456789012345ull);
     out.file().write_vector("/x", std::vector<double>{1.0});
-    EXPECT_TRUE(fs::exists(path + ".tmp"));
+    EXPECT_TRUE(fs::exists(out.tmp_path()));
+    EXPECT_TRUE(std::regex_match(out.tmp_path(), std::regex(R"(.*/result\.h5\.[0-9a-f]{16}\.tmp)")))
+        << out.tmp_path();
     EXPECT_FALSE(fs::exists(path));
     out.commit();
     EXPECT_TRUE(out.committed());
   }
-  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  EXPECT_TRUE(temporaries().empty());
   const ArtifactReader in(path, "msfab.result", 3);
   EXPECT_EQ(in.schema(), "msfab.result");
   EXPECT_EQ(in.schema_version(), 3);
@@ -305,13 +315,13 @@ TEST_F(ArtifactWriterTest, ThrowBeforeCommitKeepsOldFileAndRemovesTmp) {
     ArtifactWriter out(path, "msfab.result", 1, "msfab-test", "new config", {}, 8);
     out.file().write_matrix("/displacement", Eigen::MatrixXd::Ones(4000, 3));
     out.file().flush();
-    ASSERT_TRUE(fs::exists(path + ".tmp"));
+    ASSERT_TRUE(fs::exists(out.tmp_path()));
     throw std::runtime_error("solver blew up");
   } catch (const std::runtime_error& e) {
     EXPECT_STREQ(e.what(), "solver blew up");
   }
   EXPECT_EQ(read_bytes(path), before);
-  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  EXPECT_TRUE(temporaries().empty());
   EXPECT_EQ(ArtifactReader(path, "msfab.result", 1).config(), "solver:\n  tol: 1e-8\n");
 }
 
@@ -322,12 +332,105 @@ TEST_F(ArtifactWriterTest, MissingInputOrFolderIsInputErrorAndCreatesNothing) {
     ArtifactWriter out(path, "msfab.result", 1, "msfab-test", "", {missing_input}, 0);
   });
   EXPECT_EQ(message, missing_input + ": no such file");
-  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  EXPECT_TRUE(temporaries().empty());
   const std::string nested = file("no/such/dir/result.h5");
   const std::string folder = input_error_message([&] {
     ArtifactWriter out(nested, "msfab.result", 1, "msfab-test", "", {}, 0);
   });
   EXPECT_NE(folder.find("does not exist"), std::string::npos) << folder;
+}
+
+// Temporaries cannot be hijacked: a symlink planted under the old fixed
+// name "<path>.tmp" (or any name) is never followed, a symlink at the final
+// path is replaced rather than written through, and two writers of the same
+// output each get their own temporary.
+TEST_F(ArtifactWriterTest, PlantedSymlinkAtTheTemporaryNameIsNotFollowed) {
+  const std::string victim = file("victim.txt");
+  write_bytes(victim, "must survive");
+  const std::string path = file("result.h5");
+  fs::create_symlink(victim, path + ".tmp");
+  fs::create_symlink(victim, file("result.xmf.tmp"));
+  write_small_artifact(path, "msfab.result", 1);
+  write_hex_mesh_xdmf(file("result.xmf"), XdmfHexMesh{"result.h5", "/n", "/c", 1, 1}, {}, {});
+  EXPECT_EQ(read_bytes(victim), "must survive");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path)));
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(file("result.xmf"))));
+  EXPECT_EQ(ArtifactReader(path, "msfab.result", 1).seed(), 7u);
+}
+
+TEST_F(ArtifactWriterTest, SymlinkAtTheOutputIsReplacedNotWrittenThrough) {
+  const std::string victim = file("victim.txt");
+  write_bytes(victim, "must survive");
+  const std::string path = file("result.h5");
+  fs::create_symlink(victim, path);
+  write_small_artifact(path, "msfab.result", 1);
+  EXPECT_EQ(read_bytes(victim), "must survive");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path)));
+}
+
+TEST_F(ArtifactWriterTest, TwoWritersOfOneOutputHaveTheirOwnTemporaries) {
+  const std::string path = file("result.h5");
+  ArtifactWriter first(path, "msfab.result", 1, "msfab-test", "first", {}, 1);
+  ArtifactWriter second(path, "msfab.result", 1, "msfab-test", "second", {}, 2);
+  EXPECT_NE(first.tmp_path(), second.tmp_path());
+  first.file().write_vector("/x", std::vector<double>{1.0});
+  second.file().write_vector("/x", std::vector<double>{2.0});
+  first.commit();
+  EXPECT_EQ(ArtifactReader(path, "msfab.result", 1).config(), "first");
+  second.commit();
+  const ArtifactReader in(path, "msfab.result", 1);
+  EXPECT_EQ(in.config(), "second");
+  EXPECT_EQ(in.file().read_vector<double>("/x"), std::vector<double>{2.0});
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(ArtifactWriterTest, OutputThatIsAnInputOrAFolderIsInputErrorAndTouchesNothing) {
+  const std::string input = file("mesh.h5");
+  write_bytes(input, "the only copy");
+  const std::string same = input_error_message([&] {
+    ArtifactWriter out(input, "msfab.result", 1, "msfab-test", "", {input}, 0);
+  });
+  EXPECT_NE(same.find("also an input"), std::string::npos) << same;
+  const std::string link = file("link.h5");
+  fs::create_symlink(input, link);
+  input_error_message([&] { ArtifactWriter out(link, "msfab.result", 1, "msfab-test", "", {input}, 0); });
+  EXPECT_EQ(read_bytes(input), "the only copy");
+  fs::create_directory(file("folder.h5"));
+  const std::string folder = input_error_message([&] {
+    ArtifactWriter out(file("folder.h5"), "msfab.result", 1, "msfab-test", "", {}, 0);
+  });
+  EXPECT_NE(folder.find("is a folder"), std::string::npos) << folder;
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(ArtifactWriterTest, AtomicFileWritesPatchesAndCommitsWhole) {
+  const std::string path = file("table.csv");
+  write_bytes(path, "old");
+  {
+    AtomicFile out(path);
+    out.write("xx,b\n");
+    out.write_at(0, "a", 1);
+    out.write_at(1, ",", 1);
+    EXPECT_EQ(read_bytes(path), "old");
+  }  // destroyed without commit: nothing changes
+  EXPECT_EQ(read_bytes(path), "old");
+  EXPECT_TRUE(temporaries().empty());
+  AtomicFile out(path);
+  out.write("xx,b\n");
+  out.write_at(0, "a", 1);
+  out.commit();
+  EXPECT_EQ(read_bytes(path), "ax,b\n");
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(ArtifactWriterTest, ReadOnlyFolderIsInputError) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only folders";
+  const std::string folder = file("locked");
+  fs::create_directory(folder);
+  fs::permissions(folder, fs::perms::owner_read | fs::perms::owner_exec);
+  const std::string message = input_error_message([&] { AtomicFile out(folder + "/x.h5"); });
+  EXPECT_NE(message.find("not writable"), std::string::npos) << message;
+  fs::permissions(folder, fs::perms::owner_all);
 }
 
 TEST_F(ArtifactReaderTest, SchemaMismatchNamesFileExpectedAndFound) {
@@ -518,7 +621,7 @@ TEST_F(XdmfFiles, StaticMeshPointsAtMatchingDatasets) {
   const std::string xmf = file("result.xmf");
   write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"displacement", "/displacement", 3}},
                       {{"density", "/density", 1}});
-  EXPECT_FALSE(fs::exists(xmf + ".tmp"));
+  EXPECT_TRUE(temporaries().empty());
   const std::string xml = read_bytes(xmf);
   EXPECT_EQ(check_tag_balance(xml), "");
   EXPECT_NE(xml.find("TopologyType=\"Hexahedron\" NumberOfElements=\"2\""), std::string::npos);
@@ -572,7 +675,7 @@ TEST_F(XdmfFiles, UnsupportedComponentsThrowAndWriteNothing) {
   EXPECT_THROW(write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"weird", "/w", 2}}, {}),
                std::invalid_argument);
   EXPECT_FALSE(fs::exists(xmf));
-  EXPECT_FALSE(fs::exists(xmf + ".tmp"));
+  EXPECT_TRUE(temporaries().empty());
 }
 
 }  // namespace

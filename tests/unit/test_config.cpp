@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +11,7 @@
 
 #include "core/errors.hpp"
 #include "io/config.hpp"
+#include "io/input_file.hpp"
 
 namespace msfab {
 namespace {
@@ -322,5 +325,75 @@ TEST(Config, FailOnTheNodeItselfNamesItsPath) {
     EXPECT_NE(std::string(e.what()).find("needs one of"), std::string::npos) << e.what();
   }
 }
+}  // namespace
+}  // namespace msfab
+
+namespace msfab {
+namespace {
+
+// "A billion laughs": nine levels of nine aliases stand for 9^9 scalars in a
+// few hundred bytes. yaml-cpp shares the anchored nodes, so parsing is cheap;
+// any walk of the expanded tree is not, and must be refused, not run.
+std::string alias_bomb(int levels) {
+  std::string text = "l0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]\n";
+  for (int i = 1; i < levels; ++i) {
+    const std::string prev = "*l" + std::to_string(i - 1);
+    text += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [";
+    for (int k = 0; k < 9; ++k) text += (k ? ", " : "") + prev;
+    text += "]\n";
+  }
+  return text;
+}
+
+TEST(Config, AliasBombIsRefusedQuicklyNamingTheFile) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string message = input_error_of([] { Config::from_string(alias_bomb(9), "bomb.yaml"); });
+  EXPECT_CONTAINS(message, "bomb.yaml: YAML aliases expand the document");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_CONTAINS(input_error_of([] { Config().apply_override("x=" + alias_bomb(9)); }), "--set 'x=");
+  // An anchor that holds an alias of itself is refused, not walked forever.
+  EXPECT_THROW(Config::from_string("a: &a [*a]\n", "loop.yaml"), InputError);
+}
+
+TEST(Config, ModerateAliasesStillWork) {
+  Config c = Config::from_string("base: &m {E: 1.0e6, nu: 0.3}\nmaterials: [*m, *m, *m]\n", "ok.yaml");
+  ASSERT_EQ(c.children("materials").size(), 3u);
+  EXPECT_DOUBLE_EQ(c.children("materials")[2].get<double>("E"), 1.0e6);
+  // 9^4 expanded scalars is far below the budget.
+  EXPECT_NO_THROW(Config::from_string(alias_bomb(4), "small.yaml"));
+}
+
+TEST(Config, DevicesFifosFoldersAndHugeFilesAreRefusedNamingTheFile) {
+  const auto dir = std::filesystem::temp_directory_path() / ("msfab_config_special_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  EXPECT_CONTAINS(input_error_of([] { Config::load_file("/dev/zero"); }), "/dev/zero: is a character device");
+  const std::string fifo = (dir / "pipe.yaml").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_CONTAINS(input_error_of([&] { Config::load_file(fifo); }), fifo + ": is a FIFO");
+  EXPECT_CONTAINS(input_error_of([&] { Config::load_file(dir.string()); }), dir.string() + ": is a folder");
+  const std::string huge = (dir / "huge.yaml").string();
+  std::ofstream(huge) << "a: 1\n";
+  std::filesystem::resize_file(huge, kMaxConfigBytes + 1);  // sparse
+  EXPECT_CONTAINS(input_error_of([&] { Config::load_file(huge); }), huge + ": is 16777217 bytes, more than the 16 MiB");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(InputFile, SameFileByInodeOrByPath) {
+  const auto dir = std::filesystem::temp_directory_path() / ("msfab_same_file_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "sub");
+  const std::string a = (dir / "a.h5").string();
+  std::ofstream(a) << "x";
+  std::filesystem::create_hard_link(a, dir / "hard.h5");
+  std::filesystem::create_symlink(a, dir / "soft.h5");
+  EXPECT_TRUE(same_file(a, (dir / "hard.h5").string()));
+  EXPECT_TRUE(same_file(a, (dir / "soft.h5").string()));
+  EXPECT_TRUE(same_file(a, (dir / "sub" / ".." / "a.h5").string()));
+  EXPECT_TRUE(same_file((dir / "new.h5").string(), (dir / "sub" / ".." / "new.h5").string()));
+  EXPECT_FALSE(same_file(a, (dir / "new.h5").string()));
+  std::ofstream((dir / "b.h5").string()) << "x";
+  EXPECT_FALSE(same_file(a, (dir / "b.h5").string()));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace msfab

@@ -286,7 +286,7 @@ TEST(MarkerTrack, TrackToFrequency) {
 
 TEST(MarkerTrack, RejectsBadFiles) {
   const std::string missing = ::testing::TempDir() + "msfab_no_such_track.csv";
-  expect_input_error([&] { read_marker_track(missing, "x"); }, {missing, "cannot open"});
+  expect_input_error([&] { read_marker_track(missing, "x"); }, {missing, "no such file"});
 
   std::string text = uniform_csv(20);
   const auto line_start = [&](int line) {  // 1-based
