@@ -1,10 +1,13 @@
 #pragma once
 // Blocks, palettes and fit options shared by the DDFEM unit tests.
+#include <cmath>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/fine_block.hpp"
+#include "ddfem/force_samples.hpp"
 #include "material/neo_hookean.hpp"
 
 namespace msfab::ddfem_test {
@@ -31,6 +34,26 @@ inline CoarseFitOptions small_fit_options() {
   o.sampling.magnitudes = 2;
   o.anisotropy.directions = 10;
   return o;
+}
+
+// `count` samples of a known coarse material on the coarse element of
+// `block`: random corner displacements of up to `amplitude` per component
+// (the standardized mt19937_64 sequence of `seed`) and the material's
+// energies. Fits on them must recover the material.
+inline ForceSampleSet samples_of_coarse_material(const CoarseMaterialFit& truth, const FineBlock& block, int count,
+                                                 double amplitude, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  ForceSampleSet set;
+  set.patterns.resize(1);
+  for (int i = 0; i < count; ++i) {
+    ForceSample s;
+    for (int j = 0; j < 24; ++j) s.corner_displacement[j] = amplitude * (2 * (double(rng() >> 11) * 0x1.0p-53) - 1);
+    s.energy = coarse_energy(truth, geo, X, s.corner_displacement);
+    set.samples.push_back(s);
+  }
+  return set;
 }
 
 }  // namespace msfab::ddfem_test

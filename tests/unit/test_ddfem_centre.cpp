@@ -84,17 +84,8 @@ TEST(DdfemCentre, RecoversAKnownCoarseMaterialWithACentreTerm) {
   }
   truth.mu_centre = 2 * mu;
   truth.lambda_centre = 3 * lambda;
-  const hex8::ElementGeometry geo = block.coarse_geometry();
-  const hex8::NodeMatrix X = block.coarse_rest_positions();
-  ForceSampleSet set;
-  set.patterns.resize(1);
-  for (int i = 0; i < 200; ++i) {
-    ForceSample s;
-    s.corner_displacement = random_corners(rng, 0.1 * kVoxel);
-    s.energy = coarse_energy(truth, geo, X, s.corner_displacement);
-    ASSERT_TRUE(std::isfinite(s.energy));
-    set.samples.push_back(s);
-  }
+  const ForceSampleSet set = ddfem_test::samples_of_coarse_material(truth, block, 200, 0.1 * kVoxel, 5);
+  for (const ForceSample& s : set.samples) ASSERT_TRUE(std::isfinite(s.energy));
   CoarseFitOptions o;
   o.regularization = 0;
   o.anisotropic = false;

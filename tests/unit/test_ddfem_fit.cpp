@@ -256,17 +256,8 @@ TEST(DdfemFit, RecoversAKnownAnisotropicCoarseMaterial) {
     truth.C[k] = k % 2 ? 5 * mu * (0.5 + u01()) : 0.0;
     truth.v[k] = Vec3(1.0, 0.3 * u01(), 0.3 * u01()).normalized();
   }
-  const hex8::ElementGeometry geo = block.coarse_geometry();
-  const hex8::NodeMatrix X = block.coarse_rest_positions();
-  ForceSampleSet set;
-  set.patterns.resize(1);
-  for (int i = 0; i < 200; ++i) {
-    ForceSample s;
-    for (int j = 0; j < 24; ++j) s.corner_displacement[j] = 0.1 * kVoxel * (2 * u01() - 1);
-    s.energy = coarse_energy(truth, geo, X, s.corner_displacement);
-    ASSERT_TRUE(std::isfinite(s.energy));
-    set.samples.push_back(s);
-  }
+  const ForceSampleSet set = ddfem_test::samples_of_coarse_material(truth, block, 200, 0.1 * kVoxel, 10);
+  for (const ForceSample& s : set.samples) ASSERT_TRUE(std::isfinite(s.energy));
   CoarseFitOptions o;
   o.regularization = 0;
   const CoarseMaterialFit fit = fit_from_samples(block, set, truth.v, o);
