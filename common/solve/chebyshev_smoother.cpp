@@ -7,16 +7,19 @@
 
 namespace msfab {
 
-bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads) {
+bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, bool single_precision) {
   pattern_ = &A;
   degree_ = degree;
   threads_ = threads;
-  values_.resize(A.values.size());
+  single_precision_ = single_precision;
+  values_.resize(single_precision ? A.values.size() : 0);
+  values_.shrink_to_fit();
   diagonal_.resize(9 * std::size_t(A.rows));
   chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index i = begin; i < end; ++i) {
-      for (std::size_t k = 9 * std::size_t(A.row_start[i]); k < 9 * std::size_t(A.row_start[i + 1]); ++k)
-        values_[k] = static_cast<float>(A.values[k]);
+      if (single_precision)
+        for (std::size_t k = 9 * std::size_t(A.row_start[i]); k < 9 * std::size_t(A.row_start[i + 1]); ++k)
+          values_[k] = static_cast<float>(A.values[k]);
       std::copy_n(A.values.data() + 9 * std::size_t(A.diagonal[i]), 9, diagonal_.data() + 9 * i);
     }
   });

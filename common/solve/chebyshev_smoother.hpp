@@ -23,7 +23,14 @@ class ChebyshevSmoother {
   // inverts the diagonal blocks and estimates the largest eigenvalue of
   // D^-1 A. A must stay alive (its pattern is used) until the next setup().
   // Returns false if a diagonal block is not positive definite.
-  bool setup(const BlockMatrix& A, int degree, int threads);
+  //
+  // With single_precision = false the smoother uses A's double values. That
+  // is needed where the stiffness contrast exceeds what single precision
+  // resolves (about 1e7): rounding the stiff entries then changes the
+  // operator by more than the soft entries are worth, so the rounded matrix
+  // can be indefinite and the V-cycle is no longer a positive definite
+  // preconditioner.
+  bool setup(const BlockMatrix& A, int degree, int threads, bool single_precision = true);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).
@@ -36,10 +43,14 @@ class ChebyshevSmoother {
 
  private:
   void row_product(int i, const double* x, double out[3]) const {
-    block_row_product(*pattern_, values_.data(), i, x, out);
+    if (single_precision_)
+      block_row_product(*pattern_, values_.data(), i, x, out);
+    else
+      block_row_product(*pattern_, pattern_->values.data(), i, x, out);
   }
   const BlockMatrix* pattern_ = nullptr;
-  std::vector<float> values_;    // A in single precision, laid out like A.values
+  bool single_precision_ = true;
+  std::vector<float> values_;    // A in single precision, laid out like A.values (if single_precision_)
   std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major
   std::vector<double> inverse_;   // their inverses
   double max_eigenvalue_ = 0.0;

@@ -15,6 +15,8 @@
 #include "solve/conjugate_gradient.hpp"
 #include "solve/sparse_ops.hpp"
 
+#include <spdlog/spdlog.h>
+
 namespace msfab {
 namespace {
 
@@ -72,7 +74,7 @@ bool PeriodicGridMultigrid::supports(int nx, int ny, int nz) {
 PeriodicGridMultigrid::~PeriodicGridMultigrid() = default;
 
 PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const PeriodicMultigridOptions& options)
-    : field_(std::move(field)), options_(options) {
+    : field_(std::move(field)), options_(options), single_precision_smoothers_(options.single_precision_smoothers) {
   const auto start = std::chrono::steady_clock::now();
   validate_field(field_, "periodic multigrid");
   if (!(options_.tolerance > 0) || options_.tolerance >= 1)
@@ -225,7 +227,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
       }
     }
   }
-  if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads))
+  if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads, single_precision_smoothers_))
     throw NumericalError("periodic multigrid: a diagonal block of level " + std::to_string(l) + " (" +
                          dims_text(level.n) + ") is not positive definite");
 }
@@ -367,9 +369,27 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
   if (b.size() != n)
     throw std::invalid_argument("PeriodicGridMultigrid::solve: right-hand side has " + std::to_string(b.size()) +
                                 " entries, the grid has " + std::to_string(n) + " unknowns");
-  const int threads = options_.threads;
   VecX consistent = b;
-  project_zero_mean(consistent, threads);
+  project_zero_mean(consistent, options_.threads);
+  try {
+    return solve_cg(consistent);
+  } catch (const NumericalError& e) {
+    if (stats_.positive_definite || !single_precision_smoothers_) throw;
+    // The fine operator is exact (double, matrix-free), so an indefinite
+    // preconditioner comes from the rounded coarse operators.
+    spdlog::warn("periodic multigrid: the preconditioner is indefinite with single-precision smoothers ({}); "
+                 "retrying with double precision",
+                 e.what());
+    single_precision_smoothers_ = false;
+    for (std::size_t l = 1; l < levels_.size(); ++l)
+      if (!levels_[l]->coarsest) build_level(l);
+    stats_.positive_definite = true;
+    return solve_cg(consistent);
+  }
+}
+
+VecX PeriodicGridMultigrid::solve_cg(const VecX& consistent) {
+  const int threads = options_.threads;
   CgOperator op;
   op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
   op.multiply_dot = [this, threads](const VecX& x, VecX& y) {

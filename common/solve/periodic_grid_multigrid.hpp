@@ -43,6 +43,11 @@ struct PeriodicMultigridOptions {
   int max_iterations = 1000;
   int smoother_degree = 2;   // Chebyshev degree on the finest level (twice that below)
   int coarsest_nodes = 512;  // coarsening stops at the first level with at most this many nodes
+  // Coarse levels' smoothers in single precision (ChebyshevSmoother). A
+  // stiffness contrast beyond what single precision resolves (e.g. void at
+  // 1e-9 of the solid) can make the rounded operators indefinite; solve()
+  // detects that (r . M^-1 r <= 0) and switches to double precision once.
+  bool single_precision_smoothers = true;
   int threads = 0;           // 0: the OpenMP default
 };
 
@@ -62,8 +67,12 @@ class PeriodicGridMultigrid {
 
   // x with K x = b - mean(b), of zero mean per component. b: 3 entries per
   // node, node (i, j, k) = i + nx (j + ny k). Throws NumericalError if CG
-  // does not converge within max_iterations.
+  // does not converge within max_iterations, or if the preconditioner is
+  // indefinite with double-precision smoothers too.
   VecX solve(const VecX& b);
+  // Whether the coarse levels' smoothers use single precision (false after
+  // the fallback of solve()).
+  bool single_precision_smoothers() const { return single_precision_smoothers_; }
   const LinearSolveStats& stats() const { return stats_; }
 
   // y = K x (finest level, matrix-free, element by element in 8 colours).
@@ -82,6 +91,7 @@ class PeriodicGridMultigrid {
  private:
   struct Level;
   void build_level(std::size_t l);
+  VecX solve_cg(const VecX& consistent);
   void cycle(std::size_t level, const VecX& rhs, VecX& solution);
   // The row-wise view the Chebyshev kernels take: node row i of the product
   // last computed into fine_product_ (their before_pass hook computes it).
@@ -97,6 +107,7 @@ class PeriodicGridMultigrid {
 
   VoxelStiffnessField field_;
   PeriodicMultigridOptions options_;
+  bool single_precision_smoothers_ = true;
   LinearSolveStats stats_;
   std::vector<std::unique_ptr<Level>> levels_;
   // Finest level: diagonal blocks and their inverses, smoother bound,
