@@ -3,8 +3,11 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <charconv>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "cli/logging.hpp"
 #include "cli/progress.hpp"
@@ -25,13 +28,26 @@ void print_error(const std::string& stage, const std::string& message) {
 
 // Checks the text before CLI11 converts it: CLI11 would wrap "-1" around
 // to 2^64-1 for an unsigned option, and its range messages are unreadable.
-CLI::Validator integer_validator(bool positive) {
+// --threads above this is a typo, not a request: far more than any node's
+// cores, and each OpenMP thread reserves a stack.
+constexpr std::uint64_t kMaxThreads = 65536;
+
+// A decimal integer in [positive ? 1 : 0, max]. Checked on the text, before
+// CLI11 converts it: its conversion of a number past the type's range
+// clamps or wraps instead of failing (a --seed of 2^64 became 2^64 - 1).
+CLI::Validator integer_validator(bool positive, std::uint64_t max) {
   return CLI::Validator(
-      [positive](std::string& text) -> std::string {
-        const bool digits =
-            !text.empty() && text.size() <= 20 && text.find_first_not_of("0123456789") == std::string::npos;
-        if (digits && !(positive && text.find_first_not_of('0') == std::string::npos)) return {};
-        return std::string("expected a ") + (positive ? "positive" : "non-negative") + " integer, found '" + text + "'";
+      [positive, max](std::string& text) -> std::string {
+        const std::string kind = positive ? "positive" : "non-negative";
+        std::uint64_t value = 0;
+        const char* end = text.data() + text.size();
+        const auto [stop, error] = std::from_chars(text.data(), end, value);
+        if (text.empty() || stop != end || (error != std::errc() && error != std::errc::result_out_of_range))
+          return "expected a " + kind + " integer, found '" + text + "'";
+        if (error == std::errc::result_out_of_range || value > max)
+          return "'" + text + "' is larger than " + std::to_string(max) + ", the largest value allowed";
+        if (positive && value == 0) return "expected a " + kind + " integer, found '" + text + "'";
+        return {};
       },
       "");
 }
@@ -91,10 +107,10 @@ void StageApp::add_common_options() {
   cli_.add_option("-o,--out", options_.out, "output path")->type_name("PATH");
   cli_.add_option("-j,--threads", options_.threads, "worker threads (default: OMP_NUM_THREADS or all cores)")
       ->type_name("N")
-      ->check(integer_validator(true));
+      ->check(integer_validator(true, kMaxThreads));
   cli_.add_option("--seed", options_.seed, "global random seed (default: 0)")
       ->type_name("N")
-      ->check(integer_validator(false));
+      ->check(integer_validator(false, std::numeric_limits<std::uint64_t>::max()));
   cli_.add_option("--log-level", options_.log_level, "how much to log (default: info)")
       ->type_name("LEVEL")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));

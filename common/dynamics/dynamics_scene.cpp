@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "core/errors.hpp"
 #include "dynamics/dac_model_artifact.hpp"
@@ -262,6 +263,20 @@ DynamicsScene read_dynamics_scene(const Config& c) {
   if (!(s.newmark.time_step > 0) || !std::isfinite(s.newmark.time_step))
     sim.fail("time_step", "must be positive (got " + std::to_string(s.newmark.time_step) + ")");
   s.duration = sim.require_positive<double>("duration", "simulated time (s)");
+  // A step longer than the run takes no step at all, and a tiny one takes
+  // more steps than any run can finish: both are typos, refused up front.
+  if (s.newmark.time_step > s.duration) {
+    std::ostringstream msg;
+    msg << "is longer than duration (" << s.duration << " s): no step would be taken";
+    sim.fail("time_step", msg.str());
+  }
+  constexpr double kMaxTimeSteps = 1e8;
+  if (s.duration / s.newmark.time_step > kMaxTimeSteps) {
+    std::ostringstream msg;
+    msg << "gives " << s.duration / s.newmark.time_step << " steps over duration " << s.duration
+        << " s; at most " << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
+    sim.fail("time_step", msg.str());
+  }
   s.output_every = sim.get_or<int>("output_every", 10);
   if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
   model.body_contact = sim.get_or<bool>("body_contact", s.body_names.size() > 1);

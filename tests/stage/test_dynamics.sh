@@ -72,6 +72,9 @@ expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dyn
   --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=-1e-4
+expect_exit 2 "time_step.*longer than duration" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=1e308
+expect_exit 2 "time_step.*steps over duration.*at most" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \
+  --set simulation.time_step=1e-300
 expect_exit 2 "friction coefficient must be >= 0" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set friction.default=-0.2
 expect_exit 2 "starts inside obstacle 'ground'" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set 'placement.translation=[0,0,-0.002]'
 expect_exit 2 "unknown impact model" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.impact=bouncy

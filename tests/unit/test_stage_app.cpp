@@ -109,6 +109,14 @@ TEST(StageApp, BadOptionValuesReturnTwo) {
   EXPECT_EQ(run_stage({"--threads", "0"}, kNothing).exit_code, 2);
   EXPECT_EQ(run_stage({"--threads", "many"}, kNothing).exit_code, 2);
   EXPECT_EQ(run_stage({"--seed", "-1"}, kNothing).exit_code, 2);
+  // Past the type's range: refused, not clamped (2^64 became 2^64 - 1).
+  StageRun big = run_stage({"--seed", "18446744073709551616"}, kNothing);
+  EXPECT_EQ(big.exit_code, 2);
+  EXPECT_TRUE(contains(big.stderr_text, "larger than 18446744073709551615")) << big.stderr_text;
+  EXPECT_EQ(run_stage({"--threads", "4294967297"}, kNothing).exit_code, 2);
+  StageRun largest = run_stage({"--seed", "18446744073709551615"}, kNothing);
+  EXPECT_EQ(largest.exit_code, 0) << largest.stderr_text;
+  EXPECT_EQ(largest.options.seed, 18446744073709551615u);
   EXPECT_EQ(run_stage({"--log-level", "loud"}, kNothing).exit_code, 2);
   StageRun r = run_stage({"--set", "grid.size"}, kNothing);
   EXPECT_EQ(r.exit_code, 2);
