@@ -40,6 +40,17 @@ Vec3 sampling_transverse(const Vec3& d) {
   return (trial - trial.dot(d) * d).normalized();
 }
 
+Vec3 family_field(ForceKind kind, const Vec3& d, const Vec3& t, const Vec3& r) {
+  switch (kind) {
+    case ForceKind::stretch: return d * d.dot(r);
+    case ForceKind::shear: return d * t.dot(r) + t * d.dot(r);  // symmetric: no net moment
+    case ForceKind::bend: return d * (d.dot(r) * t.dot(r));
+    case ForceKind::twist: return d.cross(r) * d.dot(r);
+    case ForceKind::pinch: break;
+  }
+  throw std::invalid_argument("family_field: pinching is not a smooth family");
+}
+
 std::string force_kind_name(ForceKind kind) {
   switch (kind) {
     case ForceKind::stretch: return "stretch";
@@ -218,15 +229,8 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
       });
       continue;
     }
-    // Stretch: traction along d growing linearly towards the two ends.
-    add(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d * d.dot(r); });
-    // Simple shear (symmetric, so it carries no net moment).
-    add(ForceKind::shear, d, t, [&](const Vec3& r) -> Vec3 { return d * t.dot(r) + t * d.dot(r); });
-    // Bending about the axis d x t: axial forces proportional to the
-    // distance from the neutral plane, opposite at the two ends.
-    add(ForceKind::bend, d, t, [&](const Vec3& r) -> Vec3 { return d * (d.dot(r) * t.dot(r)); });
-    // Twisting about d: tangential forces, opposite torques at the two ends.
-    add(ForceKind::twist, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d.cross(r) * d.dot(r); });
+    for (ForceKind kind : kSmoothFamilies)
+      add(kind, d, family_second(kind, t), [&](const Vec3& r) { return family_field(kind, d, t, r); });
   }
   // Pinching: the two corners of each cube edge pushed towards each other.
   for (int a = 0; a < 8; ++a)

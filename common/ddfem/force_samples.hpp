@@ -5,6 +5,7 @@
 // at several magnitudes and both signs, each solved as a nonlinear static
 // problem. A sample is the displacement of the eight block corners (the
 // coarse element's u^1 = r(u^0) of Eq. 2.8) and the fine elastic energy V^0.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -158,6 +159,19 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
 // The transverse direction t of the shear and bend patterns along d: a unit
 // vector orthogonal to d, the next axis for an axis (x -> y -> z -> x).
 Vec3 sampling_transverse(const Vec3& d);
+// The smooth families as vector fields of r, the position from the block
+// centre in voxel units: nodal forces of isolated sampling, corner
+// displacements of periodic sampling. stretch d (d.r); shear
+// d (t.r) + t (d.r); bend d (d.r)(t.r) (axial, linear across the neutral
+// plane, opposite at the ends); twist (d x r)(d.r). Not for pinch.
+Vec3 family_field(ForceKind kind, const Vec3& d, const Vec3& t, const Vec3& r);
+// The smooth families in pattern order (per direction).
+inline constexpr std::array<ForceKind, 4> kSmoothFamilies{ForceKind::stretch, ForceKind::shear, ForceKind::bend,
+                                                          ForceKind::twist};
+// The family's second pattern vector: t for shear and bend, else zero.
+inline Vec3 family_second(ForceKind kind, const Vec3& t) {
+  return kind == ForceKind::shear || kind == ForceKind::bend ? t : Vec3::Zero();
+}
 // Sampling directions: axes then the seeded Fibonacci hemisphere.
 std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed);
 

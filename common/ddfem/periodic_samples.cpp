@@ -47,10 +47,8 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
   };
   for (const Vec3& d : sampling_directions(options.include_axes, options.sphere_directions, options.seed)) {
     const Vec3 t = sampling_transverse(d);
-    add(ForceKind::stretch, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d * d.dot(r); });
-    add(ForceKind::shear, d, t, [&](const Vec3& r) -> Vec3 { return d * t.dot(r) + t * d.dot(r); });
-    add(ForceKind::bend, d, t, [&](const Vec3& r) -> Vec3 { return d * (d.dot(r) * t.dot(r)); });
-    add(ForceKind::twist, d, Vec3::Zero(), [&](const Vec3& r) -> Vec3 { return d.cross(r) * d.dot(r); });
+    for (ForceKind kind : kSmoothFamilies)
+      add(kind, d, family_second(kind, t), [&](const Vec3& r) { return family_field(kind, d, t, r); });
   }
   for (int a = 0; a < 8; ++a)
     for (int bit = 0; bit < 3; ++bit) {

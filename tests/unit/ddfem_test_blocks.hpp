@@ -36,6 +36,15 @@ inline CoarseFitOptions small_fit_options() {
   return o;
 }
 
+// A level-1 coarse material that is exactly NeoHookean(mu, lambda) at all 8
+// points (its fine parameters too): the children of level-2 test blocks.
+inline CoarseMaterialFit neo_hookean_level1(double mu, double lambda) {
+  CoarseMaterialFit fit;
+  fit.fitted = true;
+  for (int k = 0; k < 8; ++k) fit.mu[k] = fit.mu0[k] = mu, fit.lambda[k] = fit.lambda0[k] = lambda;
+  return fit;
+}
+
 // `count` samples of a known coarse material on the coarse element of
 // `block`: random corner displacements of up to `amplitude` per component
 // (the standardized mt19937_64 sequence of `seed`) and the material's

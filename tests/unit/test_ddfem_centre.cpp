@@ -206,9 +206,7 @@ TEST(DdfemCentre, CoarseMeshPairsCentreMaterialsWithTheCentrePoint) {
 TEST(DdfemCentre, Level2BlockGivesCentreChildrenTheCentrePoint) {
   const FineBlock child_block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1},
                                                 ddfem_test::two_materials(1e6, 1e6), kVoxel);
-  CoarseMaterialFit child;
-  child.fitted = true;
-  for (int k = 0; k < 8; ++k) child.mu[k] = 3e5, child.lambda[k] = 1e5;
+  CoarseMaterialFit child = ddfem_test::neo_hookean_level1(3e5, 1e5);
   child.mu_centre = 4e5, child.lambda_centre = 2e6;
   const std::array<const CoarseMaterialFit*, 8> children{&child, &child, &child, &child,
                                                          &child, &child, &child, &child};

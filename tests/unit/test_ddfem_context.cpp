@@ -282,9 +282,7 @@ TEST(DdfemPeriodic, FiberBlockCarriesLoadAlongTheFiber) {
 // homogeneous block under a uniform deformation).
 TEST(DdfemContext, Level2BlockInContextAndPeriodic) {
   const double mu = 4e5, lambda = 9e5;
-  CoarseMaterialFit l1;
-  l1.fitted = true;
-  for (int k = 0; k < 8; ++k) l1.mu[k] = l1.mu0[k] = mu, l1.lambda[k] = l1.lambda0[k] = lambda;
+  const CoarseMaterialFit l1 = ddfem_test::neo_hookean_level1(mu, lambda);
   std::array<const CoarseMaterialFit*, 8> children;
   children.fill(&l1);
   const FineBlock patch = make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel, 1);

@@ -431,9 +431,7 @@ TEST(DdfemLevel2Block, BlockOfCoarseMaterialsFitsLikeItsMaterial) {
   // Eight copies of a level-1 material that is exactly a Neo-Hookean one:
   // the level-2 fit on the smooth kinds must recover it at all 64 points.
   const double mu = 4e5, lambda = 9e5;
-  CoarseMaterialFit l1;
-  l1.fitted = true;
-  for (int k = 0; k < 8; ++k) l1.mu[k] = l1.mu0[k] = mu, l1.lambda[k] = l1.lambda0[k] = lambda;
+  const CoarseMaterialFit l1 = ddfem_test::neo_hookean_level1(mu, lambda);
   std::array<const CoarseMaterialFit*, 8> children;
   children.fill(&l1);
   const FineBlock block = make_block_of_coarse_materials(children, BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, 2 * kVoxel);

@@ -118,6 +118,26 @@ TEST(Newton, NeoHookeanUniaxialStretchMatchesAnalyticStress) {
   EXPECT_NEAR(res.x[3 * corner + 1], b, 1e-9);
 }
 
+// A beam along x clamped at x = 0 with a total downward (-z) load P spread
+// over its x = max face by the region weights.
+struct Cantilever {
+  DirichletConditions dirichlet;
+  VecX force;
+  RegionNodes tip;
+};
+Cantilever clamped_with_tip_load(const VoxelGrid& grid, const VoxelMesh& vm, double P) {
+  Cantilever c{DirichletConditions::none(vm.mesh.num_dofs()), VecX::Zero(vm.mesh.num_dofs()), {}};
+  Region tip;
+  tip.axis = 0;
+  tip.upper = true;
+  c.tip = select_region(tip, grid, vm);
+  for (size_t k = 0; k < c.tip.nodes.size(); ++k) c.force[3 * c.tip.nodes[k] + 2] = -P * c.tip.weight[k];
+  for (int node = 0; node < vm.mesh.num_nodes(); ++node)
+    if (vm.mesh.nodes(node, 0) == 0)
+      for (int a = 0; a < 3; ++a) c.dirichlet.fixed[3 * node + a] = 1;
+  return c;
+}
+
 TEST(Newton, CantileverTipDeflectionConvergesToTimoshenko) {
   // Clamped beam 10 x 1 x 1, E = 1000, nu = 0, end load P: Timoshenko gives
   // w = P L^3 / (3 E I) + P L / (kappa G A), kappa = 5/6.
@@ -128,16 +148,8 @@ TEST(Newton, CantileverTipDeflectionConvergesToTimoshenko) {
     VoxelGrid grid(10 * n, n, n, 1.0 / n, 1);
     const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<LinearIsotropic>(E, 0.0)});
     ElasticAssembler asmb(vm.mesh);
-    auto DC = DirichletConditions::none(vm.mesh.num_dofs());
-    VecX f = VecX::Zero(vm.mesh.num_dofs());
-    Region tip;
-    tip.axis = 0;
-    tip.upper = true;
-    const RegionNodes sel = select_region(tip, grid, vm);
-    for (size_t k = 0; k < sel.nodes.size(); ++k) f[3 * sel.nodes[k] + 2] = -P * sel.weight[k];  // unit area
-    for (int node = 0; node < vm.mesh.num_nodes(); ++node)
-      if (vm.mesh.nodes(node, 0) == 0)
-        for (int a = 0; a < 3; ++a) DC.fixed[3 * node + a] = 1;
+    const Cantilever c = clamped_with_tip_load(grid, vm, P);  // unit area
+    const auto& [DC, f, sel] = c;
     NewtonOptions opt;
     opt.relative_tolerance = 1e-9;
     const auto res = solve_static(asmb, DC, f, opt);
@@ -172,16 +184,8 @@ TEST(Newton, SmallLoadCantileverConvergesInAFewIterations) {
                                 : MaterialPtr(std::make_shared<LinearIsotropic>(E, 0.3));
     const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, mat});
     ElasticAssembler asmb(vm.mesh);
-    auto DC = DirichletConditions::none(vm.mesh.num_dofs());
-    VecX f = VecX::Zero(vm.mesh.num_dofs());
-    Region tip;
-    tip.axis = 0;
-    tip.upper = true;
-    const RegionNodes sel = select_region(tip, grid, vm);
-    for (size_t k = 0; k < sel.nodes.size(); ++k) f[3 * sel.nodes[k] + 2] = -P * sel.weight[k];
-    for (int node = 0; node < vm.mesh.num_nodes(); ++node)
-      if (vm.mesh.nodes(node, 0) == 0)
-        for (int a = 0; a < 3; ++a) DC.fixed[3 * node + a] = 1;
+    const Cantilever c = clamped_with_tip_load(grid, vm, P);
+    const auto& [DC, f, sel] = c;
     for (const double tolerance : {1e-6, 1e-8, 1e-10}) {
       NewtonOptions opt;
       opt.relative_tolerance = tolerance;
