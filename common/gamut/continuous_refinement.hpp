@@ -26,10 +26,13 @@
 // conservative inner iterations compare objective values, and a filtered
 // sensitivity is not the gradient of any objective (docs/gamut.md).
 #include <Eigen/Eigenvalues>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/types.hpp"
 #include "fem/voxel_grid.hpp"
+#include "gamut/material_space.hpp"
 #include "gamut/structure_ops.hpp"
 #include "material/material.hpp"
 
@@ -42,6 +45,11 @@ struct ContinuousOptions {
   double density_weight = 1.0;  // w_rho
   double start_offset = 0.3;    // stiff voxels start at 0.5 + offset, others at 0.5 - offset
   double void_stiffness = 1e-6; // when the soft phase is void
+  // Heaviside projection with continuation: beta = 1, 2, 4, ... up to
+  // projection_beta, the evaluations split evenly over the stages, so the
+  // last stage optimizes a nearly black-and-white design and the
+  // thresholded structure keeps the properties MMA found. 0: none.
+  double projection_beta = 0;
   CellSymmetry symmetry = CellSymmetry::cubic;
 };
 
@@ -50,42 +58,91 @@ struct RefinementTarget {
   double rho = 0.5;  // stiff volume fraction
 };
 
+// A directed objective (the outward push of §3.2.2 with a chosen
+// direction instead of the level set's normal): maximize d . u(C^H, rho),
+// u the cell's properties in the unit cube of a material space, subject to
+// floors u_i >= floor_i (MMA inequality constraints). "Minimize nu at
+// fixed E" is d = -e_nu with a floor on E; the floors keep the push from
+// buying its direction with a collapse of the stiffness.
+struct DirectedTarget {
+  VecX direction;  // in the space's unit cube, one entry per property
+  VecX floor;      // unit-cube lower bounds; -inf (or below 0) for none
+};
+
 // The objective of one cell, for a two-phase structure of `stiff` and
 // `soft` (soft == nullptr: void). Cells are cubic/square (cubic
 // symmetry) or any box (orthotropic). InputError on bad options or a
 // target of the wrong size.
 class ContinuousCellProblem {
  public:
+  // The target objective, Eq. 3.4.
   ContinuousCellProblem(int nx, int ny, int nz, double h, MaterialPtr stiff, MaterialPtr soft,
                         const RefinementTarget& target, const ContinuousOptions& options);
+  // The directed objective f = -d . u with the floors as constraints. The
+  // space's kind must match the cell (2D space: nz = 1).
+  ContinuousCellProblem(int nx, int ny, int nz, double h, MaterialPtr stiff, MaterialPtr soft,
+                        const MaterialSpace& space, const DirectedTarget& target, const ContinuousOptions& options);
 
   int variables() const { return static_cast<int>(orbit_voxels_.size()); }
   // Densities of the voxels of a structure (stiff id -> 0.5 + offset, others 0.5 - offset), one per orbit.
   std::vector<double> start(const VoxelGrid& structure, int stiff_id) const;
   // Filtered per-voxel densities x~.
   std::vector<double> filtered(const std::vector<double>& x) const;
+  // The projection's sharpness beta (0: none); the stiffness weights and
+  // rho then use the projected densities H_beta(x~).
+  void set_projection(double beta);
   // f(x); fills `gradient` (size variables()) when non-null.
   double objective(const std::vector<double>& x, std::vector<double>* gradient) const;
-  // Voxel ids of the thresholded design: x~ >= 0.5 -> stiff_id, else soft_id.
-  VoxelGrid threshold(const std::vector<double>& x, int stiff_id, int soft_id) const;
+  // The directed objective's floors as constraints c(x) = floor - u <= 0.
+  int constraints() const { return static_cast<int>(floors_.size()); }
+  double constraint(int c, const std::vector<double>& x, std::vector<double>* gradient) const;
+  // The unit-cube properties u of the (grey) design; directed problems only.
+  VecX unit_properties(const std::vector<double>& x) const;
+  // Directed problems: the unit-cube properties of a black-and-white
+  // structure (stiff_id stiff, all else soft), and how far u falls below
+  // the floors (0: none).
+  VecX structure_unit_properties(const VoxelGrid& structure, int stiff_id) const;
+  double floor_violation(const VecX& u) const;
+  double directed_objective(const VecX& u) const { return -direction_.dot(u); }
+  bool directed() const { return space_.has_value(); }
+  // Voxel ids of the thresholded design: x~ >= level -> stiff_id, else soft_id.
+  VoxelGrid threshold(const std::vector<double>& x, int stiff_id, int soft_id, double level = 0.5) const;
 
  private:
+  struct Evaluation;
   int nx_, ny_, nz_;
   double h_;
   Mat24 K_stiff_, K_soft_;
   RefinementTarget target_;
   MatX W_;
+  std::optional<MaterialSpace> space_;  // set for a directed objective
+  VecX direction_;
+  std::vector<std::pair<int, double>> floors_;  // (property, unit floor)
   ContinuousOptions options_;
   std::vector<int> orbit_of_voxel_;
   std::vector<std::vector<int>> orbit_voxels_;
   // Filter rows: per voxel, (neighbour voxel, weight / row sum).
   std::vector<std::vector<std::pair<int, double>>> filter_;
+  // The last design evaluated: NLopt asks for the objective and each
+  // constraint at the same x, and each needs the same homogenization.
+  mutable std::shared_ptr<Evaluation> last_;
+  double beta_ = 0;
+
+  double project(double xt, double* derivative) const;
+  void setup_cell(MaterialPtr stiff, MaterialPtr soft);
+  void homogenize_densities(Evaluation& e) const;  // e.xp -> e.r, e.C, e.rho
+  const Evaluation& evaluate(const std::vector<double>& x, bool with_sensitivities) const;
+  // d(property)/dC of the plane block or the 6 x 6 tensor, and the unit-cube properties.
+  VecX properties_and_gradients(const Evaluation& e, std::vector<MatX>* dudC) const;
+  // The gradient over the design variables of a function with df/dC (m x m) and df/drho.
+  void chain(const Evaluation& e, const MatX& dfdC, double dfdrho, std::vector<double>* gradient) const;
 };
 
 struct ContinuousResult {
   VoxelGrid structure;               // thresholded, mirrored and cleaned
   double start_objective = 0, best_objective = 0;
   int evaluations = 0;
+  double threshold = 0.5;            // the level x~ was thresholded at
   std::vector<double> history;       // f per evaluation
 };
 
@@ -93,5 +150,10 @@ struct ContinuousResult {
 ContinuousResult refine_structure(const VoxelGrid& structure, int stiff_id, int soft_id, MaterialPtr stiff,
                                   MaterialPtr soft, const RefinementTarget& target,
                                   const ContinuousOptions& options = {});
+// Runs MMA from `structure` along a directed objective; the best feasible
+// iterate (floors met to 1e-3) is thresholded. Deterministic.
+ContinuousResult refine_structure_directed(const VoxelGrid& structure, int stiff_id, int soft_id, MaterialPtr stiff,
+                                           MaterialPtr soft, const MaterialSpace& space, const DirectedTarget& target,
+                                           const ContinuousOptions& options = {});
 
 }  // namespace msfab

@@ -17,7 +17,7 @@ inline constexpr int kGamutSchemaVersion = 1;
 struct GamutCycle {
   int cycle = 0;
   int samples = 0;             // structures in the set after the cycle
-  int discrete_added = 0, continuous_added = 0;
+  int discrete_added = 0, continuous_added = 0;  // continuous: the level-set pushes and the directed ones
   double coverage = 0;         // fraction of the unit cube inside the gamut (coverage())
   double seconds = 0;          // wall time of the cycle
 };

@@ -40,6 +40,13 @@ class MaterialSpace {
   // Either of the above for the full 3D tensor of a homogenized cell: a 2D
   // space reads the in-plane block (xx, yy, xy) of a plane-strain cell.
   VecX cell_properties(const Mat6& C, double rho) const;
+  // The raw properties of a 6 x 6 (3D) or 3 x 3 plane-block (2D) tensor,
+  // as above, with d property_i / dC (entries treated as independent; the
+  // same size as C) in `dC` when non-null. The last entry, rho, has a zero
+  // derivative.
+  VecX properties_with_gradient(const MatX& C, double rho, std::vector<MatX>* dC) const;
+  // d unit_i / d raw_i at raw properties `raw` (normalize() acts per coordinate).
+  VecX unit_derivative(const VecX& raw) const;
   // The tensor with given raw properties (the inverse of the above, used by
   // the topology optimizer): 6 x 6 cubic, or 3 x 3 plane strain.
   Mat6 tensor_3d(const VecX& raw) const;

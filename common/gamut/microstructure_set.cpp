@@ -25,6 +25,7 @@ const char* step_name(SampleStep step) {
     case SampleStep::discrete: return "discrete";
     case SampleStep::continuous: return "continuous";
     case SampleStep::void_variant: return "void_variant";
+    case SampleStep::directed: return "directed";
   }
   return "?";
 }
@@ -158,7 +159,7 @@ MicrostructureSet read_microstructure_set(const H5File& f, const std::string& g)
     for (int r = 0; r < 6; ++r)
       for (int c = 0; c < 6; ++c) m.C(r, c) = C.values[i * 36 + 6 * r + c];
     m.cycle = cycle[i];
-    if (step[i] < 0 || step[i] > 3) bad(f, at(g, "step"), "value " + std::to_string(step[i]) + " is not 0..3");
+    if (step[i] < 0 || step[i] > 4) bad(f, at(g, "step"), "value " + std::to_string(step[i]) + " is not 0..4");
     m.step = static_cast<SampleStep>(step[i]);
     m.parent = parent[i];
   }

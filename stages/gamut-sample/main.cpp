@@ -153,10 +153,12 @@ int main(int argc, char** argv) {
       const auto t0 = std::chrono::steady_clock::now();
       const StepReport discrete = sampler.discrete_step(state, cycle);
       const StepReport continuous = sampler.continuous_step(state, sampler.level_set(state), cycle);
+      const StepReport directed = sampler.directed_step(state, cycle);
       gamut = sampler.level_set(state);
       sampler.resample(state, *gamut, cycle);
       state.cycles_done = cycle;
-      state.history.push_back({cycle, static_cast<int>(state.set.items.size()), discrete.added, continuous.added,
+      state.history.push_back({cycle, static_cast<int>(state.set.items.size()), discrete.added,
+                               continuous.added + directed.added,
                                coverage(*gamut), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
       if (rank == 0) {
         const GamutCycle& h = state.history.back();
@@ -164,6 +166,7 @@ int main(int argc, char** argv) {
                      h.coverage, h.seconds);
         log_step("discrete", discrete);
         log_step("continuous", continuous);
+        if (options.directed_per_cycle > 0) log_step("directed", directed);
         write_sampler_checkpoint(ckpt, run_text, state);
         if (options.plot_every_cycle) {
           char name[32];
@@ -210,10 +213,12 @@ int main(int argc, char** argv) {
       write_history_csv(plots_dir + "/history.csv", state.history);
       std::filesystem::remove(ckpt);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-      int by_step[4] = {0, 0, 0, 0};
+      int by_step[5] = {0, 0, 0, 0, 0};
       for (const Microstructure& m : state.set.items) ++by_step[static_cast<int>(m.step)];
-      std::printf("msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous) after %d cycles\n",
-                  options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], options.cycles);
+      std::printf(
+          "msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous, %d directed) after %d cycles\n",
+          options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], by_step[4],
+          options.cycles);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
       const std::vector<std::string> names = sampler.space().names();
       for (std::size_t a = 0; a < names.size(); ++a) {

@@ -177,7 +177,7 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   // The unrefined structures nearest the boundary (ties: the older first).
   std::vector<std::pair<double, std::int64_t>> order;
   for (std::size_t i = 0; i < state.set.items.size(); ++i)
-    if (!state.refined[i]) order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
+    if (!(state.refined[i] & 1)) order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
   std::sort(order.begin(), order.end());
   order.resize(std::min<std::size_t>(order.size(), o_.continuous_per_cycle));
 
@@ -203,7 +203,7 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   std::vector<VoxelGrid> cells;
   std::vector<std::int64_t> parents;
   for (std::size_t i = 0; i < order.size(); ++i) {
-    state.refined[order[i].second] = 1;
+    state.refined[order[i].second] |= 1;
     const double* r = &records[i * record];
     if (r[0] != 1) {
       ++report.failed;
@@ -216,6 +216,72 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   }
   const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous, palette_);
   report.tried = static_cast<int>(order.size());
+  report.added = added.added;
+  report.duplicates = added.duplicates;
+  report.outside = added.outside;
+  report.failed += added.failed;
+  return report;
+}
+
+StepReport GamutSampler::directed_step(SamplerState& state, int cycle) const {
+  StepReport report;
+  if (o_.directed_per_cycle == 0 || o_.random_baseline) return report;
+  struct Push {
+    std::int64_t start;
+    int objective;
+  };
+  std::vector<Push> pushes;
+  std::vector<VecX> directions;
+  for (std::size_t k = 0; k < o_.directed_objectives.size(); ++k) {
+    directions.push_back(directed_direction(space_, o_.directed_objectives[k]));
+    const std::uint8_t bit = static_cast<std::uint8_t>(2u << k);
+    // The structures furthest along the objective (ties: the older first).
+    std::vector<std::pair<double, std::int64_t>> order;
+    for (std::size_t i = 0; i < state.set.items.size(); ++i)
+      if (!(state.refined[i] & bit))
+        order.emplace_back(-directions[k].dot(state.set.items[i].unit), static_cast<std::int64_t>(i));
+    std::sort(order.begin(), order.end());
+    for (std::size_t i = 0; i < order.size() && i < static_cast<std::size_t>(o_.directed_per_cycle); ++i) {
+      pushes.push_back({order[i].second, static_cast<int>(k)});
+      state.refined[order[i].second] |= bit;
+    }
+  }
+  const int voxels = o_.resolution * o_.resolution * voxels_per_side_z();
+  const int record = 1 + voxels;
+  const int soft_id = o_.soft_is_void ? 0 : 2;
+  const std::vector<double> records = fan_out(static_cast<int>(pushes.size()), record, [&](int i, double* r) {
+    const Microstructure& start = state.set.items[pushes[i].start];
+    const VecX& d = directions[pushes[i].objective];
+    DirectedTarget target;
+    target.direction = d;
+    // Floors on the moduli the objective leaves alone: the push may not buy
+    // its direction with a collapse of the stiffness.
+    target.floor = VecX::Constant(d.size(), -1.0);
+    const std::vector<std::string> names = space_.names();
+    for (int a = 0; a < d.size(); ++a)
+      if (d[a] == 0 && names[a] != "rho" && names[a].rfind("nu", 0) != 0)
+        target.floor[a] = start.unit[a] - o_.directed_modulus_drop;
+    const ContinuousResult c = refine_structure_directed(cell_of(start), 1, soft_id, palette_[1],
+                                                         o_.soft_is_void ? nullptr : palette_[2], space_, target,
+                                                         o_.directed);
+    r[0] = c.structure.count_solid() > 0;
+    for (int v = 0; v < voxels; ++v) r[1 + v] = c.structure.ids[v];
+  });
+  std::vector<VoxelGrid> cells;
+  std::vector<std::int64_t> parents;
+  for (std::size_t i = 0; i < pushes.size(); ++i) {
+    const double* r = &records[i * record];
+    if (r[0] != 1) {
+      ++report.failed;
+      continue;
+    }
+    std::vector<int> ids(voxels);
+    for (int v = 0; v < voxels; ++v) ids[v] = static_cast<int>(r[1 + v]);
+    cells.push_back(cell_with(std::move(ids)));
+    parents.push_back(pushes[i].start);
+  }
+  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::directed, palette_);
+  report.tried = static_cast<int>(pushes.size());
   report.added = added.added;
   report.duplicates = added.duplicates;
   report.outside = added.outside;

@@ -15,7 +15,9 @@ namespace msfab {
 struct SamplerState {
   MicrostructureSet set;
   std::vector<std::int64_t> population;  // indices into set.items
-  std::vector<std::uint8_t> refined;     // per structure: already a continuous start
+  // Per structure: bit 0, already a continuous start; bit 1 + k, already
+  // pushed along directed objective k.
+  std::vector<std::uint8_t> refined;
   std::vector<GamutCycle> history;
   int cycles_done = -1;                  // -1: not initialized; 0: initial population only
 };
@@ -37,6 +39,10 @@ class GamutSampler {
   // §3.2.2: up to continuous_per_cycle unrefined structures nearest the
   // boundary pushed along the level set's normal by MMA.
   StepReport continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const;
+  // Directed pushes: per objective, the directed_per_cycle structures
+  // furthest along it that it has not pushed yet, optimized along it by
+  // MMA with the other moduli floored at the parent's less modulus_drop.
+  StepReport directed_step(SamplerState& state, int cycle) const;
   // §3.6.1: every structure with its soft material replaced by void,
   // cleaned (floating pieces dropped, 3D cavities filled) and homogenized
   // again; structures left empty, outside the space or repeated are dropped.

@@ -1,5 +1,7 @@
 #include "sampler_options.hpp"
 
+#include <algorithm>
+
 #include "core/errors.hpp"
 
 namespace msfab {
@@ -14,7 +16,9 @@ population: 24
 cycles: 6
 initial_beams: 8
 beams: {max: 3, min_radius: 0.5, max_radius: 2.0}
-continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3}
+continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3, projection_beta: 0}
+# Pushes along named objectives (min_nu | max_nu | min_shear | max_shear); per_cycle 0: none.
+directed: {objectives: [min_nu], per_cycle: 0, modulus_drop: 0.25, max_iterations: 150, projection_beta: 16, filter_radius: 2.5}
 level_set: {cells: 16, margin: 0.1, smoothing_steps: 2}
 density_radius: 0.1
 boundary_depth: 0.1
@@ -33,7 +37,21 @@ BaseMaterial read_base(const Config& m) {
   m.check_no_unknown_keys();
   return b;
 }
+const std::vector<std::string> kDirectedObjectives = {"min_nu", "max_nu", "min_shear", "max_shear"};
+
 }  // namespace
+
+VecX directed_direction(const MaterialSpace& space, const std::string& objective) {
+  VecX d = VecX::Zero(space.dimension());
+  const bool ortho = space.kind() == MaterialSpaceKind::orthotropic2d;
+  const int nu = ortho ? 2 : 1, shear = ortho ? 3 : 2;
+  if (objective == "min_nu") d[nu] = -1;
+  else if (objective == "max_nu") d[nu] = 1;
+  else if (objective == "min_shear") d[shear] = -1;
+  else if (objective == "max_shear") d[shear] = 1;
+  else throw InputError("directed objective '" + objective + "': expected min_nu, max_nu, min_shear or max_shear");
+  return d;
+}
 
 SamplerOptions read_sampler_options(const Config& config) {
   SamplerOptions o;
@@ -91,10 +109,45 @@ SamplerOptions read_sampler_options(const Config& config) {
     if (!(k.density_weight >= 0)) c.fail("density_weight", "must be >= 0");
     k.start_offset = c.get_or<double>("start_offset", k.start_offset);
     if (!(k.start_offset >= 0 && k.start_offset < 0.5)) c.fail("start_offset", "must be in [0, 0.5)");
+    k.projection_beta = c.get_or<double>("projection_beta", k.projection_beta);
+    if (!(k.projection_beta >= 0 && k.projection_beta <= 1024)) c.fail("projection_beta", "must be in [0, 1024]");
     c.check_no_unknown_keys();
   }
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
+
+  o.directed = o.continuous;
+  o.directed.max_iterations = 150;
+  o.directed.projection_beta = 16;
+  o.directed.filter_radius = 2.5;
+  o.directed_objectives = {"min_nu"};
+  if (config.has("directed")) {
+    const Config d = config.child("directed");
+    o.directed_objectives = d.get_or<std::vector<std::string>>("objectives", o.directed_objectives);
+    if (o.directed_objectives.empty() || o.directed_objectives.size() > 4) d.fail("objectives", "needs 1 to 4 names");
+    for (std::size_t i = 0; i < o.directed_objectives.size(); ++i) {
+      const std::string& name = o.directed_objectives[i];
+      if (std::find(kDirectedObjectives.begin(), kDirectedObjectives.end(), name) == kDirectedObjectives.end())
+        d.fail("objectives", "'" + name + "' is not one of min_nu, max_nu, min_shear, max_shear");
+      if (std::find(o.directed_objectives.begin(), o.directed_objectives.begin() + i, name) !=
+          o.directed_objectives.begin() + i)
+        d.fail("objectives", "'" + name + "' is listed twice");
+    }
+    o.directed_per_cycle = d.get_or<int>("per_cycle", o.directed_per_cycle);
+    if (o.directed_per_cycle < 0 || o.directed_per_cycle > 10000) d.fail("per_cycle", "must be in 0..10000");
+    o.directed_modulus_drop = d.get_or<double>("modulus_drop", o.directed_modulus_drop);
+    if (!(o.directed_modulus_drop > 0 && o.directed_modulus_drop <= 1)) d.fail("modulus_drop", "must be in (0, 1]");
+    ContinuousOptions& k = o.directed;
+    k.max_iterations = d.get_or<int>("max_iterations", k.max_iterations);
+    if (k.max_iterations < 1 || k.max_iterations > 100000) d.fail("max_iterations", "must be in 1..100000");
+    k.projection_beta = d.get_or<double>("projection_beta", k.projection_beta);
+    if (!(k.projection_beta >= 0 && k.projection_beta <= 1024)) d.fail("projection_beta", "must be in [0, 1024]");
+    k.filter_radius = d.get_or<double>("filter_radius", k.filter_radius);
+    if (!(k.filter_radius >= 0 && k.filter_radius <= 64)) d.fail("filter_radius", "must be in [0, 64]");
+    k.penalty = d.get_or<double>("penalty", k.penalty);
+    if (!(k.penalty >= 1 && k.penalty <= 16)) d.fail("penalty", "must be in [1, 16]");
+    d.check_no_unknown_keys();
+  }
 
   if (config.has("level_set")) {
     const Config l = config.child("level_set");

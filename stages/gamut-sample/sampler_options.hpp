@@ -2,6 +2,7 @@
 // The gamut sampler's configuration (docs/gamut.md lists every key).
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "gamut/continuous_refinement.hpp"
 #include "gamut/level_set.hpp"
@@ -30,6 +31,15 @@ struct SamplerOptions {
   double continuous_step = 0.1;  // |q - p| in the unit cube
   ContinuousOptions continuous;
 
+  // Directed pushes (docs/gamut.md, "Directed objectives"): per cycle and
+  // objective, the `directed_per_cycle` structures furthest along the
+  // objective, not yet pushed by it, are optimized along it with the other
+  // moduli held above the parent's less `directed_modulus_drop` (unit cube).
+  std::vector<std::string> directed_objectives;  // min_nu, max_nu, min_shear, max_shear
+  int directed_per_cycle = 0;
+  double directed_modulus_drop = 0.25;
+  ContinuousOptions directed;  // MMA settings of the directed pushes
+
   LevelSetOptions level_set{16, 0.1, 0.0, 2};
   double density_radius = 0.1;   // h of Eq. 3.2 (a tenth of the lattice's extent)
   double boundary_depth = 0.1;   // depth of the boundary weight in Eq. 3.1
@@ -44,6 +54,10 @@ struct SamplerOptions {
   // number of homogenizations, no evolution, scoring or continuous step.
   bool random_baseline = false;
 };
+
+// The direction in `space`'s unit cube of a named directed objective;
+// InputError naming the choices for an unknown name.
+VecX directed_direction(const MaterialSpace& space, const std::string& objective);
 
 // InputError naming the key on anything out of range.
 SamplerOptions read_sampler_options(const Config& config);

@@ -1,6 +1,6 @@
 #!/bin/bash
 # msfab-gamut-sample on a tiny 2D gamut: artifacts and plots are written;
-# the result is identical for 1 and 3 MPI ranks, for 1 and 2 threads, and
+# the result (directed pushes included) is identical for 1 and 3 MPI ranks, for 1 and 2 threads, and
 # after a stop and --resume; bad settings exit 2 naming the key.
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
@@ -65,6 +65,10 @@ expect_exit 2 "population.*must be >= 2" -- "$SAMPLE" --config "$TINY" --set pop
 expect_exit 2 "space" -- "$SAMPLE" --config "$TINY" --set space=cubic4d --out "$WORK/bad.gamut.h5"
 expect_exit 2 "materials.soft.*E must be below" -- "$SAMPLE" --config "$TINY" --set materials.soft.E=2e6 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "continuous.step" -- "$SAMPLE" --config "$TINY" --set continuous.step=0 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "directed.objectives.*'min_mu' is not one of" -- "$SAMPLE" --config "$TINY" --set 'directed.objectives=[min_mu]' \
+  --out "$WORK/bad.gamut.h5"
+expect_exit 2 "directed.modulus_drop" -- "$SAMPLE" --config "$TINY" --set directed.modulus_drop=0 --out "$WORK/bad.gamut.h5"
+check "directed pushes ran and their structures are step 4" -- bash -c "h5dump -d /step '$WORK/one.microstructures.h5' | grep -q ' 4'"
 expect_exit 2 "unknown|not a known" -- "$SAMPLE" --config "$TINY" --set cylces=3 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "output folder does not exist" -- "$SAMPLE" --config "$TINY" --out "$WORK/missing/x.gamut.h5"
 finish
