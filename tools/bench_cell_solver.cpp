@@ -6,7 +6,8 @@
 // multigrid solver at tolerance 1e-11 (beyond).
 //
 //   bench_cell_solver [--sizes 16,24,32,64] [--tolerances 1e-5,1e-6,1e-8]
-//                     [--degrees 2] [--kinds random,sphere,frame] [--no-direct]
+//                     [--degrees 2] [--kinds random,sphere,frame,cubic-random]
+//                     [--coarsest 64,512] [--no-direct]
 //
 // Prints a Markdown table. Timings are wall-clock with the OpenMP default
 // thread count (set OMP_NUM_THREADS).
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "gamut/structure_ops.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 
@@ -42,7 +44,10 @@ std::vector<T> parse_list(const char* text) {
 // random: two phases (E 1e6 / 1e3, nu 0.45) voxel by voxel, the gamut
 // issue's contrast at its worst (no smooth geometry). sphere: a soft sphere
 // of radius 0.3 in the stiff phase. frame: three orthogonal bars of the
-// stiff phase in void (void stiffness 1e-6).
+// stiff phase in void (void stiffness 1e-6). cubic-random: random with
+// its fundamental domain mirrored (a gamut structure's symmetry). sphere,
+// frame and cubic-random are cubic, so they also run with two cell
+// problems instead of six (HomogenizationOptions::use_symmetry).
 VoxelGrid make_cell(const std::string& kind, int n) {
   VoxelGrid g(n, n, n, 1.0 / n, 1);
   std::mt19937 rng(7);
@@ -51,13 +56,14 @@ VoxelGrid make_cell(const std::string& kind, int n) {
       for (int i = 0; i < n; ++i) {
         const Vec3 x = g.voxel_center(i, j, k) - Vec3(0.5, 0.5, 0.5);
         int& id = g.at(i, j, k);
-        if (kind == "random") id = 1 + int(rng() % 2);
+        if (kind == "random" || kind == "cubic-random") id = 1 + int(rng() % 2);
         if (kind == "sphere") id = x.norm() < 0.3 ? 2 : 1;
         if (kind == "frame") {
           const double a = std::abs(x[0]), b = std::abs(x[1]), c = std::abs(x[2]), w = 1.0 / 6;
           id = ((a < w && b < w) || (b < w && c < w) || (a < w && c < w)) ? 1 : 0;
         }
       }
+  if (kind == "cubic-random") mirror_fundamental_domain(g);
   return g;
 }
 
@@ -67,6 +73,7 @@ int main(int argc, char** argv) {
   std::vector<int> sizes = {16, 24, 32, 64};
   std::vector<double> tolerances = {1e-5, 1e-6, 1e-8};
   std::vector<int> degrees = {2};
+  std::vector<int> coarsest = {PeriodicMultigridOptions{}.coarsest_nodes};
   std::vector<std::string> kinds = {"random", "sphere", "frame"};
   bool direct = true;
   for (int a = 1; a < argc; ++a) {
@@ -74,17 +81,18 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[a], "--sizes") && more) sizes = parse_list<int>(argv[++a]);
     else if (!std::strcmp(argv[a], "--tolerances") && more) tolerances = parse_list<double>(argv[++a]);
     else if (!std::strcmp(argv[a], "--degrees") && more) degrees = parse_list<int>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--coarsest") && more) coarsest = parse_list<int>(argv[++a]);
     else if (!std::strcmp(argv[a], "--kinds") && more) kinds = parse_list<std::string>(argv[++a]);
     else if (!std::strcmp(argv[a], "--no-direct")) direct = false;
     else {
-      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--no-direct]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--no-direct]\n", argv[0]);
       return 2;
     }
   }
   const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(1e6, 0.45),
                                             std::make_shared<LinearIsotropic>(1e3, 0.45)};
-  std::printf("| cell | n | solver | tolerance | degree | CG iterations (6 cases) | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| cell | n | solver | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& kind : kinds)
     for (int n : sizes) {
       const VoxelGrid cell = make_cell(kind, n);
@@ -96,7 +104,8 @@ int main(int argc, char** argv) {
         const HomogenizationResult r = homogenize(cell, palette, reference_options);
         C_ref = r.C;
         direct_seconds = r.seconds;
-        std::printf("| %s | %d | direct | | | | %.3f | %.3g | (reference) | |\n", kind.c_str(), n, r.seconds, 1 / r.seconds);
+        std::printf("| %s | %d | direct | | | | %d | | %.3f | %.3g | (reference) | |\n", kind.c_str(), n,
+                    r.symmetric_cases ? 2 : 6, r.seconds, 1 / r.seconds);
       } else {
         reference_options.solver = "multigrid";
         reference_options.multigrid_tolerance = 1e-11;
@@ -104,14 +113,20 @@ int main(int argc, char** argv) {
       }
       std::fflush(stdout);
       for (int degree : degrees)
-        for (double tolerance : tolerances) {
+        for (double tolerance : tolerances)
+          for (int coarse : coarsest)
+          for (bool symmetry : {false, true}) {
           HomogenizationOptions o;
           o.solver = "multigrid";
           o.multigrid_tolerance = tolerance;
           o.multigrid_smoother_degree = degree;
+          o.use_symmetry = symmetry;
+          o.multigrid_coarsest_nodes = coarse;
           const HomogenizationResult r = homogenize(cell, palette, o);
-          std::printf("| %s | %d | multigrid | %.0e | %d | %d | %.3f | %.3g | %.1e |", kind.c_str(), n, tolerance, degree,
-                      r.iterations, r.seconds, 1 / r.seconds, (r.C - C_ref).norm() / C_ref.norm());
+          if (symmetry && !r.symmetric_cases) continue;  // the cell has no cyclic symmetry: the row above is all
+          std::printf("| %s | %d | multigrid | %.0e | %d | %d | %d | %d | %.3f | %.3g | %.1e |", kind.c_str(), n,
+                      tolerance, degree, coarse, r.symmetric_cases ? 2 : 6, r.iterations, r.seconds, 1 / r.seconds,
+                      (r.C - C_ref).norm() / C_ref.norm());
           if (direct_seconds > 0)
             std::printf(" %.1f |\n", direct_seconds / r.seconds);
           else

@@ -35,10 +35,10 @@ void check_options(int nx, int ny, int nz, double h, const MaterialPtr& stiff, c
   if (!stiff) throw InputError("continuous step: no stiff material");
   if (options.max_iterations < 1 || !(options.penalty >= 1) || !(options.filter_radius >= 0) ||
       !(options.density_weight >= 0) || !(options.start_offset >= 0 && options.start_offset < 0.5) ||
-      !(options.void_stiffness > 0) || !(options.projection_beta >= 0 && options.projection_beta <= 1024))
+      !(options.void_stiffness > 0) || !(options.projection_beta >= 0 && options.projection_beta <= 1024) || options.min_feature < 1)
     throw InputError(
         "continuous step: need max_iterations >= 1, penalty >= 1, filter_radius >= 0, density_weight >= 0, "
-        "0 <= start_offset < 0.5, void_stiffness > 0, 0 <= projection_beta <= 1024");
+        "0 <= start_offset < 0.5, void_stiffness > 0, 0 <= projection_beta <= 1024, min_feature >= 1");
 }
 
 }  // namespace
@@ -390,14 +390,19 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
     // and intermediate densities vanish. The threshold level whose cleaned
     // structure is best on the directed objective, floors met, is kept.
     double best_score = HUGE_VAL, best_violation = HUGE_VAL;
+    result.structure = VoxelGrid(structure.nx, structure.ny, structure.nz, structure.voxel_size, soft_id);
+    result.found = false;
     for (double level : {0.5, 0.3, 0.35, 0.4, 0.45, 0.55, 0.6, 0.65, 0.7}) {
       VoxelGrid g = printable(level);
-      if (g.count_solid() == 0) continue;
+      if (g.count_solid() == 0 || thin_feature_voxels(g, options.min_feature) > 0) continue;
       const VecX u = problem.structure_unit_properties(g, stiff_id);
       const double violation = problem.floor_violation(u), score = problem.directed_objective(u);
       const bool better = violation <= kFeasible ? (best_violation > kFeasible || score < best_score)
                                                  : violation < best_violation;
-      if (better) best_score = score, best_violation = violation, result.structure = std::move(g), result.threshold = level;
+      if (better) {
+        best_score = score, best_violation = violation;
+        result.structure = std::move(g), result.threshold = level, result.found = true;
+      }
     }
   }
   return result;

@@ -50,6 +50,9 @@ struct ContinuousOptions {
   // last stage optimizes a nearly black-and-white design and the
   // thresholded structure keeps the properties MMA found. 0: none.
   double projection_beta = 0;
+  // The printer's minimum feature size in voxels (thin_feature_voxels):
+  // a directed push keeps only thresholds whose structure has none.
+  int min_feature = 1;
   CellSymmetry symmetry = CellSymmetry::cubic;
 };
 
@@ -143,6 +146,7 @@ struct ContinuousResult {
   double start_objective = 0, best_objective = 0;
   int evaluations = 0;
   double threshold = 0.5;            // the level x~ was thresholded at
+  bool found = true;                 // directed: false when no level gave a printable structure
   std::vector<double> history;       // f per evaluation
 };
 
@@ -151,7 +155,9 @@ ContinuousResult refine_structure(const VoxelGrid& structure, int stiff_id, int 
                                   MaterialPtr soft, const RefinementTarget& target,
                                   const ContinuousOptions& options = {});
 // Runs MMA from `structure` along a directed objective; the best feasible
-// iterate (floors met to 1e-3) is thresholded. Deterministic.
+// iterate (floors met to 1e-3) is thresholded at the level whose printable
+// structure (mirrored, cleaned, no feature below min_feature) is best;
+// an all-soft cell when no level gives one. Deterministic.
 ContinuousResult refine_structure_directed(const VoxelGrid& structure, int stiff_id, int soft_id, MaterialPtr stiff,
                                            MaterialPtr soft, const MaterialSpace& space, const DirectedTarget& target,
                                            const ContinuousOptions& options = {});

@@ -59,11 +59,12 @@ class MaterialSpace {
   // Clamps unit coordinates into [0, 1]; false if one lay outside by more
   // than round-off (1e-9: the solid cell sits exactly on the box's faces).
   static bool clamp_to_box(VecX& unit);
+  // Whether property `coordinate` is a modulus (log-normalized: E, Ex, Ey, G).
+  bool is_modulus(int coordinate) const;
 
  private:
   MaterialSpaceKind kind_;
   double E_stiff_, decades_;
-  bool is_modulus(int coordinate) const;
   double nu_low() const { return -1.0; }
   double nu_high() const { return kind_ == MaterialSpaceKind::cubic3d ? 0.5 : 1.0; }
 };

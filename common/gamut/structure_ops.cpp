@@ -173,4 +173,32 @@ CleanupReport clean_structure(VoxelGrid& c) {
   return report;
 }
 
+std::int64_t thin_feature_voxels(const VoxelGrid& c, int width) {
+  if (width <= 1) return 0;
+  const int wz = is_2d(c) ? 1 : width;
+  if (width > c.nx || width > c.ny || wz > c.nz) return static_cast<std::int64_t>(c.size());
+  std::vector<std::uint8_t> covered(c.size(), 0);
+  auto wrap = [](int i, int n) { return (i % n + n) % n; };
+  // Each window origin whose window is uniformly solid or uniformly void
+  // covers its voxels.
+  for (int k = 0; k < c.nz; ++k)
+    for (int j = 0; j < c.ny; ++j)
+      for (int i = 0; i < c.nx; ++i) {
+        const bool solid = c.at(i, j, k) != 0;
+        bool uniform = true;
+        for (int dk = 0; dk < wz && uniform; ++dk)
+          for (int dj = 0; dj < width && uniform; ++dj)
+            for (int di = 0; di < width && uniform; ++di)
+              uniform = (c.at(wrap(i + di, c.nx), wrap(j + dj, c.ny), wrap(k + dk, c.nz)) != 0) == solid;
+        if (!uniform) continue;
+        for (int dk = 0; dk < wz; ++dk)
+          for (int dj = 0; dj < width; ++dj)
+            for (int di = 0; di < width; ++di)
+              covered[c.index(wrap(i + di, c.nx), wrap(j + dj, c.ny), wrap(k + dk, c.nz))] = 1;
+      }
+  std::int64_t thin = 0;
+  for (std::uint8_t v : covered) thin += v == 0;
+  return thin;
+}
+
 }  // namespace msfab

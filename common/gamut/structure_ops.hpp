@@ -6,6 +6,7 @@
 // A cell with nz = 1 is 2D: its symmetry is the square's (8 elements), and
 // connectivity and wrapping are in the plane.
 #include <array>
+#include <cstdint>
 
 #include "fem/voxel_grid.hpp"
 
@@ -46,5 +47,13 @@ struct CleanupReport {
 // would trap support material) with the most frequent solid id around
 // them. A 2D cell keeps its holes.
 CleanupReport clean_structure(VoxelGrid& cell);
+
+// The printer's minimum feature size, in voxels: the voxels (solid or
+// void) that no width^d window (periodic; 2D: width x width x 1) entirely
+// of their own phase covers, i.e. what a morphological opening of the
+// solid or of the void with that window would change. 0 for width <= 1.
+// A beam or a gap thinner than `width` voxels shows up here; a two-material
+// cell is all solid, so only its void is checked.
+std::int64_t thin_feature_voxels(const VoxelGrid& cell, int width);
 
 }  // namespace msfab

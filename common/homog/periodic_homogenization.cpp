@@ -164,7 +164,8 @@ Eigen::MatrixXd strain_loads(const VoxelStiffnessField& field) {
 
 // The direct solver: K assembled with node 0 pinned (it removes the
 // translations), factorized once, six solves.
-void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, HomogenizationResult& out) {
+void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, HomogenizationResult& out,
+                  const std::vector<int>& cases) {
   const int nx = field.nx, ny = field.ny, nz = field.nz;
   const std::int64_t N = field.voxels();
   auto node = [&](int i, int j, int k) -> std::int64_t { return wrap(i, nx) + nx * (wrap(j, ny) + std::int64_t(ny) * wrap(k, nz)); };
@@ -200,22 +201,45 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
   CholmodSolver solver(solver_options);
   solver.analyze(A);
   if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
-  for (int m = 0; m < 6; ++m) {
+  for (int m : cases) {
     const VecX x = solver.solve(loads.col(m).tail(3 * N - 3));
     out.fluctuation[m] = VecX::Zero(3 * N);
     out.fluctuation[m].tail(3 * N - 3) = x;
   }
 }
 
+// The cyclic permutation P: position (x, y, z) -> (z, x, y), so P e_x = e_y,
+// P e_y = e_z, P e_z = e_x; a displacement's component r moves to r + 1.
+int cyclic_corner(int a) {  // corner offset (ox, oy, oz) -> (oz, ox, oy)
+  const int ox = a >> 2 & 1, oy = a >> 1 & 1, oz = a & 1;
+  return oz << 2 | ox << 1 | oy;
+}
+
+// Strain case m -> the case P carries it to: xx -> yy -> zz, yz -> xz -> xy.
+constexpr int kCyclicCase[6] = {1, 2, 0, 4, 5, 3};
+
+// chi_{P eps P^T}(node sigma(p)) = P chi_eps(node p), sigma(i, j, k) = (k, i, j).
+VecX permute_fluctuation(const VecX& chi, int n) {
+  VecX out(chi.size());
+  const std::int64_t nodes = std::int64_t(n) * n * n;
+  for (std::int64_t p = 0; p < nodes; ++p) {
+    const int i = static_cast<int>(p % n), j = static_cast<int>((p / n) % n), k = static_cast<int>(p / (std::int64_t(n) * n));
+    const std::int64_t q = k + n * (i + std::int64_t(n) * j);
+    for (int r = 0; r < 3; ++r) out[3 * q + (r + 1) % 3] = chi[3 * p + r];
+  }
+  return out;
+}
+
 void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, const HomogenizationOptions& options,
-                     HomogenizationResult& out) {
+                     HomogenizationResult& out, const std::vector<int>& cases) {
   PeriodicMultigridOptions mg;
   mg.tolerance = options.multigrid_tolerance;
   mg.threads = options.threads;
   mg.smoother_degree = options.multigrid_smoother_degree;
+  mg.coarsest_nodes = options.multigrid_coarsest_nodes;
   PeriodicGridMultigrid solver(field, mg);
   out.unknowns = 3 * field.voxels();
-  for (int m = 0; m < 6; ++m) {
+  for (int m : cases) {
     VecX x = solver.solve(loads.col(m));
     // The same gauge as the direct solver: zero at node 0.
     const Vec3 shift = x.head<3>();
@@ -226,6 +250,29 @@ void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& lo
 }
 
 }  // namespace
+
+bool cyclic_invariant(const VoxelStiffnessField& f) {
+  const int n = f.nx;
+  if (f.ny != n || f.nz != n || n < 2) return false;
+  for (const Mat24& K : f.basis) {
+    const double tol = 1e-12 * K.cwiseAbs().maxCoeff();
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            if (std::abs(K(3 * cyclic_corner(a) + (r + 1) % 3, 3 * cyclic_corner(b) + (c + 1) % 3) -
+                         K(3 * a + r, 3 * b + c)) > tol)
+              return false;
+  }
+  const int B = f.basis_size();
+  for (std::int64_t v = 0; v < f.voxels(); ++v) {
+    const int i = static_cast<int>(v % n), j = static_cast<int>((v / n) % n), k = static_cast<int>(v / (std::int64_t(n) * n));
+    const std::int64_t w = k + n * (i + std::int64_t(n) * j);
+    for (int b = 0; b < B; ++b)
+      if (std::abs(f.weight(v, b) - f.weight(w, b)) > 1e-12 * std::max(std::abs(f.weight(v, b)), 1e-300)) return false;
+  }
+  return true;
+}
 
 HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const HomogenizationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -238,10 +285,17 @@ HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const
   HomogenizationResult out;
   out.solver = homogenization_solver(nx, ny, nz, options.solver);
   const Eigen::MatrixXd loads = strain_loads(field);
+  const bool symmetric = options.use_symmetry && cyclic_invariant(field);
+  const std::vector<int> cases = symmetric ? std::vector<int>{0, 3} : std::vector<int>{0, 1, 2, 3, 4, 5};
   if (out.solver == "direct")
-    solve_direct(field, loads, out);
+    solve_direct(field, loads, out, cases);
   else
-    solve_multigrid(field, loads, options, out);
+    solve_multigrid(field, loads, options, out, cases);
+  if (symmetric)
+    for (int m : {0, 3})
+      for (int step = 0, from = m; step < 2; ++step, from = kCyclicCase[from])
+        out.fluctuation[kCyclicCase[from]] = permute_fluctuation(out.fluctuation[from], nx);
+  out.symmetric_cases = symmetric;
   // C^H from the element energies of the total fields, summed per element
   // first and then in element order (deterministic).
   std::vector<Mat6> contribution(cells);

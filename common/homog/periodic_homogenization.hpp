@@ -16,6 +16,7 @@
 #include "fem/voxel_stiffness_field.hpp"
 #include "fem/hex8.hpp"
 #include "homog/elastic_tensor.hpp"
+#include "solve/periodic_grid_multigrid.hpp"
 
 namespace msfab {
 
@@ -35,9 +36,22 @@ struct HomogenizationOptions {
   double multigrid_tolerance = 1e-6;
   // Multigrid: Chebyshev smoother degree on the finest level (a tuning knob).
   int multigrid_smoother_degree = 2;
+  // Multigrid: coarsening stops at this many lattice nodes (then a sparse
+  // Cholesky); PeriodicMultigridOptions::coarsest_nodes.
+  int multigrid_coarsest_nodes = PeriodicMultigridOptions{}.coarsest_nodes;
   // Multigrid: OpenMP threads (0: the OpenMP default).
   int threads = 0;
+  // A 3D cell that maps onto itself under the cyclic axis permutation
+  // x -> y -> z -> x (every cubic-symmetric cell does; see
+  // cyclic_invariant) needs two cell problems, not six: the fluctuations of
+  // yy and zz (xz and xy) are those of xx (yz) carried by the permutation.
+  bool use_symmetry = true;
 };
+
+// True when the field is invariant under the cyclic permutation of the axes
+// (voxel (i, j, k) -> (k, i, j)): a cube of voxels whose weights and
+// element bases map onto themselves (to 1e-12 relative).
+bool cyclic_invariant(const VoxelStiffnessField& field);
 
 // "auto" switches to multigrid at this many voxels: from 12^3 on it is 2.4x
 // faster than the direct solver or more, on one thread and on two; at 8^3
@@ -51,7 +65,8 @@ struct HomogenizationResult {
   int pieces = 0;                 // connected solid pieces (voxels sharing a node, periodically)
   std::int64_t unknowns = 0;      // 3 per lattice node (direct: less the 3 pinned ones)
   std::string solver;             // "direct" or "multigrid"
-  int iterations = 0;             // multigrid: CG iterations over the six strain cases
+  int iterations = 0;             // multigrid: CG iterations over the strain cases solved
+  bool symmetric_cases = false;   // two cases solved, four carried by the cyclic permutation
   // Per Voigt strain: the periodic fluctuation at the nx*ny*nz lattice
   // nodes (3 per node, x fastest), zero at node 0.
   std::array<VecX, 6> fluctuation;

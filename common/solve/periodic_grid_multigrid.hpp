@@ -42,7 +42,7 @@ struct PeriodicMultigridOptions {
   double tolerance = 1e-8;  // stop when ||b - K x|| <= tolerance ||b|| (b projected)
   int max_iterations = 1000;
   int smoother_degree = 2;   // Chebyshev degree on the finest level (twice that below)
-  int coarsest_nodes = 512;  // coarsening stops at the first level with at most this many nodes
+  int coarsest_nodes = 64;  // coarsening stops at the first level with at most this many nodes
   // Coarse levels' smoothers in single precision (ChebyshevSmoother). A
   // stiffness contrast beyond what single precision resolves (e.g. void at
   // 1e-9 of the solid) can make the rounded operators indefinite; solve()

@@ -49,8 +49,8 @@ std::string stem_of(const std::string& out) {
 }
 
 void log_step(const char* name, const StepReport& r) {
-  spdlog::info("  {}: {} tried, {} added ({} duplicates, {} outside the space, {} failed)", name, r.tried, r.added,
-               r.duplicates, r.outside, r.failed);
+  spdlog::info("  {}: {} tried, {} added ({} duplicates, {} outside the space, {} thinner than min_feature, {} failed)",
+               name, r.tried, r.added, r.duplicates, r.outside, r.thin, r.failed);
 }
 
 void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <unordered_set>
 
 #include "core/errors.hpp"
@@ -89,10 +91,12 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
                                         const std::vector<MaterialPtr>& palette) const {
   StepReport report;
   report.tried = static_cast<int>(cells.size());
+  std::vector<std::uint8_t> thin(cells.size(), 0);
+  for (std::size_t i = 0; i < cells.size(); ++i) thin[i] = thin_feature_voxels(cells[i], o_.min_feature) > 0;
   HomogenizationOptions ho;
   ho.void_stiffness = o_.void_stiffness;
   const std::vector<double> records = fan_out(report.tried, kHeader, [&](int i, double* r) {
-    if (cells[i].count_solid() == 0) return;
+    if (cells[i].count_solid() == 0 || thin[i]) return;
     const HomogenizationResult h = homogenize(cells[i], palette, ho);
     r[0] = 1;
     r[1] = h.volume_fraction.size() > 1 ? h.volume_fraction[1] : 0.0;
@@ -102,6 +106,10 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
   for (const Microstructure& m : state.set.items) known.insert(hash_ids(m.ids));
   for (int i = 0; i < report.tried; ++i) {
     const double* r = &records[static_cast<std::size_t>(i) * kHeader];
+    if (thin[i]) {
+      ++report.thin;
+      continue;
+    }
     if (r[0] != 1) {
       ++report.failed;
       continue;
@@ -171,23 +179,57 @@ StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
   return add_structures(state, cells, parents, cycle, SampleStep::discrete, palette_);
 }
 
-StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
+StepReport GamutSampler::add_refined(SamplerState& state, const std::vector<std::int64_t>& starts, int cycle,
+                                     SampleStep step,
+                                     const std::function<std::optional<VoxelGrid>(int)>& refine) const {
+  const int voxels = o_.resolution * o_.resolution * voxels_per_side_z();
+  const int record = 1 + voxels;
+  const std::vector<double> records = fan_out(static_cast<int>(starts.size()), record, [&](int i, double* r) {
+    const std::optional<VoxelGrid> cell = refine(i);
+    if (!cell) return;
+    r[0] = 1;
+    for (int v = 0; v < voxels; ++v) r[1 + v] = cell->ids[v];
+  });
   StepReport report;
-  if (o_.continuous_per_cycle == 0 || o_.random_baseline) return report;
+  std::vector<VoxelGrid> cells;
+  std::vector<std::int64_t> parents;
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    const double* r = &records[i * record];
+    if (r[0] != 1) {
+      ++report.failed;
+      continue;
+    }
+    std::vector<int> ids(voxels);
+    for (int v = 0; v < voxels; ++v) ids[v] = static_cast<int>(r[1 + v]);
+    cells.push_back(cell_with(std::move(ids)));
+    parents.push_back(starts[i]);
+  }
+  const StepReport added = add_structures(state, cells, parents, cycle, step, palette_);
+  report.tried = static_cast<int>(starts.size());
+  report.added = added.added;
+  report.duplicates = added.duplicates;
+  report.outside = added.outside;
+  report.thin = added.thin;
+  report.failed += added.failed;
+  return report;
+}
+
+StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSet& gamut, int cycle) const {
+  if (o_.continuous_per_cycle == 0 || o_.random_baseline) return {};
   // The unrefined structures nearest the boundary (ties: the older first).
   std::vector<std::pair<double, std::int64_t>> order;
   for (std::size_t i = 0; i < state.set.items.size(); ++i)
     if (!(state.refined[i] & 1)) order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
   std::sort(order.begin(), order.end());
   order.resize(std::min<std::size_t>(order.size(), o_.continuous_per_cycle));
+  std::vector<std::int64_t> starts;
+  for (const auto& [distance, i] : order) starts.push_back(i), state.refined[i] |= 1;
 
-  const int voxels = o_.resolution * o_.resolution * voxels_per_side_z();
-  const int record = 1 + voxels;
   const int soft_id = o_.soft_is_void ? 0 : 2;
-  const std::vector<double> records = fan_out(static_cast<int>(order.size()), record, [&](int i, double* r) {
-    const Microstructure& start = state.set.items[order[i].second];
+  return add_refined(state, starts, cycle, SampleStep::continuous, [&](int i) -> std::optional<VoxelGrid> {
+    const Microstructure& start = state.set.items[starts[i]];
     VecX g = gamut.gradient(start.unit);
-    if (!(g.norm() > 1e-12)) return;
+    if (!(g.norm() > 1e-12)) return std::nullopt;
     VecX q = start.unit + o_.continuous_step * g / g.norm();
     for (int a = 0; a < q.size(); ++a) q[a] = std::clamp(q[a], 0.005, 0.995);
     const VecX raw = space_.denormalize(q);
@@ -195,98 +237,45 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
     if (o_.kind == MaterialSpaceKind::cubic3d) target.G = space_.tensor_3d(raw).inverse();
     else target.G = space_.tensor_2d(raw).inverse();
     target.rho = raw[raw.size() - 1];
-    const ContinuousResult c = refine_structure(cell_of(start), 1, soft_id, palette_[1],
-                                                o_.soft_is_void ? nullptr : palette_[2], target, o_.continuous);
-    r[0] = 1;
-    for (int v = 0; v < voxels; ++v) r[1 + v] = c.structure.ids[v];
+    return refine_structure(cell_of(start), 1, soft_id, palette_[1], o_.soft_is_void ? nullptr : palette_[2], target,
+                            o_.continuous)
+        .structure;
   });
-  std::vector<VoxelGrid> cells;
-  std::vector<std::int64_t> parents;
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    state.refined[order[i].second] |= 1;
-    const double* r = &records[i * record];
-    if (r[0] != 1) {
-      ++report.failed;
-      continue;
-    }
-    std::vector<int> ids(voxels);
-    for (int v = 0; v < voxels; ++v) ids[v] = static_cast<int>(r[1 + v]);
-    cells.push_back(cell_with(std::move(ids)));
-    parents.push_back(order[i].second);
-  }
-  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::continuous, palette_);
-  report.tried = static_cast<int>(order.size());
-  report.added = added.added;
-  report.duplicates = added.duplicates;
-  report.outside = added.outside;
-  report.failed += added.failed;
-  return report;
 }
 
 StepReport GamutSampler::directed_step(SamplerState& state, int cycle) const {
-  StepReport report;
-  if (o_.directed_per_cycle == 0 || o_.random_baseline) return report;
-  struct Push {
-    std::int64_t start;
-    int objective;
-  };
-  std::vector<Push> pushes;
-  std::vector<VecX> directions;
+  if (o_.directed_per_cycle == 0 || o_.random_baseline) return {};
+  std::vector<std::int64_t> starts;
+  std::vector<VecX> directions;  // per start
   for (std::size_t k = 0; k < o_.directed_objectives.size(); ++k) {
-    directions.push_back(directed_direction(space_, o_.directed_objectives[k]));
+    const VecX d = directed_direction(space_, o_.directed_objectives[k]);
     const std::uint8_t bit = static_cast<std::uint8_t>(2u << k);
     // The structures furthest along the objective (ties: the older first).
     std::vector<std::pair<double, std::int64_t>> order;
     for (std::size_t i = 0; i < state.set.items.size(); ++i)
-      if (!(state.refined[i] & bit))
-        order.emplace_back(-directions[k].dot(state.set.items[i].unit), static_cast<std::int64_t>(i));
+      if (!(state.refined[i] & bit)) order.emplace_back(-d.dot(state.set.items[i].unit), static_cast<std::int64_t>(i));
     std::sort(order.begin(), order.end());
     for (std::size_t i = 0; i < order.size() && i < static_cast<std::size_t>(o_.directed_per_cycle); ++i) {
-      pushes.push_back({order[i].second, static_cast<int>(k)});
+      starts.push_back(order[i].second);
+      directions.push_back(d);
       state.refined[order[i].second] |= bit;
     }
   }
-  const int voxels = o_.resolution * o_.resolution * voxels_per_side_z();
-  const int record = 1 + voxels;
   const int soft_id = o_.soft_is_void ? 0 : 2;
-  const std::vector<double> records = fan_out(static_cast<int>(pushes.size()), record, [&](int i, double* r) {
-    const Microstructure& start = state.set.items[pushes[i].start];
-    const VecX& d = directions[pushes[i].objective];
+  return add_refined(state, starts, cycle, SampleStep::directed, [&](int i) -> std::optional<VoxelGrid> {
+    const Microstructure& start = state.set.items[starts[i]];
     DirectedTarget target;
-    target.direction = d;
+    target.direction = directions[i];
     // Floors on the moduli the objective leaves alone: the push may not buy
     // its direction with a collapse of the stiffness.
-    target.floor = VecX::Constant(d.size(), -1.0);
-    const std::vector<std::string> names = space_.names();
-    for (int a = 0; a < d.size(); ++a)
-      if (d[a] == 0 && names[a] != "rho" && names[a].rfind("nu", 0) != 0)
-        target.floor[a] = start.unit[a] - o_.directed_modulus_drop;
-    const ContinuousResult c = refine_structure_directed(cell_of(start), 1, soft_id, palette_[1],
-                                                         o_.soft_is_void ? nullptr : palette_[2], space_, target,
-                                                         o_.directed);
-    r[0] = c.structure.count_solid() > 0;
-    for (int v = 0; v < voxels; ++v) r[1 + v] = c.structure.ids[v];
+    target.floor = VecX::Constant(target.direction.size(), -1.0);
+    for (int a = 0; a < target.direction.size(); ++a)
+      if (target.direction[a] == 0 && space_.is_modulus(a)) target.floor[a] = start.unit[a] - o_.directed_modulus_drop;
+    ContinuousResult c = refine_structure_directed(cell_of(start), 1, soft_id, palette_[1],
+                                                   o_.soft_is_void ? nullptr : palette_[2], space_, target, o_.directed);
+    if (!c.found) return std::nullopt;
+    return std::move(c.structure);
   });
-  std::vector<VoxelGrid> cells;
-  std::vector<std::int64_t> parents;
-  for (std::size_t i = 0; i < pushes.size(); ++i) {
-    const double* r = &records[i * record];
-    if (r[0] != 1) {
-      ++report.failed;
-      continue;
-    }
-    std::vector<int> ids(voxels);
-    for (int v = 0; v < voxels; ++v) ids[v] = static_cast<int>(r[1 + v]);
-    cells.push_back(cell_with(std::move(ids)));
-    parents.push_back(pushes[i].start);
-  }
-  const StepReport added = add_structures(state, cells, parents, cycle, SampleStep::directed, palette_);
-  report.tried = static_cast<int>(pushes.size());
-  report.added = added.added;
-  report.duplicates = added.duplicates;
-  report.outside = added.outside;
-  report.failed += added.failed;
-  return report;
 }
 
 SamplerState GamutSampler::void_variants(const SamplerState& state, StepReport* report) const {

@@ -3,6 +3,8 @@
 // holds identically: the structures found so far, the particle population
 // and the per-cycle history.
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <vector>
 
 #include "gamut/gamut_artifact.hpp"
@@ -24,7 +26,8 @@ struct SamplerState {
 
 struct StepReport {
   int tried = 0, added = 0;
-  int duplicates = 0, outside = 0, failed = 0;  // rejected: already in the set, outside the space's box, no result
+  // rejected: already in the set, outside the space's box, a feature below min_feature, no result
+  int duplicates = 0, outside = 0, thin = 0, failed = 0;
 };
 
 class GamutSampler {
@@ -73,6 +76,10 @@ class GamutSampler {
                             const std::vector<std::int64_t>& parents, int cycle, SampleStep step,
                             const std::vector<MaterialPtr>& palette) const;
   bool fill_properties(Microstructure& m, const Mat6& C, double rho) const;
+  // Runs refine(i) for every start across ranks (nullopt: no result) and
+  // adds the new structures with the start as parent.
+  StepReport add_refined(SamplerState& state, const std::vector<std::int64_t>& starts, int cycle, SampleStep step,
+                         const std::function<std::optional<VoxelGrid>(int)>& refine) const;
 };
 
 }  // namespace msfab

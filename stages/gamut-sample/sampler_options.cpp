@@ -24,6 +24,7 @@ density_radius: 0.1
 boundary_depth: 0.1
 decades: 4
 void_stiffness: 1.0e-6
+min_feature: 1            # the printer's smallest beam or gap, voxels (1: no limit)
 plot_every_cycle: true
 mode: sampler             # sampler | random (the benchmark's baseline)
 void_variants: false      # also write the structures with the soft material removed (thesis 3.6.1)
@@ -113,10 +114,14 @@ SamplerOptions read_sampler_options(const Config& config) {
     if (!(k.projection_beta >= 0 && k.projection_beta <= 1024)) c.fail("projection_beta", "must be in [0, 1024]");
     c.check_no_unknown_keys();
   }
+  o.min_feature = config.get_or<int>("min_feature", o.min_feature);
+  if (o.min_feature < 1 || o.min_feature > o.resolution / 2)
+    config.fail("min_feature", "must be in 1..resolution/2 (" + std::to_string(o.resolution / 2) + ")");
+  o.continuous.min_feature = o.min_feature;
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
 
-  o.directed = o.continuous;
+  o.directed = o.continuous;  // min_feature, void_stiffness, symmetry
   o.directed.max_iterations = 150;
   o.directed.projection_beta = 16;
   o.directed.filter_radius = 2.5;

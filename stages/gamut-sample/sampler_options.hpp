@@ -21,6 +21,9 @@ struct SamplerOptions {
   bool soft_is_void = false;
   double decades = 4;            // log range of the moduli below the stiff E
   double void_stiffness = 1e-6;
+  // The printer's minimum feature size in voxels: structures with a thinner
+  // beam or gap (thin_feature_voxels) are not added. 1: no limit.
+  int min_feature = 1;
 
   int population = 24;           // particles
   int cycles = 6;                // discrete + continuous cycles after the initial population

@@ -67,6 +67,10 @@ expect_exit 2 "materials.soft.*E must be below" -- "$SAMPLE" --config "$TINY" --
 expect_exit 2 "continuous.step" -- "$SAMPLE" --config "$TINY" --set continuous.step=0 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "directed.objectives.*'min_mu' is not one of" -- "$SAMPLE" --config "$TINY" --set 'directed.objectives=[min_mu]' \
   --out "$WORK/bad.gamut.h5"
+expect_exit 2 "min_feature.*must be in 1..resolution/2 \(4\)" -- "$SAMPLE" --config "$TINY" --set min_feature=5 --out "$WORK/bad.gamut.h5"
+# A one-material cell has void, so beams or gaps thinner than 2 voxels are refused.
+expect_exit 0 " [1-9][0-9]* thinner than min_feature" -- "$SAMPLE" --config "$TINY" --set min_feature=2 \
+  --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' --out "$WORK/mf.gamut.h5"
 expect_exit 2 "directed.modulus_drop" -- "$SAMPLE" --config "$TINY" --set directed.modulus_drop=0 --out "$WORK/bad.gamut.h5"
 check "directed pushes ran and their structures are step 4" -- bash -c "h5dump -d /step '$WORK/one.microstructures.h5' | grep -q ' 4'"
 expect_exit 2 "unknown|not a known" -- "$SAMPLE" --config "$TINY" --set cylces=3 --out "$WORK/bad.gamut.h5"

@@ -95,3 +95,39 @@ TEST(StructureOps, CleanupKeepsTheWrappingNetworkAndFillsCavities) {
 
 }  // namespace
 }  // namespace msfab
+
+namespace msfab {
+namespace {
+
+// Stiff bars of `width` voxels along x and y through the cell's middle, in void.
+VoxelGrid bar_cross(int n, int nz, int width) {
+  VoxelGrid c(n, n, nz, 1.0 / n, 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        if ((i >= n / 2 - width / 2 && i < n / 2 - width / 2 + width) ||
+            (j >= n / 2 - width / 2 && j < n / 2 - width / 2 + width))
+          c.at(i, j, k) = 1;
+  return c;
+}
+
+TEST(StructureOps, ThinFeaturesAreTheVoxelsNoWindowOfTheirPhaseCovers) {
+  // Bars 3 wide, gaps 13 wide: nothing below 3; below 4 the bars are thin.
+  const VoxelGrid wide = bar_cross(16, 1, 3);
+  EXPECT_EQ(thin_feature_voxels(wide, 1), 0);
+  EXPECT_EQ(thin_feature_voxels(wide, 2), 0);
+  EXPECT_EQ(thin_feature_voxels(wide, 3), 0);
+  EXPECT_EQ(thin_feature_voxels(wide, 4), static_cast<std::int64_t>(wide.count_solid()));
+  // A one-voxel bar is thin at 2; so is a one-voxel slit cut across a wide bar.
+  EXPECT_EQ(thin_feature_voxels(bar_cross(16, 1, 1), 2), static_cast<std::int64_t>(bar_cross(16, 1, 1).count_solid()));
+  VoxelGrid slit = bar_cross(16, 1, 4);
+  for (int j = 6; j < 10; ++j) slit.at(2, j, 0) = 0;  // a gap of one voxel across the x bar
+  EXPECT_EQ(thin_feature_voxels(slit, 2), 4);
+  // 3D: the bars are slabs through z; a slab 2 thick passes 2 and fails 3.
+  const VoxelGrid slabs = bar_cross(8, 8, 2);
+  EXPECT_EQ(thin_feature_voxels(slabs, 2), 0);
+  EXPECT_GT(thin_feature_voxels(slabs, 3), 0);
+}
+
+}  // namespace
+}  // namespace msfab
