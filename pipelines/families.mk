@@ -5,6 +5,8 @@
 #   make -f Makefile.pipeline families-gamut   a random 3D cubic set of ~1500 structures at 16^3 (minutes),
 #                                              families among its nu > 0.3 structures and among its auxetic
 #                                              ones (if any)
+#   make -f Makefile.pipeline families-auxetic  auxetic families of the 3D gamut with directed min_nu pushes
+#                                              (gamut-auxetic-3d, ~6 min, then seconds)
 #
 # Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
 # a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
@@ -25,7 +27,14 @@ $(OUT)/families/stiff_nu.families.h5: configs/families/stiff_nu.yaml $(OUT)/gamu
 	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_families.microstructures.h5 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
-.PHONY: families-demo families-gamut
+$(OUT)/families/auxetic_directed.families.h5: configs/families/auxetic_directed.yaml \
+    $(OUT)/gamut/cubic3d_auxetic.gamut.h5 $(BIN)/msfab-families
+	@mkdir -p $(@D)
+	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_auxetic.microstructures.h5 \
+	  --seed $(SEED) --threads $(THREADS) --out $@
+
+.PHONY: families-demo families-gamut families-auxetic
+families-auxetic: build $(OUT)/families/auxetic_directed.families.h5
 families-demo: build $(OUT)/families/two.families.h5 $(OUT)/families/two.family1.microstructures.h5
 families-gamut: build $(OUT)/families/stiff_nu.families.h5
 	@# The auxetic selection of the same set (an input error when it holds none).
