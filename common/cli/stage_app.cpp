@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 
+#include "cli/allocator_tuning.hpp"
 #include "cli/logging.hpp"
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
@@ -92,6 +93,7 @@ void StageContext::check_out_folder() const {
 }
 
 StageApp::StageApp(std::string name, std::string description) : name_(std::move(name)), cli_(description, name_) {
+  keep_freed_memory_for_reuse();
   cli_.footer(
       "Exit codes: 0 done; 1 internal error; 2 bad usage or bad input; 3 numerical failure.\n"
       "Config keys can be overridden with --set key.path=value (value in YAML syntax).");
