@@ -156,8 +156,10 @@ ContinuousResult refine_structure(const VoxelGrid& structure, int stiff_id, int 
                                   const ContinuousOptions& options = {});
 // Runs MMA from `structure` along a directed objective; the best feasible
 // iterate (floors met to 1e-3) is thresholded at the level whose printable
-// structure (mirrored, cleaned, no feature below min_feature) is best;
-// an all-soft cell when no level gives one. Deterministic.
+// structure (mirrored, cleaned, no feature below min_feature) is best with
+// the floors met, or, if no level meets them, comes closest; found = false
+// and an all-soft cell when no level gives a printable structure.
+// Deterministic.
 ContinuousResult refine_structure_directed(const VoxelGrid& structure, int stiff_id, int soft_id, MaterialPtr stiff,
                                            MaterialPtr soft, const MaterialSpace& space, const DirectedTarget& target,
                                            const ContinuousOptions& options = {});
