@@ -79,7 +79,7 @@ ContinuousCellProblem::ContinuousCellProblem(int nx, int ny, int nz, double h, M
 }
 
 void ContinuousCellProblem::setup_cell(MaterialPtr stiff, MaterialPtr soft) {
-  const int nx = nx_, ny = ny_, nz = nz_;
+  const int nx = nx_, ny = ny_, nz = nz_;  // short names for the index loops below
   const double h = h_;
   const ContinuousOptions& options = options_;
   K_stiff_ = voxel_stiffness(stiff, h);
@@ -383,8 +383,9 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
     clean_structure(g);
     return g;
   };
-  result.structure = printable(0.5);
-  if (problem.directed()) {
+  if (!problem.directed()) {
+    result.structure = printable(0.5);
+  } else {
     // The grey optimum is not the printable one: face-disconnected pieces
     // (a one-node hinge carries load in the grey model) are cleaned away
     // and intermediate densities vanish. The threshold level whose cleaned

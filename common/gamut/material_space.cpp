@@ -71,44 +71,39 @@ VecX MaterialSpace::properties_2d(const Mat3& C, double rho) const {
 VecX MaterialSpace::properties_with_gradient(const MatX& C, double rho, std::vector<MatX>* dC) const {
   const int m = kind_ == MaterialSpaceKind::cubic3d ? 6 : 3;
   if (C.rows() != m || C.cols() != m) throw std::invalid_argument("MaterialSpace::properties_with_gradient: wrong size");
+  // The values come from the readers above, so the two cannot drift apart.
+  const VecX p = m == 6 ? properties(Mat6(C), rho) : properties_2d(Mat3(C), rho);
+  if (!dC) return p;
   const int n = dimension();
-  VecX p(n);
-  p[n - 1] = rho;
-  if (dC) dC->assign(n, MatX::Zero(m, m));
+  dC->assign(n, MatX::Zero(m, m));
   if (kind_ == MaterialSpaceKind::cubic3d) {
     // cubic_moduli(): C11, C12, C44 as means over the symmetric entries.
     const CubicModuli c = cubic_moduli(C);
     const double a = c.C11, b = c.C12, s = a + b;
-    p[0] = c.E, p[1] = c.nu, p[2] = c.G;
-    if (dC) {
-      const double dE_da = ((a + 2 * b) + (a - b)) / s - c.E / s, dE_db = (-(a + 2 * b) + 2 * (a - b)) / s - c.E / s;
-      const double dnu_da = -b / (s * s), dnu_db = a / (s * s);
-      for (int i = 0; i < 3; ++i) {
-        (*dC)[0](i, i) = dE_da / 3, (*dC)[1](i, i) = dnu_da / 3;
-        (*dC)[2](3 + i, 3 + i) = 1.0 / 3;
-      }
-      for (auto [i, j] : {std::pair{0, 1}, {0, 2}, {1, 2}}) (*dC)[0](i, j) = dE_db / 3, (*dC)[1](i, j) = dnu_db / 3;
+    const double dE_da = ((a + 2 * b) + (a - b)) / s - c.E / s, dE_db = (-(a + 2 * b) + 2 * (a - b)) / s - c.E / s;
+    const double dnu_da = -b / (s * s), dnu_db = a / (s * s);
+    for (int i = 0; i < 3; ++i) {
+      (*dC)[0](i, i) = dE_da / 3, (*dC)[1](i, i) = dnu_da / 3;
+      (*dC)[2](3 + i, 3 + i) = 1.0 / 3;
     }
+    for (auto [i, j] : {std::pair{0, 1}, {0, 2}, {1, 2}}) (*dC)[0](i, j) = dE_db / 3, (*dC)[1](i, j) = dnu_db / 3;
     return p;
   }
   // Through the compliance S = C^-1: dS = -S dC S, so d/dC = -S (d/dS) S.
   const MatX S = C.inverse();
   std::vector<MatX> dS(n - 1, MatX::Zero(3, 3));
   if (kind_ == MaterialSpaceKind::orthotropic2d) {
-    p[0] = 1 / S(0, 0), p[1] = 1 / S(1, 1), p[2] = -S(0, 1) / S(0, 0), p[3] = 1 / S(2, 2);
     dS[0](0, 0) = -p[0] * p[0];
     dS[1](1, 1) = -p[1] * p[1];
     dS[2](0, 1) = -1 / S(0, 0), dS[2](0, 0) = S(0, 1) / (S(0, 0) * S(0, 0));
     dS[3](2, 2) = -p[3] * p[3];
   } else {
     const double s11 = 0.5 * (S(0, 0) + S(1, 1));
-    p[0] = 1 / s11, p[1] = -S(0, 1) / s11, p[2] = 1 / S(2, 2);
     dS[0](0, 0) = dS[0](1, 1) = -0.5 / (s11 * s11);
     dS[1](0, 1) = -1 / s11, dS[1](0, 0) = dS[1](1, 1) = 0.5 * S(0, 1) / (s11 * s11);
     dS[2](2, 2) = -p[2] * p[2];
   }
-  if (dC)
-    for (int i = 0; i < n - 1; ++i) (*dC)[i] = -S.transpose() * dS[i] * S.transpose();
+  for (int i = 0; i < n - 1; ++i) (*dC)[i] = -S.transpose() * dS[i] * S.transpose();
   return p;
 }
 
