@@ -122,6 +122,8 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
     }
     ++iteration;
     if (iteration % history_stride == 0) history += ", " + format_number(r_norm / b_norm);
+    if (settings.progress && iteration % std::max(1, settings.progress_stride) == 0)
+      settings.progress(iteration, r_norm / b_norm);
     // Converged by the recursive residual: the true-residual check above
     // either stops or restarts with a fresh direction, so skip the update.
     if (r_norm <= target) continue;

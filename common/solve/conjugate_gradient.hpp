@@ -44,6 +44,10 @@ struct CgSettings {
   std::string curvature_label;
   // Whether that message also gives the relative residual reached so far.
   bool curvature_message_has_residual = false;
+  // Called every progress_stride iterations with the relative residual of
+  // the recursion (long solves report where they are; none when empty).
+  std::function<void(int iteration, double relative_residual)> progress;
+  int progress_stride = 50;
 };
 
 // Solves (A + shift I) x = b by preconditioned CG from x = 0, with results

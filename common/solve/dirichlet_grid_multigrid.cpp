@@ -1,5 +1,7 @@
 #include "solve/dirichlet_grid_multigrid.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -192,6 +194,8 @@ void DirichletGridMultigrid::build_fine_smoother() {
       [this](const VecX& x) { multiply(x, product_); }, options_.threads);
   if (!(max_eigenvalue_ > 0) || !std::isfinite(max_eigenvalue_))
     throw NumericalError("matrix-free multigrid: no usable eigenvalue bound for the smoother");
+  spdlog::debug("matrix-free multigrid: largest eigenvalue of the block-Jacobi-scaled operator about {:.4g}",
+                max_eigenvalue_);
 }
 
 void DirichletGridMultigrid::assemble_coarse() {
@@ -304,6 +308,11 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
       for (std::int64_t t = 0; t < count; ++t) {
         const int i = ci + 2 * static_cast<int>(t % hx), j = cj + 2 * static_cast<int>((t / hx) % hy),
                   k = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
+        // Void (all weights zero) adds nothing: skip its gather and scatter.
+        bool has_stiffness = false;
+        for (int b = 0; b < B && !has_stiffness; ++b) has_stiffness = field_.weight(e, b) != 0.0;
+        if (!has_stiffness) continue;
         std::int64_t corner[8];
         Vec24 xe, ye = Vec24::Zero();
         for (int a = 0; a < 8; ++a) {
@@ -313,7 +322,6 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
             for (int d = 0; d < 3; ++d)
               if (m >> d & 1) xe[3 * a + d] = 0.0;
         }
-        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
         for (int b = 0; b < B; ++b) {
           const double w = field_.weight(e, b);
           if (w == 0.0) continue;
@@ -434,6 +442,9 @@ VecX DirichletGridMultigrid::solve(const VecX& b) {
   settings.label = "matrix-free multigrid CG";
   settings.curvature_label = "matrix-free multigrid CG";
   settings.curvature_message_has_residual = true;
+  settings.progress = [](int iteration, double residual) {
+    spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
+  };
   return conjugate_gradient(op, preconditioner, b, settings, stats_);
 }
 

@@ -67,6 +67,7 @@ class DirichletGridMultigrid {
   void set_field(VoxelStiffnessField field);
 
   double fixed_scale() const { return fixed_scale_; }
+  const VoxelStiffnessField& field() const { return field_; }
   // x with A x = b. Throws NumericalError if CG does not converge.
   VecX solve(const VecX& b);
   // y = A x, matrix-free.

@@ -149,14 +149,13 @@ void GridElasticity::set_stiffness(const MatX& pairs) {
   const auto t0 = std::chrono::steady_clock::now();
   if (pairs.rows() != grid_.cells() || pairs.cols() != grid_.voigt_pairs())
     throw std::invalid_argument("GridElasticity::set_stiffness: cells x voigt_pairs");
-  pairs_ = pairs;
   if (matrix_free_) {
-    matrix_free_->set_field(stiffness_field(grid_, pairs_));
-    fixed_scale_ = matrix_free_->fixed_scale();
-    ++stats_.factorizations;
-    stats_.factorize_seconds += seconds_since(t0);
+    VoxelStiffnessField field = stiffness_field(grid_, pairs);
+    stats_.factorize_seconds += seconds_since(t0);  // the conversion; set_field adds the set-up
+    set_field(std::move(field));
     return;
   }
+  pairs_ = pairs;
   const int ne = grid_.element_unknowns(), m = grid_.voigt();
   const std::vector<MatX>& basis = grid_.element_basis();
   double* values = K_.valuePtr();
@@ -202,6 +201,27 @@ void GridElasticity::set_stiffness(const MatX& pairs) {
   stats_.factorize_seconds += seconds_since(t1);
 }
 
+void GridElasticity::set_field(VoxelStiffnessField field) {
+  if (!matrix_free_) throw std::logic_error("GridElasticity::set_field: solver " + solver_name_ + " is assembled");
+  if (std::abs(field.h - grid_.h()) > 1e-12 * grid_.h())
+    throw std::invalid_argument("GridElasticity::set_field: the field's voxel size is not the grid's cell size");
+  const auto t0 = std::chrono::steady_clock::now();
+  pairs_.resize(0, 0);
+  matrix_free_->set_field(std::move(field));
+  fixed_scale_ = matrix_free_->fixed_scale();
+  ++stats_.factorizations;
+  stats_.factorize_seconds += seconds_since(t0);
+}
+
+MatX GridElasticity::element_matrix(std::int64_t cell) const {
+  if (matrix_free_) return matrix_free_->field().element(cell);
+  const int m = grid_.voigt();
+  MatX C(m, m);
+  for (int s = 0; s < m; ++s)
+    for (int t = s; t < m; ++t) C(s, t) = C(t, s) = pairs_(cell, CellGrid::pair_index(s, t, m));
+  return grid_.element_stiffness(C);
+}
+
 VecX GridElasticity::run_solve(const VecX& rhs) {
   const auto t0 = std::chrono::steady_clock::now();
   VecX x = matrix_free_ ? matrix_free_->solve(rhs) : solver_->solve(rhs);
@@ -229,10 +249,7 @@ VecX GridElasticity::solve(const VecX& force, const VecX& prescribed) {
         any = any || ue[a] != 0;
       }
       if (!any) continue;
-      MatX C = MatX::Zero(grid_.voigt(), grid_.voigt());
-      for (int s = 0; s < grid_.voigt(); ++s)
-        for (int t = s; t < grid_.voigt(); ++t) C(s, t) = C(t, s) = pairs_(c, CellGrid::pair_index(s, t, grid_.voigt()));
-      const VecX r = grid_.element_stiffness(C) * ue;
+      const VecX r = element_matrix(c) * ue;
       for (int a = 0; a < ne; ++a)
         if (!fixed_[dofs[a]]) rhs[dofs[a]] -= r[a];
     }
@@ -265,8 +282,33 @@ MatX GridElasticity::pair_products(const VecX& a, const VecX& b) const {
 }
 
 double GridElasticity::energy(const VecX& u) const {
-  const MatX products = pair_products(u, u);
-  return 0.5 * (products.cwiseProduct(pairs_)).sum();
+  if (!matrix_free_) {
+    const MatX products = pair_products(u, u);
+    return 0.5 * (products.cwiseProduct(pairs_)).sum();
+  }
+  // 1/2 sum_e u_e^T K_e u_e from the field, cell by cell in a fixed order.
+  const VoxelStiffnessField& field = matrix_free_->field();
+  const int B = field.basis_size();
+  const std::int64_t cells = grid_.cells();
+  constexpr std::int64_t kChunk = 4096;
+  const std::int64_t chunks = (cells + kChunk - 1) / kChunk;
+  std::vector<double> partial(std::size_t(chunks), 0.0);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t t = 0; t < chunks; ++t) {
+    double sum = 0;
+    std::int64_t dofs[24];
+    Vec24 ue;
+    for (std::int64_t c = t * kChunk; c < std::min(cells, (t + 1) * kChunk); ++c) {
+      grid_.cell_unknowns(c, dofs);
+      for (int i = 0; i < 24; ++i) ue[i] = u[dofs[i]];
+      for (int b = 0; b < B; ++b)
+        if (const double w = field.weight(c, b); w != 0.0) sum += w * ue.dot(field.basis[std::size_t(b)] * ue);
+    }
+    partial[std::size_t(t)] = sum;
+  }
+  double total = 0;
+  for (double p : partial) total += p;
+  return 0.5 * total;
 }
 
 }  // namespace msfab

@@ -59,6 +59,10 @@ class GridElasticity {
   // C_st (s <= t, CellGrid::pair_index order) per cell: cells x voigt_pairs.
   // Assembles and factorizes; NumericalError if K is not positive definite.
   void set_stiffness(const MatX& pairs);
+  // Solver "matrix-free" only: the element stiffnesses as a field (its
+  // dimensions the grid's, its voxel size h), without the cells x 21 table:
+  // a voxel model of a few materials then costs a weight or two per cell.
+  void set_field(VoxelStiffnessField field);
   // Displacement for nodal forces with the fixed unknowns at `prescribed`
   // (entries at free unknowns are ignored; an empty vector means zeros).
   VecX solve(const VecX& force, const VecX& prescribed = VecX());
@@ -73,6 +77,8 @@ class GridElasticity {
  private:
   void build_pattern();
   VecX run_solve(const VecX& rhs);
+  // K_e of a cell, from the field (matrix-free) or the pairs.
+  MatX element_matrix(std::int64_t cell) const;
 
   CellGrid grid_;
   std::vector<char> fixed_;

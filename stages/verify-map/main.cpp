@@ -5,7 +5,9 @@
 //   1. homogenized: the design grid, each cell with the homogenized
 //      stiffness of the structure mapped to it
 //   2. full resolution: the voxel model of the mapping (r^3 voxels per
-//      cell), base material in solid voxels, void_ratio x stiff in void ones
+//      cell), base material in solid voxels; void carries no unknowns
+//      (pieces its supports do not hold are removed and reported), or is
+//      an ersatz material void_ratio x stiff (void: ersatz)
 //
 // Supports and loads of the coarse nodes are carried to the fine grid
 // (common/verify/refinement.hpp), the fine displacement is sampled at the
@@ -29,6 +31,7 @@
 #include "topopt/grid_elasticity.hpp"
 #include "topopt/topopt_scene.hpp"
 #include "verify/refinement.hpp"
+#include "verify/solid_pieces.hpp"
 #include "verify_report.hpp"
 
 using namespace msfab;
@@ -36,7 +39,8 @@ using namespace msfab;
 namespace {
 
 constexpr const char* kDefaults = R"(
-void_ratio: 1.0e-6       # void voxels and forced-empty cells: this times the stiff material
+void: remove             # remove (void carries no unknowns; pieces not held are removed) | ersatz
+void_ratio: 1.0e-6       # void: ersatz: void voxels and forced-empty cells are this times the stiff material
 fill: mapped             # mapped | solid (every non-empty cell solid in both models: the mesh-only reference)
                          # | tile (every design cell holds structure tile_structure, unshifted: a periodic tiling)
 tile_structure: 0        # fill: tile: index into the microstructure set
@@ -47,6 +51,7 @@ tolerance: 1.0e-8        # iterative solvers: relative residual
 )";
 
 struct Settings {
+  bool remove_void = true;
   double void_ratio = 1e-6;
   ModelFill fill = ModelFill::mapped;
   std::string fill_name = "mapped";
@@ -58,6 +63,7 @@ struct Settings {
 
 Settings read_settings(const Config& config, const std::string& solver_option) {
   Settings s;
+  s.remove_void = config.one_of("void", {"remove", "ersatz"}) == "remove";
   s.void_ratio = config.get_or<double>("void_ratio", 1e-6);
   if (!(s.void_ratio > 0 && s.void_ratio <= 1)) config.fail("void_ratio", "must be in (0, 1]");
   s.fill_name = config.one_of("fill", {"mapped", "solid", "tile"});
@@ -206,10 +212,11 @@ int main(int argc, char** argv) {
     report.grid[0] = coarse.nx(), report.grid[1] = coarse.ny(), report.grid[2] = coarse.nz();
     report.cell_size = coarse.h();
     report.resolution = r;
-    report.void_ratio = settings.void_ratio;
+    report.void_ratio = settings.remove_void ? 0.0 : settings.void_ratio;
+    report.void_model = settings.remove_void ? "remove" : "ersatz";
 
     // The homogenized model.
-    const ModelMaterials materials = model_materials(set, settings.void_ratio);
+    const ModelMaterials materials = model_materials(set, report.void_ratio);
     // With homogenized_elements = m each cell is m^3 hexahedra of its C^H,
     // its supports and loads carried over as to the voxel model.
     const int m = settings.homogenized_elements;
@@ -218,8 +225,28 @@ int main(int argc, char** argv) {
     const std::vector<char> everywhere(std::size_t(hgrid.nodes()), 1);
     const CellRefinement::Supports hsupports =
         m > 1 ? split.refine_supports(scene.setup.fixed, everywhere) : CellRefinement::Supports();
-    const auto homogenized_model = make_model(hgrid, m > 1 ? hsupports.fixed : scene.setup.fixed,
-                                              settings.homogenized_solver, "homogenized_solver", solver_options);
+    std::vector<char> hfixed = m > 1 ? hsupports.fixed : scene.setup.fixed;
+    std::vector<char> hsolid(std::size_t(hgrid.cells()));
+    for (std::int64_t e = 0; e < hgrid.cells(); ++e) {
+      const auto q = hgrid.cell_coords(e);
+      hsolid[std::size_t(e)] = mapped.roles[std::size_t(coarse.cell_index(q[0] / m, q[1] / m, q[2] / m))] != CellRole::empty;
+    }
+    if (settings.remove_void) {
+      const PieceRemoval removal = remove_unheld_pieces(hgrid, hsolid, hfixed);
+      if (removal.kept_cells == 0)
+        throw InputError(design_path + ": the scene's supports hold none of the design's non-empty cells (every "
+                         "piece of them can move freely); nothing to check");
+      report.pieces_homogenized = removal.pieces;
+      report.removed_pieces_homogenized = removal.removed;
+      report.removed_cells_homogenized = removal.removed_cells;
+      report.inactive_nodes_homogenized = fix_unknowns_without_material(hgrid, solid_nodes(hgrid, hsolid), hfixed);
+      if (removal.removed > 0)
+        spdlog::warn("homogenized model: {} of {} pieces of cells are not held by the supports and were removed "
+                     "({} hexahedra)",
+                     removal.removed, removal.pieces, removal.removed_cells);
+    }
+    const auto homogenized_model =
+        make_model(hgrid, hfixed, settings.homogenized_solver, "homogenized_solver", solver_options);
     GridElasticity& homogenized = *homogenized_model;
     {
       const MatX cell_pairs = homogenized_pairs(coarse, mapped, set, materials, settings.fill);
@@ -227,6 +254,7 @@ int main(int argc, char** argv) {
       for (std::int64_t e = 0; e < hgrid.cells(); ++e) {
         const auto q = hgrid.cell_coords(e);
         pairs.row(e) = cell_pairs.row(coarse.cell_index(q[0] / m, q[1] / m, q[2] / m));
+        if (settings.remove_void && !hsolid[std::size_t(e)]) pairs.row(e).setZero();
       }
       homogenized.set_stiffness(pairs);
     }
@@ -246,12 +274,39 @@ int main(int argc, char** argv) {
     }
     const CellRefinement refinement(coarse, r);
     const CellGrid& fine = refinement.fine();
+    // A soft material that is void has no stiffness: with void removed it is void.
+    const bool soft_is_material = !(settings.remove_void && set.soft_is_void);
     std::vector<char> voxel_material(voxels.size());
-    for (std::size_t i = 0; i < voxels.size(); ++i) voxel_material[i] = voxels[i] != 0;
+    for (std::size_t i = 0; i < voxels.size(); ++i)
+      voxel_material[i] = voxels[i] == 1 || (voxels[i] == 2 && soft_is_material);
     report.voxels = std::int64_t(voxels.size());
     report.material_voxels = std::count(voxel_material.begin(), voxel_material.end(), char(1));
-    const std::vector<char> node_material = refinement.material_nodes(voxel_material);
-    const CellRefinement::Supports supports = refinement.refine_supports(scene.setup.fixed, node_material);
+    std::vector<char> node_material = refinement.material_nodes(voxel_material);
+    CellRefinement::Supports supports = refinement.refine_supports(scene.setup.fixed, node_material);
+    if (settings.remove_void) {
+      // Removing a piece can move a point support onto another one: repeat until nothing is removed.
+      for (int pass = 0;; ++pass) {
+        const PieceRemoval removal = remove_unheld_pieces(fine, voxel_material, supports.fixed);
+        if (pass == 0) report.pieces_full = removal.pieces;
+        report.removed_pieces_full += removal.removed;
+        report.removed_voxels_full += removal.removed_cells;
+        if (removal.kept_cells == 0)
+          throw InputError(mapped_path + ": the scene's supports hold none of the voxel model's " +
+                           std::to_string(removal.pieces) +
+                           " pieces (each can move freely); nothing to check (" + design_path + ")");
+        if (removal.removed == 0) break;
+        node_material = refinement.material_nodes(voxel_material);
+        supports = refinement.refine_supports(scene.setup.fixed, node_material);
+      }
+      for (std::size_t i = 0; i < voxels.size(); ++i)
+        if (!voxel_material[i]) voxels[i] = 0;
+      report.inactive_nodes_full = fix_unknowns_without_material(fine, node_material, supports.fixed);
+      if (report.removed_pieces_full > 0)
+        spdlog::warn("full-resolution model: {} of {} pieces are not held by the supports (floating, or held at a "
+                     "point or along a line) and were removed: {} voxels, {:.2f}% of the material",
+                     report.removed_pieces_full, report.pieces_full, report.removed_voxels_full,
+                     100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
+    }
     report.point_supports = supports.point_supports;
     report.moved_point_supports = supports.moved_point_supports;
     report.lost_point_supports = supports.lost_point_supports;
@@ -259,12 +314,18 @@ int main(int argc, char** argv) {
       spdlog::warn("{} point support(s) find no material within half a cell in the full-resolution model: they "
                    "hold only void there",
                    supports.lost_point_supports);
-    spdlog::info("full-resolution model: {} voxels ({:.1f}% material), {} unknowns", report.voxels,
+    spdlog::info("full-resolution model: {} voxels ({:.1f}% material), {} unknowns ({} nodes without material "
+                 "fixed)",
+                 report.voxels,
                  100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
-                 fine.unknowns());
+                 fine.unknowns(), report.inactive_nodes_full);
     const auto full_model = make_model(fine, supports.fixed, settings.solver, "solver", solver_options);
     GridElasticity& full = *full_model;
-    {
+    if (full.solver_name() == "matrix-free") {
+      VoxelStiffnessField field = voxel_field(fine, voxels, materials);
+      report.seconds_model = seconds_since(model_start);
+      full.set_field(std::move(field));
+    } else {
       MatX pairs = voxel_pairs(voxels, materials);
       report.seconds_model = seconds_since(model_start);
       full.set_stiffness(pairs);

@@ -4,6 +4,7 @@
 
 #include "mapping/voxel_model.hpp"
 #include "topopt/cell_material.hpp"
+#include "topopt/grid_elasticity.hpp"
 
 namespace msfab {
 
@@ -71,6 +72,31 @@ MatX voxel_pairs(const std::vector<std::uint8_t>& ids, const ModelMaterials& mat
 #pragma omp parallel for schedule(static)
   for (std::int64_t c = 0; c < std::int64_t(ids.size()); ++c) pairs.row(c) = by_id[ids[std::size_t(c)]].transpose();
   return pairs;
+}
+
+VoxelStiffnessField voxel_field(const CellGrid& fine, const std::vector<std::uint8_t>& ids,
+                                const ModelMaterials& materials) {
+  if (std::int64_t(ids.size()) != fine.cells()) throw std::invalid_argument("voxel_field: one id per fine cell");
+  for (std::uint8_t id : ids)
+    if (id > 2) throw std::invalid_argument("voxel_field: voxel id above 2");
+  const CellGrid by_id(3, 3, 1, 1, fine.h());
+  MatX pairs(3, 21);
+  pairs.row(0) = voigt_pairs(materials.empty).transpose();
+  pairs.row(1) = voigt_pairs(materials.stiff).transpose();
+  pairs.row(2) = voigt_pairs(materials.soft).transpose();
+  const VoxelStiffnessField table = stiffness_field(by_id, pairs);
+  const std::size_t G = table.basis.size();
+  VoxelStiffnessField field;
+  field.nx = fine.nx(), field.ny = fine.ny(), field.nz = fine.nz();
+  field.h = fine.h();
+  field.basis = table.basis;
+  field.weights.resize(ids.size() * G);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t v = 0; v < std::int64_t(ids.size()); ++v) {
+    const std::size_t id = ids[std::size_t(v)];
+    for (std::size_t g = 0; g < G; ++g) field.weights[std::size_t(v) * G + g] = table.weights[id * G + g];
+  }
+  return field;
 }
 
 }  // namespace msfab

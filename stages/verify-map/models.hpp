@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "fem/voxel_stiffness_field.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "mapping/mapped_artifact.hpp"
 #include "topopt/cell_grid.hpp"
@@ -37,5 +38,11 @@ std::vector<std::uint8_t> model_voxels(const MappedDesign& mapped, const Microst
 
 // fine cells x 21 from the voxel ids.
 MatX voxel_pairs(const std::vector<std::uint8_t>& ids, const ModelMaterials& materials);
+
+// The same as a stiffness field for the matrix-free solver: one base
+// matrix per independent material (stiffness_field of the three ids), and
+// per voxel its id's weights, a few numbers instead of 21.
+VoxelStiffnessField voxel_field(const CellGrid& fine, const std::vector<std::uint8_t>& ids,
+                                const ModelMaterials& materials);
 
 }  // namespace msfab

@@ -20,6 +20,15 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "voxels", r.voxels);
   f.write_attribute("/", "material_voxels", r.material_voxels);
   f.write_attribute("/", "void_ratio", r.void_ratio);
+  f.write_attribute("/", "void", r.void_model);
+  f.write_attribute("/", "pieces_full", r.pieces_full);
+  f.write_attribute("/", "removed_pieces_full", r.removed_pieces_full);
+  f.write_attribute("/", "removed_voxels_full", r.removed_voxels_full);
+  f.write_attribute("/", "inactive_nodes_full", r.inactive_nodes_full);
+  f.write_attribute("/", "pieces_homogenized", r.pieces_homogenized);
+  f.write_attribute("/", "removed_pieces_homogenized", r.removed_pieces_homogenized);
+  f.write_attribute("/", "removed_cells_homogenized", r.removed_cells_homogenized);
+  f.write_attribute("/", "inactive_nodes_homogenized", r.inactive_nodes_homogenized);
   f.write_attribute("/", "homogenized_elements", static_cast<std::int32_t>(r.homogenized_elements));
   f.write_attribute("/", "solver_homogenized", r.solver_homogenized);
   f.write_attribute("/", "solver_full", r.solver_full);

@@ -32,6 +32,13 @@ struct VerifyReport {
   int resolution = 0;  // voxels per cell edge
   std::int64_t voxels = 0, material_voxels = 0;
   double void_ratio = 0;
+  std::string void_model;  // remove | ersatz
+  // void: remove: face-connected solid pieces of each model, those removed
+  // because their supports leave a rigid motion free, and nodes fixed
+  // because no solid voxel touches them (docs/verify_map.md).
+  std::int64_t pieces_full = 0, removed_pieces_full = 0, removed_voxels_full = 0, inactive_nodes_full = 0;
+  std::int64_t pieces_homogenized = 0, removed_pieces_homogenized = 0, removed_cells_homogenized = 0,
+               inactive_nodes_homogenized = 0;
   int homogenized_elements = 1;  // hexahedra per cell edge in the homogenized model
   std::string solver_homogenized, solver_full;  // as resolved by GridElasticity
   std::int64_t unknowns_homogenized = 0, unknowns_full = 0;

@@ -106,6 +106,33 @@ for c in bend stretch; do
   check "(b) $c: displacement difference below 30%" -- below "$(percent $c "$out" displacement)" 30
   check "(b) $c: energy difference below 40%" -- below "$(percent $c "$out" energy)" 40
 done
+# Void removed (the default) against ersatz void at 1e-6: the same answers
+# to well below the differences measured, and the pieces are reported.
+attr() { h5dump -a "/$2" "$1" | grep -oE '\(0\): [-0-9.e+]+' | head -1 | cut -d' ' -f2; }
+check "(b) pieces reported" -- test "$(attr "$WORK/bar.verify.h5" pieces_full)" -ge 1
+removed=$(attr "$WORK/bar.verify.h5" removed_voxels_full)
+check "(b) removed voxels counted" -- test "$removed" -ge 0
+check "(b) void fixed at nodes without material" -- test "$(attr "$WORK/bar.verify.h5" inactive_nodes_full)" -gt 0
+ersatz=$("$V" "${A[@]}" --set void=ersatz --out "$WORK/ersatz.verify.h5" --quiet 2>&1)
+echo "$ersatz"
+close() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(a != "" && b != "" && d <= t) }'; }
+# The matrix-free multigrid (the voxel model as a field of one weight per
+# voxel, energies from the field) against CHOLMOD on the assembled model.
+free=$("$V" "${A[@]}" --solver matrix-free --out "$WORK/free.verify.h5" --quiet 2>&1)
+echo "$free"
+for c in bend stretch; do
+  for k in displacement energy; do
+    check "(b) $c: matrix-free and cholmod agree ($k)" -- close "$(percent $c "$out" $k)" "$(percent $c "$free" $k)" 0.01
+  done
+done
+if [ "$removed" = 0 ]; then
+  for c in bend stretch; do
+    check "(b) $c: void removed and ersatz void agree (displacement)" -- \
+      close "$(percent $c "$out" displacement)" "$(percent $c "$ersatz" displacement)" 0.05
+    check "(b) $c: void removed and ersatz void agree (energy)" -- \
+      close "$(percent $c "$out" energy)" "$(percent $c "$ersatz" energy)" 0.05
+  done
+fi
 
 # (c) Bad input: exit 2, the file or key named, nothing written.
 B="$WORK/bad.verify.h5"
@@ -141,7 +168,11 @@ expect_exit 2 "fill = bogus" -- "$V" "${A[@]}" --set fill=bogus --out "$B"
 expect_exit 2 "void_ratio = 0: must be in \(0, 1\]" -- "$V" "${A[@]}" --set void_ratio=0 --out "$B"
 expect_exit 2 "homogenized_elements = 0: must be 1..64" -- "$V" "${A[@]}" --set homogenized_elements=0 --out "$B"
 expect_exit 2 "tile_structure = 99: is 99, the set .* holds" -- "$V" "${A[@]}" --set fill=tile --set tile_structure=99 --out "$B"
-expect_exit 2 "unknown key 'void'" -- "$V" "${A[@]}" --set void=0.1 --out "$B"
+expect_exit 2 "void = 0.1: must be one of" -- "$V" "${A[@]}" --set void=0.1 --out "$B"
+expect_exit 2 "unknown key 'voids'" -- "$V" "${A[@]}" --set voids=remove --out "$B"
+# Hinged on one line of nodes, the bar can turn about it: no piece is held.
+sed 's/supports: .*/supports: [{box: {min: [0, 0, 0], max: [0, 0, 2]}}]/' "$WORK/bar.yaml" > "$WORK/hinge.yaml"
+expect_exit 2 "supports hold none of the design's non-empty cells" -- "$V" "${A[@]}" --scene "$WORK/hinge.yaml" --out "$B"
 expect_exit 2 "solver = bogus: linear solver 'bogus' is unknown" -- "$V" "${A[@]}" --solver bogus --out "$B"
 expect_exit 2 "--mapped is required" -- "$V" --design "$WORK/bar.design.h5" --structures "$S" --out "$B"
 expect_exit 2 "output folder does not exist" -- "$V" "${A[@]}" --out "$WORK/nowhere/x.verify.h5"
