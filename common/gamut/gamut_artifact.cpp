@@ -43,6 +43,7 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
   f.write_attribute("/level_set", "cells", static_cast<std::int32_t>(ls.cells()));
   f.write_attribute("/level_set", "lower", ls.lower());
   f.write_attribute("/level_set", "spacing", ls.spacing());
+  f.write_attribute("/level_set", "padding", ls.padding());
   f.write_attribute("/level_set", "meaning",
                     "signed distance in normalized property space, negative inside; node i at lower + (i + 1/2) spacing");
   std::vector<std::int32_t> cycle, samples, discrete, continuous;
@@ -62,6 +63,21 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
   out.commit();
 }
 
+namespace {
+
+// Artifacts written before the padding was stored used the default radius
+// of the implicit function, 1.5 grid spacings.
+double read_padding(const H5File& f, const std::string& path) {
+  const double padding = f.has_attribute("/level_set", "padding")
+                             ? f.read_attribute<double>("/level_set", "padding")
+                             : 1.5 * f.read_attribute<double>("/level_set", "spacing");
+  if (!(padding >= 0) || !std::isfinite(padding))
+    throw InputError(path + ": /level_set attribute padding must be finite and >= 0");
+  return padding;
+}
+
+}  // namespace
+
 Gamut read_gamut_artifact(const std::string& path) {
   const ArtifactReader in(path, kGamutSchema, kGamutSchemaVersion);
   const H5File& f = in.file();
@@ -77,7 +93,8 @@ Gamut read_gamut_artifact(const std::string& path) {
   const NdArray<double> phi = f.read_dataset<double>("/level_set/phi");
   g.level_set = GamutLevelSet::from_values(d, f.read_attribute<std::int32_t>("/level_set", "cells"),
                                            f.read_attribute<double>("/level_set", "lower"),
-                                           f.read_attribute<double>("/level_set", "spacing"), phi.values);
+                                           f.read_attribute<double>("/level_set", "spacing"), phi.values,
+                                           read_padding(f, path));
   if (f.exists("/history/cycle")) {
     const auto cycle = f.read_vector<std::int32_t>("/history/cycle");
     const auto samples = f.read_vector<std::int32_t>("/history/samples");

@@ -29,9 +29,11 @@ double GamutLevelSet::node(const std::vector<int>& index) const {
   return phi_[flat];
 }
 
-GamutLevelSet GamutLevelSet::from_values(int d, int cells, double lower, double spacing, std::vector<double> values) {
+GamutLevelSet GamutLevelSet::from_values(int d, int cells, double lower, double spacing, std::vector<double> values,
+                                         double padding) {
   if (d < 1 || d > 6 || cells < 2 || !(spacing > 0) || !std::isfinite(lower))
     throw InputError("gamut level set: need dimension 1..6, cells >= 2, spacing > 0");
+  if (!(padding >= 0) || !std::isfinite(padding)) throw InputError("gamut level set: padding must be finite and >= 0");
   GamutLevelSet ls;
   ls.dim_ = d;
   ls.cells_ = cells;
@@ -45,7 +47,15 @@ GamutLevelSet GamutLevelSet::from_values(int d, int cells, double lower, double 
   for (double v : values)
     if (!std::isfinite(v)) throw InputError("gamut level set: a node value is not finite");
   ls.phi_ = std::move(values);
+  ls.padding_ = padding;
   return ls;
+}
+
+GamutLevelSet GamutLevelSet::shifted(double offset) const {
+  GamutLevelSet out = *this;
+  for (double& v : out.phi_) v += offset;
+  out.padding_ = std::max(0.0, padding_ - offset);
+  return out;
 }
 
 GamutLevelSet GamutLevelSet::from_points(const std::vector<VecX>& points, const LevelSetOptions& o) {
@@ -80,6 +90,7 @@ GamutLevelSet GamutLevelSet::from_points(const std::vector<VecX>& points, const 
   for (int a = 1; a < d; ++a) ls.stride_[a] = ls.stride_[a - 1] * o.cells;
   const long long n = ls.stride_[d - 1] * o.cells;
   const double h = ls.h_, r = o.radius > 0 ? o.radius : 1.5 * h, reach = 2 * r;
+  ls.padding_ = r;
 
   // 1. Zhu-Bridson implicit function, from buckets of edge 2r.
   const long long buckets_per_axis = static_cast<long long>(std::ceil((1 + 2 * o.margin) / reach)) + 2;

@@ -38,13 +38,21 @@ class GamutLevelSet {
   // A level set from stored node values (an artifact): `values` has
   // cells^dimension entries, axis 0 fastest, node centres at
   // lower + (i + 1/2) spacing. InputError on a size mismatch.
-  static GamutLevelSet from_values(int dimension, int cells, double lower, double spacing, std::vector<double> values);
+  static GamutLevelSet from_values(int dimension, int cells, double lower, double spacing, std::vector<double> values,
+                                   double padding = 0.0);
 
   int dimension() const { return dim_; }
   int cells() const { return cells_; }
   double spacing() const { return h_; }
   double lower() const { return lo_; }
   const std::vector<double>& values() const { return phi_; }  // axis 0 fastest
+  // How far the zero level lies outside the samples: the radius r of the
+  // implicit function (a single sample's Phi is -r). from_values() sets
+  // it from its argument.
+  double padding() const { return padding_; }
+  // The same level set moved inward by `offset` (Phi + offset): with
+  // offset = padding() its zero level runs through the outermost samples.
+  GamutLevelSet shifted(double offset) const;
 
   // Multilinear interpolation of the node values; beyond the outermost
   // node centres the nearest in-range value plus the distance to it.
@@ -62,6 +70,7 @@ class GamutLevelSet {
  private:
   int dim_ = 0, cells_ = 0;
   double lo_ = 0, h_ = 0;
+  double padding_ = 0;
   std::vector<double> phi_;
   std::vector<long long> stride_;
   double node(const std::vector<int>& index) const;

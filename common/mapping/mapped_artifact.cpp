@@ -18,6 +18,7 @@ std::string size_problem(const MappedDesign& m) {
   if (m.structure.size() != n) return "/cells/structure must have one entry per cell";
   if (m.shift.size() != n) return "/cells/shift must have one entry per cell";
   if (m.distance.size() != n) return "/cells/distance must have one entry per cell";
+  if (!m.property_gap.empty() && m.property_gap.size() != n) return "/cells/property_gap must have one entry per cell";
   if (m.candidates.size() != n) return "/cells/candidates must have one entry per cell";
   if (m.mismatch.size() != n) return "/cells/mismatch must have one entry per cell";
   if (m.history.empty() || m.history.size() != m.history_cell.size())
@@ -70,6 +71,12 @@ void write_mapped_artifact(const std::string& path, const MappedDesign& m, const
   f.write_attribute("/cells/distance", "meaning",
                     "Euclidean distance between the structure's and the cell's normalized properties");
   f.write_attribute("/cells/distance", "units", "1");
+  if (!m.property_gap.empty()) {
+    f.write_vector("/cells/property_gap", m.property_gap, packed);
+    f.write_attribute("/cells/property_gap", "meaning",
+                      "|C(structure) - C(target)|_F / |C(target)|_F, C the space's stiffness of the raw properties");
+    f.write_attribute("/cells/property_gap", "units", "1");
+  }
   f.write_vector("/cells/candidates", m.candidates, packed);
   f.write_attribute("/cells/candidates", "meaning", "candidate structures of the cell (each with its variants)");
   f.write_vector("/cells/mismatch", m.mismatch, packed);
@@ -110,6 +117,7 @@ MappedDesign read_mapped_artifact(const std::string& path) {
   m.structure = f.read_vector<std::int32_t>("/cells/structure");
   m.shift = f.read_vector<std::uint8_t>("/cells/shift");
   m.distance = f.read_vector<double>("/cells/distance");
+  if (f.exists("/cells/property_gap")) m.property_gap = f.read_vector<double>("/cells/property_gap");
   m.candidates = f.read_vector<std::int32_t>("/cells/candidates");
   m.mismatch = f.read_vector<std::int64_t>("/cells/mismatch");
   m.history = f.read_vector<std::int64_t>("/history/mismatch");

@@ -28,6 +28,12 @@ struct MappedDesign {
   std::vector<std::int32_t> structure;     // per cell, index into the set; -1 for forced empty / solid cells
   std::vector<std::uint8_t> shift;         // per cell, 1: the half-shifted exemplar
   std::vector<double> distance;            // per cell, |unit(structure) - unit(target)|; 0 for fixed cells
+  // Per cell, |C(structure) - C(target)|_F / |C(target)|_F with C the
+  // space's stiffness tensor of the raw properties: the property gap the
+  // printed cell has against what the optimizer used; 0 for fixed cells.
+  // Empty when read from an artifact written before it existed (or for a
+  // set whose properties are not the space's).
+  std::vector<double> property_gap;
   std::vector<std::int32_t> candidates;    // per cell, candidate structures considered (0 for fixed cells)
   std::vector<std::int64_t> mismatch;      // per cell, the final I_i
   std::vector<std::int64_t> history;       // total mismatch I after each accepted move; [0] the initial one

@@ -1,8 +1,10 @@
 #include "mapping/mapper.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/errors.hpp"
+#include "gamut/material_space.hpp"
 
 namespace msfab {
 namespace {
@@ -105,6 +107,13 @@ MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, c
   m.structure.assign(n, -1);
   m.shift.assign(n, 0);
   m.distance.assign(n, 0.0);
+  const MaterialSpace space(MaterialSpace::parse_kind(set.space), set.E_stiff, set.decades);
+  // Every artifact's properties are the space's (moduli, ratios and rho);
+  // a set without them has no tensor to compare and no gap.
+  const bool with_gap = design.raw.cols() == space.dimension() &&
+                        std::all_of(set.items.begin(), set.items.end(),
+                                    [&](const Microstructure& s) { return s.properties.size() == space.dimension(); });
+  if (with_gap) m.property_gap.assign(n, 0.0);
   m.candidates.assign(n, 0);
   m.mismatch.resize(n);
   for (std::size_t c = 0; c < n; ++c) {
@@ -115,6 +124,9 @@ MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, c
     m.structure[c] = candidates.structure[std::size_t(j)];
     m.shift[c] = static_cast<std::uint8_t>(o % variants);
     m.distance[c] = candidates.distance[std::size_t(j)];
+    if (with_gap)
+      m.property_gap[c] = relative_stiffness_gap(space, set.items[std::size_t(m.structure[c])].properties,
+                                                 design.raw.row(Eigen::Index(c)).transpose());
     m.candidates[c] = std::int32_t(candidates.count(std::int64_t(c)));
   }
   m.history = report.history;
@@ -128,6 +140,17 @@ MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, c
   return m;
 }
 
+double relative_stiffness_gap(const MaterialSpace& ms, const VecX& a, const VecX& b) {
+  if (a.size() != ms.dimension() || b.size() != ms.dimension())
+    throw std::invalid_argument("relative_stiffness_gap: properties of another space");
+  if (ms.kind() == MaterialSpaceKind::cubic3d) {
+    const Mat6 Cb = ms.tensor_3d(b);
+    return (ms.tensor_3d(a) - Cb).norm() / Cb.norm();
+  }
+  const Mat3 Cb = ms.tensor_2d(b);
+  return (ms.tensor_2d(a) - Cb).norm() / Cb.norm();
+}
+
 DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped,
                                     double max_distance) {
   DistanceSummary s;
@@ -138,7 +161,12 @@ DistanceSummary summarize_distances(const CellCandidates& candidates, const Mapp
     if (nearest > max_distance) ++s.far_cells;
     s.max_nearest = std::max(s.max_nearest, nearest);
     s.max_chosen = std::max(s.max_chosen, mapped.distance[std::size_t(c)]);
+    if (!mapped.property_gap.empty()) {
+      s.max_gap = std::max(s.max_gap, mapped.property_gap[std::size_t(c)]);
+      s.mean_gap += mapped.property_gap[std::size_t(c)];
+    }
   }
+  if (s.design_cells > 0) s.mean_gap /= double(s.design_cells);
   return s;
 }
 

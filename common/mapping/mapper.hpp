@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <string>
 
+#include "gamut/material_space.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapped_artifact.hpp"
@@ -56,7 +57,12 @@ struct DistanceSummary {
   std::int64_t far_cells = 0;  // nearest candidate farther than max_distance
   double max_nearest = 0;      // largest distance to the nearest candidate
   double max_chosen = 0;       // largest distance to the structure chosen
+  double max_gap = 0, mean_gap = 0;  // property gap (MappedDesign::property_gap) of the chosen structures
 };
+// |C(a) - C(b)|_F / |C(b)|_F for raw properties a (a structure's) and b (a
+// target) of a gamut space (MaterialSpace::tensor_2d / tensor_3d).
+double relative_stiffness_gap(const MaterialSpace& space, const VecX& a, const VecX& b);
+
 DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped,
                                     double max_distance);
 

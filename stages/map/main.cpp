@@ -149,6 +149,8 @@ int main(int argc, char** argv) {
     std::printf("  distance to target: max %.4g (nearest candidate: max %.4g; %lld cells beyond max_distance %g)\n",
                 distances.max_chosen, distances.max_nearest, static_cast<long long>(distances.far_cells),
                 settings.mapper.max_distance);
+    std::printf("  property gap |C(structure) - C(target)| / |C(target)|: max %.4g, mean %.4g\n", distances.max_gap,
+                distances.mean_gap);
     std::printf("  artifact: %s\n", out.c_str());
 
     // Exports of the voxel model, each streamed layer by layer.

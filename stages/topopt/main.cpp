@@ -63,8 +63,17 @@ int main(int argc, char** argv) {
       if (gamut.space != needs)
         config.fail("gamut", path + " is a " + gamut.space + " gamut; space " + space + " needs a " + needs + " gamut");
       inputs.push_back(path);
+      // The level set's zero lies `padding` outside the outermost samples;
+      // subtracting it leaves the optimizer only properties structures have.
+      if (config.has("gamut_padding") && config.one_of("gamut_padding", {"keep", "subtract"}) == "subtract") {
+        const double padding = gamut.level_set.padding();
+        gamut.level_set = gamut.level_set.shifted(padding);
+        spdlog::info("gamut constraint moved inward by its padding: Phi + {:.4g} <= 0", padding);
+      }
     } else if (config.has("gamut")) {
       config.fail("gamut", "space " + space + " takes no gamut");
+    } else if (config.has("gamut_padding")) {
+      config.fail("gamut_padding", "space " + space + " takes no gamut");
     }
 
     // 1. The scene.

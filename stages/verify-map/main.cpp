@@ -147,6 +147,51 @@ TopoptScene scene_for(const std::string& scene_path, const Design& design, const
 
 bool all_finite(const VecX& v) { return v.allFinite(); }
 
+// The homogenized model without void (docs/verify_map.md, "Void"): pieces
+// of non-empty cells the supports do not hold are removed, nodes only empty
+// cells touch are fixed.
+void remove_void_from_cells(const CellGrid& grid, std::vector<char>& solid, std::vector<char>& fixed,
+                            VerifyReport& report, const std::string& design_path) {
+  const PieceRemoval removal = remove_unheld_pieces(grid, solid, fixed);
+  if (removal.kept_cells == 0)
+    throw InputError(design_path + ": the scene's supports hold none of the design's non-empty cells (every "
+                     "piece of them can move freely); nothing to check");
+  report.pieces_homogenized = removal.pieces;
+  report.removed_pieces_homogenized = removal.removed;
+  report.removed_cells_homogenized = removal.removed_cells;
+  report.inactive_nodes_homogenized = fix_unknowns_without_material(grid, solid_nodes(grid, solid), fixed);
+  if (removal.removed > 0)
+    spdlog::warn("homogenized model: {} of {} pieces of cells are not held by the supports and were removed ({} "
+                 "hexahedra)",
+                 removal.removed, removal.pieces, removal.removed_cells);
+}
+
+// The same for the voxel model. Removing a piece can move a point support
+// (it had been moved onto that piece's material), so the supports are
+// carried over again until nothing more is removed.
+void remove_void_from_voxels(const CellRefinement& refinement, const std::vector<char>& coarse_fixed,
+                             std::vector<char>& voxel_material, std::vector<char>& node_material,
+                             CellRefinement::Supports& supports, VerifyReport& report, const std::string& mapped_path) {
+  for (int pass = 0;; ++pass) {
+    const PieceRemoval removal = remove_unheld_pieces(refinement.fine(), voxel_material, supports.fixed);
+    if (pass == 0) report.pieces_full = removal.pieces;
+    report.removed_pieces_full += removal.removed;
+    report.removed_voxels_full += removal.removed_cells;
+    if (removal.kept_cells == 0)
+      throw InputError(mapped_path + ": the scene's supports hold none of the voxel model's " +
+                       std::to_string(removal.pieces) + " pieces (each can move freely); nothing to check");
+    if (removal.removed == 0) break;
+    node_material = refinement.material_nodes(voxel_material);
+    supports = refinement.refine_supports(coarse_fixed, node_material);
+  }
+  report.inactive_nodes_full = fix_unknowns_without_material(refinement.fine(), node_material, supports.fixed);
+  if (report.removed_pieces_full > 0)
+    spdlog::warn("full-resolution model: {} of {} pieces are not held by the supports (floating, or held at a point "
+                 "or along a line) and were removed: {} voxels, {:.2f}% of the material",
+                 report.removed_pieces_full, report.pieces_full, report.removed_voxels_full,
+                 100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
+}
+
 // GridElasticity, with a bad solver name reported against its config key.
 std::unique_ptr<GridElasticity> make_model(const CellGrid& grid, const std::vector<char>& fixed,
                                            const std::string& solver, const std::string& key,
@@ -231,20 +276,7 @@ int main(int argc, char** argv) {
       const auto q = hgrid.cell_coords(e);
       hsolid[std::size_t(e)] = mapped.roles[std::size_t(coarse.cell_index(q[0] / m, q[1] / m, q[2] / m))] != CellRole::empty;
     }
-    if (settings.remove_void) {
-      const PieceRemoval removal = remove_unheld_pieces(hgrid, hsolid, hfixed);
-      if (removal.kept_cells == 0)
-        throw InputError(design_path + ": the scene's supports hold none of the design's non-empty cells (every "
-                         "piece of them can move freely); nothing to check");
-      report.pieces_homogenized = removal.pieces;
-      report.removed_pieces_homogenized = removal.removed;
-      report.removed_cells_homogenized = removal.removed_cells;
-      report.inactive_nodes_homogenized = fix_unknowns_without_material(hgrid, solid_nodes(hgrid, hsolid), hfixed);
-      if (removal.removed > 0)
-        spdlog::warn("homogenized model: {} of {} pieces of cells are not held by the supports and were removed "
-                     "({} hexahedra)",
-                     removal.removed, removal.pieces, removal.removed_cells);
-    }
+    if (settings.remove_void) remove_void_from_cells(hgrid, hsolid, hfixed, report, design_path);
     const auto homogenized_model =
         make_model(hgrid, hfixed, settings.homogenized_solver, "homogenized_solver", solver_options);
     GridElasticity& homogenized = *homogenized_model;
@@ -284,28 +316,10 @@ int main(int argc, char** argv) {
     std::vector<char> node_material = refinement.material_nodes(voxel_material);
     CellRefinement::Supports supports = refinement.refine_supports(scene.setup.fixed, node_material);
     if (settings.remove_void) {
-      // Removing a piece can move a point support onto another one: repeat until nothing is removed.
-      for (int pass = 0;; ++pass) {
-        const PieceRemoval removal = remove_unheld_pieces(fine, voxel_material, supports.fixed);
-        if (pass == 0) report.pieces_full = removal.pieces;
-        report.removed_pieces_full += removal.removed;
-        report.removed_voxels_full += removal.removed_cells;
-        if (removal.kept_cells == 0)
-          throw InputError(mapped_path + ": the scene's supports hold none of the voxel model's " +
-                           std::to_string(removal.pieces) +
-                           " pieces (each can move freely); nothing to check (" + design_path + ")");
-        if (removal.removed == 0) break;
-        node_material = refinement.material_nodes(voxel_material);
-        supports = refinement.refine_supports(scene.setup.fixed, node_material);
-      }
+      remove_void_from_voxels(refinement, scene.setup.fixed, voxel_material, node_material, supports, report,
+                              mapped_path);
       for (std::size_t i = 0; i < voxels.size(); ++i)
         if (!voxel_material[i]) voxels[i] = 0;
-      report.inactive_nodes_full = fix_unknowns_without_material(fine, node_material, supports.fixed);
-      if (report.removed_pieces_full > 0)
-        spdlog::warn("full-resolution model: {} of {} pieces are not held by the supports (floating, or held at a "
-                     "point or along a line) and were removed: {} voxels, {:.2f}% of the material",
-                     report.removed_pieces_full, report.pieces_full, report.removed_voxels_full,
-                     100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
     }
     report.point_supports = supports.point_supports;
     report.moved_point_supports = supports.moved_point_supports;

@@ -110,6 +110,8 @@ TEST(GamutArtifacts, GamutLevelSetReadsBackWithTheSameQueries) {
   EXPECT_EQ(r.property_names, g.property_names);
   EXPECT_EQ(r.E_stiff, 2e9);
   EXPECT_EQ(r.level_set.values(), g.level_set.values());
+  EXPECT_EQ(r.level_set.padding(), g.level_set.padding());
+  EXPECT_DOUBLE_EQ(g.level_set.padding(), 1.5 * g.level_set.spacing());  // the default radius
   for (const VecX& p : {VecX(Eigen::Vector3d(0.5, 0.5, 0.5)), VecX(Eigen::Vector3d(0.1, 0.9, 0.33))}) {
     EXPECT_EQ(r.level_set.value(p), g.level_set.value(p));
     EXPECT_EQ(r.level_set.gradient(p), g.level_set.gradient(p));

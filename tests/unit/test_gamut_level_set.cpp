@@ -133,6 +133,31 @@ TEST(GamutLevelSet, GradientMatchesFiniteDifferencesAndHasUnitLength) {
   EXPECT_NEAR(ls.gradient(far).norm(), 1.0, 0.2);
 }
 
+// The zero level sits the implicit function's radius outside the samples;
+// shifted(padding()) moves it back onto them (the optimizer's honest
+// feasible set, docs/topopt.md "gamut_padding").
+TEST(GamutLevelSet, SubtractingThePaddingPutsTheZeroLevelOnTheSamples) {
+  const auto pts = fill(2, 20000, 5, [](const VecX& p) { return p.minCoeff() > 0.3 && p.maxCoeff() < 0.7; });
+  LevelSetOptions o;
+  o.cells = 64;
+  const GamutLevelSet ls = GamutLevelSet::from_points(pts, o);
+  const double h = ls.spacing(), r = ls.padding();
+  EXPECT_DOUBLE_EQ(r, 1.5 * h);
+  const GamutLevelSet honest = ls.shifted(r);
+  EXPECT_EQ(honest.padding(), 0.0);
+  // Where the samples end (x = 0.7 on the mid line) the padded set is still
+  // about r inside; the shifted one is on its boundary, within a grid cell.
+  const VecX edge = Eigen::Vector2d(0.7, 0.5);
+  EXPECT_NEAR(ls.value(edge), -r, h);
+  EXPECT_NEAR(honest.value(edge), 0.0, h);
+  EXPECT_LT(honest.value(Eigen::Vector2d(0.5, 0.5)), -0.1);
+  // A point r outside the samples is feasible only with the padding.
+  const VecX beyond = Eigen::Vector2d(0.7 + r, 0.5);
+  EXPECT_LT(ls.value(beyond), 0.5 * h);
+  EXPECT_GT(honest.value(beyond), 0.5 * h);
+  EXPECT_LT((honest.gradient(edge) - ls.gradient(edge)).norm(), 1e-9);
+}
+
 TEST(GamutLevelSet, BadInputIsAnInputError) {
   EXPECT_THROW(GamutLevelSet::from_points({}), InputError);
   EXPECT_THROW(GamutLevelSet::from_points({VecX::Constant(2, 0.5), VecX::Constant(3, 0.5)}), InputError);

@@ -392,6 +392,7 @@ TEST(Mapping, MappedDesignMatchesTheVoxelsAndTheTargets) {
   EXPECT_EQ(back.structure, m.structure);
   EXPECT_EQ(back.shift, m.shift);
   EXPECT_EQ(back.distance, m.distance);
+  EXPECT_EQ(back.property_gap, m.property_gap);
   EXPECT_EQ(back.mismatch, m.mismatch);
   EXPECT_EQ(back.history, m.history);
   EXPECT_EQ(back.history_cell, m.history_cell);
@@ -399,6 +400,66 @@ TEST(Mapping, MappedDesignMatchesTheVoxelsAndTheTargets) {
   EXPECT_EQ(back.nx, 4);
   EXPECT_EQ(back.vz, 2);
   EXPECT_EQ(back.k, 5);
+}
+
+// A cubic3d set and design with physical properties (E, nu, G, rho), so
+// that the property gap (a relative difference of stiffness tensors) is
+// defined: zero for a structure exactly at its cell's target, and relative
+// in the Frobenius norm of C.
+TEST(Mapping, PropertyGapIsZeroAtTheTargetAndRelativeInTheNormOfC) {
+  const MaterialSpace space(MaterialSpaceKind::cubic3d, 1e6);
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto physical = [&] {
+    VecX raw(4);
+    raw << 1e6 * std::pow(10.0, -2 * u(rng)), 0.4 * u(rng), 1e6 * std::pow(10.0, -2.5 * u(rng)), 0.1 + 0.9 * u(rng);
+    return raw;
+  };
+  MicrostructureSet set = random_set(30, 2, 2, 2, 32, false);
+  set.property_names = {"E", "nu", "G", "rho"};
+  for (Microstructure& m : set.items) {
+    m.properties = physical();
+    m.unit = space.normalize(m.properties);
+  }
+  Design d = random_design(set, 3, 3, 2, 33);
+  d.unit = MatX(d.cells(), 4);
+  d.raw = MatX(d.cells(), 4);
+  for (std::int64_t c = 0; c < d.cells(); ++c) {
+    d.raw.row(c) = physical().transpose();
+    d.unit.row(c) = space.normalize(d.raw.row(c).transpose()).transpose();
+  }
+  const MapperRun r = run_mapper(d, set, default_options(3), 4);
+  double mean = 0, largest = 0;
+  for (std::int64_t c = 0; c < d.cells(); ++c) {
+    const double gap = r.mapped.property_gap[std::size_t(c)];
+    if (d.roles[std::size_t(c)] != CellRole::design) {
+      EXPECT_EQ(gap, 0.0);
+      continue;
+    }
+    const Mat6 target = space.tensor_3d(d.raw.row(c).transpose());
+    const Mat6 chosen = space.tensor_3d(set.items[std::size_t(r.mapped.structure[std::size_t(c)])].properties);
+    EXPECT_NEAR(gap, (chosen - target).norm() / target.norm(), 1e-12 * (1 + gap));
+    mean += gap;
+    largest = std::max(largest, gap);
+  }
+  const DistanceSummary summary = summarize_distances(r.candidates, r.mapped, 0.1);
+  EXPECT_NEAR(summary.mean_gap, mean / double(summary.design_cells), 1e-12);
+  EXPECT_EQ(summary.max_gap, largest);
+  EXPECT_GT(largest, 0.0);
+  // Targets on the samples themselves, one candidate: gap zero everywhere.
+  Design exact = d;
+  for (std::int64_t c = 0; c < d.cells(); ++c) {
+    exact.raw.row(c) = set.items[std::size_t(c % 30)].properties.transpose();
+    exact.unit.row(c) = set.items[std::size_t(c % 30)].unit.transpose();
+  }
+  const MapperRun on_samples = run_mapper(exact, set, default_options(1, false), 1);
+  for (double gap : on_samples.mapped.property_gap) EXPECT_EQ(gap, 0.0);
+  // Twice E and G at the same nu: twice C.
+  VecX target(4), doubled(4);
+  target << 2e5, 0.25, 7e4, 0.5;
+  doubled << 4e5, 0.25, 1.4e5, 0.5;
+  EXPECT_NEAR(relative_stiffness_gap(space, doubled, target), 1.0, 1e-12);
+  EXPECT_NEAR(relative_stiffness_gap(space, target, doubled), 0.5, 1e-12);
 }
 
 // --- exports ---------------------------------------------------------------------
