@@ -6,6 +6,7 @@
 #include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/dirichlet_grid_multigrid.hpp"
+#include "solve/sparse_ops.hpp"
 
 namespace msfab {
 
@@ -289,26 +290,18 @@ double GridElasticity::energy(const VecX& u) const {
   // 1/2 sum_e u_e^T K_e u_e from the field, cell by cell in a fixed order.
   const VoxelStiffnessField& field = matrix_free_->field();
   const int B = field.basis_size();
-  const std::int64_t cells = grid_.cells();
-  constexpr std::int64_t kChunk = 4096;
-  const std::int64_t chunks = (cells + kChunk - 1) / kChunk;
-  std::vector<double> partial(std::size_t(chunks), 0.0);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t t = 0; t < chunks; ++t) {
+  return 0.5 * chunked_reduce(grid_.cells(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
     double sum = 0;
     std::int64_t dofs[24];
     Vec24 ue;
-    for (std::int64_t c = t * kChunk; c < std::min(cells, (t + 1) * kChunk); ++c) {
+    for (Eigen::Index c = begin; c < end; ++c) {
       grid_.cell_unknowns(c, dofs);
       for (int i = 0; i < 24; ++i) ue[i] = u[dofs[i]];
       for (int b = 0; b < B; ++b)
         if (const double w = field.weight(c, b); w != 0.0) sum += w * ue.dot(field.basis[std::size_t(b)] * ue);
     }
-    partial[std::size_t(t)] = sum;
-  }
-  double total = 0;
-  for (double p : partial) total += p;
-  return 0.5 * total;
+    return sum;
+  });
 }
 
 }  // namespace msfab

@@ -1,4 +1,5 @@
 #include "verify/refinement.hpp"
+#include "verify/solid_pieces.hpp"
 
 #include <algorithm>
 #include <array>
@@ -61,22 +62,7 @@ CellRefinement::Entity CellRefinement::entity(std::int64_t fine_node) const {
 std::vector<char> CellRefinement::material_nodes(const std::vector<char>& voxel_material) const {
   if (std::int64_t(voxel_material.size()) != fine_.cells())
     throw std::invalid_argument("material_nodes: one flag per fine cell");
-  std::vector<char> out(std::size_t(fine_.nodes()), 0);
-  const int NX = fine_.nx(), NY = fine_.ny(), NZ = fine_.nz();
-#pragma omp parallel for schedule(static)
-  for (std::int64_t n = 0; n < fine_.nodes(); ++n) {
-    const auto p = fine_.node_coords(n);
-    char any = 0;
-    for (int dz = -1; dz <= 0 && !any; ++dz)
-      for (int dy = -1; dy <= 0 && !any; ++dy)
-        for (int dx = -1; dx <= 0 && !any; ++dx) {
-          const int i = p[0] + dx, j = p[1] + dy, k = p[2] + dz;
-          if (i < 0 || j < 0 || k < 0 || i >= NX || j >= NY || k >= NZ) continue;
-          any = voxel_material[std::size_t(fine_.cell_index(i, j, k))];
-        }
-    out[std::size_t(n)] = any ? 1 : 0;
-  }
-  return out;
+  return solid_nodes(fine_, voxel_material);
 }
 
 bool CellRefinement::on_faces_of(std::int64_t coarse_node, std::int64_t fine_node) const {

@@ -123,9 +123,18 @@ std::vector<char> solid_nodes(const CellGrid& grid, const std::vector<char>& sol
   require_3d(grid, "solid_nodes");
   if (std::int64_t(solid.size()) != grid.cells()) throw std::invalid_argument("solid_nodes: one flag per cell");
   std::vector<char> out(std::size_t(grid.nodes()), 0);
-  for (std::int64_t c = 0; c < grid.cells(); ++c)
-    if (solid[std::size_t(c)])
-      for (std::int64_t node : grid.cell_nodes(c)) out[std::size_t(node)] = 1;
+  const int n[3] = {grid.nx(), grid.ny(), grid.nz()};
+#pragma omp parallel for schedule(static)
+  for (std::int64_t node = 0; node < grid.nodes(); ++node) {
+    const auto p = grid.node_coords(node);
+    char any = 0;
+    for (int a = 0; a < 8 && !any; ++a) {
+      const int i = p[0] - (a & 1), j = p[1] - (a >> 1 & 1), k = p[2] - (a >> 2 & 1);
+      if (i >= 0 && j >= 0 && k >= 0 && i < n[0] && j < n[1] && k < n[2])
+        any = solid[std::size_t(grid.cell_index(i, j, k))] ? 1 : 0;
+    }
+    out[std::size_t(node)] = any;
+  }
   return out;
 }
 
