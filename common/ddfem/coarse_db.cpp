@@ -13,25 +13,27 @@ namespace msfab {
 
 std::int64_t CoarseDatabase::num_combinations() const {
   std::int64_t n = 1;
-  for (int c = 0; c < 8; ++c) n *= num_materials();
+  for (int c = 0; c < 8; ++c) n *= digits();
   return n;
 }
 
 std::int64_t CoarseDatabase::combination_code(const BlockMaterials& ids) const {
+  const int lowest = void_children ? 0 : 1;
   std::int64_t code = 0, base = 1;
   for (int c = 0; c < 8; ++c) {
-    if (ids[c] < 1 || ids[c] > num_materials()) return -1;
-    code += base * (ids[c] - 1);
-    base *= num_materials();
+    if (ids[c] < lowest || ids[c] > num_materials()) return -1;
+    code += base * (ids[c] - lowest);
+    base *= digits();
   }
   return code;
 }
 
 BlockMaterials CoarseDatabase::combination_ids(std::int64_t code) const {
+  const int lowest = void_children ? 0 : 1;
   BlockMaterials ids{};
   for (int c = 0; c < 8; ++c) {
-    ids[c] = static_cast<int>(code % num_materials()) + 1;
-    code /= num_materials();
+    ids[c] = static_cast<int>(code % digits()) + lowest;
+    code /= digits();
   }
   return ids;
 }
@@ -138,7 +140,10 @@ void write_level1(H5File& f, const std::string& prefix, const CoarseDatabase& db
   f.write_matrix(g + "/ids", ids);
   f.write_vector(g + "/orbit", db.orbit);
   f.write_vector(g + "/entry", db.entry_of);
-  f.write_attribute(g, "order", "row = sum_c (id_c - 1) n^c, child c in hex8 order");
+  f.write_attribute(g, "void_children", int(db.void_children));
+  f.write_attribute(g, "order", db.void_children
+                                    ? "row = sum_c id_c (n + 1)^c, child c in hex8 order (id 0 void; row 0, all void, has entry -1)"
+                                    : "row = sum_c (id_c - 1) n^c, child c in hex8 order");
   f.write_attribute(g + "/entry", "meaning", "row of " + prefix + "/fit/* holding the combination's coarse material");
   write_fits(f, prefix, db.entries);
 }
@@ -214,10 +219,11 @@ void shape_ok(const std::string& path, const std::string& name, std::int64_t row
                   std::to_string(want_rows) + " x " + std::to_string(want_cols));
 }
 
-// `<prefix>/fit/*` with P points per entry; material ids must be in [1, max_id].
-// mu0 / lambda0 are left for the caller (they come from the palette).
+// `<prefix>/fit/*` with P points per entry; material ids must be in
+// [min_id, max_id]. mu0 / lambda0 are left for the caller (they come from
+// the palette).
 std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& path, const std::string& prefix,
-                                         int P, int max_id, std::int64_t max_rows) {
+                                         int P, int min_id, int max_id, std::int64_t max_rows) {
   const std::string g = prefix + "/fit";
   const auto entry_ids = f.read_matrix<int>(g + "/ids");
   const std::int64_t K = entry_ids.rows();
@@ -251,9 +257,9 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
     CoarseMaterialFit& fit = entries[e];
     for (int k = 0; k < 8; ++k) {
       fit.material_ids[k] = entry_ids(e, k);
-      if (fit.material_ids[k] < 1 || fit.material_ids[k] > max_id)
+      if (fit.material_ids[k] < min_id || fit.material_ids[k] > max_id)
         bad(path, g + "/ids row " + std::to_string(e) + " has id " + std::to_string(fit.material_ids[k]) +
-                      " outside 1.." + std::to_string(max_id));
+                      " outside " + std::to_string(min_id) + ".." + std::to_string(max_id));
     }
     fit.fitted = fitted[e] != 0;
     for (int k = 0; k < P; ++k) {
@@ -277,6 +283,8 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
 // A level-1 database under `prefix`; the palette must already be in `db`.
 void read_level1(const H5File& f, const std::string& path, const std::string& prefix, CoarseDatabase& db) {
   const std::string g = prefix + "/combinations";
+  // Databases written before void children could be fitted have no attribute.
+  db.void_children = f.has_attribute(g, "void_children") && f.read_attribute<int>(g, "void_children") != 0;
   const auto ids = f.read_matrix<int>(g + "/ids");
   const std::int64_t N = db.num_combinations();
   if (ids.rows() != N || ids.cols() != 8)
@@ -287,7 +295,7 @@ void read_level1(const H5File& f, const std::string& path, const std::string& pr
   db.entry_of = f.read_vector<int>(g + "/entry");
   shape_ok(path, g + "/orbit", db.orbit.size(), 1, N, 1);
   shape_ok(path, g + "/entry", db.entry_of.size(), 1, N, 1);
-  db.entries = read_fits(f, path, prefix, 8, db.num_materials(), N);
+  db.entries = read_fits(f, path, prefix, 8, db.void_children ? 0 : 1, db.num_materials(), N);
   const std::int64_t K = static_cast<std::int64_t>(db.entries.size());
   for (std::int64_t c = 0; c < N; ++c) {
     BlockMaterials b;
@@ -301,8 +309,9 @@ void read_level1(const H5File& f, const std::string& path, const std::string& pr
   const auto pal = db.palette();
   for (CoarseMaterialFit& fit : db.entries)
     for (int k = 0; k < 8; ++k) {
-      fit.mu0[k] = pal[fit.material_ids[k]]->shear_modulus();
-      fit.lambda0[k] = pal[fit.material_ids[k]]->lame_lambda();
+      const MaterialPtr& m = pal[fit.material_ids[k]];  // null for a void child
+      fit.mu0[k] = m ? m->shear_modulus() : 0.0;
+      fit.lambda0[k] = m ? m->lame_lambda() : 0.0;
     }
 }
 
@@ -357,7 +366,7 @@ CoarseDatabase read_coarse_db(const std::string& path) {
   read_level1(f, path, "/level1", *level1);
   db.hierarchy = read_hierarchy(f, path, static_cast<int>(level1->entries.size()));
   const int K = db.hierarchy.num_final();
-  db.entries = read_fits(f, path, "", 64, static_cast<int>(level1->entries.size()), K);
+  db.entries = read_fits(f, path, "", 64, 1, static_cast<int>(level1->entries.size()), K);
   if (static_cast<int>(db.entries.size()) != K)
     bad(path, "/fit has " + std::to_string(db.entries.size()) + " rows, expected one per final representative (" +
                   std::to_string(K) + ")");
@@ -419,10 +428,13 @@ CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const 
   return [&db, combos = level1_grid.combinations, fallback](const ChildIds& ids) {
     Arrangement entries;
     for (int c = 0; c < 8; ++c) {
-      if (ids[c] == 0) return fallback(ids);  // a void level-1 child
+      if (ids[c] == 0) return fallback(ids);  // an all-void level-1 child
       const std::array<int, 8>& fine = combos.at(ids[c] - 1);
       const std::int64_t code = db.level1->combination_code(fine);
-      if (code < 0 || db.level1->entry_of[code] < 0) return fallback(ids);  // a void voxel in the child
+      // A child the level-1 database holds no fit for (a void voxel in a
+      // database without void children).
+      if (code < 0 || db.level1->entry_of[code] < 0) return fallback(ids);
+      if (!db.level1->entries[db.level1->entry_of[code]].fitted) return fallback(ids);
       entries[c] = db.level1->entry_of[code];
     }
     return coarse_quadrature_materials(db.find_level2(entries));

@@ -4,9 +4,12 @@
 // of Eq. 2.7, stored in the `msfab.coarse_db` artifact (docs/artifacts.md).
 //
 // Combinations are keyed by the block's eight palette ids in hex8 child
-// order (level 1; level 2 goes through the hierarchy of hierarchy.hpp). Only all-solid combinations are stored; a block with a void child
-// has a coarse corner without a fine node and is coarsened naively online
-// (docs/ddfem.md, "Void").
+// order (level 1; level 2 goes through the hierarchy of hierarchy.hpp). A
+// database built without void children stores the n^8 all-solid
+// combinations, and a block with a void child is coarsened naively online;
+// one built with them (`void_children`, periodic sampling) stores the
+// (n + 1)^8 - 1 combinations with at least one solid child (docs/ddfem.md,
+// "Blocks with void").
 #include <array>
 #include <cstdint>
 #include <string>
@@ -32,6 +35,9 @@ struct DbMaterial {
 struct CoarseDatabase {
   int level = 1;
   std::vector<DbMaterial> materials;          // ids 1..n
+  // Combinations include void children (id 0): codes in base n + 1, the
+  // all-void code 0 has no entry. Otherwise base n over the solid ids.
+  bool void_children = false;
   // The stored coarse materials: one per combination in a full database,
   // the representatives in a compressed one (msfab-ddfem-compress).
   std::vector<CoarseMaterialFit> entries;
@@ -50,12 +56,16 @@ struct CoarseDatabase {
 
   int num_materials() const { return static_cast<int>(materials.size()); }
   bool compressed() const { return entries.size() < entry_of.size(); }
-  // Base-n digits of the ids minus one, child 0 least significant; -1 if a
-  // child is void or out of range.
+  // Digits per child: n, or n + 1 with void children.
+  int digits() const { return num_materials() + (void_children ? 1 : 0); }
+  // Base-digits() digits, child 0 least significant: the ids minus one, or
+  // the ids themselves with void children; -1 if an id is out of range (a
+  // void child in a database without void children).
   std::int64_t combination_code(const BlockMaterials& ids) const;
   BlockMaterials combination_ids(std::int64_t code) const;
-  std::int64_t num_combinations() const;  // n^8
-  // The fit for a combination, or nullptr for a void child / unknown id.
+  std::int64_t num_combinations() const;  // digits()^8
+  // The fitted coarse material of a combination, or nullptr (a combination
+  // the database does not hold, or one that could not be fitted).
   const CoarseMaterialFit* find(const BlockMaterials& ids) const;
   // Level 2: the fit for the level-1 entries of a cell's children.
   const CoarseMaterialFit& find_level2(const Arrangement& level1_entries) const;
@@ -76,14 +86,15 @@ CoarseDatabase read_coarse_db(const std::string& path);
 void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
                          const std::vector<MaterialPtr>& scene_palette, const std::vector<int>& used_ids);
 
-// Level-1 lookup for build_coarse_mesh: the database fit for all-solid
-// blocks, `fallback` (naive coarsening) for blocks with a void child.
+// Level-1 lookup for build_coarse_mesh: the database fit where it has one,
+// `fallback` (naive coarsening) for the rest (blocks with a void child in a
+// database without void children, and blocks that could not be fitted).
 CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMaterialLookup fallback);
 
 // Level-2 lookup for build_coarse_mesh on coarsen_grid(level1_grid): each
 // child's level-1 combination to its level-1 entry, then the pairing
-// stages. `fallback` (naive level-2 coarsening) where a child is void or
-// has a void voxel (no level-1 entry).
+// stages. `fallback` (naive level-2 coarsening) where a child is all void
+// or has no level-1 entry.
 CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const CoarseGrid& level1_grid,
                                                 CoarseMaterialLookup fallback);
 

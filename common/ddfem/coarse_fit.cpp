@@ -102,11 +102,6 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.mu0[k] = block.point_mu0[k];
     fit.lambda0[k] = block.point_lambda0[k];
   }
-  if (!block.all_children_solid() || !block.has_all_corners()) {
-    fit.not_fitted_reason = "a child of the block is void";
-    return fit;
-  }
-
   // Basis energies of the samples the coarse element can represent.
   const hex8::ElementGeometry coarse = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
@@ -224,6 +219,13 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.mu_centre = sol.x[centre] * scale[centre];
     fit.lambda_centre = sol.x[centre + 1] * scale[centre + 1];
   }
+  // A block whose samples all cost (almost) nothing, e.g. void children
+  // that leave the solid ones hinged, fits to no stiffness at all: a coarse
+  // element without energy would leave its nodes free in a coarse mesh.
+  if (!(sol.x.maxCoeff() > 0.0)) {
+    fit.not_fitted_reason = "the fit has no stiffness";
+    return fit;
+  }
   fit.fitted = true;
   fit.objective = sol.residual * sol.residual;
 
@@ -248,18 +250,28 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 }
 
 CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options) {
-  if (!block.all_children_solid() || !block.has_all_corners()) {
+  const bool periodic = options.sampling.mode == ForceSamplingOptions::Mode::periodic;
+  // Isolated and patch samples load the block's own nodes: a void child
+  // leaves a coarse corner without a fine node there.
+  if (!periodic && (!block.all_children_solid() || !block.has_all_corners())) {
     CoarseMaterialFit fit(block.coarse_points());
     fit.material_ids = block.material_ids;
-    fit.not_fitted_reason = "a child of the block is void";
+    fit.not_fitted_reason = "a child of the block is void (fitted with periodic sampling only)";
     return fit;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const bool periodic = options.sampling.mode == ForceSamplingOptions::Mode::periodic;
   const ForceSampleSet samples =
       periodic ? sample_periodic(block, options.sampling) : sample_force_space(block, options.sampling);
   std::vector<Vec3> directions(block.coarse_points(), Vec3::UnitX());
-  if (options.anisotropic) directions = estimate_anisotropy(block, options.anisotropy).direction;
+  if (options.anisotropic) {
+    if (block.all_children_solid()) {
+      directions = estimate_anisotropy(block, options.anisotropy).direction;
+    } else {
+      const AnisotropyOptions& a = options.anisotropy;
+      directions.assign(block.coarse_points(),
+                        stiffest_periodic_direction(block, a.directions, a.strain, a.seed, a.newton_tolerance));
+    }
+  }
   CoarseMaterialFit fit = fit_from_samples(block, samples, directions, options);
   fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return fit;

@@ -91,9 +91,11 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
                      const hex8::NodeMatrix& X, const Vec24& u);
 
-// Whole pipeline for one block: sampling, directions, fit. Blocks with a
-// void child are returned with fitted = false (the online coarsening falls
-// back to naive coarsening for them).
+// Whole pipeline for one block: sampling, directions, fit. A block with a
+// void child is fitted with periodic sampling (its spring direction from
+// stiffest_periodic_direction); in the other modes it is returned with
+// fitted = false, as is any block without usable samples or whose fit has
+// no stiffness (the online coarsening falls back to naive coarsening).
 CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options);
 
 // The fit on given samples and directions (C_k = 0 unless

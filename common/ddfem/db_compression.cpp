@@ -99,18 +99,29 @@ CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformat
   FineBlock unit;
   unit.voxel_size = 1e-3;
   const auto defs = common_deformations(unit.coarse_rest_positions(), deformations, strain, seed);
-  const MatX features = energy_features(full.entries, defs, unit.voxel_size);
-  std::vector<int> seeds;
+  // Only fitted entries take part (a database with void children keeps the
+  // blocks it could not fit, and the all-void one, as unfitted rows; online
+  // they are coarsened naively, so they map to no representative).
+  std::vector<CoarseMaterialFit> fitted;
+  std::vector<int> row_of_entry(full.entries.size(), -1);
   for (std::size_t e = 0; e < full.entries.size(); ++e)
-    if (is_homogeneous(full.entries[e].material_ids)) seeds.push_back(static_cast<int>(e));
+    if (full.entries[e].fitted) {
+      row_of_entry[e] = static_cast<int>(fitted.size());
+      fitted.push_back(full.entries[e]);
+    }
+  if (fitted.empty()) throw InputError("compression: the database has no fitted coarse material");
+  const MatX features = energy_features(fitted, defs, unit.voxel_size);
+  std::vector<int> seeds;
+  for (std::size_t e = 0; e < fitted.size(); ++e)
+    if (is_homogeneous(fitted[e].material_ids)) seeds.push_back(static_cast<int>(e));
   if (seeds.empty()) seeds.push_back(0);
   const FarthestPointSet fps = farthest_point_sampling(features, k, seeds);
 
   CoarseDatabase out = full;
   out.entries.clear();
-  for (int row : fps.representatives) out.entries.push_back(full.entries[row]);
+  for (int row : fps.representatives) out.entries.push_back(fitted[row]);
   for (auto& e : out.entry_of)
-    if (e >= 0) e = fps.nearest[e];
+    if (e >= 0) e = row_of_entry[e] >= 0 ? fps.nearest[row_of_entry[e]] : -1;
   if (report) {
     *report = CompressionReport();
     double n = 0, err = 0;

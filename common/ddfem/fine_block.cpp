@@ -7,17 +7,31 @@
 
 namespace msfab {
 
+bool is_all_void(const BlockMaterials& ids) {
+  for (int id : ids)
+    if (id != 0) return false;
+  return true;
+}
+
+bool is_all_solid(const BlockMaterials& ids) {
+  for (int id : ids)
+    if (id == 0) return false;
+  return true;
+}
+
+std::string block_name(const BlockMaterials& ids) {
+  std::string s = "[";
+  for (int c = 0; c < 8; ++c) s += (c ? " " : "") + std::to_string(ids[c]);
+  return s + "]";
+}
+
 bool FineBlock::has_all_corners() const {
   for (int n : corner_nodes)
     if (n < 0) return false;
   return true;
 }
 
-bool FineBlock::all_children_solid() const {
-  for (int id : material_ids)
-    if (id == 0) return false;
-  return true;
-}
+bool FineBlock::all_children_solid() const { return is_all_solid(material_ids); }
 
 int FineBlock::child_of_element(int e) const {
   const int n = 2 + 2 * context;

@@ -3,6 +3,7 @@
 // (thesis §2.3): its hex mesh, the materials of its children and the fine
 // nodes that coincide with the coarse element's eight corners.
 #include <array>
+#include <string>
 #include <vector>
 
 #include "fem/voxel_grid.hpp"
@@ -12,6 +13,10 @@ namespace msfab {
 // Child (i, j, k) of the block, i, j, k in {0, 1}, has index 4i + 2j + k:
 // the hex8 node order, so child c sits at coarse corner c.
 using BlockMaterials = std::array<int, 8>;
+bool is_all_void(const BlockMaterials& ids);
+bool is_all_solid(const BlockMaterials& ids);
+// "[1 2 0 1 1 2 2 1]", for messages.
+std::string block_name(const BlockMaterials& ids);
 
 struct FineBlock {
   double voxel_size = 1.0;           // fine edge h; the coarse element has edge 2h

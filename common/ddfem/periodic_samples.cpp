@@ -1,5 +1,6 @@
 #include "ddfem/periodic_samples.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -68,8 +69,9 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
 PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_tolerance)
     : block_(block), assembler_(block.mesh()), tolerance_(newton_tolerance) {
   if (block.context != 0) throw std::invalid_argument("PeriodicBlockSolver: takes the isolated block (context 0)");
-  if (!block.all_children_solid())
-    throw std::invalid_argument("PeriodicBlockSolver: a child of the block is void");
+  // A void child is fine here: among periodic copies every node class
+  // (corners included) is touched by all eight children, so one solid child
+  // puts material at every class; the corners are prescribed.
   const HexMesh& mesh = block.mesh();
   rest_ = assembler_.rest_positions();
   node_class_.assign(mesh.num_nodes(), -1);
@@ -90,6 +92,32 @@ PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_t
   reduce_ = MatX::Zero(3 * mesh.num_nodes(), kFree);
   for (int n = 0; n < mesh.num_nodes(); ++n)
     if (node_class_[n] > 0) reduce_.block<3, 3>(3 * n, 3 * (node_class_[n] - 1)).setIdentity();
+  // Void corners: the nodal displacements are U(X) + w with U trilinear in
+  // u1, so the least-squares corner values are u1 plus the fit of w by the
+  // void corners' shape functions, (N_v^T N_v)^+ N_v^T w at the nodes.
+  for (int c = 0; c < 8; ++c)
+    if (block.corner_nodes[c] < 0) void_corners_.push_back(c);
+  const int nv = static_cast<int>(void_corners_.size());
+  if (nv > 0) {
+    MatX N(mesh.num_nodes(), nv);
+    for (int n = 0; n < mesh.num_nodes(); ++n)
+      for (int i = 0; i < nv; ++i) N(n, i) = node_weights_[n][void_corners_[i]];
+    const MatX fit = N.completeOrthogonalDecomposition().pseudoInverse();  // nv x nodes
+    MatX per_dof = MatX::Zero(3 * nv, 3 * mesh.num_nodes());
+    for (int i = 0; i < nv; ++i)
+      for (int n = 0; n < mesh.num_nodes(); ++n)
+        per_dof.block<3, 3>(3 * i, 3 * n) = fit(i, n) * Mat3::Identity();
+    extrapolate_ = per_dof * reduce_;
+  }
+}
+
+Vec24 PeriodicBlockSolver::corner_displacements(const Vec24& u1, const VecX& w) const {
+  Vec24 u = u1;
+  if (void_corners_.empty() || w.size() != kFree) return u;
+  const VecX correction = extrapolate_ * w;
+  for (std::size_t i = 0; i < void_corners_.size(); ++i)
+    u.segment<3>(3 * void_corners_[i]) += correction.segment<3>(3 * i);
+  return u;
 }
 
 VecX PeriodicBlockSolver::positions(const Vec24& u1, const VecX& w) const {
@@ -116,14 +144,22 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
     if (!std::isfinite(E)) return kInfiniteEnergy;  // the trilinear field itself inverts a fine element
   }
   const double h = block_.voxel_size;
+  double mu_max = 0;
+  for (const MaterialPtr& m : block_.child_material)
+    if (m) mu_max = std::max(mu_max, m->shear_modulus());
+  const double force_round_off = mu_max * h * h;
   for (int it = 0; it < 100; ++it) {
     assembler_.evaluate(positions(u1, w), &g, &K);
     const VecX gw = P.transpose() * g;
     // Converged when the fluctuation's forces are a small fraction of the
-    // forces the block carries (the corner reactions), or at round-off.
+    // forces the block carries (the corner reactions), or at round-off:
+    // relative to those forces, or absolute, at the nodal forces' own
+    // round-off (mu h^2 eps for the stiffest child), which is what is left
+    // when the block takes the deformation without strain and carries
+    // nothing (void layers opening).
     const double scale = g.norm();
-    if (gw.norm() <= std::max(tolerance_ * scale, 1e3 * std::numeric_limits<double>::epsilon() * scale) ||
-        scale == 0.0) {
+    const double round_off = 1e3 * std::numeric_limits<double>::epsilon() * std::max(scale, force_round_off);
+    if (gw.norm() <= std::max(tolerance_ * scale, round_off) || scale == 0.0) {
       if (iterations) *iterations = it;
       return E;
     }
@@ -152,6 +188,16 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
   ForceSampleSet set;
   set.patterns = make_corner_displacement_patterns(block, options);
   const PeriodicBlockSolver solver(block, options.newton_tolerance);
+  // A deformation the block takes without strain (a slab's void layers
+  // opening, children hinged at an edge) stores round-off, not energy: its
+  // relative residual would be noise. Such samples are dropped when they
+  // store less than 1e-8 of what the block's stiffest child would at the
+  // same peak strain; an all-solid block stores at least its softest
+  // child's share.
+  double mu_max = 0;
+  for (const MaterialPtr& m : block.child_material)
+    if (m) mu_max = std::max(mu_max, m->shear_modulus());
+  const double volume = std::pow(2 * block.voxel_size, 3);
   for (int p = 0; p < static_cast<int>(set.patterns.size()); ++p) {
     const Vec24 unit = set.patterns[p].force;
     for (int sign : {1, -1}) {
@@ -162,7 +208,7 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
         VecX trial = w;
         int its = 0;
         const double E = solver.relax(load * unit, trial, &its);
-        if (!std::isfinite(E) || !(E > 0)) {
+        if (!std::isfinite(E) || !(E > 1e-8 * mu_max * volume * load * load)) {
           ++set.dropped;
           continue;
         }
@@ -170,7 +216,7 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
         ForceSample s;
         s.pattern = p;
         s.load = load;
-        s.corner_displacement = load * unit;
+        s.corner_displacement = solver.corner_displacements(load * unit, w);
         s.energy = E;
         s.newton_iterations = its;
         set.samples.push_back(s);
@@ -179,6 +225,25 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
   }
   set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return set;
+}
+
+Vec3 stiffest_periodic_direction(const FineBlock& block, int directions, double strain, std::uint64_t seed,
+                                 double newton_tolerance) {
+  const PeriodicBlockSolver solver(block, newton_tolerance);
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const Vec3 center = Vec3::Constant(block.voxel_size);
+  Vec3 best = Vec3::UnitX();
+  double best_energy = -1;
+  for (const Vec3& d : sampling_directions(true, directions, seed)) {
+    Vec24 u;
+    for (int c = 0; c < 8; ++c) u.segment<3>(3 * c) = strain * d * d.dot(X.row(c).transpose() - center);
+    VecX w;
+    const double E = solver.relax(u, w);
+    if (std::isfinite(E) && E > best_energy) best_energy = E, best = d;
+  }
+  Eigen::Index a;  // canonical sign, as estimate_anisotropy: largest component positive
+  best.cwiseAbs().maxCoeff(&a);
+  return best[a] < 0 ? Vec3(-best) : best;
 }
 
 }  // namespace msfab

@@ -35,6 +35,16 @@ class PeriodicBlockSolver {
   double relax(const Vec24& u1, VecX& w, int* iterations = nullptr) const;
   // Deformed positions for corner displacements u1 and fluctuation w.
   VecX positions(const Vec24& u1, const VecX& w) const;
+  // The coarse element's corner displacements of the relaxed block: u1 at
+  // corners with a fine node; at a corner whose child is void (no fine
+  // node), the value for which the trilinear field of the corners best
+  // matches the fine displacements at the block's nodes (least squares).
+  // There the corner is not held by the block, and the fine block relaxes
+  // through it (a slab with void above contracts freely across its
+  // thickness): the sample records that relaxed corner, as a coarse element
+  // in a body finds it, instead of the prescribed one, which the fine energy
+  // does not depend on.
+  Vec24 corner_displacements(const Vec24& u1, const VecX& w) const;
 
  private:
   const FineBlock& block_;
@@ -44,11 +54,23 @@ class PeriodicBlockSolver {
   std::vector<int> node_class_;        // mesh node -> periodic class 0..7 (0: corners)
   std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node
   MatX reduce_;                         // DOFs x 21: sums nodal forces over each free periodic class
+  std::vector<int> void_corners_;       // corners without a fine node
+  MatX extrapolate_;                    // (3 void corners) x 21: their least-squares correction from w
 };
 
 // Every pattern at options.magnitudes magnitudes in both signs, peak coarse
 // strain options.max_strain at the largest, each magnitude started from the
-// previous one's fluctuation. Requires a block without void children.
+// previous one's fluctuation. Blocks with void children are sampled the
+// same way (docs/ddfem.md, "Blocks with void").
 ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOptions& options);
+
+// The spring direction of a block sampled among periodic copies, for blocks
+// whose isolated stretching (estimate_anisotropy) is not defined (a void
+// child leaves a corner without a fine node): of `directions` seeded
+// hemisphere directions d, the one whose relaxed uniaxial strain
+// strain * d (d . X) stores the most energy, i.e. the stiffest. One
+// direction for all points of the block.
+Vec3 stiffest_periodic_direction(const FineBlock& block, int directions, double strain, std::uint64_t seed,
+                                 double newton_tolerance = 1e-9);
 
 }  // namespace msfab

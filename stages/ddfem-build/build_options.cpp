@@ -98,6 +98,18 @@ BuildOptions read_build_options(const Config& config) {
     }
     f.check_no_unknown_keys();
   }
+  if (config.has("void_children")) {
+    if (!o.base_database.empty())
+      config.fail("void_children", "applies to level-1 builds only (level 2 takes the level-1 database's blocks)");
+    o.void_children = config.get<bool>("void_children");
+    // An isolated or patch sample loads the block's own nodes; a void child
+    // leaves its coarse corner without a fine node and its solid children
+    // may hang together by an edge. Among periodic copies every corner class
+    // has material and the sample prescribes the corners.
+    if (o.void_children && o.fit.sampling.mode != ForceSamplingOptions::Mode::periodic)
+      config.fail("void_children", "needs sampling.mode: periodic (blocks with void children are sampled among "
+                                   "their periodic copies)");
+  }
   o.use_symmetry = config.get_or<bool>("symmetry", o.use_symmetry);
   o.orbits_per_round = config.get_or<int>("orbits_per_round", o.orbits_per_round);
   if (o.orbits_per_round < 1) config.fail("orbits_per_round", "must be >= 1");

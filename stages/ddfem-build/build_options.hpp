@@ -10,6 +10,9 @@ namespace msfab {
 
 struct BuildOptions {
   std::vector<DbMaterial> materials;  // palette ids 1..n (level 1)
+  // Fit blocks with void children too (level 1, periodic sampling): the
+  // thesis's palettes always include void (§2.2). docs/ddfem.md.
+  bool void_children = false;
   // Level 2 (§2.3.5): a level-1 database, compressed to at most 1024
   // coarse materials, is the palette; the hierarchy's options.
   std::string base_database;

@@ -37,9 +37,11 @@ BuildPlan plan_level1(const BuildOptions& options) {
   BuildPlan plan;
   plan.db.level = 1;
   plan.db.materials = options.materials;
+  plan.db.void_children = options.void_children;
   const std::int64_t N = plan.db.num_combinations();
-  plan.item_of.resize(N);
+  plan.item_of.assign(N, -1);
   for (std::int64_t code = 0; code < N; ++code) {
+    if (is_all_void(plan.db.combination_ids(code))) continue;  // no element, nothing to fit
     const std::int64_t rep = options.use_symmetry
                                  ? plan.db.combination_code(canonical_block(plan.db.combination_ids(code)).ids)
                                  : code;
@@ -49,8 +51,9 @@ BuildPlan plan_level1(const BuildOptions& options) {
   plan.db.num_orbits = static_cast<int>(plan.items.size());
   plan.points = 8;
   const auto palette = plan.db.palette();
-  CoarseDatabase codes;  // only the palette size matters for decoding
+  CoarseDatabase codes;  // only the palette size and void_children matter for decoding
   codes.materials = plan.db.materials;
+  codes.void_children = plan.db.void_children;
   plan.block = [palette, codes, h = options.voxel_size, context = patch_context(options)](std::int64_t code) {
     return make_fine_block(codes.combination_ids(code), palette, h, 2, context);
   };
@@ -62,6 +65,11 @@ BuildPlan plan_level2(const BuildOptions& options) {
   if (base->level != 1)
     throw InputError(options.base_database + ": base_database must be a level-1 database, this one is level " +
                      std::to_string(base->level));
+  for (const CoarseMaterialFit& fit : base->entries)
+    if (!fit.fitted)
+      throw InputError(options.base_database + ": holds blocks that were not fitted (the all-void block, or blocks "
+                       "with void children without usable samples); compress it first with msfab-ddfem-compress, "
+                       "which keeps the fitted ones");
   const int k1 = static_cast<int>(base->entries.size());
   if (k1 > 1024)
     throw InputError(options.base_database + ": " + std::to_string(k1) +
@@ -98,9 +106,25 @@ BuildPlan plan_level2(const BuildOptions& options) {
 
 CoarseDatabase assemble_database(BuildPlan plan, const FittedOrbits& done) {
   CoarseDatabase& db = plan.db;
-  int unfitted = 0;
-  for (const auto& [item, fit] : done) unfitted += !fit.fitted;
+  // A block with a void child may have no fit (every sample a mechanism,
+  // e.g. children that touch only along an edge); online it is coarsened
+  // naively, as in a database without void children. Any other block must fit.
+  int unfitted = 0, unfitted_void = 0;
+  for (const auto& [item, fit] : done) {
+    if (fit.fitted) continue;
+    if (db.level == 1 && !is_all_solid(fit.material_ids)) {
+      ++unfitted_void;
+      spdlog::debug("block {} not fitted ({}); coarsened naively online", block_name(fit.material_ids),
+                    fit.not_fitted_reason);
+    } else {
+      ++unfitted;
+      spdlog::error("block {} could not be fitted: {}", block_name(fit.material_ids), fit.not_fitted_reason);
+    }
+  }
   if (unfitted > 0) throw NumericalError(std::to_string(unfitted) + " block(s) could not be fitted");
+  if (unfitted_void > 0)
+    spdlog::warn("{} of {} orbits with void children have no fit (no usable samples); they are coarsened naively",
+                 unfitted_void, done.size());
   if (db.level == 2) {
     for (std::int64_t r : plan.items) db.entries.push_back(done.at(r));
     return db;
@@ -113,6 +137,12 @@ CoarseDatabase assemble_database(BuildPlan plan, const FittedOrbits& done) {
   db.orbit.resize(N);
   for (std::int64_t c = 0; c < N; ++c) {
     const std::int64_t rep = plan.item_of[c];
+    if (rep < 0) {  // the all-void combination: no element
+      db.orbit[c] = -1;
+      db.entry_of[c] = -1;
+      db.entries[c].material_ids = db.combination_ids(c);
+      continue;
+    }
     db.orbit[c] = static_cast<int>(rep);
     db.entry_of[c] = static_cast<int>(c);
     const CoarseMaterialFit& image = done.at(rep);

@@ -34,7 +34,8 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
                                 : averaged_coarsening(scene.material_by_id);
   else {
-    // Blocks the database cannot key (a void voxel or child) are coarsened naively.
+    // Blocks the database holds no fit for (void children in a database
+    // built without them, blocks that could not be fitted) are coarsened naively.
     const CoarseMaterialLookup naive = request.level == 2 ? naive_coarsening(scene.material_by_id, m.level1)
                                                           : naive_coarsening(scene.material_by_id);
     int* fallbacks = &m.fallback_blocks;

@@ -23,7 +23,7 @@ struct CoarseModel {
   StaticConditions conditions;
   CoarseMeshStats stats;
   double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
-  int fallback_blocks = 0;           // ddfem: distinct partly-void combinations coarsened naively
+  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit, coarsened naively
   std::shared_ptr<CoarseDatabase> database;
 };
 

@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
       spdlog::info("coarsened to level {} with {} materials: {} -> {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, fine.mesh.num_elements(), vm.mesh.num_elements(),
                    coarse.stats.distinct_combinations, 1e3 * coarse.seconds,
-                   coarse.fallback_blocks ? fmt::format(" ({} partly void block kinds coarsened naively)",
+                   coarse.fallback_blocks ? fmt::format(" ({} block kinds without a database fit coarsened naively)",
                                                         coarse.fallback_blocks)
                                           : std::string());
 
