@@ -6,6 +6,7 @@
 #   make -f Makefile.pipeline ddfem-table        regenerate the Table 2.2 analogue in docs/BENCHMARKS.md
 #   make -f Makefile.pipeline ddfem-table-periodic  the same with in-situ (periodic) sampling, its own section
 #   make -f Makefile.pipeline ddfem-table-centre    periodic sampling and a fitted centre point, its own section
+#   make -f Makefile.pipeline ddfem-table-void      periodic sampling with void in the palette, its own section
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -27,7 +28,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
-.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre
+.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -48,3 +49,11 @@ ddfem-table-centre: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
 	BENCH_SECTION=ddfem-centre DATABASE2=$(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-centre docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5
+
+# Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
+# children fitted, periodic sampling at both levels.
+ddfem-table-void: build $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
+                  $(OUT)/ddfem/palette3_periodic_void.level2.coarse_db.h5
+	BENCH_SECTION=ddfem-void DATABASE2=$(OUT)/ddfem/palette3_periodic_void.level2.coarse_db.h5 \
+	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-void docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5

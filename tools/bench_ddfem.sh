@@ -17,7 +17,7 @@ BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
 shift 4
 SCENES=("$@")
 DB2=${DATABASE2:-}
-[ ${#SCENES[@]} -gt 0 ] || SCENES=(pushing bending bending_uniform twisting buckling fibers bridge bridge_arch layers1 checker random3 skeleton sole)
+[ ${#SCENES[@]} -gt 0 ] || SCENES=(pushing bending bending_uniform twisting buckling fibers bridge bridge_arch layers1 checker random3 skeleton sole holes3)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
 

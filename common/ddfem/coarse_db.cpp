@@ -161,6 +161,7 @@ void write_hierarchy(H5File& f, const Level2Hierarchy& h) {
     f.write_attribute(g, "mean_distance", stage.mean_distance);
     f.write_attribute(g, "max_distance", stage.max_distance);
   }
+  f.write_attribute("/hierarchy", "void_input", int(h.void_input));
   f.write_attribute("/hierarchy", "meaning",
                     "stage s pairs its inputs along axis s: table[a * inputs + b] = representative of (a, b), b on "
                     "the +axis side; pairs[r] = (a, b) of representative r. Stage-0 inputs are rows of "
@@ -317,7 +318,9 @@ void read_level1(const H5File& f, const std::string& path, const std::string& pr
 
 Level2Hierarchy read_hierarchy(const H5File& f, const std::string& path, int level1_entries) {
   Level2Hierarchy h;
-  int inputs = level1_entries;
+  // Written before the all-void child could be an input: absent, 0.
+  h.void_input = f.has_attribute("/hierarchy", "void_input") && f.read_attribute<int>("/hierarchy", "void_input") != 0;
+  int inputs = level1_entries + (h.void_input ? 1 : 0);
   for (int s = 0; s < 3; ++s) {
     PairStage& stage = h.stages[s];
     const std::string g = "/hierarchy/stage" + std::to_string(s);
@@ -366,22 +369,26 @@ CoarseDatabase read_coarse_db(const std::string& path) {
   read_level1(f, path, "/level1", *level1);
   db.hierarchy = read_hierarchy(f, path, static_cast<int>(level1->entries.size()));
   const int K = db.hierarchy.num_final();
-  db.entries = read_fits(f, path, "", 64, 1, static_cast<int>(level1->entries.size()), K);
+  if (db.hierarchy.void_input && !level1->void_children)
+    bad(path, "/hierarchy has a void input, but /level1 has no void children");
+  db.entries = read_fits(f, path, "", 64, db.hierarchy.void_input ? 0 : 1, static_cast<int>(level1->entries.size()), K);
   if (static_cast<int>(db.entries.size()) != K)
     bad(path, "/fit has " + std::to_string(db.entries.size()) + " rows, expected one per final representative (" +
                   std::to_string(K) + ")");
   for (int r = 0; r < K; ++r) {
     CoarseMaterialFit& fit = db.entries[r];
     const Arrangement arr = db.hierarchy.arrangement(2, r);
+    const int void_entry = db.hierarchy.void_entry();
     for (int c = 0; c < 8; ++c)
-      if (fit.material_ids[c] != arr[c] + 1)
+      if (fit.material_ids[c] != (arr[c] == void_entry ? 0 : arr[c] + 1))
         bad(path, "/fit/ids row " + std::to_string(r) + " does not match the arrangement of representative " +
                       std::to_string(r) + " in /hierarchy");
     for (int q = 0; q < 64; ++q) {
       int child = 0;
       const int k = level1_point_of(q, &child);
-      fit.mu0[q] = level1->entries[arr[child]].mu0[k];
-      fit.lambda0[q] = level1->entries[arr[child]].lambda0[k];
+      const bool is_void = arr[child] == void_entry;
+      fit.mu0[q] = is_void ? 0.0 : level1->entries[arr[child]].mu0[k];
+      fit.lambda0[q] = is_void ? 0.0 : level1->entries[arr[child]].lambda0[k];
     }
   }
   db.level1 = level1;
@@ -428,7 +435,11 @@ CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const 
   return [&db, combos = level1_grid.combinations, fallback](const ChildIds& ids) {
     Arrangement entries;
     for (int c = 0; c < 8; ++c) {
-      if (ids[c] == 0) return fallback(ids);  // an all-void level-1 child
+      if (ids[c] == 0) {  // an all-void level-1 child
+        if (!db.hierarchy.void_input) return fallback(ids);
+        entries[c] = db.hierarchy.void_entry();
+        continue;
+      }
       const std::array<int, 8>& fine = combos.at(ids[c] - 1);
       const std::int64_t code = db.level1->combination_code(fine);
       // A child the level-1 database holds no fit for (a void voxel in a
@@ -437,7 +448,9 @@ CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const 
       if (!db.level1->entries[db.level1->entry_of[code]].fitted) return fallback(ids);
       entries[c] = db.level1->entry_of[code];
     }
-    return coarse_quadrature_materials(db.find_level2(entries));
+    const CoarseMaterialFit& fit = db.find_level2(entries);
+    if (!fit.fitted) return fallback(ids);
+    return coarse_quadrature_materials(fit);
   };
 }
 

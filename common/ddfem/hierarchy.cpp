@@ -90,7 +90,9 @@ Mat24 condensed_stiffness(const Arrangement& arr, const std::vector<Mat24>& K1, 
   // A relative shift keeps K_ii invertible where a level-1 material has a
   // zero-energy mode; it is far below any physical stiffness.
   MatX Kii = K.bottomRightCorner(ni, ni);
-  Kii.diagonal().array() += 1e-12 * Kii.diagonal().cwiseAbs().maxCoeff();
+  const double diag = Kii.diagonal().cwiseAbs().maxCoeff();
+  if (!(diag > 0.0)) return K.topLeftCorner<24, 24>();  // all void inside: nothing to condense
+  Kii.diagonal().array() += 1e-12 * diag;
   const Eigen::LDLT<MatX> ldlt(Kii);
   const MatX Kic = K.bottomLeftCorner(ni, 24);
   return K.topLeftCorner<24, 24>() - Kic.transpose() * ldlt.solve(Kic);
@@ -132,7 +134,7 @@ Arrangement Level2Hierarchy::arrangement(int stage, int r) const {
 }
 
 Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& level1, double child_size,
-                                       const HierarchyOptions& options) {
+                                       const HierarchyOptions& options, bool void_input) {
   if (level1.empty()) throw InputError("level 2: the level-1 database has no coarse materials");
   for (std::size_t e = 0; e < level1.size(); ++e)
     if (!level1[e].fitted || level1[e].points() != 8)
@@ -140,18 +142,21 @@ Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& lev
   for (int k : options.representatives)
     if (k < 1) throw InputError("level 2: representatives per stage must be >= 1");
   const auto defs = smooth_deformations(2 * child_size, options.deformations, options.strain, options.seed);
-  const std::vector<Mat24> K1 = level1_rest_stiffness(level1, child_size);
+  std::vector<Mat24> K1 = level1_rest_stiffness(level1, child_size);
+  if (void_input) K1.push_back(Mat24::Zero());  // the all-void child
   const int D = static_cast<int>(defs.size());
 
   Level2Hierarchy h;
-  int inputs = static_cast<int>(level1.size());
+  h.void_input = void_input;
+  int inputs = static_cast<int>(K1.size());
   // Seeds (kept exactly, docs/ddfem.md): the homogeneous level-1 materials;
   // then at each stage every seed paired with itself and every two uniform
   // items paired with each other: all cells of one material, and all
   // layerings of uniform level-1 elements along one axis.
   std::vector<int> seeds, uniform;
-  for (int e = 0; e < inputs; ++e)
+  for (int e = 0; e < static_cast<int>(level1.size()); ++e)
     if (is_homogeneous(level1[e].material_ids)) seeds.push_back(e), uniform.push_back(e);
+  if (void_input) seeds.push_back(inputs - 1), uniform.push_back(inputs - 1);
   for (int s = 0; s < 3; ++s) {
     std::vector<Arrangement> items(inputs);
     for (int t = 0; t < inputs; ++t) items[t] = h.arrangement(s - 1, t);

@@ -46,7 +46,12 @@ struct PairStage {
 
 struct Level2Hierarchy {
   std::array<PairStage, 3> stages;
-  int level1_entries() const { return stages[0].inputs; }
+  // Over a level-1 database with void children: stage 0's alphabet has one
+  // more letter, the all-void level-1 child (index void_entry()), so a
+  // level-2 cell on an outline or in an odd grid's padding has a fit too.
+  bool void_input = false;
+  int level1_entries() const { return stages[0].inputs - (void_input ? 1 : 0); }
+  int void_entry() const { return void_input ? stages[0].inputs - 1 : -1; }
   int num_final() const { return stages[2].outputs(); }
   // The final representative for the level-1 entries of a cell's 8 children
   // (all >= 0). Throws std::out_of_range on an entry outside the alphabet.
@@ -91,8 +96,10 @@ Mat24 condensed_stiffness(const Arrangement& arrangement, const std::vector<Mat2
 Vec24 box_corner_displacements(const SmoothDeformation& d, const Eigen::Vector3i& extent, double child_size);
 
 // Builds the three stages. A stage with at least as many representatives as
-// candidates keeps every candidate (an exact lookup).
+// candidates keeps every candidate (an exact lookup). With `void_input` the
+// all-void level-1 child is one more input (no stiffness), seeded like a
+// homogeneous material: all-void and solid/void layerings are kept exactly.
 Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& level1, double child_size,
-                                       const HierarchyOptions& options);
+                                       const HierarchyOptions& options, bool void_input = false);
 
 }  // namespace msfab

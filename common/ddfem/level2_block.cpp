@@ -1,6 +1,7 @@
 #include "ddfem/level2_block.hpp"
 
 #include <sstream>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 #include "material/neo_hookean.hpp"
@@ -23,22 +24,31 @@ int level1_point_of(int q, int* child) {
 
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
                                          const BlockMaterials& ids, double child_size, int context) {
+  BlockMaterials shape{};  // 1 where a child has an element
   for (int c = 0; c < 8; ++c) {
-    if (!children[c] || !children[c]->fitted || children[c]->points() != 8) {
+    if (!children[c]) {
+      if (ids[c] != 0) throw std::invalid_argument("level-2 block: a void child needs id 0");
+      continue;
+    }
+    if (!children[c]->fitted || children[c]->points() != 8) {
       std::ostringstream os;
       os << "level-2 block: child " << c << " is not a fitted level-1 coarse material";
       throw InputError(os.str());
     }
+    shape[c] = 1;
   }
-  // Geometry and topology of a 2 x 2 x 2 voxel block; the materials are
-  // replaced by the children's fitted ones below.
+  if (is_all_void(shape)) throw InputError("level-2 block: all eight children are void");
+  // Geometry and topology of a 2 x 2 x 2 voxel block (void children left
+  // out); the materials are replaced by the children's fitted ones below.
   const std::vector<MaterialPtr> shape_only = {nullptr, std::make_shared<NeoHookean>(1.0, 0.3)};
-  FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, shape_only, child_size, 4, context);
+  FineBlock block = make_fine_block(shape, shape_only, child_size, 4, context);
   block.material_ids = ids;
   block.child_material.assign(8, nullptr);
   HexMesh& mesh = block.voxels.mesh;
   mesh.materials.clear();
-  for (int c = 0; c < 8; ++c) mesh.materials.push_back(coarse_quadrature_materials(*children[c]));
+  // One entry per child (a void child's is never referenced).
+  for (int c = 0; c < 8; ++c)
+    mesh.materials.push_back(children[c] ? coarse_quadrature_materials(*children[c]) : QuadratureMaterials{});
   // Children fitted with a centre term need the element centre as a ninth
   // point: geometry 1 (all elements are the same cube).
   const hex8::ElementGeometry gauss = mesh.geometries.at(0);
@@ -52,8 +62,8 @@ FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFi
   for (int q = 0; q < block.coarse_points(); ++q) {
     int c = 0;
     const int k = level1_point_of(q, &c);
-    block.point_mu0[q] = children[c]->mu0[k];
-    block.point_lambda0[q] = children[c]->lambda0[k];
+    block.point_mu0[q] = children[c] ? children[c]->mu0[k] : 0.0;
+    block.point_lambda0[q] = children[c] ? children[c]->lambda0[k] : 0.0;
   }
   return block;
 }

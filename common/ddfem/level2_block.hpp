@@ -18,8 +18,10 @@ namespace msfab {
 // voxel the point lies in (the child's own p^0 at its level-1 point in that
 // voxel), not the child's fitted parameters, which are a poor prior: a
 // level-1 fit often moves its stiffness between points and parameters
-// (docs/ddfem.md, "Level 2"). Throws InputError on an unfitted
-// child or a child with another point count. `context`: layers of periodic
+// (docs/ddfem.md, "Level 2"). A null child is void (ids[c] must then
+// be 0): no element there, p^0 = 0 at its points, as a void voxel in a
+// level-1 block. Throws InputError on an unfitted child, a child with
+// another point count, or no child at all. `context`: layers of periodic
 // copies around the block, in level-1 elements (see make_fine_block).
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
                                          const BlockMaterials& ids, double child_size, int context = 0);

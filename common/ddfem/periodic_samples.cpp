@@ -28,6 +28,14 @@ double coarse_peak_strain(const FineBlock& block, const Vec24& u) {
   return peak;
 }
 
+// The shear modulus of the block's stiffest fine material (its children's
+// at level 1, the palette's under its level-1 children at level 2).
+double stiffest_point_mu(const FineBlock& block) {
+  double mu = 0;
+  for (double m : block.point_mu0) mu = std::max(mu, m);
+  return mu;
+}
+
 }  // namespace
 
 std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& block,
@@ -144,9 +152,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
     if (!std::isfinite(E)) return kInfiniteEnergy;  // the trilinear field itself inverts a fine element
   }
   const double h = block_.voxel_size;
-  double mu_max = 0;
-  for (const MaterialPtr& m : block_.child_material)
-    if (m) mu_max = std::max(mu_max, m->shear_modulus());
+  const double mu_max = stiffest_point_mu(block_);
   const double force_round_off = mu_max * h * h;
   for (int it = 0; it < 100; ++it) {
     assembler_.evaluate(positions(u1, w), &g, &K);
@@ -194,9 +200,7 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
   // store less than 1e-8 of what the block's stiffest child would at the
   // same peak strain; an all-solid block stores at least its softest
   // child's share.
-  double mu_max = 0;
-  for (const MaterialPtr& m : block.child_material)
-    if (m) mu_max = std::max(mu_max, m->shear_modulus());
+  const double mu_max = stiffest_point_mu(block);
   const double volume = std::pow(2 * block.voxel_size, 3);
   for (int p = 0; p < static_cast<int>(set.patterns.size()); ++p) {
     const Vec24 unit = set.patterns[p].force;

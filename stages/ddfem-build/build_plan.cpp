@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -57,6 +58,10 @@ BuildPlan plan_level1(const BuildOptions& options) {
   plan.block = [palette, codes, h = options.voxel_size, context = patch_context(options)](std::int64_t code) {
     return make_fine_block(codes.combination_ids(code), palette, h, 2, context);
   };
+  plan.void_children = [codes](std::int64_t code) {
+    const BlockMaterials ids = codes.combination_ids(code);
+    return static_cast<int>(std::count(ids.begin(), ids.end(), 0));
+  };
   return plan;
 }
 
@@ -79,8 +84,14 @@ BuildPlan plan_level2(const BuildOptions& options) {
   plan.db.materials = base->materials;
   plan.db.num_orbits = base->num_orbits;
   plan.db.level1 = base;
+  // Over a database with void children, the all-void level-1 child is one
+  // more input of the hierarchy; its level-2 blocks are sampled among
+  // periodic copies, as at level 1.
+  const bool void_input = base->void_children;
+  if (void_input && options.fit.sampling.mode != ForceSamplingOptions::Mode::periodic)
+    throw InputError(options.base_database + ": has void children; its level-2 blocks need sampling.mode: periodic");
   const auto t0 = std::chrono::steady_clock::now();
-  plan.db.hierarchy = build_level2_hierarchy(base->entries, 2 * options.voxel_size, options.hierarchy);
+  plan.db.hierarchy = build_level2_hierarchy(base->entries, 2 * options.voxel_size, options.hierarchy, void_input);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   int inputs = k1;
   for (int s = 0; s < 3; ++s) {
@@ -98,8 +109,16 @@ BuildPlan plan_level2(const BuildOptions& options) {
     const Arrangement arr = hierarchy.arrangement(2, static_cast<int>(r));
     std::array<const CoarseMaterialFit*, 8> children;
     BlockMaterials ids;
-    for (int c = 0; c < 8; ++c) children[c] = &base->entries[arr[c]], ids[c] = arr[c] + 1;
+    for (int c = 0; c < 8; ++c) {
+      const bool is_void = arr[c] == hierarchy.void_entry();
+      children[c] = is_void ? nullptr : &base->entries[arr[c]];
+      ids[c] = is_void ? 0 : arr[c] + 1;
+    }
     return make_block_of_coarse_materials(children, ids, 2 * h, context);
+  };
+  plan.void_children = [hierarchy = plan.db.hierarchy](std::int64_t r) {
+    const Arrangement arr = hierarchy.arrangement(2, static_cast<int>(r));
+    return static_cast<int>(std::count(arr.begin(), arr.end(), hierarchy.void_entry()));
   };
   return plan;
 }
@@ -112,18 +131,20 @@ CoarseDatabase assemble_database(BuildPlan plan, const FittedOrbits& done) {
   int unfitted = 0, unfitted_void = 0;
   for (const auto& [item, fit] : done) {
     if (fit.fitted) continue;
-    if (db.level == 1 && !is_all_solid(fit.material_ids)) {
+    const int void_children = plan.void_children(item);
+    if (void_children == 8) continue;  // no element
+    if (void_children > 0) {
       ++unfitted_void;
-      spdlog::debug("block {} not fitted ({}); coarsened naively online", block_name(fit.material_ids),
+      spdlog::debug("block {} {} not fitted ({}); coarsened naively online", item, block_name(fit.material_ids),
                     fit.not_fitted_reason);
     } else {
       ++unfitted;
-      spdlog::error("block {} could not be fitted: {}", block_name(fit.material_ids), fit.not_fitted_reason);
+      spdlog::error("block {} {} could not be fitted: {}", item, block_name(fit.material_ids), fit.not_fitted_reason);
     }
   }
   if (unfitted > 0) throw NumericalError(std::to_string(unfitted) + " block(s) could not be fitted");
   if (unfitted_void > 0)
-    spdlog::warn("{} of {} orbits with void children have no fit (no usable samples); they are coarsened naively",
+    spdlog::warn("{} of {} fitted blocks with void children have no fit (no usable samples); they are coarsened naively",
                  unfitted_void, done.size());
   if (db.level == 2) {
     for (std::int64_t r : plan.items) db.entries.push_back(done.at(r));

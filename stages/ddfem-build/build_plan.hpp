@@ -21,6 +21,10 @@ struct BuildPlan {
   int points = 8;                         // quadrature points of each fit
   std::string fingerprint;                // the inputs a checkpoint must agree on besides the config
   std::function<FineBlock(std::int64_t item)> block;  // the block fitted for an item
+  // Void children of an item's block (0..8). A block with void children
+  // may stay unfitted (coarsened naively online); one with 8 is no element
+  // and is not fitted at all (level 2's all-void arrangement).
+  std::function<int(std::int64_t item)> void_children;
 };
 
 // Level 1: the palette's n^8 combinations grouped into orbits of the 48

@@ -48,6 +48,10 @@ void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::ve
     if (i % size != rank) continue;
     CoarseMaterialFit fit(plan.points);
     try {
+      if (plan.void_children(pending[begin + i]) == 8) {  // no element: nothing to fit
+        pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
+        continue;
+      }
       fit = fit_coarse_material(plan.block(pending[begin + i]), options.fit);
     } catch (const std::exception& e) {  // must not escape the parallel region
       fit = CoarseMaterialFit(plan.points);

@@ -4,7 +4,8 @@
 # on a holed cantilever of odd size (partly-void blocks along the hole and
 # on the padded faces) its level-1 error is below a third of naive
 # coarsening's and below half of a database without void children; it
-# compresses, builds a level 2 and runs there; bad requests exit 2.
+# compresses, and its level 2 (with the all-void child as a hierarchy input)
+# beats naive level 2; bad requests exit 2.
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 BUILD="$BIN/msfab-ddfem-build"
@@ -43,8 +44,13 @@ check "compressed to 32" -- "$BIN/msfab-ddfem-compress" --database "$WORK/v1.h5"
 check "level-2 database" -- "$BUILD" --config "$SRC/configs/ddfem/tiny_level2.yaml" --set base_database="$WORK/k32.h5" \
   --set sampling.mode=periodic --out "$WORK/l2.h5" --quiet
 level2=$(error_of "$WORK/l2.h5" ddfem 2)
-echo "level-2 error: $level2"
-check "level 2 runs" -- awk -v d="$level2" 'BEGIN { exit !(d > 0 && d < 0.01) }'
+naive2=$(error_of "$WORK/l2.h5" naive 2)
+echo "level-2 errors: ddfem $level2, naive $naive2"
+check "level 2: below naive level 2" -- awk -v d="$level2" -v n="$naive2" 'BEGIN { exit !(d > 0 && d < n) }'
+check "level 2: the all-void child is an input of the hierarchy" -- bash -c \
+  "h5dump -a /hierarchy/void_input '$WORK/l2.h5' | grep -q '(0): 1'"
+expect_exit 2 "has void children.*need sampling.mode: periodic" -- "$BUILD" --config "$SRC/configs/ddfem/tiny_level2.yaml" \
+  --set base_database="$WORK/k32.h5" --out "$WORK/bad.h5"
 
 # Bad requests.
 expect_exit 2 "void_children.*needs sampling.mode: periodic" -- "$BUILD" --config "$CFG" --set sampling.mode=isolated \

@@ -6,8 +6,11 @@
 #include <cmath>
 #include <random>
 
+#include "core/errors.hpp"
 #include "ddfem/coarse_db.hpp"
 #include "ddfem/db_compression.hpp"
+#include "ddfem/hierarchy.hpp"
+#include "ddfem/level2_block.hpp"
 #include "ddfem/periodic_samples.hpp"
 #include "ddfem_test_blocks.hpp"
 #include "homog/elastic_tensor.hpp"
@@ -159,6 +162,67 @@ TEST(DdfemVoid, CompressionSkipsUnfittedRows) {
   }
   EXPECT_EQ(small.find({0, 0, 0, 0, 0, 0, 0, 1}), nullptr);
   EXPECT_NE(small.find({0, 0, 0, 0, 0, 0, 1, 1}), nullptr);
+}
+
+// A level-2 block whose level-1 children are exactly Neo-Hookean at their 8
+// Gauss points is the same finite element model as a fine block of those
+// materials at twice the voxel size, void children included: the relaxed
+// periodic energies agree to round-off.
+TEST(DdfemVoid, Level2BlockWithVoidChildrenIsTheFineBlockAtTwiceTheSize) {
+  const auto palette = ddfem_test::two_materials(1e5, 1e7);
+  const BlockMaterials ids = {2, 1, 0, 2, 0, 0, 1, 2};
+  std::array<CoarseMaterialFit, 3> level1;
+  for (int m = 1; m <= 2; ++m)
+    level1[m] = ddfem_test::neo_hookean_level1(palette[m]->shear_modulus(), palette[m]->lame_lambda());
+  std::array<const CoarseMaterialFit*, 8> children;
+  for (int c = 0; c < 8; ++c) children[c] = ids[c] ? &level1[ids[c]] : nullptr;
+  const FineBlock level2 = make_block_of_coarse_materials(children, ids, 2 * kVoxel);
+  const FineBlock fine = make_fine_block(ids, palette, 2 * kVoxel);
+  ASSERT_EQ(level2.mesh().num_elements(), 5);
+  const PeriodicBlockSolver a(level2), b(fine);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> pm1(-1, 1);
+  for (int trial = 0; trial < 4; ++trial) {
+    Vec24 u;
+    for (int i = 0; i < 24; ++i) u[i] = 0.02 * 4 * kVoxel * pm1(rng);
+    VecX wa, wb;
+    const double Ea = a.relax(u, wa), Eb = b.relax(u, wb);
+    ASSERT_TRUE(std::isfinite(Ea));
+    EXPECT_NEAR(Ea, Eb, 1e-9 * Eb);
+    EXPECT_TRUE((a.corner_displacements(u, wa) - b.corner_displacements(u, wb)).norm() < 1e-9 * u.norm());
+  }
+  const std::array<const CoarseMaterialFit*, 8> none{};
+  EXPECT_THROW(make_block_of_coarse_materials(none, BlockMaterials{}, 2 * kVoxel), InputError);
+}
+
+// With the all-void child as one more input, a hierarchy that keeps every
+// candidate looks every arrangement of two materials and void up to itself,
+// and the all-void and solid/void layered cells are seeds.
+TEST(DdfemVoid, HierarchyWithAVoidInputLooksArrangementsUpExactly) {
+  std::vector<CoarseMaterialFit> level1 = {ddfem_test::neo_hookean_level1(3.4e4, 3.1e5),
+                                           ddfem_test::neo_hookean_level1(3.4e6, 3.1e7)};
+  for (int m = 0; m < 2; ++m) level1[m].material_ids.fill(m + 1);
+  HierarchyOptions o;
+  o.representatives = {9, 81, 6561};
+  o.deformations = 8;
+  const Level2Hierarchy h = build_level2_hierarchy(level1, 2 * kVoxel, o, true);
+  EXPECT_EQ(h.level1_entries(), 2);
+  EXPECT_EQ(h.void_entry(), 2);
+  ASSERT_EQ(h.num_final(), 6561);
+  std::mt19937_64 rng(4);
+  for (int t = 0; t < 300; ++t) {
+    Arrangement e;
+    for (int& x : e) x = static_cast<int>(rng() % 3);
+    ASSERT_EQ(h.arrangement(2, h.lookup(e)), e);
+  }
+  // Compressed: the seeds survive (all void; a stiff slab under void).
+  o.representatives = {5, 8, 12};
+  const Level2Hierarchy small = build_level2_hierarchy(level1, 2 * kVoxel, o, true);
+  Arrangement all_void, slab;
+  all_void.fill(2);
+  for (int c = 0; c < 8; ++c) slab[c] = (c & 1) ? 2 : 1;
+  EXPECT_EQ(small.arrangement(2, small.lookup(all_void)), all_void);
+  EXPECT_EQ(small.arrangement(2, small.lookup(slab)), slab);
 }
 
 }  // namespace
