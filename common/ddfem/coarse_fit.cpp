@@ -84,6 +84,26 @@ double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& 
   return V + fit.mu_centre * e.a_centre + fit.lambda_centre * e.b_centre;
 }
 
+// The fitted element stores at least 1e-3 of the naive element's energy
+// (the fine materials at their points, void points empty) under each unit
+// Voigt strain.
+bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& block) {
+  CoarseMaterialFit naive = fit;
+  for (int k = 0; k < fit.points(); ++k) naive.mu[k] = fit.mu0[k], naive.lambda[k] = fit.lambda0[k], naive.C[k] = 0.0;
+  naive.mu_centre = naive.lambda_centre = 0.0;
+  const hex8::ElementGeometry geo = block.coarse_geometry();
+  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  for (int m = 0; m < 6; ++m) {
+    Mat3 eps = Mat3::Zero();
+    const int a = m < 3 ? m : (m == 3 ? 1 : 0), b = m < 3 ? m : (m == 5 ? 1 : 2);
+    eps(a, b) = eps(b, a) = 1e-3;
+    Vec24 u;
+    for (int c = 0; c < 8; ++c) u.segment<3>(3 * c) = eps * X.row(c).transpose();
+    if (!(coarse_energy(fit, geo, X, u) >= 1e-3 * coarse_energy(naive, geo, X, u))) return false;
+  }
+  return true;
+}
+
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
                                    const std::vector<Vec3>& directions, const CoarseFitOptions& options) {
   if (!(options.regularization >= 0.0)) throw InputError("coarse fit: regularization must be >= 0");
@@ -228,6 +248,16 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   }
   fit.fitted = true;
   fit.objective = sol.residual * sol.residual;
+  if (!block.all_children_solid() && !fit_resists_uniform_strains(fit, block)) {
+    // Fitted to the samples of a block that is nearly a mechanism among its
+    // copies (children hinged at edges, void layers), the element can lose
+    // all stiffness in some uniform strain: in a coarse mesh its nodes
+    // would be free in that mode, and a Newton solve fails. Naive
+    // coarsening, stiff where the children are solid, is the safe choice.
+    fit.fitted = false;
+    fit.not_fitted_reason = "the fit has (almost) no stiffness in a uniform strain";
+    return fit;
+  }
 
   std::vector<double> rel_train, rel_held, w_train, w_held;
   double abs_held = 0, sum_held = 0;

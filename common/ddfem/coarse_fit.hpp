@@ -91,6 +91,13 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
                      const hex8::NodeMatrix& X, const Vec24& u);
 
+// True when the fit stores at least 1e-3 of the naive element's energy (the
+// block's fine materials at their points, void points empty) under each
+// small unit Voigt strain. A fit of a block with void children that fails
+// this is not kept: a coarse element without stiffness in some uniform
+// strain leaves its nodes free in that mode.
+bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& block);
+
 // Whole pipeline for one block: sampling, directions, fit. A block with a
 // void child is fitted with periodic sampling (its spring direction from
 // stiffest_periodic_direction); in the other modes it is returned with

@@ -108,6 +108,29 @@ TEST(DdfemVoid, SlabRecordsItsRelaxedUpperCornersAndIsFittedThere) {
   EXPECT_NEAR(E_coarse, E_fine, 0.3 * E_fine);
 }
 
+// A fit of a block with void children must keep some stiffness in every
+// uniform strain: the block's own fine materials do; a fit with mu = 0 at
+// every point (bulk only) has none in shear and is refused.
+TEST(DdfemVoid, FitsWithoutShearStiffnessAreRefused) {
+  const auto palette = ddfem_test::two_materials(1e5, 1e7);
+  const FineBlock block = make_fine_block({2, 1, 0, 2, 0, 0, 1, 2}, palette, kVoxel);
+  CoarseMaterialFit fit(8);
+  fit.fitted = true;
+  for (int k = 0; k < 8; ++k) {
+    fit.mu0[k] = fit.mu[k] = block.point_mu0[k];
+    fit.lambda0[k] = fit.lambda[k] = block.point_lambda0[k];
+  }
+  EXPECT_TRUE(fit_resists_uniform_strains(fit, block));
+  for (int k = 0; k < 8; ++k) fit.mu[k] *= 1e-2;
+  EXPECT_TRUE(fit_resists_uniform_strains(fit, block));
+  for (int k = 0; k < 8; ++k) fit.mu[k] = 0.0;
+  EXPECT_FALSE(fit_resists_uniform_strains(fit, block));
+  // A spring along x gives stiffness in xx and in the shears that turn x,
+  // not in yz.
+  for (int k = 0; k < 8; ++k) fit.C[k] = 1e7, fit.v[k] = Vec3::UnitX();
+  EXPECT_FALSE(fit_resists_uniform_strains(fit, block));
+}
+
 // A database with void children keys every combination with a solid child;
 // codes round-trip, and the all-void block has none.
 TEST(DdfemVoid, CombinationCodesIncludeVoidChildren) {
