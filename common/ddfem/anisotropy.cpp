@@ -14,6 +14,12 @@ std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coar
   return F;
 }
 
+Vec3 canonical_direction(const Vec3& v) {
+  Eigen::Index a;
+  v.cwiseAbs().maxCoeff(&a);
+  return v[a] < 0 ? Vec3(-v) : v;
+}
+
 AnisotropyEstimate estimate_anisotropy(const FineBlock& block, const AnisotropyOptions& options) {
   if (options.directions < 3) throw InputError("anisotropy: at least 3 stretching directions are needed");
   if (!(options.strain > 0.0)) throw InputError("anisotropy: strain must be > 0");
@@ -58,12 +64,7 @@ AnisotropyEstimate estimate_anisotropy(const FineBlock& block, const AnisotropyO
     MatX M(cloud[q].size(), 3);
     for (size_t i = 0; i < cloud[q].size(); ++i) M.row(i) = cloud[q][i].transpose();
     Eigen::JacobiSVD<MatX> svd(M, Eigen::ComputeThinV);
-    Vec3 v = svd.matrixV().col(2);
-    // Canonical sign: largest component positive.
-    Eigen::Index a;
-    v.cwiseAbs().maxCoeff(&a);
-    if (v[a] < 0) v = -v;
-    out.direction[q] = v;
+    out.direction[q] = canonical_direction(svd.matrixV().col(2));
     out.singular_values[q] = svd.singularValues();
   }
   return out;

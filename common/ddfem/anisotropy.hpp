@@ -35,6 +35,10 @@ struct AnisotropyEstimate {
 std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
                                                  const hex8::NodeMatrix& X, const Vec24& u);
 
+// A spring direction's canonical sign (v and -v are the same spring): the
+// largest component positive.
+Vec3 canonical_direction(const Vec3& v);
+
 // Requires a block with all corners (std::invalid_argument otherwise).
 AnisotropyEstimate estimate_anisotropy(const FineBlock& block, const AnisotropyOptions& options);
 

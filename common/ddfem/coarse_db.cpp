@@ -445,7 +445,6 @@ CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const 
       // A child the level-1 database holds no fit for (a void voxel in a
       // database without void children).
       if (code < 0 || db.level1->entry_of[code] < 0) return fallback(ids);
-      if (!db.level1->entries[db.level1->entry_of[code]].fitted) return fallback(ids);
       entries[c] = db.level1->entry_of[code];
     }
     const CoarseMaterialFit& fit = db.find_level2(entries);

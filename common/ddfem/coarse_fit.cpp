@@ -93,9 +93,9 @@ bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& 
   naive.mu_centre = naive.lambda_centre = 0.0;
   const hex8::ElementGeometry geo = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
-  for (int m = 0; m < 6; ++m) {
+  constexpr int kVoigt[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};  // xx yy zz yz xz xy
+  for (const auto& [a, b] : kVoigt) {
     Mat3 eps = Mat3::Zero();
-    const int a = m < 3 ? m : (m == 3 ? 1 : 0), b = m < 3 ? m : (m == 5 ? 1 : 2);
     eps(a, b) = eps(b, a) = 1e-3;
     Vec24 u;
     for (int c = 0; c < 8; ++c) u.segment<3>(3 * c) = eps * X.row(c).transpose();

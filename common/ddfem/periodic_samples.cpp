@@ -75,7 +75,10 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
 }
 
 PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_tolerance)
-    : block_(block), assembler_(block.mesh()), tolerance_(newton_tolerance) {
+    : block_(block),
+      assembler_(block.mesh()),
+      tolerance_(newton_tolerance),
+      force_round_off_(stiffest_point_mu(block) * block.voxel_size * block.voxel_size) {
   if (block.context != 0) throw std::invalid_argument("PeriodicBlockSolver: takes the isolated block (context 0)");
   // A void child is fine here: among periodic copies every node class
   // (corners included) is touched by all eight children, so one solid child
@@ -152,8 +155,6 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
     if (!std::isfinite(E)) return kInfiniteEnergy;  // the trilinear field itself inverts a fine element
   }
   const double h = block_.voxel_size;
-  const double mu_max = stiffest_point_mu(block_);
-  const double force_round_off = mu_max * h * h;
   for (int it = 0; it < 100; ++it) {
     assembler_.evaluate(positions(u1, w), &g, &K);
     const VecX gw = P.transpose() * g;
@@ -164,7 +165,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
     // when the block takes the deformation without strain and carries
     // nothing (void layers opening).
     const double scale = g.norm();
-    const double round_off = 1e3 * std::numeric_limits<double>::epsilon() * std::max(scale, force_round_off);
+    const double round_off = 1e3 * std::numeric_limits<double>::epsilon() * std::max(scale, force_round_off_);
     if (gw.norm() <= std::max(tolerance_ * scale, round_off) || scale == 0.0) {
       if (iterations) *iterations = it;
       return E;
@@ -245,9 +246,7 @@ Vec3 stiffest_periodic_direction(const FineBlock& block, int directions, double 
     const double E = solver.relax(u, w);
     if (std::isfinite(E) && E > best_energy) best_energy = E, best = d;
   }
-  Eigen::Index a;  // canonical sign, as estimate_anisotropy: largest component positive
-  best.cwiseAbs().maxCoeff(&a);
-  return best[a] < 0 ? Vec3(-best) : best;
+  return canonical_direction(best);
 }
 
 }  // namespace msfab

@@ -50,6 +50,7 @@ class PeriodicBlockSolver {
   const FineBlock& block_;
   ElasticAssembler assembler_;
   double tolerance_;
+  double force_round_off_;              // mu h^2 of the stiffest fine material: nodal forces' scale at round-off
   VecX rest_;
   std::vector<int> node_class_;        // mesh node -> periodic class 0..7 (0: corners)
   std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node

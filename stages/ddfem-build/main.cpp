@@ -47,17 +47,14 @@ void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::ve
   for (int i = 0; i < count; ++i) {
     if (i % size != rank) continue;
     CoarseMaterialFit fit(plan.points);
+    const bool element = plan.void_children(pending[begin + i]) < 8;  // an all-void block has nothing to fit
     try {
-      if (plan.void_children(pending[begin + i]) == 8) {  // no element: nothing to fit
-        pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
-        continue;
-      }
-      fit = fit_coarse_material(plan.block(pending[begin + i]), options.fit);
+      if (element) fit = fit_coarse_material(plan.block(pending[begin + i]), options.fit);
     } catch (const std::exception& e) {  // must not escape the parallel region
       fit = CoarseMaterialFit(plan.points);
       spdlog::error("block {}: {}", pending[begin + i], e.what());
     }
-    if (!fit.fitted) spdlog::warn("block {}: not fitted: {}", pending[begin + i], fit.not_fitted_reason);
+    if (element && !fit.fitted) spdlog::warn("block {}: not fitted: {}", pending[begin + i], fit.not_fitted_reason);
     pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
   }
   // Rows not owned are zero, so a sum over ranks assembles the round exactly.
