@@ -23,25 +23,38 @@ namespace {
 
 // Debian's CHOLMOD 3 (SuiteSparse 5) opens OpenMP regions with a fixed
 // num_threads(4) in the supernodal numeric factorization, whatever the
-// caller's thread count. A single-threaded caller (`--threads 1`, each rank
-// of an MPI fan-out, or a solver asked for one thread) then oversubscribes
-// the cores and spends its time waking threads: 8500 futex calls per
-// Newmark step of a 432-element mesh, a third of the step. With dynamic
-// adjustment on, libgomp caps such a request at omp_get_max_threads(), here
-// set to 1; the OpenMP build of OpenBLAS follows omp_get_max_threads() too.
-// Only for one thread: with more, libgomp would also cap by the load
-// average, and OpenBLAS waits forever for threads it planned for but was
-// not given. Both settings are restored afterwards.
+// caller's thread count, and the OpenMP build of OpenBLAS opens its own
+// regions inside them. On two cores that oversubscription is ruinous: a
+// bridge of 21 627 unknowns took 3.37 s per factorization with two threads
+// against 0.27 s with one (docs/solvers.md, "CHOLMOD threads"); a
+// single-threaded caller spent a third of a Newmark step waking threads.
+// So CHOLMOD always runs on one thread: with dynamic adjustment on,
+// libgomp caps the fixed requests at omp_get_max_threads(), here 1, and
+// OpenBLAS is asked for one thread too (planning more than libgomp then
+// grants makes it wait forever). Every setting is restored afterwards, so
+// the caller's own parallel kernels keep their threads.
+// OpenBLAS's thread count, found at run time so that another BLAS (or none
+// with these entry points) still works.
+void set_blas_threads(int threads) {
+  using SetThreads = void (*)(int);
+  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) reinterpret_cast<SetThreads>(symbol)(threads);
+}
+
+int blas_threads() {
+  using GetThreads = int (*)();
+  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_get_num_threads")) return reinterpret_cast<GetThreads>(symbol)();
+  return 1;
+}
+
 class CholmodThreadScope {
  public:
-  explicit CholmodThreadScope(int threads)
-      : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()), single_(threads == 1 || threads_ == 1) {
-    if (!single_) return;
+  CholmodThreadScope() : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()), blas_(blas_threads()) {
     omp_set_num_threads(1);
     omp_set_dynamic(1);
+    set_blas_threads(1);
   }
   ~CholmodThreadScope() {
-    if (!single_) return;
+    set_blas_threads(blas_);
     omp_set_dynamic(dynamic_);
     omp_set_num_threads(threads_);
   }
@@ -51,7 +64,7 @@ class CholmodThreadScope {
  private:
   int threads_;
   int dynamic_;
-  bool single_;
+  int blas_;
 };
 
 // A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to
@@ -89,15 +102,6 @@ cholmod_dense dense_view(const double* data, Eigen::Index rows, Eigen::Index col
   view.xtype = CHOLMOD_REAL;
   view.dtype = CHOLMOD_DOUBLE;
   return view;
-}
-
-// The supernodal kernels spend their time in the BLAS. OpenBLAS is found at
-// run time so that another BLAS (or none with this entry point) still works.
-void set_blas_threads(int threads) {
-  using SetThreads = void (*)(int);
-  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) {
-    reinterpret_cast<SetThreads>(symbol)(threads);
-  }
 }
 
 std::string status_text(int status) {
@@ -164,7 +168,6 @@ struct CholmodSolver::Cholmod {
 CholmodSolver::CholmodSolver(const LinearSolverOptions& options)
     : cholmod_(std::make_unique<Cholmod>()), options_(options) {
   validate_linear_solver_options(options);
-  if (options.threads > 0) set_blas_threads(options.threads);
 }
 
 CholmodSolver::~CholmodSolver() = default;
@@ -227,7 +230,7 @@ bool CholmodSolver::factorize(const SpMat& A, double shift) {
   if (c.n > 0) {
     cholmod_sparse view = lower_triangle_view(A);
     double beta[2] = {shift, 0.0};  // CHOLMOD factors A + beta[0] * I
-    const CholmodThreadScope threads(options_.threads);
+    const CholmodThreadScope one_thread;
     const int ok = cholmod_factorize_p(&view, beta, nullptr, 0, c.factor, &c.common);
     const int status = c.common.status;
     if (status < CHOLMOD_OK || (!ok && status != CHOLMOD_NOT_POSDEF)) {
@@ -258,7 +261,7 @@ VecX CholmodSolver::solve(const VecX& b) {
   VecX x = VecX::Zero(c.n);
   if (c.n > 0) {
     cholmod_dense rhs = dense_view(b.data(), b.size(), 1);
-    const CholmodThreadScope threads(options_.threads);
+    const CholmodThreadScope one_thread;
     if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e,
                         &c.common)) {
       throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
@@ -288,7 +291,7 @@ MatX CholmodSolver::solve_columns(const MatX& B) {
     cholmod_dense rhs = dense_view(B.data(), B.rows(), B.cols());
     // Its own workspace: c.x and c.y are sized for one column.
     cholmod_dense *x = nullptr, *y = nullptr, *e = nullptr;
-    const CholmodThreadScope threads(options_.threads);
+    const CholmodThreadScope one_thread;
     const int ok = cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &x, nullptr, &y, &e, &c.common);
     if (ok) X = Eigen::Map<const MatX>(static_cast<const double*>(x->x), c.n, B.cols());
     cholmod_free_dense(&x, &c.common);
