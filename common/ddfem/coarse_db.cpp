@@ -428,28 +428,33 @@ CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMateria
   };
 }
 
+const CoarseMaterialFit* find_level2_fit(const CoarseDatabase& db, const std::vector<ChildIds>& level1_combinations,
+                                         const ChildIds& ids) {
+  Arrangement entries;
+  for (int c = 0; c < 8; ++c) {
+    if (ids[c] == 0) {  // an all-void level-1 child
+      if (!db.hierarchy.void_input) return nullptr;
+      entries[c] = db.hierarchy.void_entry();
+      continue;
+    }
+    const std::array<int, 8>& fine = level1_combinations.at(ids[c] - 1);
+    const std::int64_t code = db.level1->combination_code(fine);
+    // A child the level-1 database holds no fit for (a void voxel in a
+    // database without void children).
+    if (code < 0 || db.level1->entry_of[code] < 0) return nullptr;
+    entries[c] = db.level1->entry_of[code];
+  }
+  const CoarseMaterialFit& fit = db.find_level2(entries);
+  return fit.fitted ? &fit : nullptr;
+}
+
 CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const CoarseGrid& level1_grid,
                                                 CoarseMaterialLookup fallback) {
   if (db.level != 2 || !db.level1) throw std::invalid_argument("database_coarsening_level2: not a level-2 database");
   if (level1_grid.level != 1) throw std::invalid_argument("database_coarsening_level2: needs the level-1 grid");
   return [&db, combos = level1_grid.combinations, fallback](const ChildIds& ids) {
-    Arrangement entries;
-    for (int c = 0; c < 8; ++c) {
-      if (ids[c] == 0) {  // an all-void level-1 child
-        if (!db.hierarchy.void_input) return fallback(ids);
-        entries[c] = db.hierarchy.void_entry();
-        continue;
-      }
-      const std::array<int, 8>& fine = combos.at(ids[c] - 1);
-      const std::int64_t code = db.level1->combination_code(fine);
-      // A child the level-1 database holds no fit for (a void voxel in a
-      // database without void children).
-      if (code < 0 || db.level1->entry_of[code] < 0) return fallback(ids);
-      entries[c] = db.level1->entry_of[code];
-    }
-    const CoarseMaterialFit& fit = db.find_level2(entries);
-    if (!fit.fitted) return fallback(ids);
-    return coarse_quadrature_materials(fit);
+    if (const CoarseMaterialFit* fit = find_level2_fit(db, combos, ids)) return coarse_quadrature_materials(*fit);
+    return fallback(ids);
   };
 }
 

@@ -95,6 +95,12 @@ CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMateria
 // child's level-1 combination to its level-1 entry, then the pairing
 // stages. `fallback` (naive level-2 coarsening) where a child is all void
 // or has no level-1 entry.
+// The level-2 fit of a cell whose children are the level-1 combinations
+// `ids` (index + 1 into level1_combinations, 0 = all void), or nullptr where
+// database_coarsening_level2 falls back.
+const CoarseMaterialFit* find_level2_fit(const CoarseDatabase& db, const std::vector<ChildIds>& level1_combinations,
+                                         const ChildIds& ids);
+
 CoarseMaterialLookup database_coarsening_level2(const CoarseDatabase& db, const CoarseGrid& level1_grid,
                                                 CoarseMaterialLookup fallback);
 

@@ -18,4 +18,7 @@ VecX interpolate_to_fine(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh,
 double mean_vertex_error(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh, const VecX& fine_displacement,
                          const CoarseGrid& coarse, const VoxelMesh& coarse_mesh, const VecX& coarse_displacement);
 
+// The same error for displacements already interpolated to the fine nodes.
+double mean_vertex_error(const VoxelMesh& fine_mesh, const VecX& fine_displacement, const VecX& interpolated);
+
 }  // namespace msfab

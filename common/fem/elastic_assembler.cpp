@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace msfab {
 
@@ -38,7 +39,60 @@ ElasticAssembler::ElasticAssembler(const HexMesh& mesh) : mesh_(mesh) {
   }
 }
 
+ElasticAssembler::ElasticAssembler(const HexMesh& mesh, std::shared_ptr<const NodeConstraints> constraints)
+    : ElasticAssembler(mesh) {
+  if (!constraints) return;
+  const SpMat& T = constraints->node_map;
+  if (T.rows() != mesh.num_nodes() || T.cols() != constraints->unknown_rest.rows())
+    throw std::invalid_argument("ElasticAssembler: the node constraints do not match the mesh");
+  constraints_ = std::move(constraints);
+  std::vector<Eigen::Triplet<double, int>> trip;
+  trip.reserve(3 * size_t(T.nonZeros()));
+  for (int j = 0; j < T.outerSize(); ++j)
+    for (SpMat::InnerIterator it(T, j); it; ++it)
+      for (int a = 0; a < 3; ++a) trip.emplace_back(3 * int(it.row()) + a, 3 * j + a, it.value());
+  dof_map_.resize(3 * T.rows(), 3 * T.cols());
+  dof_map_.setFromTriplets(trip.begin(), trip.end());
+  dof_map_.makeCompressed();
+  dof_map_t_ = dof_map_.transpose();
+  // The symbolic product of the pattern: ones, so that no entry cancels.
+  SpMat ones = mesh_pattern();
+  std::fill(ones.valuePtr(), ones.valuePtr() + ones.nonZeros(), 1.0);
+  SpMat abs_map = dof_map_.cwiseAbs(), abs_map_t = dof_map_t_.cwiseAbs();
+  reduced_pattern_ = SpMat(abs_map_t * ones * abs_map);
+  reduced_pattern_.makeCompressed();
+  std::fill(reduced_pattern_.valuePtr(), reduced_pattern_.valuePtr() + reduced_pattern_.nonZeros(), 0.0);
+  // The reduction plan: mesh entry (i, j) adds T(i, a) T(j, b) into (a, b).
+  const SpMat map_rows = SpMat(dof_map_t_);  // column i: the unknowns of mesh DOF i
+  const int* rp = reduced_pattern_.outerIndexPtr();
+  const int* ri = reduced_pattern_.innerIndexPtr();
+  for (int j = 0; j < ones.outerSize(); ++j)
+    for (int k = ones.outerIndexPtr()[j]; k < ones.outerIndexPtr()[j + 1]; ++k) {
+      const int i = ones.innerIndexPtr()[k];
+      for (SpMat::InnerIterator b(map_rows, j); b; ++b)
+        for (SpMat::InnerIterator a(map_rows, i); a; ++a) {
+          const int col = static_cast<int>(b.row()), row = static_cast<int>(a.row());
+          const int* pos = std::lower_bound(ri + rp[col], ri + rp[col + 1], row);
+          reduce_from_.push_back(k);
+          reduce_to_.push_back(static_cast<int>(pos - ri));
+          reduce_weight_.push_back(a.value() * b.value());
+        }
+    }
+}
+
+int ElasticAssembler::num_dofs() const {
+  return constraints_ ? 3 * static_cast<int>(constraints_->unknown_rest.rows()) : mesh_.num_dofs();
+}
+
+const NodeArray& ElasticAssembler::unknown_rest_nodes() const {
+  return constraints_ ? constraints_->unknown_rest : mesh_.nodes;
+}
+
 SpMat ElasticAssembler::pattern() const {
+  return constraints_ ? reduced_pattern_ : mesh_pattern();
+}
+
+SpMat ElasticAssembler::mesh_pattern() const {
   const int n = mesh_.num_dofs();
   SpMat A(n, n);
   A.resizeNonZeros(static_cast<Eigen::Index>(row_idx_.size()));
@@ -49,9 +103,14 @@ SpMat ElasticAssembler::pattern() const {
 }
 
 VecX ElasticAssembler::rest_positions() const {
-  VecX x(mesh_.num_dofs());
-  for (int i = 0; i < mesh_.num_nodes(); ++i) x.segment<3>(3 * i) = mesh_.nodes.row(i).transpose();
+  const NodeArray& nodes = unknown_rest_nodes();
+  VecX x(3 * nodes.rows());
+  for (int i = 0; i < nodes.rows(); ++i) x.segment<3>(3 * i) = nodes.row(i).transpose();
   return x;
+}
+
+VecX ElasticAssembler::mesh_positions(const VecX& x) const {
+  return constraints_ ? VecX(dof_map_ * x) : x;
 }
 
 hex8::NodeMatrix ElasticAssembler::gather(const VecX& x, int e) const {
@@ -65,6 +124,26 @@ double ElasticAssembler::energy(const VecX& x) const {
 }
 
 double ElasticAssembler::evaluate(const VecX& x, VecX* gradient, SpMat* hessian) const {
+  if (!constraints_) return evaluate_mesh(x, gradient, hessian);
+  if (x.size() != num_dofs()) throw std::invalid_argument("ElasticAssembler: x does not match the unknowns");
+  VecX mesh_gradient;
+  SpMat mesh_hessian;
+  if (hessian) mesh_hessian = mesh_pattern();
+  const double E = evaluate_mesh(dof_map_ * x, gradient ? &mesh_gradient : nullptr, hessian ? &mesh_hessian : nullptr);
+  if (!std::isfinite(E)) return E;
+  if (gradient) *gradient = dof_map_t_ * mesh_gradient;
+  if (hessian) {
+    if (hessian->nonZeros() != reduced_pattern_.nonZeros())
+      throw std::invalid_argument("ElasticAssembler: the Hessian does not carry the constrained pattern");
+    double* out = hessian->valuePtr();
+    std::fill(out, out + hessian->nonZeros(), 0.0);
+    const double* in = mesh_hessian.valuePtr();
+    for (size_t k = 0; k < reduce_from_.size(); ++k) out[reduce_to_[k]] += reduce_weight_[k] * in[reduce_from_[k]];
+  }
+  return E;
+}
+
+double ElasticAssembler::evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hessian) const {
   const int ne = mesh_.num_elements();
   std::vector<double> element_energy(ne, 0.0);
   if (gradient) gradient->setZero(mesh_.num_dofs());

@@ -68,7 +68,7 @@ std::string format_history(const std::vector<NewtonIteration>& history, size_t m
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                           const VecX& force, const NewtonOptions& options, const VecX& x0) {
   const auto t_start = Clock::now();
-  const int n = assembler.mesh().num_dofs();
+  const int n = assembler.num_dofs();
   const VecX X = assembler.rest_positions();
   const std::vector<char>& fixed = dirichlet.fixed;
   if (static_cast<int>(fixed.size()) != n || dirichlet.displacement.size() != n || force.size() != n)
@@ -81,7 +81,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
   std::string solver_name = options.linear_solver;
   if (solver_name == "auto") solver_name = n < options.auto_iterative_dofs ? "cholmod" : "pcg-mg";
   if (solver_name == "pcg-mg" && !linear.node_positions)
-    linear.node_positions = std::make_shared<const NodeArray>(assembler.mesh().nodes);  // the MG hierarchy's lattice
+    linear.node_positions = std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
   auto solver = make_linear_solver(solver_name, linear);
   spdlog::debug("linear solver: {}", solver->name());
   {

@@ -5,7 +5,10 @@
 //   2. embed the voxels in a hex mesh (void voxels dropped, nodes shared)
 //   3. with --coarsen L: replace every 2^L block by one coarse element whose
 //      materials come from the DDFEM database (or a baseline), and move the
-//      conditions onto the coarse mesh
+//      conditions onto the coarse mesh; with --target-error E: solve the
+//      level-2 model first, choose per 4^3 cell between fine, level 1 and
+//      level 2 so that the estimated error is at most E, and mesh the scene
+//      with those levels (hanging nodes constrained)
 //   4. Newton with line search until the relative residual is small,
 //      stepping the load when it is large
 //   5. with --compare-fine: also solve the fine model and report the error
@@ -14,6 +17,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "cli/progress.hpp"
@@ -21,6 +25,7 @@
 #include "cli/stage_app.hpp"
 #include "coarse_model.hpp"
 #include "core/errors.hpp"
+#include "adaptive_model.hpp"
 #include "ddfem/coarsening_error.hpp"
 #include "default_scene.hpp"
 #include "result_artifact.hpp"
@@ -43,6 +48,19 @@ NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticCondi
   return result;
 }
 
+// Displacements of the unknowns (positions x minus their rest positions).
+VecX displacement(const ElasticAssembler& assembler, const VecX& x) { return x - assembler.rest_positions(); }
+
+// A per-unknown vector placed on the mesh nodes that carry the unknowns
+// (zero on hanging nodes), for the result artifact.
+template <typename T>
+std::vector<T> on_mesh_nodes(const MixedLevelMesh& mixed, const std::vector<T>& per_unknown) {
+  std::vector<T> out(3 * size_t(mixed.mesh.num_nodes()), T(0));
+  for (int u = 0; u < mixed.num_unknown_nodes(); ++u)
+    for (int a = 0; a < 3; ++a) out[3 * size_t(mixed.unknown_node[u]) + a] = per_unknown[3 * size_t(u) + a];
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,6 +77,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"ddfem", "naive", "averaged"}));
   app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
   app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
+  double target_error = 0;
+  auto* target_option = app.cli().add_option(
+      "--target-error", target_error,
+      "adaptive coarsening: the mean-vertex error (thesis 2.5.2) to stay within, choosing fine, level 1 or level 2 "
+      "per 4x4x4 cell (needs a level-2 --database)");
   std::string reference;
   app.cli().add_option("--reference", reference,
                        "a fine msfab.result of the same scene to compare with instead of solving it again");
@@ -74,18 +97,53 @@ int main(int argc, char** argv) {
     const VoxelMesh fine = build_voxel_mesh(scene.grid, scene.material_by_id);
     const StaticConditions fine_conditions = build_static_conditions(scene, fine);
 
-    // 3. Coarse model.
+    // 3. Coarse model: uniform, or adaptive from a first level-2 solve.
+    const bool adaptive = target_option->count() > 0;
+    if (adaptive) {
+      if (!(target_error > 0) || !std::isfinite(target_error))
+        throw InputError("--target-error: must be a finite number > 0 (the mean-vertex error), got " +
+                         fmt::format("{}", target_error));
+      if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
+      if (coarsening.material != "ddfem")
+        throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
+      if (scene.newton.linear_solver == "pcg-mg")
+        throw InputError((ctx.options.config_path.empty() ? std::string("built-in scene") : ctx.options.config_path) +
+                         ": solver.linear_solver: pcg-mg needs a mesh of equal elements and --target-error meshes "
+                         "several sizes (use auto, cholmod or pcg)");
+      coarsening.level = 2;
+    }
     CoarseModel coarse;
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
     const bool coarsened = coarsening.level > 0;
+    AdaptiveModel adapted;
+    double uniform_seconds = 0;  // adaptive: the two uniform solves the estimate comes from
+    if (adaptive) {
+      const NewtonResult solve2 =
+          solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
+      const CoarseModel level1 = level1_model_of(scene, fine, coarse);
+      const NewtonResult solve1 =
+          solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, scene.newton, "level-1 load");
+      uniform_seconds = solve2.timings.total + solve1.timings.total;
+      adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, target_error);
+    }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
-    const StaticConditions& conditions = coarsened ? coarse.conditions : fine_conditions;
-    const ElasticAssembler assembler(vm.mesh);
+    const HexMesh& solved_mesh = adaptive ? adapted.mixed.mesh : vm.mesh;
+    const StaticConditions& conditions = adaptive ? adapted.conditions : coarsened ? coarse.conditions : fine_conditions;
+    const ElasticAssembler assembler =
+        adaptive ? ElasticAssembler(solved_mesh, adapted.mixed.constraints) : ElasticAssembler(solved_mesh);
     const double setup = seconds_since(t0);
     spdlog::info("scene '{}': {} x {} x {} grid, {} elements, {} DOFs ({} fixed), {} model", scene.name, scene.grid.nx,
-                 scene.grid.ny, scene.grid.nz, vm.mesh.num_elements(), vm.mesh.num_dofs(),
+                 scene.grid.ny, scene.grid.nz, solved_mesh.num_elements(), assembler.num_dofs(),
                  conditions.dirichlet.count_fixed(), scene.nonlinear ? "Neo-Hookean" : "linear");
-    if (coarsened)
+    if (adaptive)
+      spdlog::info("adaptive: level-1/level-2 difference {:.3g} (estimated errors {:.3g} / {:.3g}); target {:.3g}, "
+                   "predicted {:.3g}; elements fine {} / level 1 {} / level 2 {}, {} hanging nodes; uniform solves "
+                   "{:.3f} s, level choice and mesh {:.3f} s",
+                   adapted.level_difference, adapted.level_errors[1], adapted.level_errors[2], target_error,
+                   adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
+                   adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2],
+                   adapted.mixed.hanging_nodes, uniform_seconds, adapted.seconds);
+    else if (coarsened)
       spdlog::info("coarsened to level {} with {} materials: {} -> {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, fine.mesh.num_elements(), vm.mesh.num_elements(),
                    coarse.stats.distinct_combinations, 1e3 * coarse.seconds,
@@ -93,8 +151,15 @@ int main(int argc, char** argv) {
                                                         coarse.fallback_blocks)
                                           : std::string());
 
-    // 4. Newton.
-    const NewtonResult result = solve_or_throw(assembler, conditions, scene.newton, coarsened ? "coarse load" : "load");
+    // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
+    // step apart, which elements of mixed sizes are not: adaptive models are
+    // factored directly (they are the smaller ones; docs/ddfem.md).
+    NewtonOptions newton = scene.newton;
+    if (adaptive && newton.linear_solver == "auto") newton.linear_solver = "cholmod";
+    const NewtonResult result = solve_or_throw(assembler, conditions, newton,
+                                               adaptive ? "adaptive load" : coarsened ? "coarse load" : "load");
+    // The coarse model's Newton time; adaptive runs include the uniform solves.
+    const double coarse_seconds = result.timings.total + (adaptive ? uniform_seconds + adapted.seconds : 0.0);
 
     // 5. Fine reference.
     SimulationRecord record;
@@ -113,17 +178,40 @@ int main(int argc, char** argv) {
         uf = ref.displacement;
         record.fine_seconds = ref.newton_seconds;
       }
-      VecX uc = result.x;
-      for (int n = 0; n < vm.mesh.num_nodes(); ++n) uc.segment<3>(3 * n) -= vm.mesh.nodes.row(n).transpose();
+      const VecX uc = displacement(assembler, result.x);
       record.compared = true;
-      record.error_vs_fine = mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, uc);
+      if (adaptive) {
+        using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+        const SpMat W = mixed_to_fine_interpolation(scene.grid, fine, adapted.mixed);
+        VecX interpolated(fine.mesh.num_dofs());
+        Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
+            W * Eigen::Map<const Rows3>(uc.data(), adapted.mixed.num_unknown_nodes(), 3);
+        record.error_vs_fine = mean_vertex_error(fine, uf, interpolated);
+      } else {
+        record.error_vs_fine = mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, uc);
+      }
     }
 
-    // 6. Artifact.
+    // 6. Artifact (adaptive runs: every node of the mixed mesh, hanging ones interpolated).
+    VoxelMesh mixed_mesh;
+    StaticConditions mixed_conditions;
+    NewtonResult mixed_result;
+    if (adaptive) {
+      mixed_mesh.mesh = adapted.mixed.mesh;
+      mixed_conditions.force = Eigen::Map<const VecX>(
+          on_mesh_nodes(adapted.mixed, std::vector<double>(conditions.force.data(),
+                                                           conditions.force.data() + conditions.force.size()))
+              .data(),
+          mixed_mesh.mesh.num_dofs());
+      mixed_conditions.dirichlet.fixed = on_mesh_nodes(adapted.mixed, conditions.dirichlet.fixed);
+      mixed_conditions.dirichlet.displacement = VecX::Zero(mixed_mesh.mesh.num_dofs());
+      mixed_result = result;
+      mixed_result.x = assembler.mesh_positions(result.x);
+    }
     record.scene = &scene;
-    record.mesh = &vm;
-    record.conditions = &conditions;
-    record.newton = &result;
+    record.mesh = adaptive ? &mixed_mesh : &vm;
+    record.conditions = adaptive ? &mixed_conditions : &conditions;
+    record.newton = adaptive ? &mixed_result : &result;
     record.setup_seconds = setup;
     record.config_text = ctx.config.resolved_text();
     record.command_line = ctx.command_line;
@@ -135,16 +223,32 @@ int main(int argc, char** argv) {
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();
     }
+    if (adaptive) {
+      record.adaptive = true;
+      record.target_error = target_error;
+      record.predicted_error = adapted.choice.predicted_error;
+      record.uniform_solve_seconds = uniform_seconds;
+      record.level_difference = adapted.level_difference;
+      record.elements_per_level = adapted.mixed.elements_per_level;
+      record.coarsening_seconds = coarse.seconds + adapted.seconds;
+    }
     const std::string xmf = write_result_artifact(out, record);
 
     double max_u = 0;
-    for (int n = 0; n < vm.mesh.num_nodes(); ++n)
-      max_u = std::max(max_u, (result.x.segment<3>(3 * n) - vm.mesh.nodes.row(n).transpose()).norm());
+    const VecX u_solved = displacement(assembler, result.x);
+    for (int n = 0; n < assembler.num_dofs() / 3; ++n) max_u = std::max(max_u, u_solved.segment<3>(3 * n).norm());
     const int its = std::max(1, result.iterations);
     std::printf("msfab-simulate: scene '%s' converged in %d Newton iterations (%d load steps)\n", scene.name.c_str(),
                 result.iterations, result.load_steps);
-    std::printf("  elements %d, DOFs %d, max displacement %.6g m\n", vm.mesh.num_elements(), vm.mesh.num_dofs(), max_u);
-    if (coarsened)
+    std::printf("  elements %d, DOFs %d, max displacement %.6g m\n", solved_mesh.num_elements(), assembler.num_dofs(),
+                max_u);
+    if (adaptive)
+      std::printf("  adaptive: target error %.3g, predicted %.3g; elements fine %d / level 1 %d / level 2 %d "
+                  "(of %d fine); level-1 and level-2 solves %.3f s\n",
+                  target_error, adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
+                  adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2], fine.mesh.num_elements(),
+                  uniform_seconds);
+    else if (coarsened)
       std::printf("  coarsening: level %d, %s materials, %d -> %d elements, %.3f ms\n", coarsening.level,
                   coarsening.material.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
                   1e3 * coarse.seconds);
@@ -153,8 +257,7 @@ int main(int argc, char** argv) {
                 result.timings.total / its);
     if (record.compared)
       std::printf("  vs fine: error %.4e, Newton time fine %.3f s / coarse %.3f s = speedup %.1fx\n",
-                  record.error_vs_fine, record.fine_seconds, result.timings.total,
-                  record.fine_seconds / result.timings.total);
+                  record.error_vs_fine, record.fine_seconds, coarse_seconds, record.fine_seconds / coarse_seconds);
     std::printf("  artifact: %s\n  ParaView: %s\n", out.c_str(), xmf.c_str());
   });
 }

@@ -81,6 +81,15 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);
     f.write_attribute("/coarsening", "fine_elements", r.fine_elements);
+    if (r.adaptive) {
+      f.write_attribute("/coarsening", "adaptive", 1);
+      f.write_attribute("/coarsening", "target_error", r.target_error);
+      f.write_attribute("/coarsening", "predicted_error", r.predicted_error);
+      f.write_attribute("/coarsening", "uniform_solve_seconds", r.uniform_solve_seconds);
+      f.write_attribute("/coarsening", "level_difference", r.level_difference);
+      f.write_attribute("/coarsening", "elements_per_level",
+                        std::vector<int>(r.elements_per_level.begin(), r.elements_per_level.end()));
+    }
     if (r.compared) {
       f.write_attribute("/coarsening", "fine_newton_seconds", r.fine_seconds);
       f.write_attribute("/coarsening", "error_vs_fine", r.error_vs_fine);

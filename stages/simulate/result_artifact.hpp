@@ -1,5 +1,6 @@
 #pragma once
 // The `msfab.result` artifact of msfab-simulate (docs/artifacts.md).
+#include <array>
 #include <string>
 
 #include "fem/voxel_grid.hpp"
@@ -26,6 +27,12 @@ struct SimulationRecord {
   std::string database;              // ddfem: the coarse_db path
   double coarsening_seconds = 0;
   int fine_elements = 0;
+  // Adaptive runs (--target-error; coarsen_level is 2, the coarsest level used).
+  bool adaptive = false;
+  double target_error = 0, predicted_error = 0;
+  double uniform_solve_seconds = 0;   // the level-2 and level-1 solves the levels are chosen from
+  double level_difference = 0;        // mean-vertex distance between those two solutions
+  std::array<int, 3> elements_per_level{};
   // With --compare-fine: the fine reference run and the §2.5.2 error.
   bool compared = false;
   double fine_seconds = 0, error_vs_fine = 0;

@@ -51,6 +51,35 @@ check "result records level 2" -- bash -c "h5dump -a /coarsening/level '$WORK/l2
 expect_exit 2 "level-2 database cannot coarsen to level 1" -- \
   "$SIM" --config "$BAR" --coarsen 1 --database "$WORK/db2.h5" --out "$WORK/o.h5"
 
+# Adaptive coarsening (--target-error): a target above the level-2 error
+# keeps the uniform level-2 model; tighter targets are met against the fine
+# solution with fewer elements than the fine mesh; bad targets exit 2.
+adaptive_of() {  # adaptive_of TARGET: prints "error elements"
+  "$SIM" --config "$BAR" --target-error "$1" --database "$WORK/db2.h5" --reference "$WORK/fine.h5" \
+    --out "$WORK/adaptive.h5" --quiet >/dev/null || return 1
+  echo "$(h5dump -a /coarsening/error_vs_fine "$WORK/adaptive.h5" | sed -n 's/.*(0): *//p') $(
+    h5dump -a /elements "$WORK/adaptive.h5" | sed -n 's/.*(0): *//p')"
+}
+read loose_error loose_elements <<< "$(adaptive_of 1)"
+echo "adaptive, target 1: error $loose_error, $loose_elements elements"
+check "a loose target keeps level 2" -- awk -v a="$loose_error" -v b="$ddfem2" -v n="$loose_elements" \
+  'BEGIN { exit !(n == 4 && a > 0 && (a - b) < 1e-6 * b && (b - a) < 1e-6 * b) }'
+for target in 0.01 0.004; do
+  read err elements <<< "$(adaptive_of $target)"
+  echo "adaptive, target $target: error $err, $elements elements (fine: 256)"
+  check "target $target met with fewer elements than fine" -- \
+    awk -v e="$err" -v t="$target" -v n="$elements" 'BEGIN { exit !(e > 0 && e <= t && n < 256) }'
+done
+check "result records the adaptive run" -- bash -c "h5dump -a /coarsening/adaptive '$WORK/adaptive.h5' | grep -q '(0): 1'"
+for bad in 0 -0.01 nan inf; do
+  expect_exit 2 "target-error" -- "$SIM" --config "$BAR" --target-error "$bad" --database "$WORK/db2.h5" --out "$WORK/o.h5"
+done
+expect_exit 2 "drop --coarsen" -- "$SIM" --config "$BAR" --target-error 0.01 --coarsen 1 --database "$WORK/db2.h5" --out "$WORK/o.h5"
+expect_exit 2 "needs --coarse-material ddfem" -- \
+  "$SIM" --config "$BAR" --target-error 0.01 --coarse-material naive --out "$WORK/o.h5"
+expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
+  "$SIM" --config "$BAR" --target-error 0.01 --database "$WORK/db.h5" --out "$WORK/o.h5"
+
 # Bad requests.
 expect_exit 2 "needs --database" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material ddfem --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \

@@ -1,0 +1,111 @@
+#include "ddfem/adaptive_levels.hpp"
+
+#include <cmath>
+#include <queue>
+#include <tuple>
+
+#include "core/errors.hpp"
+#include "fem/hex_element.hpp"
+
+namespace msfab {
+
+LevelErrors level_errors_from_difference(double difference, double rate) {
+  if (!(difference >= 0) || !std::isfinite(difference)) throw InputError("level difference must be finite and >= 0");
+  if (!(rate > 0) || !std::isfinite(rate)) throw InputError("convergence rate must be finite and > 0");
+  const double e1 = difference / (std::pow(2.0, rate) - 1.0);
+  return {0.0, e1, std::pow(2.0, rate) * e1};
+}
+
+double predicted_error(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
+                       const std::vector<int>& cell_level) {
+  if (cell_level.size() != cells.size()) throw InputError("predicted_error: one level per cell expected");
+  double sum = 0;
+  for (size_t c = 0; c < cells.size(); ++c) sum += cells[c].energy_share * errors[cell_level[c]] * errors[cell_level[c]];
+  return std::sqrt(sum);
+}
+
+LevelChoice choose_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors, double target) {
+  if (!(target >= 0) || !std::isfinite(target)) throw InputError("target error must be finite and >= 0");
+  for (double e : errors)
+    if (!(e >= 0) || !std::isfinite(e)) throw InputError("level errors must be finite and >= 0");
+  LevelChoice out;
+  const size_t n = cells.size();
+  out.cell_level.assign(n, target == 0 ? 0 : 2);
+  if (target > 0) {
+    auto term = [&](size_t c, int level) { return cells[c].energy_share * errors[level] * errors[level]; };
+    double sum = 0;
+    for (size_t c = 0; c < n; ++c) sum += term(c, 2);
+    const double goal = target * target;
+    // Moves (gain per element added, -cell, to-level, from-level); ties go to the lower cell index.
+    using Move = std::tuple<double, long, int, int>;
+    std::priority_queue<Move> moves;
+    auto push_moves = [&](size_t c, int from) {
+      for (int to = from - 1; to >= 0; --to) {
+        const double gain = term(c, from) - term(c, to);
+        if (!(gain > 0)) continue;
+        const double added = std::max(1.0, double(cells[c].elements[to] - cells[c].elements[from]));
+        moves.emplace(gain / added, -long(c), to, from);
+      }
+    };
+    for (size_t c = 0; c < n; ++c) push_moves(c, 2);
+    // Relative slack so that round-off in the running sum cannot keep refining.
+    while (sum > goal * (1 + 1e-12) && !moves.empty()) {
+      const auto [ratio, minus_c, to, from] = moves.top();
+      moves.pop();
+      const size_t c = size_t(-minus_c);
+      if (out.cell_level[c] != from) continue;  // stale: the cell moved since
+      sum += term(c, to) - term(c, from);
+      out.cell_level[c] = to;
+      push_moves(c, to);
+    }
+  }
+  out.predicted_error = predicted_error(cells, errors, out.cell_level);
+  return out;
+}
+
+std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1,
+                                              const CoarseGrid& level2, const VoxelMesh& level1_mesh,
+                                              const std::vector<double>& level1_energy) {
+  if (level1.level != 1 || level2.level != 2 || level1_mesh.voxel_element.size() != size_t(level1.num_cells()))
+    throw InputError("cell_error_models: the level-1 mesh and the grids do not belong together");
+  if (level1_energy.size() != size_t(level1_mesh.mesh.num_elements()))
+    throw InputError("cell_error_models: one energy per level-1 element expected");
+  std::vector<CellErrorModel> cells(level2.num_cells());
+  double total = 0;
+  for (int K = 0; K < level2.nz; ++K)
+    for (int J = 0; J < level2.ny; ++J)
+      for (int I = 0; I < level2.nx; ++I) {
+        const size_t cell = level2.index(I, J, K);
+        if (level2.cell_combination[cell] < 0) continue;
+        CellErrorModel& m = cells[cell];
+        m.elements[2] = 1;
+        for (int q = 0; q < 8; ++q) {
+          const int i1 = 2 * I + (q >> 2 & 1), j1 = 2 * J + (q >> 1 & 1), k1 = 2 * K + (q & 1);
+          if (i1 >= level1.nx || j1 >= level1.ny || k1 >= level1.nz) continue;
+          const int e = level1_mesh.voxel_element[level1.index(i1, j1, k1)];
+          if (e < 0) continue;
+          ++m.elements[1];
+          m.energy_share += std::max(0.0, level1_energy[e]);
+          for (int r = 0; r < 8; ++r) {
+            const int i = 2 * i1 + (r >> 2 & 1), j = 2 * j1 + (r >> 1 & 1), k = 2 * k1 + (r & 1);
+            if (i < fine.nx && j < fine.ny && k < fine.nz && fine.at(i, j, k) != 0) ++m.elements[0];
+          }
+        }
+        total += m.energy_share;
+      }
+  for (CellErrorModel& m : cells) m.energy_share = total > 0 ? m.energy_share / total : 0.0;
+  return cells;
+}
+
+std::vector<double> element_energies(const HexMesh& mesh, const VecX& x) {
+  std::vector<double> out(mesh.num_elements());
+#pragma omp parallel for schedule(static)
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    hex8::NodeMatrix xe;
+    for (int i = 0; i < 8; ++i) xe.row(i) = x.segment<3>(3 * mesh.elements[e][i]).transpose();
+    out[e] = hex_energy(mesh.geometries[mesh.element_geometry[e]], mesh.materials[mesh.element_material[e]], xe);
+  }
+  return out;
+}
+
+}  // namespace msfab

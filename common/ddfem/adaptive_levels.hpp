@@ -1,0 +1,69 @@
+#pragma once
+// Error-driven choice of the coarsening level per level-2 cell ("model only
+// what a scene needs"; docs/ddfem.md, "Adaptive coarsening").
+//
+// The estimate. The scene is solved on the uniform level-2 and level-1
+// models. Their difference D (the mean-vertex distance of §2.5.2 between
+// the two, both interpolated to the fine nodes) measures how fast the error
+// falls with the element size: with errors e_L ~ C h^p, e_1 = D / (2^p - 1)
+// and e_2 = 2^p e_1. p = 1, the rate of trilinear elements in the energy
+// norm, is the conservative choice (a faster rate gives smaller errors), so
+// e_1 = D and e_2 = 2 D.
+//
+// A cell whose stiffness is off changes the solution, to first order, by a
+// field whose energy norm grows with the square root of the cell's strain
+// energy U_c; summing the cells as independent contributions gives for a
+// model with level L(c) in cell c
+//
+//     e = sqrt( sum_c e_{L(c)}^2 U_c / sum_c U_c ),
+//
+// which equals e_L when every cell has level L, and by Jensen's inequality
+// is not below the energy-weighted mean that coherent (same-sign) errors
+// would give to first order. U_c comes from the level-1 solve.
+//
+// The choice. All cells start at level 2; cells are refined greedily by the
+// largest decrease of the squared estimate per element added (to level 1 or
+// directly to level 0) until the estimate meets the target.
+#include <array>
+#include <vector>
+
+#include "ddfem/coarse_grid.hpp"
+
+namespace msfab {
+
+struct CellErrorModel {
+  double energy_share = 0;                // U_c / sum U
+  std::array<int, 3> elements{};          // elements the cell has at levels 0, 1, 2
+};
+
+// The uniform models' errors at levels 0, 1, 2 (level 0 is the fine model: 0).
+using LevelErrors = std::array<double, 3>;
+
+// e_1 and e_2 from the level-1 / level-2 difference D, for convergence rate p.
+LevelErrors level_errors_from_difference(double difference, double rate = 1.0);
+
+struct LevelChoice {
+  std::vector<int> cell_level;            // per level-2 cell
+  double predicted_error = 0;             // the estimate for these levels
+};
+
+// The estimate for given levels.
+double predicted_error(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
+                       const std::vector<int>& cell_level);
+
+// Levels meeting `target` (the mean-vertex error) with few elements.
+// target 0 gives level 0 everywhere (the fine model). Deterministic.
+LevelChoice choose_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors, double target);
+
+// The cells of `level2` (coarsen_grid(level1)) with their energy shares
+// from a solve on the level-1 mesh (`level1_energy` per element of
+// level1_mesh) and their element counts per level. All-void cells have no
+// elements and no share.
+std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1,
+                                              const CoarseGrid& level2, const VoxelMesh& level1_mesh,
+                                              const std::vector<double>& level1_energy);
+
+// Strain energy of every element of `mesh` at positions x (node-major).
+std::vector<double> element_energies(const HexMesh& mesh, const VecX& x);
+
+}  // namespace msfab

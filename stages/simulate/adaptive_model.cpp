@@ -1,0 +1,88 @@
+#include "adaptive_model.hpp"
+
+#include <chrono>
+
+#include "core/errors.hpp"
+#include "core/timing.hpp"
+#include "ddfem/baseline_coarsening.hpp"
+#include "ddfem/coarsening_error.hpp"
+
+namespace msfab {
+
+namespace {
+
+CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseDatabase& db) {
+  return database_coarsening(*db.level1, naive_coarsening(scene.material_by_id));
+}
+
+CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseDatabase& db, const CoarseGrid& level1) {
+  return database_coarsening_level2(db, level1, naive_coarsening(scene.material_by_id, level1));
+}
+
+// Displacements of a coarse solution (positions x) interpolated to the fine nodes.
+VecX on_fine_nodes(const Scene& scene, const VoxelMesh& fine, const CoarseModel& model, const VecX& x) {
+  VecX u = x;
+  const HexMesh& mesh = model.mesh.mesh;
+  for (int n = 0; n < mesh.num_nodes(); ++n) u.segment<3>(3 * n) -= mesh.nodes.row(n).transpose();
+  return interpolate_to_fine(scene.grid, fine, model.grid, model.mesh, u);
+}
+
+}  // namespace
+
+CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2) {
+  if (!level2.database || level2.database->level != 2)
+    throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
+  const auto t0 = std::chrono::steady_clock::now();
+  CoarseModel m;
+  m.database = level2.database;
+  m.level1 = level2.level1;
+  m.grid = level2.level1;
+  m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, *level2.database), 0, &m.stats);
+  m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
+  m.seconds = seconds_since(t0);
+  return m;
+}
+
+AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
+                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
+                                   const VecX& x1, double target_error) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!level2.database || level2.database->level != 2)
+    throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
+  const CoarseDatabase& db = *level2.database;
+  AdaptiveModel m;
+
+  // The estimate: the two uniform solutions' difference, energies of the finer one.
+  m.level_difference = mean_vertex_error(fine, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
+  m.level_errors = level_errors_from_difference(m.level_difference);
+  const std::vector<CellErrorModel> cells = cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh,
+                                                              element_energies(level1.mesh.mesh, x1));
+  m.choice = choose_cell_levels(cells, m.level_errors, target_error);
+
+  // The mixed mesh, with the same materials as the uniform models. A node
+  // the scene fixes must not hang on free corners: the cells around it are
+  // meshed fine (face conditions fix whole faces, so this is rare).
+  const CoarseMaterialLookup lookup1 = level1_lookup(scene, db);
+  const CoarseMaterialLookup lookup2 = level2_lookup(scene, db, level2.level1);
+  std::vector<int>& levels = m.choice.cell_level;
+  for (;;) {
+    m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels, lookup1,
+                                     lookup2);
+    std::vector<int> unresolved;
+    m.conditions =
+        mixed_static_conditions(scene, fine, fine_conditions, level2.level1, level2.grid, m.mixed, &unresolved);
+    int changed = 0;
+    for (int c : unresolved)
+      if (levels[c] != 0) {
+        levels[c] = 0;
+        ++changed;
+      }
+    if (changed == 0) break;
+    m.cells_refined_for_conditions += changed;
+  }
+  m.choice.predicted_error = predicted_error(cells, m.level_errors, levels);
+  m.seconds = seconds_since(t0);
+  return m;
+}
+
+}  // namespace msfab

@@ -1,0 +1,33 @@
+#pragma once
+// Adaptive coarsening for msfab-simulate (--target-error; docs/ddfem.md,
+// "Adaptive coarsening"): from solves of the uniform level-2 and level-1
+// models, the level of every level-2 cell (fine, level 1 or level 2) is
+// chosen so that the estimated error meets the target, and the scene is
+// meshed with those levels, hanging nodes constrained.
+#include "coarse_model.hpp"
+#include "ddfem/adaptive_levels.hpp"
+#include "ddfem/mixed_level_mesh.hpp"
+
+namespace msfab {
+
+struct AdaptiveModel {
+  MixedLevelMesh mixed;
+  StaticConditions conditions;     // on the unknowns
+  LevelErrors level_errors{};      // estimated errors of the uniform models
+  double level_difference = 0;     // D: mean-vertex distance between the level-1 and level-2 solutions
+  LevelChoice choice;
+  int cells_refined_for_conditions = 0;  // level-2 cells set to level 0 so that no fixed node hangs
+  double seconds = 0;              // estimate, choice and mesh (not the two solves)
+};
+
+// The uniform level-1 model of the scene with the level-1 materials of the
+// level-2 model's database (the database's compressed level-1 entries).
+CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2);
+
+// `level2` / `level1` are the uniform models and x2 / x1 their solutions
+// (positions).
+AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
+                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
+                                   const VecX& x1, double target_error);
+
+}  // namespace msfab

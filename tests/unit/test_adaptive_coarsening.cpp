@@ -1,0 +1,266 @@
+// Adaptive coarsening (docs/ddfem.md, "Adaptive coarsening"): meshes that
+// mix fine voxels, level-1 and level-2 elements with hanging nodes
+// constrained, the constrained assembler, and the choice of levels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/errors.hpp"
+#include "ddfem/adaptive_levels.hpp"
+#include "ddfem/baseline_coarsening.hpp"
+#include "ddfem/coarsening_error.hpp"
+#include "ddfem/mixed_level_mesh.hpp"
+#include "fem/elastic_assembler.hpp"
+#include "material/neo_hookean.hpp"
+#include "solve/newton.hpp"
+
+namespace msfab {
+namespace {
+
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// An 8 x 12 x 8 block of two materials in an irregular pattern (so that
+// level-1 and level-2 blocks mix them), with a few void voxels, clamped at
+// y = 0 and pulled and sheared at y = max.
+Scene two_material_block() {
+  Scene s;
+  s.name = "mixed-block";
+  s.grid = VoxelGrid(8, 12, 8, 0.001, 0);
+  std::mt19937 rng(3);
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 8; ++i) s.grid.at(i, j, k) = rng() % 3 == 0 ? 2 : 1;
+  s.grid.at(5, 6, 2) = 0;
+  s.grid.at(1, 9, 6) = 0;
+  s.material_by_id = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e6, 0.45)};
+  BoundaryCondition clamp;
+  clamp.where = "boundary[0]";
+  clamp.region.kind = Region::Kind::Face;
+  clamp.region.axis = 1;
+  clamp.fix[0] = clamp.fix[1] = clamp.fix[2] = true;
+  s.boundary.push_back(clamp);
+  Load pull;
+  pull.where = "loads[0]";
+  pull.region.kind = Region::Kind::Face;
+  pull.region.axis = 1;
+  pull.region.upper = true;
+  pull.value = Vec3(0.3, 0.2, -0.1);
+  s.loads.push_back(pull);
+  return s;
+}
+
+struct Grids {
+  CoarseGrid level1, level2;
+};
+
+Grids grids_of(const Scene& s) {
+  Grids g;
+  g.level1 = coarsen_grid(s.grid);
+  g.level2 = coarsen_grid(g.level1);
+  return g;
+}
+
+// Levels 0, 1 and 2 side by side, so that every kind of interface occurs
+// (fine next to level 2 included).
+std::vector<int> patchwork_levels(const CoarseGrid& level2) {
+  std::vector<int> levels(level2.num_cells());
+  for (int K = 0; K < level2.nz; ++K)
+    for (int J = 0; J < level2.ny; ++J)
+      for (int I = 0; I < level2.nx; ++I) levels[level2.index(I, J, K)] = (I + 2 * J + K) % 3;
+  return levels;
+}
+
+MixedLevelMesh naive_mixed_mesh(const Scene& s, const Grids& g, const std::vector<int>& levels) {
+  return build_mixed_level_mesh(s.grid, s.material_by_id, g.level1, g.level2, levels,
+                                naive_coarsening(s.material_by_id), naive_coarsening(s.material_by_id, g.level1));
+}
+
+TEST(AdaptiveMixedMesh, HangingNodesInterpolateRestPositionsAndRowsSumToOne) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
+  EXPECT_GT(m.elements_per_level[0], 0);
+  EXPECT_GT(m.elements_per_level[1], 0);
+  EXPECT_GT(m.elements_per_level[2], 0);
+  EXPECT_GT(m.hanging_nodes, 0);
+  const SpMat& T = m.constraints->node_map;
+  EXPECT_LT((T * VecX::Ones(T.cols()) - VecX::Ones(T.rows())).cwiseAbs().maxCoeff(), 1e-14);
+  const Rows3 interpolated = T * m.constraints->unknown_rest;
+  EXPECT_LT((interpolated - Rows3(m.mesh.nodes)).cwiseAbs().maxCoeff(), 1e-15);
+  // Every fine voxel is covered by exactly the volume of the elements.
+  double volume = 0;
+  for (int e = 0; e < m.mesh.num_elements(); ++e) volume += std::pow(std::ldexp(s.grid.voxel_size, m.element_level[e]), 3);
+  EXPECT_GT(volume, s.grid.count_solid() * std::pow(s.grid.voxel_size, 3));
+}
+
+// Gradient and Hessian of the constrained energy E(T y) against central
+// differences.
+TEST(AdaptiveMixedMesh, ConstrainedGradientAndHessianMatchFiniteDifferences) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
+  const ElasticAssembler a(m.mesh, m.constraints);
+  ASSERT_EQ(a.num_dofs(), 3 * m.num_unknown_nodes());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1e-4, 1e-4);
+  VecX y = a.rest_positions();
+  for (int i = 0; i < y.size(); ++i) y[i] += u(rng);
+  VecX grad;
+  SpMat K = a.pattern();
+  const double E = a.evaluate(y, &grad, &K);
+  ASSERT_TRUE(std::isfinite(E));
+  const double h = 1e-8;
+  VecX v(y.size());
+  for (int i = 0; i < v.size(); ++i) v[i] = u(rng) * 1e4;
+  const double dE = (a.energy(y + h * v) - a.energy(y - h * v)) / (2 * h);
+  EXPECT_NEAR(dE, grad.dot(v), 1e-6 * std::abs(grad.dot(v)));
+  VecX gp, gm;
+  a.evaluate(y + h * v, &gp, nullptr);
+  a.evaluate(y - h * v, &gm, nullptr);
+  const VecX dg = (gp - gm) / (2 * h);
+  EXPECT_LT((dg - K * v).norm(), 1e-5 * (K * v).norm());
+  EXPECT_LT((SpMat(K.transpose()) - K).norm(), 1e-12 * K.norm());
+}
+
+// A homogeneous body under an affine boundary displacement stays affine: the
+// hanging nodes must not add stiffness or slack at the interfaces.
+TEST(AdaptiveMixedMesh, AffineDisplacementIsReproducedAcrossLevelInterfaces) {
+  Scene s = two_material_block();
+  for (int& id : s.grid.ids) id = id == 0 ? 0 : 1;
+  s.grid.at(5, 6, 2) = 1;  // no holes: the body is a box
+  s.grid.at(1, 9, 6) = 1;
+  const Grids g = grids_of(s);
+  const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
+  const ElasticAssembler a(m.mesh, m.constraints);
+  Mat3 strain;
+  strain << 0.02, 0.005, 0, 0.005, -0.01, 0.004, 0, 0.004, 0.015;
+  const NodeArray& X = m.constraints->unknown_rest;
+  const Vec3 lo = m.mesh.bbox_min(), hi = m.mesh.bbox_max();
+  DirichletConditions bc = DirichletConditions::none(a.num_dofs());
+  for (int n = 0; n < X.rows(); ++n) {
+    const Vec3 p = X.row(n).transpose();
+    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-12) || ((hi - p).cwiseAbs().minCoeff() < 1e-12);
+    if (!boundary) continue;
+    for (int c = 0; c < 3; ++c) {
+      bc.fixed[3 * n + c] = 1;
+      bc.displacement[3 * n + c] = (strain * p)[c];
+    }
+  }
+  NewtonOptions opt;
+  opt.linear_solver = "cholmod";
+  opt.relative_tolerance = 1e-10;
+  const NewtonResult r = solve_static(a, bc, VecX::Zero(a.num_dofs()), opt);
+  ASSERT_TRUE(r.converged) << r.failure;
+  const VecX x = a.mesh_positions(r.x);
+  double worst = 0;
+  for (int n = 0; n < m.mesh.num_nodes(); ++n) {
+    const Vec3 p = m.mesh.nodes.row(n).transpose();
+    worst = std::max(worst, (x.segment<3>(3 * n) - p - strain * p).norm());
+  }
+  EXPECT_LT(worst, 1e-9 * s.grid.voxel_size);
+}
+
+// With every cell at level 0 (a zero budget) the mixed model is the fine
+// model: same solution as the voxel mesh, and its conditions are the fine ones.
+TEST(AdaptiveMixedMesh, AllFineLevelsSolveTheFineModel) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const LevelChoice choice = choose_cell_levels(std::vector<CellErrorModel>(g.level2.num_cells()), {0, 0.1, 0.2}, 0.0);
+  for (int l : choice.cell_level) ASSERT_EQ(l, 0);
+  const MixedLevelMesh m = naive_mixed_mesh(s, g, choice.cell_level);
+  EXPECT_EQ(m.hanging_nodes, 0);
+  const VoxelMesh fine = build_voxel_mesh(s.grid, s.material_by_id);
+  EXPECT_EQ(m.mesh.num_elements(), fine.mesh.num_elements());
+  EXPECT_EQ(m.num_unknown_nodes(), fine.mesh.num_nodes());
+  const StaticConditions fc = build_static_conditions(s, fine);
+  const StaticConditions mc = mixed_static_conditions(s, fine, fc, g.level1, g.level2, m);
+  EXPECT_EQ(mc.dirichlet.count_fixed(), fc.dirichlet.count_fixed());
+
+  NewtonOptions opt;
+  opt.linear_solver = "cholmod";
+  opt.relative_tolerance = 1e-10;
+  const ElasticAssembler af(fine.mesh);
+  const NewtonResult rf = solve_static(af, fc.dirichlet, fc.force, opt);
+  const ElasticAssembler am(m.mesh, m.constraints);
+  const NewtonResult rm = solve_static(am, mc.dirichlet, mc.force, opt);
+  ASSERT_TRUE(rf.converged && rm.converged);
+  const SpMat W = mixed_to_fine_interpolation(s.grid, fine, m);
+  const VecX um = rm.x - am.rest_positions();
+  VecX interpolated(fine.mesh.num_dofs());
+  Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
+      W * Eigen::Map<const Rows3>(um.data(), m.num_unknown_nodes(), 3);
+  const VecX uf = rf.x - af.rest_positions();
+  EXPECT_LT(mean_vertex_error(fine, uf, interpolated), 1e-8 * uf.cwiseAbs().maxCoeff());
+}
+
+// Loads restricted to the unknowns keep their total; the interpolation to the
+// fine nodes reproduces affine fields.
+TEST(AdaptiveMixedMesh, ConditionsKeepTheLoadAndInterpolationIsExactForAffineFields) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
+  const VoxelMesh fine = build_voxel_mesh(s.grid, s.material_by_id);
+  const StaticConditions fc = build_static_conditions(s, fine);
+  const StaticConditions mc = mixed_static_conditions(s, fine, fc, g.level1, g.level2, m);
+  const Vec3 total = Eigen::Map<const Rows3>(mc.force.data(), m.num_unknown_nodes(), 3).colwise().sum().transpose();
+  EXPECT_LT((total - Vec3(0.3, 0.2, -0.1)).norm(), 1e-12);
+  // The clamped face has unknowns at y = 0 only, every one fixed.
+  for (int u = 0; u < m.num_unknown_nodes(); ++u) {
+    const bool on_face = std::abs(m.constraints->unknown_rest(u, 1)) < 1e-12;
+    EXPECT_EQ(bool(mc.dirichlet.fixed[3 * u]), on_face) << "unknown " << u;
+  }
+  const SpMat W = mixed_to_fine_interpolation(s.grid, fine, m);
+  Mat3 A;
+  A << 1, 2, 3, -1, 0.5, 2, 0.3, -0.7, 1;
+  const Rows3 field = m.constraints->unknown_rest * A.transpose();
+  const Rows3 expected = fine.mesh.nodes * A.transpose();
+  EXPECT_LT((Rows3(W * field) - expected).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+TEST(AdaptiveLevels, ChoiceMeetsTheTargetAndRefinesHighEnergyCellsFirst) {
+  // Four cells; the second carries most of the energy.
+  std::vector<CellErrorModel> cells(4);
+  const double shares[4] = {0.1, 0.6, 0.2, 0.1};
+  for (int c = 0; c < 4; ++c) {
+    cells[c].energy_share = shares[c];
+    cells[c].elements = {64, 8, 1};
+  }
+  const LevelErrors e = level_errors_from_difference(0.05);
+  EXPECT_DOUBLE_EQ(e[1], 0.05);
+  EXPECT_DOUBLE_EQ(e[2], 0.10);
+  EXPECT_NEAR(level_errors_from_difference(0.05, 2.0)[1], 0.05 / 3, 1e-15);
+  // A target above the level-2 error keeps everything at level 2.
+  const LevelChoice loose = choose_cell_levels(cells, e, 0.2);
+  for (int l : loose.cell_level) EXPECT_EQ(l, 2);
+  EXPECT_NEAR(loose.predicted_error, 0.1, 1e-15);
+  int previous_elements = 4;
+  for (double target : {0.09, 0.07, 0.05, 0.03, 0.01}) {
+    const LevelChoice c = choose_cell_levels(cells, e, target);
+    EXPECT_LE(c.predicted_error, target * (1 + 1e-9));
+    EXPECT_NEAR(c.predicted_error, predicted_error(cells, e, c.cell_level), 1e-15);
+    int elements = 0;
+    for (int i = 0; i < 4; ++i) elements += cells[i].elements[c.cell_level[i]];
+    EXPECT_GE(elements, previous_elements);
+    previous_elements = elements;
+    // The high-energy cell is never coarser than a low-energy one.
+    for (int i : {0, 2, 3}) EXPECT_LE(c.cell_level[1], c.cell_level[i]) << "target " << target;
+  }
+  EXPECT_THROW(choose_cell_levels(cells, e, -1), InputError);
+  EXPECT_THROW(choose_cell_levels(cells, e, NAN), InputError);
+  EXPECT_THROW(level_errors_from_difference(INFINITY), InputError);
+}
+
+TEST(AdaptiveMixedMesh, BadLevelsAndGridsAreRefused) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  std::vector<int> levels(g.level2.num_cells(), 3);
+  EXPECT_THROW(naive_mixed_mesh(s, g, levels), InputError);
+  levels.assign(g.level2.num_cells() - 1, 0);
+  EXPECT_THROW(naive_mixed_mesh(s, g, levels), InputError);
+  Grids swapped{g.level2, g.level1};
+  EXPECT_THROW(naive_mixed_mesh(s, swapped, std::vector<int>(g.level1.num_cells(), 0)), InputError);
+}
+
+}  // namespace
+}  // namespace msfab
