@@ -7,6 +7,7 @@
 #   make -f Makefile.pipeline ddfem-table-periodic  the same with in-situ (periodic) sampling, its own section
 #   make -f Makefile.pipeline ddfem-table-centre    periodic sampling and a fitted centre point, its own section
 #   make -f Makefile.pipeline ddfem-table-void      periodic sampling with void in the palette, its own section
+#   make -f Makefile.pipeline ddfem-table-adaptive  adaptive coarsening (--target-error): speed against error, PNG
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -21,6 +22,9 @@ $(OUT)/ddfem/%.coarse_db.h5: configs/ddfem/%.yaml $(BIN)/msfab-ddfem-build
 # Level 2 (§2.3.5): <name>_level2.yaml over <name>'s level-1 database
 # compressed to K1 materials.
 K1 ?= 400
+# Kept: the compressed level-1 database is an input others reuse (make would
+# delete it as an intermediate of the level-2 build).
+.PRECIOUS: $(OUT)/ddfem/%.k$(K1).coarse_db.h5
 $(OUT)/ddfem/%.k$(K1).coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(BIN)/msfab-ddfem-compress
 	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$(K1) --out $@
 $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k$(K1).coarse_db.h5 $(BIN)/msfab-ddfem-build
@@ -28,7 +32,8 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
-.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void
+.PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
+        ddfem-table-adaptive
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -57,3 +62,9 @@ ddfem-table-void: build $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
 	BENCH_SECTION=ddfem-void DATABASE2=$(OUT)/ddfem/palette3_periodic_void.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-void docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5
+
+# Adaptive coarsening (docs/ddfem.md, "Adaptive coarsening") over the
+# periodic level-2 database; TARGETS="..." picks the target errors.
+ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+	bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5

@@ -27,7 +27,42 @@ VecX on_fine_nodes(const Scene& scene, const VoxelMesh& fine, const CoarseModel&
   return interpolate_to_fine(scene.grid, fine, model.grid, model.mesh, u);
 }
 
+// A per-unknown vector (3 entries per unknown node) placed on the mesh nodes
+// that carry the unknowns, zero on hanging nodes.
+template <typename T, typename Vector>
+std::vector<T> on_mesh_nodes(const MixedLevelMesh& mixed, const Vector& per_unknown) {
+  std::vector<T> out(3 * size_t(mixed.mesh.num_nodes()), T(0));
+  for (int u = 0; u < mixed.num_unknown_nodes(); ++u)
+    for (int a = 0; a < 3; ++a) out[3 * size_t(mixed.unknown_node[u]) + a] = per_unknown[3 * size_t(u) + a];
+  return out;
+}
+
+VecX as_vecx(const std::vector<double>& v) { return Eigen::Map<const VecX>(v.data(), VecX::Index(v.size())); }
+
 }  // namespace
+
+VecX adaptive_displacement_on_fine(const Scene& scene, const VoxelMesh& fine, const AdaptiveModel& model,
+                                   const ElasticAssembler& assembler, const VecX& x) {
+  using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  const VecX u = x - assembler.rest_positions();
+  const SpMat W = mixed_to_fine_interpolation(scene.grid, fine, model.mixed);
+  VecX out(fine.mesh.num_dofs());
+  Eigen::Map<Rows3>(out.data(), fine.mesh.num_nodes(), 3) =
+      W * Eigen::Map<const Rows3>(u.data(), model.mixed.num_unknown_nodes(), 3);
+  return out;
+}
+
+AdaptiveResultOnMesh adaptive_result_on_mesh(const AdaptiveModel& model, const ElasticAssembler& assembler,
+                                             const NewtonResult& result) {
+  AdaptiveResultOnMesh r;
+  r.mesh.mesh = model.mixed.mesh;
+  r.conditions.force = as_vecx(on_mesh_nodes<double>(model.mixed, model.conditions.force));
+  r.conditions.dirichlet.fixed = on_mesh_nodes<char>(model.mixed, model.conditions.dirichlet.fixed);
+  r.conditions.dirichlet.displacement = as_vecx(on_mesh_nodes<double>(model.mixed, model.conditions.dirichlet.displacement));
+  r.newton = result;
+  r.newton.x = assembler.mesh_positions(result.x);
+  return r;
+}
 
 CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2) {
   if (!level2.database || level2.database->level != 2)

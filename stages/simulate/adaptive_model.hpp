@@ -7,6 +7,7 @@
 #include "coarse_model.hpp"
 #include "ddfem/adaptive_levels.hpp"
 #include "ddfem/mixed_level_mesh.hpp"
+#include "solve/newton.hpp"
 
 namespace msfab {
 
@@ -29,5 +30,22 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
                                    const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
                                    const VecX& x1, double target_error);
+
+// The solution of the adaptive model (positions of the unknowns) as
+// displacements at the fine mesh's nodes, for the error against the fine
+// solution.
+VecX adaptive_displacement_on_fine(const Scene& scene, const VoxelMesh& fine, const AdaptiveModel& model,
+                                   const ElasticAssembler& assembler, const VecX& x);
+
+// The adaptive model's mesh, conditions and solution with one entry per mesh
+// node (hanging nodes: interpolated positions, no force or condition), as the
+// result artifact stores them.
+struct AdaptiveResultOnMesh {
+  VoxelMesh mesh;
+  StaticConditions conditions;
+  NewtonResult newton;
+};
+AdaptiveResultOnMesh adaptive_result_on_mesh(const AdaptiveModel& model, const ElasticAssembler& assembler,
+                                             const NewtonResult& result);
 
 }  // namespace msfab

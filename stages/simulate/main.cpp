@@ -6,9 +6,9 @@
 //   3. with --coarsen L: replace every 2^L block by one coarse element whose
 //      materials come from the DDFEM database (or a baseline), and move the
 //      conditions onto the coarse mesh; with --target-error E: solve the
-//      level-2 model first, choose per 4^3 cell between fine, level 1 and
-//      level 2 so that the estimated error is at most E, and mesh the scene
-//      with those levels (hanging nodes constrained)
+//      uniform level-2 and level-1 models, choose per 4^3 cell between fine,
+//      level 1 and level 2 so that the estimated error is at most E, and mesh
+//      the scene with those levels (hanging nodes constrained)
 //   4. Newton with line search until the relative residual is small,
 //      stepping the load when it is large
 //   5. with --compare-fine: also solve the fine model and report the error
@@ -48,19 +48,6 @@ NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticCondi
   return result;
 }
 
-// Displacements of the unknowns (positions x minus their rest positions).
-VecX displacement(const ElasticAssembler& assembler, const VecX& x) { return x - assembler.rest_positions(); }
-
-// A per-unknown vector placed on the mesh nodes that carry the unknowns
-// (zero on hanging nodes), for the result artifact.
-template <typename T>
-std::vector<T> on_mesh_nodes(const MixedLevelMesh& mixed, const std::vector<T>& per_unknown) {
-  std::vector<T> out(3 * size_t(mixed.mesh.num_nodes()), T(0));
-  for (int u = 0; u < mixed.num_unknown_nodes(); ++u)
-    for (int a = 0; a < 3; ++a) out[3 * size_t(mixed.unknown_node[u]) + a] = per_unknown[3 * size_t(u) + a];
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,7 +84,7 @@ int main(int argc, char** argv) {
     const VoxelMesh fine = build_voxel_mesh(scene.grid, scene.material_by_id);
     const StaticConditions fine_conditions = build_static_conditions(scene, fine);
 
-    // 3. Coarse model: uniform, or adaptive from a first level-2 solve.
+    // 3. Coarse model: uniform, or adaptive from the uniform level-2 and level-1 solves.
     const bool adaptive = target_option->count() > 0;
     if (adaptive) {
       if (!(target_error > 0) || !std::isfinite(target_error))
@@ -178,40 +165,19 @@ int main(int argc, char** argv) {
         uf = ref.displacement;
         record.fine_seconds = ref.newton_seconds;
       }
-      const VecX uc = displacement(assembler, result.x);
       record.compared = true;
-      if (adaptive) {
-        using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
-        const SpMat W = mixed_to_fine_interpolation(scene.grid, fine, adapted.mixed);
-        VecX interpolated(fine.mesh.num_dofs());
-        Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
-            W * Eigen::Map<const Rows3>(uc.data(), adapted.mixed.num_unknown_nodes(), 3);
-        record.error_vs_fine = mean_vertex_error(fine, uf, interpolated);
-      } else {
-        record.error_vs_fine = mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, uc);
-      }
+      record.error_vs_fine =
+          adaptive ? mean_vertex_error(fine, uf, adaptive_displacement_on_fine(scene, fine, adapted, assembler, result.x))
+                   : mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, result.x - assembler.rest_positions());
     }
 
     // 6. Artifact (adaptive runs: every node of the mixed mesh, hanging ones interpolated).
-    VoxelMesh mixed_mesh;
-    StaticConditions mixed_conditions;
-    NewtonResult mixed_result;
-    if (adaptive) {
-      mixed_mesh.mesh = adapted.mixed.mesh;
-      mixed_conditions.force = Eigen::Map<const VecX>(
-          on_mesh_nodes(adapted.mixed, std::vector<double>(conditions.force.data(),
-                                                           conditions.force.data() + conditions.force.size()))
-              .data(),
-          mixed_mesh.mesh.num_dofs());
-      mixed_conditions.dirichlet.fixed = on_mesh_nodes(adapted.mixed, conditions.dirichlet.fixed);
-      mixed_conditions.dirichlet.displacement = VecX::Zero(mixed_mesh.mesh.num_dofs());
-      mixed_result = result;
-      mixed_result.x = assembler.mesh_positions(result.x);
-    }
+    AdaptiveResultOnMesh on_mesh;
+    if (adaptive) on_mesh = adaptive_result_on_mesh(adapted, assembler, result);
     record.scene = &scene;
-    record.mesh = adaptive ? &mixed_mesh : &vm;
-    record.conditions = adaptive ? &mixed_conditions : &conditions;
-    record.newton = adaptive ? &mixed_result : &result;
+    record.mesh = adaptive ? &on_mesh.mesh : &vm;
+    record.conditions = adaptive ? &on_mesh.conditions : &conditions;
+    record.newton = adaptive ? &on_mesh.newton : &result;
     record.setup_seconds = setup;
     record.config_text = ctx.config.resolved_text();
     record.command_line = ctx.command_line;
@@ -235,7 +201,7 @@ int main(int argc, char** argv) {
     const std::string xmf = write_result_artifact(out, record);
 
     double max_u = 0;
-    const VecX u_solved = displacement(assembler, result.x);
+    const VecX u_solved = result.x - assembler.rest_positions();
     for (int n = 0; n < assembler.num_dofs() / 3; ++n) max_u = std::max(max_u, u_solved.segment<3>(3 * n).norm());
     const int its = std::max(1, result.iterations);
     std::printf("msfab-simulate: scene '%s' converged in %d Newton iterations (%d load steps)\n", scene.name.c_str(),

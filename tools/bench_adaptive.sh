@@ -1,0 +1,87 @@
+#!/bin/bash
+# Adaptive coarsening (msfab-simulate --target-error; docs/ddfem.md,
+# "Adaptive coarsening"): speed against error per scene. Every scene is solved
+# fine once; the uniform level-2 model and the adaptive model at each target
+# are compared with that fine result (--reference), so one row's numbers come
+# from one run of this script.
+#
+#   tools/bench_adaptive.sh BIN OUTDIR BENCHMARKS.md DATABASE2 [scene ...]
+# DATABASE2: a level-2 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
+# nu = 0.45). TARGETS (environment) lists the target errors (default
+# "0.02 0.01 0.005 0.002"); PYTHON, a python3 with matplotlib (Debian
+# python3-matplotlib). Writes the section bench:ddfem-adaptive of
+# BENCHMARKS.md, OUTDIR/adaptive.csv and docs/images/ddfem-adaptive.png.
+set -euo pipefail
+BIN=$1 OUTDIR=$2 DOC=$3 DB2=$4
+shift 4
+SCENES=("$@")
+[ ${#SCENES[@]} -gt 0 ] || SCENES=(bending twisting pushing layers1 checker random3 sole bridge_arch skeleton holes3)
+read -r -a TARGET_LIST <<< "${TARGETS:-0.02 0.01 0.005 0.002}"
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$OUTDIR"
+
+attr() {  # attr FILE OBJECT NAME -> value (first element)
+  h5dump -a "$2/$3" "$1" | sed -n 's/^ *(0): *//p' | head -n1
+}
+run() {  # run OUT ARGS...: msfab-simulate quietly, log kept next to OUT
+  local out=$1
+  shift
+  timeout "${BENCH_RUN_LIMIT:-900}" "$BIN/msfab-simulate" --out "$out" --log-level warn "$@" > "${out%.h5}.log" 2>&1 ||
+    { echo "bench: failed, see ${out%.h5}.log" >&2; tail -3 "${out%.h5}.log" >&2; return 1; }
+}
+levels() {  # "fine/L1/L2" element counts of an adaptive result
+  h5dump -a /coarsening/elements_per_level "$1" | sed -n 's/^ *(0): *//p' | head -n1 | tr -d ' ' | tr ',' '/'
+}
+# Seconds after the fine mesh: coarsening, the uniform solves the estimate
+# comes from, and the Newton solve of the model itself.
+coarse_seconds() {
+  local f=$1 extra=0
+  [ "$(h5dump -a /coarsening/adaptive "$f" 2>/dev/null | sed -n 's/^ *(0): *//p')" = 1 ] &&
+    extra=$(attr "$f" /coarsening uniform_solve_seconds)
+  awk -v a="$(attr "$f" /timings newton_total)" -v b="$(attr "$f" /coarsening seconds)" -v c="$extra" \
+    'BEGIN { printf "%.4f", a + b + c }'
+}
+
+rows="" csv="scene,model,target,predicted,error,seconds,fine_seconds"$'\n'
+for scene in "${SCENES[@]}"; do
+  cfg="$SRC/configs/scenes/$scene.yaml"
+  fine="$OUTDIR/$scene-L0.h5"
+  echo "bench: $scene fine ..." >&2
+  [ -f "$fine" ] || run "$fine" --config "$cfg" || continue
+  tf=$(attr "$fine" /timings newton_total)
+  nf=$(attr "$fine" / elements)
+  echo "bench: $scene level 2 ..." >&2
+  if run "$OUTDIR/$scene-L2.h5" --config "$cfg" --coarsen 2 --database "$DB2" --reference "$fine"; then
+    f="$OUTDIR/$scene-L2.h5"
+    e=$(attr "$f" /coarsening error_vs_fine) t=$(coarse_seconds "$f")
+    rows+=$(awk -v s="$scene" -v e="$e" -v t="$t" -v tf="$tf" -v n="$(attr "$f" / elements)" -v nf="$nf" \
+      'BEGIN { printf "| %s | level 2 | — | — | %.2e | — | 0/0/%d of %d | %.3f | %.3f | %.1f |", s, e, n, nf, t, tf, tf / t }')$'\n'
+    csv+="$scene,level2,,,$e,$t,$tf"$'\n'
+  fi
+  for target in "${TARGET_LIST[@]}"; do
+    echo "bench: $scene adaptive $target ..." >&2
+    f="$OUTDIR/$scene-A$target.h5"
+    run "$f" --config "$cfg" --target-error "$target" --database "$DB2" --reference "$fine" || continue
+    e=$(attr "$f" /coarsening error_vs_fine) p=$(attr "$f" /coarsening predicted_error) t=$(coarse_seconds "$f")
+    rows+=$(awk -v s="$scene" -v g="$target" -v p="$p" -v e="$e" -v t="$t" -v tf="$tf" -v l="$(levels "$f")" \
+      -v nf="$nf" 'BEGIN { printf "| %s | adaptive | %g | %.2e | %.2e | %s | %s of %d | %.3f | %.3f | %.1f |", s, g, p, e,
+        (e <= g ? "yes" : "**no**"), l, nf, t, tf, tf / t }')$'\n'
+    csv+="$scene,adaptive,$target,$p,$e,$t,$tf"$'\n'
+  done
+done
+printf "%s" "$csv" > "$OUTDIR/adaptive.csv"
+"${PYTHON:-python3}" "$SRC/tools/plot_adaptive.py" "$OUTDIR/adaptive.csv" "$SRC/docs/images/ddfem-adaptive.png" ||
+  echo "bench: no plot (python3 with matplotlib needed)" >&2
+
+machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), database $(basename "$DB2").
+
+| scene | model | target | predicted | error | met | elements fine/L1/L2 | s | fine s | speedup |
+|---|---|---|---|---|---|---|---|---|---|
+${rows}
+Seconds after the fine mesh is built: coarsening, for adaptive runs the uniform level-2 and level-1 solves the
+estimate comes from, and Newton on the model; \"fine s\" is the fine model's Newton time in the same run.
+
+![adaptive speed against error](images/ddfem-adaptive.png)"
+python3 "$SRC/tools/replace_bench_section.py" "$DOC" ddfem-adaptive "$table"
+echo "bench: table written to $DOC" >&2
