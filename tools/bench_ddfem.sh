@@ -21,15 +21,7 @@ DB2=${DATABASE2:-}
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
 
-attr() {  # attr FILE OBJECT NAME -> value
-  h5dump -a "$2/$3" "$1" | sed -n 's/^ *(0): *//p' | head -n1
-}
-run() {  # run OUT ARGS...: msfab-simulate quietly, log kept next to OUT
-  local out=$1
-  shift
-  timeout "${BENCH_RUN_LIMIT:-900}" "$BIN/msfab-simulate" --out "$out" --log-level warn "$@" > "${out%.h5}.log" 2>&1 ||
-    { echo "bench: failed, see ${out%.h5}.log" >&2; tail -3 "${out%.h5}.log" >&2; return 1; }
-}
+source "$SRC/tools/simulate_bench_lib.sh"
 grid_of() {  # the grid size as NxMxK from a result
   h5dump -a /grid/size "$1" | sed -n 's/^ *(0): *//p' | head -n1 | tr -d ' ' | tr ',' 'x'
 }
