@@ -70,6 +70,11 @@ for target in 0.01 0.004; do
   check "target $target met with fewer elements than fine" -- \
     awk -v e="$err" -v t="$target" -v n="$elements" 'BEGIN { exit !(e > 0 && e <= t && n < 256) }'
 done
+cp "$WORK/adaptive.h5" "$WORK/adaptive_threads2.h5"
+"$SIM" --config "$BAR" --target-error 0.004 --database "$WORK/db2.h5" --threads 1 --out "$WORK/adaptive_threads1.h5" \
+  --quiet >/dev/null
+check "adaptive result independent of the thread count" -- \
+  h5diff -d 0 "$WORK/adaptive_threads1.h5" "$WORK/adaptive_threads2.h5" /displacement
 check "result records the adaptive run" -- bash -c "h5dump -a /coarsening/adaptive '$WORK/adaptive.h5' | grep -q '(0): 1'"
 for bad in 0 -0.01 nan inf; do
   expect_exit 2 "target-error" -- "$SIM" --config "$BAR" --target-error "$bad" --database "$WORK/db2.h5" --out "$WORK/o.h5"
