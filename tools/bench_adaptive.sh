@@ -7,7 +7,8 @@
 #
 #   tools/bench_adaptive.sh BIN OUTDIR BENCHMARKS.md DATABASE2 [scene ...]
 # DATABASE2: a level-2 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
-# nu = 0.45). TARGETS (environment) lists the target errors (default
+# nu = 0.45); DATABASE1 (environment, optional) a level-1 one for the uniform
+# level-1 rows. Naive coarsening at both levels is measured too. TARGETS (environment) lists the target errors (default
 # "0.02 0.01 0.005 0.002"); PYTHON, a python3 with matplotlib (Debian
 # python3-matplotlib). Writes the section bench:ddfem-adaptive of
 # BENCHMARKS.md, OUTDIR/adaptive.csv and docs/images/ddfem-adaptive.png.
@@ -34,6 +35,20 @@ coarse_seconds() {
     'BEGIN { printf "%.4f", a + b + c }'
 }
 
+# One uniform coarse model of the current scene: a table row and a CSV line.
+uniform() {  # uniform NAME LABEL ARGS...
+  local name=$1 label=$2 f="$OUTDIR/$scene-$1.h5"
+  shift 2
+  echo "bench: $scene $label ..." >&2
+  run "$f" --config "$cfg" --reference "$fine" "$@" || return 0
+  local e t levels
+  e=$(attr "$f" /coarsening error_vs_fine) t=$(coarse_seconds "$f")
+  levels="0/0/$(attr "$f" / elements)"
+  [ "$(attr "$f" /coarsening level)" = 1 ] && levels="0/$(attr "$f" / elements)/0"
+  rows+=$(awk -v s="$scene" -v m="$label" -v e="$e" -v t="$t" -v tf="$tf" -v l="$levels" -v nf="$nf" \
+    'BEGIN { printf "| %s | %s | — | — | %.2e | — | %s of %d | %.3f | %.3f | %.1f |", s, m, e, l, nf, t, tf, tf / t }')$'\n'
+  csv+="$scene,$name,,,$e,$t,$tf"$'\n'
+}
 rows="" csv="scene,model,target,predicted,error,seconds,fine_seconds"$'\n'
 for scene in "${SCENES[@]}"; do
   cfg="$SRC/configs/scenes/$scene.yaml"
@@ -42,13 +57,11 @@ for scene in "${SCENES[@]}"; do
   [ -f "$fine" ] || run "$fine" --config "$cfg" || continue
   tf=$(attr "$fine" /timings newton_total)
   nf=$(attr "$fine" / elements)
-  echo "bench: $scene level 2 ..." >&2
-  if run "$OUTDIR/$scene-L2.h5" --config "$cfg" --coarsen 2 --database "$DB2" --reference "$fine"; then
-    f="$OUTDIR/$scene-L2.h5"
-    e=$(attr "$f" /coarsening error_vs_fine) t=$(coarse_seconds "$f")
-    rows+=$(awk -v s="$scene" -v e="$e" -v t="$t" -v tf="$tf" -v n="$(attr "$f" / elements)" -v nf="$nf" \
-      'BEGIN { printf "| %s | level 2 | — | — | %.2e | — | 0/0/%d of %d | %.3f | %.3f | %.1f |", s, e, n, nf, t, tf, tf / t }')$'\n'
-    csv+="$scene,level2,,,$e,$t,$tf"$'\n'
+  uniform naive2 "naive level 2" --coarsen 2 --coarse-material naive
+  uniform level2 "level 2" --coarsen 2 --database "$DB2"
+  if [ -n "${DATABASE1:-}" ]; then
+    uniform naive1 "naive level 1" --coarsen 1 --coarse-material naive
+    uniform level1 "level 1" --coarsen 1 --database "$DATABASE1"
   fi
   for target in "${TARGET_LIST[@]}"; do
     echo "bench: $scene adaptive $target ..." >&2
@@ -66,7 +79,7 @@ printf "%s" "$csv" > "$OUTDIR/adaptive.csv"
   echo "bench: no plot (python3 with matplotlib needed)" >&2
 
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), database $(basename "$DB2").
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB2")${DATABASE1:+ (level 2) and $(basename "$DATABASE1") (level 1)}.
 
 | scene | model | target | predicted | error | met | elements fine/L1/L2 | s | fine s | speedup |
 |---|---|---|---|---|---|---|---|---|---|
