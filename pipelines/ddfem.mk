@@ -65,6 +65,7 @@ ddfem-table-void: build $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
 
 # Adaptive coarsening (docs/ddfem.md, "Adaptive coarsening") over the
 # periodic level-2 database; TARGETS="..." picks the target errors.
-ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
-	bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive docs/BENCHMARKS.md \
+ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+	DATABASE1=$(OUT)/ddfem/palette3_periodic.coarse_db.h5 \
+	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
