@@ -87,7 +87,7 @@ MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& 
     for (std::int64_t j = candidates.offsets[c]; j < candidates.offsets[c + 1]; ++j)
       for (int v = 0; v < variants; ++v) options[o++] = first_entry[candidates.structure[j]] + v;
   }
-  CellGrid grid{design.dimension, design.nx, design.ny, design.nz};
+  FaceGrid grid{design.dimension, design.nx, design.ny, design.nz};
   return MismatchProblem(grid, std::move(table), std::move(offsets), std::move(options));
 }
 

@@ -10,7 +10,7 @@
 
 namespace msfab {
 
-std::int64_t CellGrid::neighbour(std::int64_t cell, int face) const {
+std::int64_t FaceGrid::neighbour(std::int64_t cell, int face) const {
   const int axis = face / 2;
   const int step = face % 2 == 0 ? -1 : 1;
   const std::int64_t i = cell % nx, j = (cell / nx) % ny, k = cell / (std::int64_t(nx) * ny);
@@ -118,7 +118,7 @@ std::uint64_t hash_seed(std::uint64_t seed, std::uint64_t index) {
   return splitmix(splitmix(seed) ^ splitmix(index ^ 0x5851F42D4C957F2Dull));
 }
 
-MismatchProblem::MismatchProblem(CellGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
+MismatchProblem::MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
                                  std::vector<std::int32_t> options)
     : grid_(grid), table_(std::move(table)), offsets_(std::move(offsets)), options_(std::move(options)) {
   const std::int64_t cells = grid_.cells();

@@ -19,8 +19,9 @@
 
 namespace msfab {
 
-// Cells numbered i + nx (j + ny k); nz = 1 in 2D.
-struct CellGrid {
+// The design grid as the mismatch energy sees it: cells numbered
+// i + nx (j + ny k) (nz = 1 in 2D) and their face neighbours.
+struct FaceGrid {
   int dimension = 2;
   int nx = 1, ny = 1, nz = 1;
 
@@ -87,10 +88,10 @@ struct DescentReport {
 // at least one per cell; a cell with one option is fixed.
 class MismatchProblem {
  public:
-  MismatchProblem(CellGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
+  MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
                   std::vector<std::int32_t> options);
 
-  const CellGrid& grid() const { return grid_; }
+  const FaceGrid& grid() const { return grid_; }
   const FaceTable& table() const { return table_; }
   std::int64_t option_count(std::int64_t cell) const { return offsets_[cell + 1] - offsets_[cell]; }
   int entry(std::int64_t cell, int option) const { return options_[std::size_t(offsets_[cell] + option)]; }
@@ -122,7 +123,7 @@ class MismatchProblem {
  private:
   std::int64_t pair_mismatch(int entry, int face, std::int64_t other) const;
 
-  CellGrid grid_;
+  FaceGrid grid_;
   FaceTable table_;
   std::vector<std::int64_t> offsets_;
   std::vector<std::int32_t> options_;

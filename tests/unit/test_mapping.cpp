@@ -141,7 +141,7 @@ std::vector<int> complement(std::vector<int> ids) {
   return ids;
 }
 
-MismatchProblem two_cells(const CellGrid& grid, const std::vector<int>& a, const std::vector<int>& b, int vz = 1) {
+MismatchProblem two_cells(const FaceGrid& grid, const std::vector<int>& a, const std::vector<int>& b, int vz = 1) {
   FaceTable table(4, 4, vz, grid.dimension);
   const int ea = table.add(a), eb = table.add(b);
   return MismatchProblem(grid, std::move(table), {0, 1, 2}, {ea, eb});
@@ -288,7 +288,7 @@ TEST(Mapping, CandidatesAreTheTrueNearestWithTiesByIndex) {
 
 // --- the greedy descent --------------------------------------------------------
 
-void expect_descent_to_local_minimum(const CellGrid& grid, int vx, int vy, int vz, unsigned seed) {
+void expect_descent_to_local_minimum(const FaceGrid& grid, int vx, int vy, int vz, unsigned seed) {
   std::mt19937 rng(seed);
   FaceTable table(vx, vy, vz, grid.dimension);
   const int empty = table.add_uniform(0);

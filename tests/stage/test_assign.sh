@@ -1,0 +1,63 @@
+#!/bin/bash
+# msfab-assign (designs written by hand, thesis Table 3.1 cubes): a tiny 3D
+# set, a 2x2x2 cube of one structure mapped back with one candidate and
+# checked at full resolution, which must give exactly what msfab-verify-map's
+# own periodic tiling (fill: tile) gives on the same design; layers and
+# random patterns; bad input exits 2 naming the file or key, writing nothing.
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+A="$BIN/msfab-assign"
+
+cat > "$WORK/set.yaml" <<'Y'
+space: cubic3d
+resolution: 8
+materials:
+  stiff: {E: 1.0e6, nu: 0.3}
+population: 16
+cycles: 1
+initial_beams: 2
+beams: {max: 2, min_radius: 0.5, max_radius: 1.5}
+continuous: {per_cycle: 0}
+level_set: {cells: 8}
+Y
+check "a tiny 3D set" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 3 --out "$WORK/set.gamut.h5" --quiet
+S="$WORK/set.microstructures.h5"
+C="$SRC/configs/assign/cube.yaml"
+check "a uniform cube" -- "$A" --config "$C" --structures "$S" --set 'pattern.structures=[3]' \
+  --out "$WORK/cube.design.h5" --quiet
+check "mapped with one candidate" -- "$BIN/msfab-map" --design "$WORK/cube.design.h5" --structures "$S" \
+  --set candidates=1 --set half_shift=false --out "$WORK/cube.mapped.h5" --quiet
+map_out=$("$BIN/msfab-map" --design "$WORK/cube.design.h5" --structures "$S" --set candidates=1 \
+  --set half_shift=false --out "$WORK/cube2.mapped.h5" 2>&1)
+check "every cell at its target (distance and property gap 0)" -- \
+  grep -q "distance to target: max 0 .*property gap .*max 0, mean 0" <<<"$(tr '\n' ' ' <<<"$map_out")"
+V=(--design "$WORK/cube.design.h5" --mapped "$WORK/cube.mapped.h5" --structures "$S")
+mapped=$("$BIN/msfab-verify-map" "${V[@]}" --out "$WORK/cube.verify.h5" 2>&1 | grep '^msfab-verify-map:')
+tiled=$("$BIN/msfab-verify-map" "${V[@]}" --set fill=tile --set tile_structure=3 --out "$WORK/tile.verify.h5" 2>&1 |
+  grep '^msfab-verify-map:')
+numbers() { sed -e 's/fill [a-z]*//' -e 's/homogenized [0-9.]* s/homogenized/' -e 's/full [0-9.]* s/full/' -e 's/;[^;]*h5$//' <<<"$1"; }
+check "assigned cube = verify-map's tiling of structure 3" -- test -n "$mapped" -a "$(numbers "$mapped")" = "$(numbers "$tiled")"
+
+check "layers along x" -- "$A" --config "$C" --structures "$S" --set 'pattern={kind: layers, structures: [1, 4], axis: x}' \
+  --out "$WORK/layers.design.h5" --quiet
+check "random over three" -- "$A" --config "$C" --structures "$S" --set 'pattern={kind: random, structures: [0, 2, 5]}' \
+  --seed 4 --out "$WORK/random.design.h5" --quiet
+check "the random design checks at full resolution" -- bash -c "'$BIN/msfab-map' --design '$WORK/random.design.h5' \
+  --structures '$S' --set candidates=1 --out '$WORK/random.mapped.h5' --quiet && '$BIN/msfab-verify-map' \
+  --design '$WORK/random.design.h5' --mapped '$WORK/random.mapped.h5' --structures '$S' --out '$WORK/random.verify.h5' --quiet"
+
+OUT="$WORK/bad.design.h5"
+expect_exit 2 "--structures is required" -- "$A" --config "$C" --out "$OUT"
+expect_exit 2 "pattern.structures = .*index 999 is outside the set .*set.microstructures.h5" -- \
+  "$A" --config "$C" --structures "$S" --set 'pattern.structures=[999]' --out "$OUT"
+expect_exit 2 "pattern.structures = .*a uniform pattern takes exactly one structure" -- \
+  "$A" --config "$C" --structures "$S" --set 'pattern.structures=[1, 2]' --out "$OUT"
+expect_exit 2 "pattern.kind = .*stripes" -- "$A" --config "$C" --structures "$S" --set pattern.kind=stripes --out "$OUT"
+expect_exit 2 "pattern.axis = w" -- "$A" --config "$C" --structures "$S" --set pattern.kind=layers --set pattern.axis=w --out "$OUT"
+expect_exit 2 "pattern.thickness = 0: must be >= 1" -- "$A" --config "$C" --structures "$S" --set pattern.thickness=0 --out "$OUT"
+expect_exit 2 "space = cubic2d: is cubic2d, the set .*holds cubic3d structures" -- \
+  "$A" --config "$C" --structures "$S" --set space=cubic2d --set 'grid.size=[2, 2]' --out "$OUT"
+expect_exit 2 "unknown key 'patern'" -- "$A" --config "$C" --structures "$S" --set 'patern.kind=uniform' --out "$OUT"
+expect_exit 2 "expected schema 'msfab.microstructures'" -- "$A" --config "$C" --structures "$WORK/set.gamut.h5" --out "$OUT"
+check "nothing written on bad input" -- bash -c "! ls '$WORK'/bad.* 2>/dev/null | grep -q ."
+finish
