@@ -13,6 +13,8 @@ std::string size_problem(const MappedDesign& m) {
   if (m.dimension != 2 && m.dimension != 3) return "dimension must be 2 or 3";
   if (m.nx < 1 || m.ny < 1 || m.nz < 1 || (m.dimension == 2 && m.nz != 1)) return "bad cell grid";
   if (m.vx < 1 || m.vy < 1 || m.vz < 1 || (m.dimension == 2 && m.vz != 1)) return "bad voxels per cell";
+  if (m.tiling < 1 || m.tiling > kMaxTiling)
+    return "attribute tiling is " + std::to_string(m.tiling) + " (expected 1.." + std::to_string(kMaxTiling) + ")";
   const std::size_t n = std::size_t(m.cells());
   if (m.roles.size() != n) return "/cells/role must have one entry per cell";
   if (m.structure.size() != n) return "/cells/structure must have one entry per cell";
@@ -46,6 +48,7 @@ void write_mapped_artifact(const std::string& path, const MappedDesign& m, const
   f.write_attribute("/", "grid", std::vector<std::int32_t>{m.nx, m.ny, m.nz});
   f.write_attribute("/", "cell_size", m.cell_size);
   f.write_attribute("/", "cell_voxels", std::vector<std::int32_t>{m.vx, m.vy, m.vz});
+  f.write_attribute("/", "tiling", static_cast<std::int32_t>(m.tiling));
   f.write_attribute("/", "candidates_k", static_cast<std::int32_t>(m.k));
   f.write_attribute("/", "radius", m.radius);
   f.write_attribute("/", "half_shift", static_cast<std::int32_t>(m.half_shift));
@@ -102,6 +105,8 @@ MappedDesign read_mapped_artifact(const std::string& path) {
   if (voxels.size() != 3) throw InputError(path + ": attribute cell_voxels must have 3 entries");
   m.nx = grid[0], m.ny = grid[1], m.nz = grid[2];
   m.vx = voxels[0], m.vy = voxels[1], m.vz = voxels[2];
+  // Artifacts written before tilings existed hold one structure per cell.
+  if (f.has_attribute("/", "tiling")) m.tiling = f.read_attribute<std::int32_t>("/", "tiling");
   m.cell_size = f.read_attribute<double>("/", "cell_size");
   m.k = f.read_attribute<std::int32_t>("/", "candidates_k");
   m.radius = f.read_attribute<double>("/", "radius");

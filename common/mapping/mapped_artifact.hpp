@@ -16,6 +16,7 @@ namespace msfab {
 
 inline constexpr const char* kMappedSchema = "msfab.mapped";
 inline constexpr int kMappedSchemaVersion = 1;
+inline constexpr int kMaxTiling = 16;  // copies of a structure per cell edge
 
 struct MappedDesign {
   std::string space;                       // the design's (and the set's) material space
@@ -23,7 +24,12 @@ struct MappedDesign {
   int dimension = 2;
   int nx = 0, ny = 0, nz = 1;              // cells
   double cell_size = 1.0;                  // cell edge (m)
-  int vx = 0, vy = 0, vz = 1;              // voxels per cell (the structures' size)
+  int vx = 0, vy = 0, vz = 1;              // voxels per structure (the structures' size)
+  // Copies of its structure per cell edge (thesis §3.6: a cell replaced by
+  // a tiling of its microstructure, which shrinks the boundary layers the
+  // periodic homogenization leaves out): a cell is tiling x vx voxels wide
+  // (and tiling x vz high in 3D; a 2D model stays one voxel thick).
+  int tiling = 1;
   std::vector<CellRole> roles;             // per cell, from the design
   std::vector<std::int32_t> structure;     // per cell, index into the set; -1 for forced empty / solid cells
   std::vector<std::uint8_t> shift;         // per cell, 1: the half-shifted exemplar

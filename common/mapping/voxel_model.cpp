@@ -36,33 +36,34 @@ VoxelModel::VoxelModel(const MappedDesign& mapped, const MicrostructureSet& set)
 }
 
 Vec3 VoxelModel::voxel_size() const {
-  const double hx = m_.cell_size / m_.vx, hy = m_.cell_size / m_.vy;
-  return {hx, hy, m_.dimension == 3 ? m_.cell_size / m_.vz : hx};
+  const double hx = m_.cell_size / cell_voxels_x(), hy = m_.cell_size / cell_voxels_y();
+  return {hx, hy, m_.dimension == 3 ? m_.cell_size / cell_voxels_z() : hx};
 }
 
 void VoxelModel::layer(std::int64_t z, std::vector<int>& ids) const {
   const std::int64_t NX = nx(), NY = ny();
   ids.resize(std::size_t(NX * NY));
-  const int vx = m_.vx, vy = m_.vy, vz = m_.vz;
-  const std::int64_t k = z / vz;
+  const int vx = m_.vx, vy = m_.vy, vz = m_.vz, t = m_.tiling;
+  const std::int64_t k = z / cell_voxels_z();
   const int lz = int(z % vz);
 #pragma omp parallel for schedule(static)
   for (std::int64_t Y = 0; Y < NY; ++Y) {
-    const std::int64_t j = Y / vy;
+    const std::int64_t j = Y / cell_voxels_y();
     const int ly = int(Y % vy);
     int* row = &ids[std::size_t(Y * NX)];
     for (std::int64_t i = 0; i < m_.nx; ++i) {
       const std::size_t cell = std::size_t(i + m_.nx * (j + m_.ny * k));
-      int* out = row + i * vx;
+      int* out = row + i * std::int64_t(vx) * t;
       if (m_.roles[cell] != CellRole::design) {
-        std::fill(out, out + vx, m_.roles[cell] == CellRole::solid ? 1 : 0);
+        std::fill(out, out + std::int64_t(vx) * t, m_.roles[cell] == CellRole::solid ? 1 : 0);
         continue;
       }
       const std::vector<int>& s = set_.items[std::size_t(m_.structure[cell])].ids;
       const bool shift = m_.shift[cell] != 0;
       const int sx = shift ? vx / 2 : 0, y = shift ? (ly + vy / 2) % vy : ly, zz = shift ? (lz + vz / 2) % vz : lz;
       const int* src = &s[std::size_t(vx) * (y + std::size_t(vy) * zz)];
-      for (int x = 0; x < vx; ++x) out[x] = src[(x + sx) % vx];
+      for (int copy = 0; copy < t; ++copy, out += vx)
+        for (int x = 0; x < vx; ++x) out[x] = src[(x + sx) % vx];
     }
   }
 }
@@ -84,13 +85,16 @@ void write_voxels_artifact(const std::string& path, const VoxelModel& model, con
   f.write_attribute("/", "voxel_size", std::vector<double>{h.x(), h.y(), h.z()});
   f.write_attribute("/", "dimension", static_cast<std::int32_t>(m.dimension));
   f.write_attribute("/", "grid", std::vector<std::int32_t>{m.nx, m.ny, m.nz});
-  f.write_attribute("/", "cell_voxels", std::vector<std::int32_t>{m.vx, m.vy, m.vz});
+  f.write_attribute("/", "cell_voxels",
+                    std::vector<std::int32_t>{model.cell_voxels_x(), model.cell_voxels_y(), model.cell_voxels_z()});
+  f.write_attribute("/", "tiling", static_cast<std::int32_t>(m.tiling));
 
   // Chunks of about 1 MiB: whole layers (up to one layer of cells) when a
   // layer is small, parts of a layer when it is large.
   constexpr std::size_t kChunk = std::size_t(1) << 20;
   const std::size_t chunk_cols = std::min(row_bytes, kChunk);
-  const std::size_t chunk_rows = std::clamp<std::size_t>(kChunk / chunk_cols, 1, std::size_t(m.vz));
+  const int cz = model.cell_voxels_z();  // voxel layers per layer of cells
+  const std::size_t chunk_rows = std::clamp<std::size_t>(kChunk / chunk_cols, 1, std::size_t(cz));
   f.create_chunked_dataset<std::uint8_t>("/voxels", {hsize_t(model.nz()), hsize_t(row_bytes)},
                                          {hsize_t(chunk_rows), hsize_t(chunk_cols)}, 4);
   f.write_attribute("/voxels", "bits_per_voxel", static_cast<std::int32_t>(bits));
@@ -99,16 +103,16 @@ void write_voxels_artifact(const std::string& path, const VoxelModel& model, con
                     "padded to whole bytes");
   f.write_attribute("/voxels", "ids", model.max_id() == 1 ? "0 void, 1 stiff" : "0 void, 1 stiff, 2 soft");
 
-  std::vector<std::uint8_t> slab(std::size_t(m.vz) * row_bytes);
+  std::vector<std::uint8_t> slab(std::size_t(cz) * row_bytes);
   std::vector<int> ids;
   Progress progress("voxel file", std::uint64_t(m.nz));
   for (int k = 0; k < m.nz; ++k) {
-    for (int lz = 0; lz < m.vz; ++lz) {
-      model.layer(std::int64_t(k) * m.vz + lz, ids);
+    for (int lz = 0; lz < cz; ++lz) {
+      model.layer(std::int64_t(k) * cz + lz, ids);
       const std::vector<std::uint8_t> packed = pack_voxels(ids, bits);
       std::copy(packed.begin(), packed.end(), slab.begin() + std::ptrdiff_t(lz * row_bytes));
     }
-    f.write_slab("/voxels", slab.data(), {hsize_t(k) * hsize_t(m.vz), 0}, {hsize_t(m.vz), hsize_t(row_bytes)});
+    f.write_slab("/voxels", slab.data(), {hsize_t(k) * hsize_t(cz), 0}, {hsize_t(cz), hsize_t(row_bytes)});
     progress.tick();
   }
   progress.done();

@@ -8,8 +8,9 @@
 // every export streams layer by layer, so memory stays at a few layers
 // (plus one layer of cells for the voxel file) whatever the model's size.
 //
-// Voxel (X, Y, Z) lies in cell (X / vx, Y / vy, Z / vz) at local
-// (x, y, z) = (X mod vx, ...); a design cell holding structure s with the
+// Voxel (X, Y, Z) lies in cell (X / (t vx), Y / (t vy), Z / (t vz)), t the
+// mapping's tiling (1 unless each cell holds t^3 copies of its structure;
+// no tiling along z in 2D), at local (x, y, z) = (X mod vx, ...); a design cell holding structure s with the
 // half shift reads s at ((x + vx/2) mod vx, (y + vy/2) mod vy,
 // (z + vz/2) mod vz), as half_shifted() builds it. Forced empty cells are id
 // 0 (void), forced solid cells id 1 (the stiff material).
@@ -32,12 +33,16 @@ class VoxelModel {
   // the mapping does not fit the set (voxels per cell, structure indices).
   VoxelModel(const MappedDesign& mapped, const MicrostructureSet& set);
 
-  std::int64_t nx() const { return std::int64_t(m_.nx) * m_.vx; }
-  std::int64_t ny() const { return std::int64_t(m_.ny) * m_.vy; }
-  std::int64_t nz() const { return std::int64_t(m_.nz) * m_.vz; }
+  std::int64_t nx() const { return std::int64_t(m_.nx) * m_.vx * m_.tiling; }
+  std::int64_t ny() const { return std::int64_t(m_.ny) * m_.vy * m_.tiling; }
+  std::int64_t nz() const { return std::int64_t(m_.nz) * m_.vz * tiling_z(); }
+  // Voxels per cell edge along x, y, z.
+  int cell_voxels_x() const { return m_.vx * m_.tiling; }
+  int cell_voxels_y() const { return m_.vy * m_.tiling; }
+  int cell_voxels_z() const { return m_.vz * tiling_z(); }
   std::int64_t voxels() const { return nx() * ny() * nz(); }
   int max_id() const { return set_.soft_is_void ? 1 : 2; }
-  // Edge lengths of a voxel (m): cell_size / voxels per cell; a 2D model is
+  // Edge lengths of a voxel (m): cell_size / voxels per cell edge; a 2D model is
   // one voxel thick, as thick as a voxel is wide.
   Vec3 voxel_size() const;
   const MappedDesign& mapping() const { return m_; }
@@ -46,6 +51,7 @@ class VoxelModel {
   void layer(std::int64_t z, std::vector<int>& ids) const;
 
  private:
+  int tiling_z() const { return m_.dimension == 3 ? m_.tiling : 1; }
   const MappedDesign& m_;
   const MicrostructureSet& set_;
 };

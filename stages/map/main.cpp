@@ -34,6 +34,7 @@ constexpr const char* kDefaults = R"(
 candidates: 16          # nearest structures per cell
 half_shift: true        # also offer every candidate translated by half a cell
 max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
+tiling: 1               # copies of its structure per cell edge (each cell holds tiling^3 smaller copies)
 export:
   voxels: false         # <stem>.voxels.h5, bit-packed, written layer by layer
   stl: false            # <stem>.material<id>.stl per material
@@ -48,6 +49,7 @@ struct ExportOptions {
 
 struct Settings {
   MapperOptions mapper;
+  int tiling = 1;
   ExportOptions exports;
 };
 
@@ -59,6 +61,8 @@ Settings read_settings(const Config& config) {
   s.mapper.half_shift = config.get_or<bool>("half_shift", true);
   s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
   if (!(s.mapper.max_distance > 0)) config.fail("max_distance", "must be > 0");
+  s.tiling = config.get_or<int>("tiling", 1);
+  if (s.tiling < 1 || s.tiling > kMaxTiling) config.fail("tiling", "must be 1.." + std::to_string(kMaxTiling));
   s.exports.voxels = config.get_or<bool>("export.voxels", false);
   s.exports.stl = config.get_or<bool>("export.stl", false);
   s.exports.png = config.get_or<bool>("export.png", false);
@@ -98,7 +102,8 @@ int main(int argc, char** argv) {
     const MicrostructureSet set = read_microstructures_artifact(structures_path);
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
-    const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz;
+    const std::int64_t tiles = std::int64_t(settings.tiling) * settings.tiling * (design.dimension == 3 ? settings.tiling : 1);
+    const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz * tiles;
     if (settings.exports.stl && model_voxels > settings.exports.stl_max_voxels)
       ctx.config.fail("export.stl", "the model has " + std::to_string(model_voxels) +
                                         " voxels, more than export.stl_max_voxels = " +
@@ -119,7 +124,8 @@ int main(int argc, char** argv) {
     spdlog::info("final mismatch {} after {} moves ({} cells evaluated)", descent.final, descent.moves,
                  descent.evaluations);
     // 4. The mapping artifact.
-    const MappedDesign mapped = mapped_design(design, set, candidates, problem, descent, settings.mapper);
+    MappedDesign mapped = mapped_design(design, set, candidates, problem, descent, settings.mapper);
+    mapped.tiling = settings.tiling;
     const double mapping_seconds = seconds_since(start);
     write_mapped_artifact(out, mapped, "msfab-map", ctx.config.resolved_text(), {design_path, structures_path},
                           ctx.options.seed);
@@ -140,6 +146,8 @@ int main(int argc, char** argv) {
     const double mean_cand = distances.design_cells ? double(sum_cand) / double(distances.design_cells) : 0.0;
     std::printf("msfab-map: %lld cells (%d x %d x %d, %lld to map), %.3f s\n", static_cast<long long>(design.cells()),
                 design.nx, design.ny, design.nz, static_cast<long long>(distances.design_cells), mapping_seconds);
+    if (settings.tiling > 1)
+      std::printf("  tiling: %d^%d copies of its structure per cell\n", settings.tiling, design.dimension);
     std::printf("  candidates per cell: %.1f (min %lld, max %lld)%s\n", mean_cand, static_cast<long long>(min_cand),
                 static_cast<long long>(max_cand), settings.mapper.half_shift ? ", each with its half-shifted exemplar" : "");
     const double drop = descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;

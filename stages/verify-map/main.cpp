@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
     }
     const TopoptScene scene = scene_for(scene_path, design, design_path);
     const CellGrid& coarse = scene.setup.grid;
-    const int r = set.nx;
+    const int r = set.nx * mapped.tiling;  // voxels per cell edge
 
     LinearSolverOptions solver_options;
     solver_options.threads = ctx.options.threads;
@@ -257,6 +257,7 @@ int main(int argc, char** argv) {
     report.grid[0] = coarse.nx(), report.grid[1] = coarse.ny(), report.grid[2] = coarse.nz();
     report.cell_size = coarse.h();
     report.resolution = r;
+    report.tiling = mapped.tiling;
     report.void_ratio = settings.remove_void ? 0.0 : settings.void_ratio;
     report.void_model = settings.remove_void ? "remove" : "ersatz";
 
@@ -425,9 +426,10 @@ int main(int argc, char** argv) {
       hom_solve += c.solve_seconds_homogenized;
     }
     const std::string elements = m > 1 ? ", " + std::to_string(m) + "^3 elements per cell" : "";
-    std::printf("msfab-verify-map: %d x %d x %d cells, %lld voxels (%d^3 per cell, fill %s)%s; homogenized %.3f s "
+    const std::string tiles = mapped.tiling > 1 ? ", " + std::to_string(mapped.tiling) + "^3 copies per cell" : "";
+    std::printf("msfab-verify-map: %d x %d x %d cells, %lld voxels (%d^3 per cell%s, fill %s)%s; homogenized %.3f s "
                 "(%s%s), full %.3f s (%s, %lld unknowns); %s\n",
-                coarse.nx(), coarse.ny(), coarse.nz(), static_cast<long long>(report.voxels), r,
+                coarse.nx(), coarse.ny(), coarse.nz(), static_cast<long long>(report.voxels), r, tiles.c_str(),
                 report.fill.c_str(), cases.c_str(), report.seconds_factorize_homogenized + hom_solve,
                 report.solver_homogenized.c_str(), elements.c_str(), report.seconds_factorize_full + full_solve,
                 report.solver_full.c_str(), static_cast<long long>(report.unknowns_full), out.c_str());

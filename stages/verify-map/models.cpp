@@ -57,7 +57,8 @@ std::vector<std::uint8_t> model_voxels(const MappedDesign& mapped, const Microst
       for (std::int64_t y = 0; y < NY; ++y)
         for (std::int64_t x = 0; x < NX; ++x) {
           const std::size_t cell =
-              std::size_t(x / mapped.vx + mapped.nx * (y / mapped.vy + std::int64_t(mapped.ny) * (z / mapped.vz)));
+              std::size_t(x / model.cell_voxels_x() +
+                          mapped.nx * (y / model.cell_voxels_y() + std::int64_t(mapped.ny) * (z / model.cell_voxels_z())));
           ids[std::size_t(x + NX * (y + NY * z))] = mapped.roles[cell] == CellRole::empty ? 0 : 1;
         }
   }

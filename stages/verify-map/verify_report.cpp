@@ -14,6 +14,7 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "grid", std::vector<std::int32_t>{r.grid[0], r.grid[1], r.grid[2]});
   f.write_attribute("/", "cell_size", r.cell_size);
   f.write_attribute("/", "cell_voxels", static_cast<std::int32_t>(r.resolution));
+  f.write_attribute("/", "tiling", static_cast<std::int32_t>(r.tiling));
   f.write_attribute("/", "voxel_grid", std::vector<std::int64_t>{std::int64_t(r.grid[0]) * r.resolution,
                                                                  std::int64_t(r.grid[1]) * r.resolution,
                                                                  std::int64_t(r.grid[2]) * r.resolution});

@@ -30,6 +30,7 @@ struct VerifyReport {
   int grid[3] = {0, 0, 0};
   double cell_size = 1;
   int resolution = 0;  // voxels per cell edge
+  int tiling = 1;      // copies of its structure per cell edge (the mapping's)
   std::int64_t voxels = 0, material_voxels = 0;
   double void_ratio = 0;
   std::string void_model;  // remove | ersatz

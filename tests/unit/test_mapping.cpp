@@ -400,6 +400,11 @@ TEST(Mapping, MappedDesignMatchesTheVoxelsAndTheTargets) {
   EXPECT_EQ(back.nx, 4);
   EXPECT_EQ(back.vz, 2);
   EXPECT_EQ(back.k, 5);
+  EXPECT_EQ(back.tiling, 1);
+  MappedDesign tiled = m;
+  tiled.tiling = 3;
+  write_mapped_artifact(path, tiled, "test", "", {}, 9);
+  EXPECT_EQ(read_mapped_artifact(path).tiling, 3);
 }
 
 // A cubic3d set and design with physical properties (E, nu, G, rho), so
@@ -500,6 +505,45 @@ struct SmallModel {
     return cell[std::size_t(X % 4 + 4 * (Y % 3 + 3 * (Z % 2)))];
   }
 };
+
+// A cell tiled t times holds t^3 copies of its structure (same exemplar):
+// voxel (X, Y, Z) is the untiled model's voxel of the same cell at the
+// position within one copy.
+TEST(Mapping, TiledCellsRepeatTheirStructure) {
+  for (int t : {2, 3}) {
+    SmallModel small;
+    small.m.tiling = t;
+    const VoxelModel model(small.m, small.set);
+    ASSERT_EQ(model.nx(), 12 * t);
+    ASSERT_EQ(model.ny(), 6 * t);
+    ASSERT_EQ(model.nz(), 4 * t);
+    EXPECT_DOUBLE_EQ(model.voxel_size()[0], 0.012 / (4 * t));
+    std::vector<int> layer;
+    for (std::int64_t Z = 0; Z < model.nz(); ++Z) {
+      model.layer(Z, layer);
+      for (std::int64_t Y = 0; Y < model.ny(); ++Y)
+        for (std::int64_t X = 0; X < model.nx(); ++X) {
+          // Cell of the tiled voxel, then the voxel inside one copy.
+          const std::int64_t cx = X / (4 * t), cy = Y / (3 * t), cz = Z / (2 * t);
+          ASSERT_EQ(layer[std::size_t(X + model.nx() * Y)], small.id(4 * cx + X % 4, 3 * cy + Y % 3, 2 * cz + Z % 2))
+              << t << ": " << X << " " << Y << " " << Z;
+        }
+    }
+    // The voxel file holds every layer of the tiled model.
+    const std::string path = scratch("tiled.voxels.h5").string();
+    write_voxels_artifact(path, model, "test", "", {}, 0);
+    const VoxelsReader in(path);
+    ASSERT_EQ(in.nz(), model.nz());
+    for (std::int64_t Z = 0; Z < model.nz(); ++Z) {
+      model.layer(Z, layer);
+      ASSERT_EQ(in.layer(Z), layer) << t << ": layer " << Z;
+    }
+  }
+  SmallModel bad;
+  bad.m.tiling = 0;
+  EXPECT_THROW(write_mapped_artifact(scratch("bad_tiling.mapped.h5").string(), bad.m, "test", "", {}, 0),
+               std::invalid_argument);
+}
 
 TEST(Mapping, VoxelFileReadsBackAsTheAssembledModel) {
   const SmallModel small;
