@@ -7,14 +7,17 @@
 #   make -f Makefile.pipeline topopt-gripper-check   the gripper as a 32x16x2 plate (512x256x32 voxels)
 #   make -f Makefile.pipeline topopt-bridge-check    a 24x6x4 bridge (384x96x64 voxels)
 #   make -f Makefile.pipeline topopt-checks          all three
+#   make -f Makefile.pipeline topopt-cubes           Table 3.1's cubes and the tiling study (Fig. 3-23) in
+#                                                    the same gamut: out/topopt/cubes.md (tools/bench_cubes.sh)
 #
 # Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.{design,mapped}.h5
 # (the mapping with its STL surfaces and PNG slice stack for the bar and the
 # gripper, the voxel model for all), and S.verify.h5, the thesis's comparison
 # (one hexahedron per cell). The bar adds bar.h4.verify.h5 (the homogenized
 # model with 4^3 hexahedra per cell: the homogenization's own error, without
-# most of the coarse mesh's stiffness) and bar.solid.verify.h5 (every cell
-# solid: the coarse mesh's error alone). Each check prints one summary line
+# most of the coarse mesh's stiffness), bar.solid.verify.h5 (every cell
+# solid: the coarse mesh's error alone) and bar.t2.verify.h5 (each cell 2^3
+# copies of its structure, 4^3 hexahedra per cell: thinner boundary layers). Each check prints one summary line
 # (docs/verify_map.md). SEED (pipelines/gamut.mk) seeds the gamut and the mapping.
 BAR_GAMUT := $(OUT)/gamut/cubic3d_bar
 TWO_SCALE_SCENES := bar gripper3d bridge_cubic
@@ -49,8 +52,25 @@ $(OUT)/topopt/bar.solid.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
 	  --structures $(BAR_GAMUT).microstructures.h5 --set fill=solid --threads $(THREADS) --out $@
 
-.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-checks
-topopt-bar-check: build $(OUT)/topopt/bar.verify.h5 $(OUT)/topopt/bar.h4.verify.h5 $(OUT)/topopt/bar.solid.verify.h5
+$(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(BAR_GAMUT).microstructures.h5 --seed $(SEED) --set tiling=2 \
+	  --threads $(THREADS) --out $@ --quiet
+
+$(OUT)/topopt/bar.t2.verify.h5: $(OUT)/topopt/bar.t2.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
+	  --structures $(BAR_GAMUT).microstructures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
+
+$(OUT)/topopt/cubes.md: $(BAR_GAMUT).microstructures.h5 tools/bench_cubes.sh configs/assign/cube.yaml \
+    $(BIN)/msfab-assign $(BIN)/msfab-map $(BIN)/msfab-verify-map
+	@mkdir -p $(@D)
+	bash tools/bench_cubes.sh $(BIN) $(OUT)/topopt/cubes $(BAR_GAMUT).microstructures.h5 > $@.tmp
+	mv $@.tmp $@
+	@cat $@
+
+.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-checks topopt-cubes
+topopt-bar-check: build $(OUT)/topopt/bar.verify.h5 $(OUT)/topopt/bar.h4.verify.h5 $(OUT)/topopt/bar.solid.verify.h5 \
+    $(OUT)/topopt/bar.t2.verify.h5
+topopt-cubes: build $(OUT)/topopt/cubes.md
 topopt-gripper-check: build $(OUT)/topopt/gripper3d.verify.h5
 topopt-bridge-check: build $(OUT)/topopt/bridge_cubic.verify.h5
 topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check

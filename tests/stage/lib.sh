@@ -32,3 +32,22 @@ finish() {
   echo "$PASSES checks passed, $FAILURES failed"
   [ "$FAILURES" = 0 ]
 }
+
+# tiny_cubic3d_set CYCLES: a tiny 3D cubic gamut of one material and void
+# (8^3 voxels per cell, 16 particles, seed 3) as $WORK/set.gamut.h5 and
+# $WORK/set.microstructures.h5, in about a second per cycle.
+tiny_cubic3d_set() {
+  cat > "$WORK/set.yaml" <<Y
+space: cubic3d
+resolution: 8
+materials:
+  stiff: {E: 1.0e6, nu: 0.3}
+population: 16
+cycles: $1
+initial_beams: 2
+beams: {max: 2, min_radius: 0.5, max_radius: 1.5}
+continuous: {per_cycle: 0}
+level_set: {cells: 8}
+Y
+  check "a tiny 3D gamut" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 3 --out "$WORK/set.gamut.h5" --quiet
+}

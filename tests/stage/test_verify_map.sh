@@ -12,19 +12,7 @@ BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 V="$BIN/msfab-verify-map"
 
-cat > "$WORK/set.yaml" <<'Y'
-space: cubic3d
-resolution: 8
-materials:
-  stiff: {E: 1.0e6, nu: 0.3}
-population: 16
-cycles: 2
-initial_beams: 2
-beams: {max: 2, min_radius: 0.5, max_radius: 1.5}
-continuous: {per_cycle: 0}
-level_set: {cells: 8}
-Y
-check "a tiny 3D gamut" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 3 --out "$WORK/set.gamut.h5" --quiet
+tiny_cubic3d_set 2
 S="$WORK/set.microstructures.h5"
 cat > "$WORK/bar.yaml" <<Y
 grid: {size: [4, 2, 2], cell_size: 1.0}
