@@ -23,9 +23,15 @@ std::vector<std::int32_t> pattern_structures(const CellGrid& grid, const std::ve
     if (roles[std::size_t(c)] != CellRole::design) continue;
     std::int64_t pick = 0;
     switch (pattern.kind) {
-      case PatternKind::uniform: pick = 0; break;
-      case PatternKind::layers: pick = (grid.cell_coords(c)[std::size_t(pattern.axis)] / pattern.thickness) % count; break;
-      case PatternKind::random: pick = std::int64_t(hash_seed(pattern.seed, std::uint64_t(c)) % std::uint64_t(count)); break;
+      case PatternKind::uniform:
+        pick = 0;
+        break;
+      case PatternKind::layers:
+        pick = (grid.cell_coords(c)[std::size_t(pattern.axis)] / pattern.thickness) % count;
+        break;
+      case PatternKind::random:
+        pick = std::int64_t(hash_seed(pattern.seed, std::uint64_t(c)) % std::uint64_t(count));
+        break;
     }
     out[std::size_t(c)] = pattern.structures[std::size_t(pick)];
   }

@@ -102,7 +102,8 @@ int main(int argc, char** argv) {
     const MicrostructureSet set = read_microstructures_artifact(structures_path);
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
-    const std::int64_t tiles = std::int64_t(settings.tiling) * settings.tiling * (design.dimension == 3 ? settings.tiling : 1);
+    const std::int64_t tiles =
+        std::int64_t(settings.tiling) * settings.tiling * (design.dimension == 3 ? settings.tiling : 1);
     const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz * tiles;
     if (settings.exports.stl && model_voxels > settings.exports.stl_max_voxels)
       ctx.config.fail("export.stl", "the model has " + std::to_string(model_voxels) +
