@@ -9,10 +9,29 @@
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
 #include "material/neo_hookean.hpp"
+#include "scene/scene.hpp"
 
 namespace msfab::ddfem_test {
 
 constexpr double kVoxel = 1e-3;
+
+// A cantilever along y: the face y = 0 clamped, the face y = max loaded
+// by `traction`.
+inline void clamp_y0_load_top(Scene& s, const Vec3& traction) {
+  BoundaryCondition clamp;
+  clamp.where = "boundary[0]";
+  clamp.region.kind = Region::Kind::Face;
+  clamp.region.axis = 1;
+  clamp.fix[0] = clamp.fix[1] = clamp.fix[2] = true;
+  s.boundary.push_back(clamp);
+  Load load;
+  load.where = "loads[0]";
+  load.region.kind = Region::Kind::Face;
+  load.region.axis = 1;
+  load.region.upper = true;
+  load.value = traction;
+  s.loads.push_back(load);
+}
 
 // Ids 1 (soft) and 2 (stiff), nu = 0.3; id 0 is void.
 inline std::vector<MaterialPtr> two_materials(double E_soft, double E_stiff) {

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "ddfem/adaptive_levels.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarsening_error.hpp"
@@ -34,19 +35,7 @@ Scene two_material_block() {
   s.grid.at(5, 6, 2) = 0;
   s.grid.at(1, 9, 6) = 0;
   s.material_by_id = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e6, 0.45)};
-  BoundaryCondition clamp;
-  clamp.where = "boundary[0]";
-  clamp.region.kind = Region::Kind::Face;
-  clamp.region.axis = 1;
-  clamp.fix[0] = clamp.fix[1] = clamp.fix[2] = true;
-  s.boundary.push_back(clamp);
-  Load pull;
-  pull.where = "loads[0]";
-  pull.region.kind = Region::Kind::Face;
-  pull.region.axis = 1;
-  pull.region.upper = true;
-  pull.value = Vec3(0.3, 0.2, -0.1);
-  s.loads.push_back(pull);
+  ddfem_test::clamp_y0_load_top(s, Vec3(0.3, 0.2, -0.1));
   return s;
 }
 

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarse_grid.hpp"
 #include "ddfem/coarsening_error.hpp"
@@ -275,19 +276,7 @@ Scene layered_bar(bool aligned) {
         s.grid.at(i, j, k) = layer % 2 == 0 ? 1 : 2;
       }
   s.material_by_id = soft_stiff_palette();
-  BoundaryCondition clamp;
-  clamp.where = "boundary[0]";
-  clamp.region.kind = Region::Kind::Face;
-  clamp.region.axis = 1;
-  clamp.fix[0] = clamp.fix[1] = clamp.fix[2] = true;
-  s.boundary.push_back(clamp);
-  Load tip;
-  tip.where = "loads[0]";
-  tip.region.kind = Region::Kind::Face;
-  tip.region.axis = 1;
-  tip.region.upper = true;
-  tip.value = Vec3(0.2, 0, 0);
-  s.loads.push_back(tip);
+  ddfem_test::clamp_y0_load_top(s, Vec3(0.2, 0, 0));
   return s;
 }
 
