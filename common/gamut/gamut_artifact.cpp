@@ -46,6 +46,13 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
   f.write_attribute("/level_set", "padding", ls.padding());
   f.write_attribute("/level_set", "meaning",
                     "signed distance in normalized property space, negative inside; node i at lower + (i + 1/2) spacing");
+  if (g.bound_stiff.size() > 0) {
+    f.write_matrix("/bound/stiff", g.bound_stiff);
+    f.write_matrix("/bound/soft", g.bound_soft);
+    f.write_attribute("/bound", "meaning",
+                      "base-material tensors (Voigt, engineering shear; 2D: plane-strain xx, yy, xy block; soft zero "
+                      "for void): every structure has C <= rho stiff + (1 - rho) soft");
+  }
   std::vector<std::int32_t> cycle, samples, discrete, continuous;
   std::vector<double> cover, seconds;
   for (const GamutCycle& c : g.history) {
@@ -76,6 +83,13 @@ double read_padding(const H5File& f, const std::string& path) {
   return padding;
 }
 
+MatX read_bound_tensor(const H5File& f, const std::string& path, const std::string& name, int m) {
+  const MatX M = f.read_matrix<double>(name, m);
+  if (M.rows() != m) throw InputError(path + ": " + name + " must be " + std::to_string(m) + " x " + std::to_string(m));
+  if (!M.allFinite()) throw InputError(path + ": " + name + " has a value that is not finite");
+  return M;
+}
+
 }  // namespace
 
 Gamut read_gamut_artifact(const std::string& path) {
@@ -95,6 +109,11 @@ Gamut read_gamut_artifact(const std::string& path) {
                                            f.read_attribute<double>("/level_set", "lower"),
                                            f.read_attribute<double>("/level_set", "spacing"), phi.values,
                                            read_padding(f, path));
+  if (f.exists("/bound/stiff")) {
+    const int m = g.space == "cubic3d" ? 6 : 3;
+    g.bound_stiff = read_bound_tensor(f, path, "/bound/stiff", m);
+    g.bound_soft = read_bound_tensor(f, path, "/bound/soft", m);
+  }
   if (f.exists("/history/cycle")) {
     const auto cycle = f.read_vector<std::int32_t>("/history/cycle");
     const auto samples = f.read_vector<std::int32_t>("/history/samples");

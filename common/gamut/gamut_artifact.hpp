@@ -28,6 +28,12 @@ struct Gamut {
   double E_stiff = 0, decades = 4;
   GamutLevelSet level_set;
   std::vector<GamutCycle> history;
+  // The base materials as tensors of the space (3 x 3 plane-strain in-plane
+  // block in 2D, 6 x 6 in 3D; soft zero for void): every structure obeys
+  // the Voigt bound C <= rho C_stiff + (1 - rho) C_soft, which the topology
+  // optimizer imposes with the level set (topopt/voigt_bound.hpp). Empty in
+  // artifacts written before they were stored.
+  MatX bound_stiff, bound_soft;
 };
 
 // Fraction of the level-set nodes inside the unit cube with Phi <= 0: the

@@ -106,6 +106,7 @@ class OrthotropicModel : public CellMaterialModel {
   OrthotropicModel(UnitScale scale, const GamutLevelSet* ls) : scale_(scale), ls_(ls) {}
   std::string space() const override { return "orthotropic2d"; }
   std::vector<std::string> names() const override { return {"Ex", "Ey", "nu_xy", "G", "rho"}; }
+  VoigtBoundModes bound_modes() const override { return VoigtBoundModes::orthotropic2d; }
   int dimension() const override { return 2; }
   VecX raw(const VecX& p) const override {
     VecX r(5);
@@ -266,6 +267,22 @@ void CellMaterialModel::tensor(const VecX& p, MatX& C, std::vector<MatX>* dC) co
   if (!dC) return;
   dC->resize(dS.size());
   for (std::size_t k = 0; k < dS.size(); ++k) (*dC)[k] = -C * dS[k] * C;
+}
+
+void CellMaterialModel::set_voigt_bound(MatX stiff, MatX soft) {
+  const int m = voigt_size(dimension());
+  if (stiff.rows() != m || soft.rows() != m)
+    throw InputError("material space " + space() + ": the Voigt bound needs " + std::to_string(m) + " x " +
+                     std::to_string(m) + " base-material tensors");
+  bound_ = VoigtBound(std::move(stiff), std::move(soft), bound_modes());
+}
+
+VecX CellMaterialModel::bound_constraints(const VecX& p, MatX* jacobian) const {
+  if (!bound_.active()) return VecX();
+  MatX C;
+  std::vector<MatX> dC;
+  tensor(p, C, jacobian ? &dC : nullptr);
+  return bound_.evaluate(C, p[density_index()], jacobian ? &dC : nullptr, density_index(), jacobian);
 }
 
 double CellMaterialModel::constraint(const VecX& p, VecX* gradient) const {

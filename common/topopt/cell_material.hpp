@@ -25,6 +25,7 @@
 
 #include "core/types.hpp"
 #include "gamut/level_set.hpp"
+#include "topopt/voigt_bound.hpp"
 
 namespace msfab {
 
@@ -48,9 +49,24 @@ class CellMaterialModel {
   // A point to start from: inside the constraint where there is one.
   virtual VecX initial_point(double rho) const = 0;
 
+  // The Voigt bound C(p) <= rho C_stiff + (1 - rho) C_soft (voigt_bound.hpp)
+  // as bound_conditions() more per-cell conditions g(p) <= 0; none unless
+  // set (the gamut spaces, from the gamut artifact's base materials:
+  // Gamut::bound_stiff, bound_soft).
+  // InputError on tensors of the wrong size for the space's dimension.
+  void set_voigt_bound(MatX stiff, MatX soft);
+  int bound_conditions() const { return bound_.count(); }
+  // The conditions at p, with d g / d p (bound_conditions() x parameters()).
+  VecX bound_constraints(const VecX& p, MatX* jacobian) const;
+
  protected:
   // S(p) and dS/dp_k (m x m each).
   virtual void compliance(const VecX& p, MatX& S, std::vector<MatX>& dS) const = 0;
+  // Which conditions express the bound for this space's symmetry.
+  virtual VoigtBoundModes bound_modes() const { return VoigtBoundModes::cubic; }
+
+ private:
+  VoigtBound bound_;
 };
 
 struct CellMaterialSettings {

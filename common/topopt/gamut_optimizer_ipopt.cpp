@@ -19,16 +19,18 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
-// Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: one
-// Phi per design cell (when the space has a constraint), then the mass
-// budget (when asked for), scaled to a volume fraction.
+// Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: per
+// design cell (when the space has a constraint) Phi and the Voigt bound's
+// conditions (rows r * per_cell_ + c), then the mass budget
+// (when asked for), scaled to a volume fraction.
 class GamutProblem : public Ipopt::TNLP {
  public:
   GamutProblem(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings,
                OptimizationResult& result)
       : obj_(objective), model_(objective.model()), q0_(q0), settings_(settings), result_(result),
         rows_(q0.rows()), d_(q0.cols()), t0_(std::chrono::steady_clock::now()) {
-    gamut_rows_ = model_.has_constraint() ? rows_ : 0;
+    per_cell_ = model_.has_constraint() ? 1 + model_.bound_conditions() : 0;
+    gamut_rows_ = per_cell_ * rows_;
     const double V = obj_.grid().cell_volume();
     volume_ = V * double(obj_.grid().cells());
     if (settings.mass_limit) {
@@ -45,7 +47,7 @@ class GamutProblem : public Ipopt::TNLP {
     m = Index(gamut_rows_ + (settings_.mass_limit ? 1 : 0));
     const auto& H = obj_.filter().weights();
     const Eigen::Index per_row = obj_.filter().identity() ? 1 : 0;
-    nnz_jac = Index(gamut_rows_ * d_ * per_row + (per_row ? 0 : (gamut_rows_ ? H.nonZeros() * d_ : 0)) +
+    nnz_jac = Index(gamut_rows_ * d_ * per_row + (per_row ? 0 : per_cell_ * H.nonZeros() * d_) +
                     (settings_.mass_limit ? rows_ : 0));
     nnz_h = 0;
     style = C_STYLE;
@@ -96,8 +98,13 @@ class GamutProblem : public Ipopt::TNLP {
   }
 
   bool eval_g(Index n, const Number* x, bool, Index m, Number* g) override {
-    const MatX p = obj_.physical(as_q(n, x));
-    for (Eigen::Index r = 0; r < gamut_rows_; ++r) g[r] = model_.constraint(p.row(r).transpose(), nullptr);
+    if (per_cell_ > 0) {
+      const MatX p = obj_.physical(as_q(n, x));
+      for (Eigen::Index r = 0; r < rows_; ++r) {
+        const VecX c = cell_constraints(p.row(r).transpose(), nullptr);
+        for (Eigen::Index i = 0; i < per_cell_; ++i) g[r * per_cell_ + i] = c[i];
+      }
+    }
     if (settings_.mass_limit) g[m - 1] = obj_.mass(as_q(n, x)) / volume_;
     return true;
   }
@@ -107,12 +114,13 @@ class GamutProblem : public Ipopt::TNLP {
     const bool identity = obj_.filter().identity();
     Index e = 0;
     if (!values) {
-      for (Eigen::Index r = 0; r < gamut_rows_; ++r) {
+      for (Eigen::Index row = 0; row < gamut_rows_; ++row) {
+        const Eigen::Index r = row / per_cell_;
         if (identity) {
-          for (Eigen::Index k = 0; k < d_; ++k) iRow[e] = Index(r), jCol[e] = Index(r * d_ + k), ++e;
+          for (Eigen::Index k = 0; k < d_; ++k) iRow[e] = Index(row), jCol[e] = Index(r * d_ + k), ++e;
         } else {
           for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(H, r); it; ++it)
-            for (Eigen::Index k = 0; k < d_; ++k) iRow[e] = Index(r), jCol[e] = Index(it.col() * d_ + k), ++e;
+            for (Eigen::Index k = 0; k < d_; ++k) iRow[e] = Index(row), jCol[e] = Index(it.col() * d_ + k), ++e;
         }
       }
       if (settings_.mass_limit)
@@ -120,15 +128,17 @@ class GamutProblem : public Ipopt::TNLP {
           iRow[e] = Index(gamut_rows_), jCol[e] = Index(j * d_ + model_.density_index()), ++e;
       return true;
     }
-    const MatX p = obj_.physical(as_q(n, x));
-    for (Eigen::Index r = 0; r < gamut_rows_; ++r) {
-      VecX grad;
-      model_.constraint(p.row(r).transpose(), &grad);
-      if (identity) {
-        for (Eigen::Index k = 0; k < d_; ++k) values[e++] = grad[k];
-      } else {
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(H, r); it; ++it)
-          for (Eigen::Index k = 0; k < d_; ++k) values[e++] = grad[k] * it.value();
+    const MatX p = per_cell_ > 0 ? obj_.physical(as_q(n, x)) : MatX();
+    MatX jac;
+    for (Eigen::Index r = 0; r < (per_cell_ > 0 ? rows_ : 0); ++r) {
+      cell_constraints(p.row(r).transpose(), &jac);
+      for (Eigen::Index i = 0; i < per_cell_; ++i) {
+        if (identity) {
+          for (Eigen::Index k = 0; k < d_; ++k) values[e++] = jac(i, k);
+        } else {
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(H, r); it; ++it)
+            for (Eigen::Index k = 0; k < d_; ++k) values[e++] = jac(i, k) * it.value();
+        }
       }
     }
     if (settings_.mass_limit)
@@ -161,6 +171,21 @@ class GamutProblem : public Ipopt::TNLP {
   }
 
  private:
+  // Phi and the Voigt bound's conditions of one cell at physical p, with
+  // their gradients as rows of `jacobian`.
+  VecX cell_constraints(const VecX& p, MatX* jacobian) const {
+    VecX c(per_cell_);
+    VecX grad;
+    c[0] = model_.constraint(p, jacobian ? &grad : nullptr);
+    MatX bound_jac;
+    if (per_cell_ > 1) c.tail(per_cell_ - 1) = model_.bound_constraints(p, jacobian ? &bound_jac : nullptr);
+    if (jacobian) {
+      jacobian->resize(per_cell_, d_);
+      jacobian->row(0) = grad.transpose();
+      if (per_cell_ > 1) jacobian->bottomRows(per_cell_ - 1) = bound_jac;
+    }
+    return c;
+  }
   MatX as_q(Index n, const Number* x) const {
     MatX q(rows_, d_);
     for (Index i = 0; i < n; ++i) q(i / d_, i % d_) = x[i];
@@ -176,7 +201,7 @@ class GamutProblem : public Ipopt::TNLP {
   MatX q0_;
   const OptimizerSettings& settings_;
   OptimizationResult& result_;
-  Eigen::Index rows_, d_, gamut_rows_ = 0;
+  Eigen::Index rows_, d_, per_cell_ = 0, gamut_rows_ = 0;
   double scale_ = 1, volume_ = 1;
   VecX mass_gradient_;
   std::chrono::steady_clock::time_point t0_;

@@ -16,7 +16,11 @@ namespace {
 double max_gamut_violation(const CellMaterialModel& model, const MatX& p) {
   if (!model.has_constraint()) return -1.0;
   double worst = -std::numeric_limits<double>::infinity();
-  for (Eigen::Index r = 0; r < p.rows(); ++r) worst = std::max(worst, model.constraint(p.row(r).transpose(), nullptr));
+  for (Eigen::Index r = 0; r < p.rows(); ++r) {
+    worst = std::max(worst, model.constraint(p.row(r).transpose(), nullptr));
+    if (model.bound_conditions() > 0)
+      worst = std::max(worst, model.bound_constraints(p.row(r).transpose(), nullptr).maxCoeff());
+  }
   return worst;
 }
 

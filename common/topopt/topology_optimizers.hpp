@@ -38,7 +38,7 @@ struct OptimizationResult {
   std::string status;                // optimizer's own words
   bool converged = false;
   int iterations = 0, evaluations = 0;
-  double max_violation = 0;          // max_i Phi(p_i) (or the mass excess) at q
+  double max_violation = 0;          // max_i of Phi(p_i) and the Voigt bound's conditions (or the mass excess) at q
   double seconds = 0;
 };
 
@@ -46,7 +46,8 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
 // Requires a one-parameter space (simp*) and settings.mass_limit.
 OptimizationResult optimize_oc(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings);
 
-// Largest Phi over the design cells at filtered parameters p.
+// Largest Phi, or Voigt-bound condition, over the design cells at filtered
+// parameters p.
 double max_gamut_violation(const CellMaterialModel& model, const MatX& p);
 
 }  // namespace msfab

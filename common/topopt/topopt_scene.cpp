@@ -95,6 +95,15 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
   if (!(scene.penalty >= 1)) mat.fail("penalty", "must be >= 1");
   if (!(scene.E_min_ratio > 0 && scene.E_min_ratio < 1)) mat.fail("E_min_ratio", "must be in (0, 1)");
   if (!(scene.decades > 0)) mat.fail("decades", "must be > 0");
+  // 2D cells carry in-plane constants; a plane-strain solid (what a 2D
+  // gamut's homogenized cells are) has E / (1 - nu^2), nu / (1 - nu).
+  const std::string plane = mat.has("plane") ? mat.one_of("plane", {"stress", "strain"}) : "stress";
+  if (plane == "strain") {
+    if (dim != 2) mat.fail("plane", "applies to 2D grids only");
+    if (!(scene.nu < 0.5)) mat.fail("nu", "must be below 0.5 for plane strain");
+    scene.E0 /= 1 - scene.nu * scene.nu;
+    scene.nu /= 1 - scene.nu;
+  }
   if (!required_gamut_space(scene.space).empty() && gamut_E_stiff > 0) {
     scene.E0 = gamut_E_stiff;
     scene.decades = gamut_decades;

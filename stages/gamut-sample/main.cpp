@@ -32,6 +32,7 @@
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "gamut_plots.hpp"
+#include "homog/elastic_tensor.hpp"
 #include "io/atomic_file.hpp"
 #include "parallel/fan_out.hpp"
 #include "sampler.hpp"
@@ -46,6 +47,13 @@ std::string stem_of(const std::string& out) {
   if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
     return out.substr(0, out.size() - suffix.size());
   return out;
+}
+
+// A base material as a tensor of the space: 6 x 6 in 3D, the plane-strain
+// in-plane block in 2D (what a solid cell of it homogenizes to).
+MatX base_tensor(const BaseMaterial& m, bool three_d) {
+  const Mat6 C = isotropic_tensor(m.E, m.nu);
+  return three_d ? MatX(C) : MatX(plane_block(C));
 }
 
 void log_step(const char* name, const StepReport& r) {
@@ -189,6 +197,10 @@ int main(int argc, char** argv) {
       g.decades = options.decades;
       g.level_set = gamut ? *gamut : sampler.level_set(state);  // resampling leaves the set as it was
       g.history = state.history;
+      const bool three_d = sampler.space().kind() == MaterialSpaceKind::cubic3d;
+      g.bound_stiff = base_tensor(options.stiff, three_d);
+      g.bound_soft = options.soft_is_void ? MatX::Zero(g.bound_stiff.rows(), g.bound_stiff.cols())
+                                          : base_tensor(options.soft, three_d);
       write_microstructures_artifact(structures_path, state.set, "msfab-gamut-sample", run_text, {}, ctx.options.seed);
       write_gamut_artifact(out, g, "msfab-gamut-sample", run_text, {structures_path}, ctx.options.seed);
       plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
@@ -200,6 +212,7 @@ int main(int argc, char** argv) {
         Gamut vg = g;
         vg.level_set = sampler.level_set(voids);
         vg.history.clear();
+        vg.bound_soft.setZero();
         const std::string vstem = stem_of(out) + ".void";
         write_microstructures_artifact(vstem + ".microstructures.h5", voids.set, "msfab-gamut-sample", run_text,
                                        {structures_path}, ctx.options.seed);

@@ -7,8 +7,9 @@
 //      E <= rho^3 E0, or SIMP E = rho^p E0
 //   3. the start: uniform rho inside the space, or a coarser design
 //      (coarse-to-fine continuation, §3.6.3)
-//   4. minimize S(p, u) s.t. K(p) u = f (adjoint) and Phi(p_i) <= 0 per cell,
-//      with Ipopt (limited-memory Hessian); SIMP by optimality criteria or MMA
+//   4. minimize S(p, u) s.t. K(p) u = f (adjoint), Phi(p_i) <= 0 and the
+//      Voigt bound C(p_i) <= rho_i C_stiff per cell, with Ipopt
+//      (limited-memory Hessian); SIMP by optimality criteria or MMA
 //   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
 #include <spdlog/spdlog.h>
 
@@ -75,12 +76,24 @@ int main(int argc, char** argv) {
     } else if (config.has("gamut_padding")) {
       config.fail("gamut_padding", "space " + space + " takes no gamut");
     }
+    // The Voigt bound (topopt/voigt_bound.hpp): no structure is stiffer than
+    // its base materials' volume average, whatever the level set allows.
+    const bool bound_asked = config.has("gamut_bound");
+    const bool use_bound = bound_asked ? config.one_of("gamut_bound", {"voigt", "none"}) == "voigt" : !needs.empty();
+    if (bound_asked && needs.empty()) config.fail("gamut_bound", "space " + space + " takes no gamut");
+    if (use_bound && gamut.bound_stiff.size() == 0) {
+      if (bound_asked)
+        config.fail("gamut_bound", config.get_path("gamut") + " stores no base materials (/bound); sample it again");
+      spdlog::warn("{}: no base materials stored (/bound), so the Voigt bound is not applied; sample it again",
+                   config.get_path("gamut"));
+    }
 
     // 1. The scene.
     const TopoptScene scene = read_topopt_scene(config, gamut.E_stiff, gamut.decades);
     CellMaterialSettings ms{scene.space, scene.E0, scene.decades, scene.nu, scene.penalty, scene.E_min_ratio,
                             needs.empty() ? nullptr : &gamut.level_set};
     const auto model = make_cell_material_model(ms);
+    if (use_bound && gamut.bound_stiff.size() > 0) model->set_voigt_bound(gamut.bound_stiff, gamut.bound_soft);
 
     OptimizerSettings os;
     const std::string optimizer =

@@ -45,11 +45,21 @@ Y
 out=$("$T" --config "$WORK/cubic.yaml" --out "$WORK/cubic.design.h5" --quiet 2>&1)
 check "cubic2d design written" -- test -s "$WORK/cubic.design.h5"
 check "cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-0[4-9]|0\.000)" <<<"$out"
+check "the gamut stores its base materials for the Voigt bound" -- h5ls "$WORK/set.gamut.h5/bound/stiff"
 check "the design maps to microstructures" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
   --structures "$WORK/set.microstructures.h5" --out "$WORK/cubic.mapped.h5" --quiet
 check "coarse-to-fine continuation" -- "$T" --config "$WORK/cubic.yaml" --set 'grid.size=[24,12]' \
   --set "initial.design=$WORK/cubic.design.h5" --set 'loads=[{objective: compliance, forces: [{node: [24, 0], force: [0, -1]}]}]' \
   --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' --set optimizer.max_iterations=20 --out "$WORK/fine.design.h5" --quiet
+
+# Plane strain: the same as the plane-stress plate of E / (1 - nu^2), nu / (1 - nu).
+simp=(--set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]'
+  --set 'loads=[{objective: compliance, forces: [{box: {min: [12, 0], max: [24, 0]}, force: [0, -1], distribute: total}]}]'
+  --set optimizer.max_iterations=5 --quiet)
+a=$("$T" "${simp[@]}" --set material.plane=strain --out "$WORK/strain.design.h5" 2>&1 | grep -oE "compliance [0-9.e+-]+")
+b=$("$T" "${simp[@]}" --set material.E=1.0989010989010989 --set material.nu=0.42857142857142855 \
+  --out "$WORK/strain2.design.h5" 2>&1 | grep -oE "compliance [0-9.e+-]+")
+check "plane strain is the equivalent plane-stress plate ($a)" -- test -n "$a" -a "$a" = "$b"
 
 # 3. Bad input.
 D=(--out "$WORK/bad.design.h5")
@@ -60,6 +70,10 @@ expect_exit 2 "is a cubic2d gamut; space cubic3d needs a cubic3d gamut" -- "$T" 
   --set space=cubic3d --set 'grid.size=[4,2,2]' "${D[@]}"
 expect_exit 2 "space simp2d takes no gamut" -- "$T" --config "$WORK/cubic.yaml" --set space=simp2d "${D[@]}"
 expect_exit 2 "none.h5: no such file" -- "$T" --config "$WORK/cubic.yaml" --set gamut=$WORK/none.h5 "${D[@]}"
+expect_exit 2 "gamut_bound.*space simp2d takes no gamut" -- "$T" --set gamut_bound=voigt "${D[@]}"
+expect_exit 2 "gamut_bound.*one of" -- "$T" --config "$WORK/cubic.yaml" --set gamut_bound=reuss "${D[@]}"
+expect_exit 2 "material.plane.*applies to 2D grids only" -- "$T" --set space=simp3d --set 'grid.size=[4,2,2]' \
+  --set material.plane=strain "${D[@]}"
 expect_exit 2 "mma is for the simp spaces" -- "$T" --set space=analytic2d --set optimizer.name=mma "${D[@]}"
 expect_exit 2 "optimizer.change_tolerance.*must be in" -- "$T" --set optimizer.change_tolerance=-1 "${D[@]}"
 expect_exit 2 "unknown key 'fitler'" -- "$T" --set fitler.radius=2 "${D[@]}"

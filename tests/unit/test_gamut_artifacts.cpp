@@ -104,9 +104,13 @@ TEST(GamutArtifacts, GamutLevelSetReadsBackWithTheSameQueries) {
   g.E_stiff = 2e9;
   g.level_set = GamutLevelSet::from_points(points);
   g.history = {{0, 10, 10, 0, 0.01, 1.5}, {1, 20, 8, 2, 0.02, 2.5}};
+  g.bound_stiff = MatX::Random(3, 3);
+  g.bound_soft = MatX::Zero(3, 3);
   const std::string path = scratch("gamut.h5").string();
   write_gamut_artifact(path, g, "msfab-test", "", {}, 1);
   const Gamut r = read_gamut_artifact(path);
+  EXPECT_EQ(r.bound_stiff, g.bound_stiff);  // the Voigt bound's base materials
+  EXPECT_EQ(r.bound_soft, g.bound_soft);
   EXPECT_EQ(r.property_names, g.property_names);
   EXPECT_EQ(r.E_stiff, 2e9);
   EXPECT_EQ(r.level_set.values(), g.level_set.values());
