@@ -1,7 +1,6 @@
 #include "solve/cholmod_solver.hpp"
 
 #include <cholmod.h>
-#include <dlfcn.h>
 #include <omp.h>
 
 #include <chrono>
@@ -14,6 +13,7 @@
 
 #include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "solve/blas_threads.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
 
@@ -33,28 +33,13 @@ namespace {
 // OpenBLAS is asked for one thread too (planning more than libgomp then
 // grants makes it wait forever). Every setting is restored afterwards, so
 // the caller's own parallel kernels keep their threads.
-// OpenBLAS's thread count, found at run time so that another BLAS (or none
-// with these entry points) still works.
-void set_blas_threads(int threads) {
-  using SetThreads = void (*)(int);
-  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads")) reinterpret_cast<SetThreads>(symbol)(threads);
-}
-
-int blas_threads() {
-  using GetThreads = int (*)();
-  if (void* symbol = dlsym(RTLD_DEFAULT, "openblas_get_num_threads")) return reinterpret_cast<GetThreads>(symbol)();
-  return 1;
-}
-
 class CholmodThreadScope {
  public:
-  CholmodThreadScope() : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()), blas_(blas_threads()) {
+  CholmodThreadScope() : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()) {
     omp_set_num_threads(1);
     omp_set_dynamic(1);
-    set_blas_threads(1);
   }
   ~CholmodThreadScope() {
-    set_blas_threads(blas_);
     omp_set_dynamic(dynamic_);
     omp_set_num_threads(threads_);
   }
@@ -64,7 +49,7 @@ class CholmodThreadScope {
  private:
   int threads_;
   int dynamic_;
-  int blas_;
+  SingleThreadedBlas blas_;  // OpenBLAS on one thread for the scope too
 };
 
 // A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to

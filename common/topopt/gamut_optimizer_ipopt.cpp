@@ -10,6 +10,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "solve/blas_threads.hpp"
 #include "topopt/topology_optimizers.hpp"
 
 namespace msfab {
@@ -234,7 +235,13 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   app->Options()->SetNumericValue("acceptable_dual_inf_tol", 1e10);
   app->Options()->SetNumericValue("acceptable_compl_inf_tol", 1e-2);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");
-  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(problem);
+  // MUMPS factorizes Ipopt's KKT system in BLAS; one BLAS thread keeps the
+  // iterates independent of the thread count and is faster on two cores
+  // (solve/blas_threads.hpp). The objective's own kernels keep their threads.
+  const Ipopt::ApplicationReturnStatus status = [&] {
+    const SingleThreadedBlas blas;
+    return app->OptimizeTNLP(problem);
+  }();
   switch (status) {
     case Ipopt::Solve_Succeeded: result.status = "converged", result.converged = true; break;
     case Ipopt::Solved_To_Acceptable_Level: result.status = "converged to the acceptable level", result.converged = true; break;
