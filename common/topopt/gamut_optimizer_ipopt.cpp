@@ -3,6 +3,7 @@
 // with Open MPI in the MPI stages, so only the stages that optimize link it.
 #include <IpIpoptApplication.hpp>
 #include <IpTNLP.hpp>
+#include <omp.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -18,6 +19,18 @@ namespace msfab {
 namespace {
 
 using Ipopt::Index;
+
+// OpenMP's thread count for a scope (the calling thread's setting).
+class OmpThreads {
+ public:
+  explicit OmpThreads(int threads) : saved_(omp_get_max_threads()) { omp_set_num_threads(threads); }
+  ~OmpThreads() { omp_set_num_threads(saved_); }
+  OmpThreads(const OmpThreads&) = delete;
+  OmpThreads& operator=(const OmpThreads&) = delete;
+
+ private:
+  int saved_;
+};
 using Ipopt::Number;
 
 // Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: per
@@ -29,7 +42,7 @@ class GamutProblem : public Ipopt::TNLP {
   GamutProblem(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings,
                OptimizationResult& result)
       : obj_(objective), model_(objective.model()), q0_(q0), settings_(settings), result_(result),
-        rows_(q0.rows()), d_(q0.cols()), t0_(std::chrono::steady_clock::now()) {
+        rows_(q0.rows()), d_(q0.cols()), threads_(omp_get_max_threads()), t0_(std::chrono::steady_clock::now()) {
     per_cell_ = model_.has_constraint() ? 1 + model_.bound_conditions() : 0;
     gamut_rows_ = per_cell_ * rows_;
     const double V = obj_.grid().cell_volume();
@@ -76,6 +89,7 @@ class GamutProblem : public Ipopt::TNLP {
   }
 
   bool eval_f(Index n, const Number* x, bool, Number& f) override {
+    const OmpThreads threads(threads_);
     try {
       f = scale_ * obj_.evaluate(as_q(n, x), nullptr).total;
       ++result_.evaluations;
@@ -87,6 +101,7 @@ class GamutProblem : public Ipopt::TNLP {
   }
 
   bool eval_grad_f(Index n, const Number* x, bool, Number* grad) override {
+    const OmpThreads threads(threads_);
     try {
       MatX g;
       obj_.evaluate(as_q(n, x), &g);
@@ -203,6 +218,7 @@ class GamutProblem : public Ipopt::TNLP {
   const OptimizerSettings& settings_;
   OptimizationResult& result_;
   Eigen::Index rows_, d_, per_cell_ = 0, gamut_rows_ = 0;
+  int threads_;  // the caller's, for the objective inside Ipopt's one-thread scope
   double scale_ = 1, volume_ = 1;
   VecX mass_gradient_;
   std::chrono::steady_clock::time_point t0_;
@@ -235,10 +251,12 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   app->Options()->SetNumericValue("acceptable_dual_inf_tol", 1e10);
   app->Options()->SetNumericValue("acceptable_compl_inf_tol", 1e-2);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");
-  // MUMPS factorizes Ipopt's KKT system in BLAS; one BLAS thread keeps the
-  // iterates independent of the thread count and is faster on two cores
-  // (solve/blas_threads.hpp). The objective's own kernels keep their threads.
+  // MUMPS factorizes Ipopt's KKT system with OpenMP and BLAS threads of its
+  // own: on one thread the iterates do not depend on the thread count, and
+  // on two cores shared with the FEM it is faster (solve/blas_threads.hpp).
+  // The objective's callbacks get the caller's threads back (OmpThreads).
   const Ipopt::ApplicationReturnStatus status = [&] {
+    const OmpThreads one(1);
     const SingleThreadedBlas blas;
     return app->OptimizeTNLP(problem);
   }();
