@@ -5,9 +5,9 @@
 // of their time in BLAS on small dense fronts. With the OpenMP build of
 // OpenBLAS each call opens its own thread team: on two cores shared with
 // our element loops that is slower than one thread (Ipopt on the 2D
-// cantilever: 4x slower per iteration under load), and the sums it splits
-// make results depend on the thread count. Found at run time, so another
-// BLAS (or none with these entry points) still works.
+// cantilever: 4x slower per iteration under load), and CHOLMOD's factors
+// would depend on the thread count. Found at run time, so another BLAS (or
+// none with these entry points) still works.
 namespace msfab {
 
 class SingleThreadedBlas {

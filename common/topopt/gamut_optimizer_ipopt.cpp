@@ -19,6 +19,7 @@ namespace msfab {
 namespace {
 
 using Ipopt::Index;
+using Ipopt::Number;
 
 // OpenMP's thread count for a scope (the calling thread's setting).
 class OmpThreads {
@@ -31,7 +32,6 @@ class OmpThreads {
  private:
   int saved_;
 };
-using Ipopt::Number;
 
 // Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: per
 // design cell (when the space has a constraint) Phi and the Voigt bound's
@@ -252,9 +252,10 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   app->Options()->SetNumericValue("acceptable_compl_inf_tol", 1e-2);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw std::runtime_error("Ipopt failed to initialize");
   // MUMPS factorizes Ipopt's KKT system with OpenMP and BLAS threads of its
-  // own: on one thread the iterates do not depend on the thread count, and
-  // on two cores shared with the FEM it is faster (solve/blas_threads.hpp).
-  // The objective's callbacks get the caller's threads back (OmpThreads).
+  // own, which on two cores shared with the FEM cost more than they gain
+  // (a 20-iteration cantilever run: 4x faster on one thread under load;
+  // solve/blas_threads.hpp). The objective's callbacks get the caller's
+  // threads back (OmpThreads).
   const Ipopt::ApplicationReturnStatus status = [&] {
     const OmpThreads one(1);
     const SingleThreadedBlas blas;
