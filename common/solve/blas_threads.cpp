@@ -1,6 +1,7 @@
 #include "solve/blas_threads.hpp"
 
 #include <dlfcn.h>
+#include <omp.h>
 
 namespace msfab {
 
@@ -21,5 +22,8 @@ int blas_threads() {
 
 SingleThreadedBlas::SingleThreadedBlas() : saved_(blas_threads()) { set_blas_threads(1); }
 SingleThreadedBlas::~SingleThreadedBlas() { set_blas_threads(saved_); }
+
+OmpThreads::OmpThreads(int threads) : saved_(omp_get_max_threads()) { omp_set_num_threads(threads); }
+OmpThreads::~OmpThreads() { omp_set_num_threads(saved_); }
 
 }  // namespace msfab

@@ -1,5 +1,5 @@
 #pragma once
-// OpenBLAS's own thread count, set for a scope.
+// OpenBLAS's own thread count, and OpenMP's, set for a scope.
 //
 // The direct solvers we call (CHOLMOD, and MUMPS inside Ipopt) spend most
 // of their time in BLAS on small dense fronts. With the OpenMP build of
@@ -16,6 +16,19 @@ class SingleThreadedBlas {
   ~SingleThreadedBlas();
   SingleThreadedBlas(const SingleThreadedBlas&) = delete;
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
+
+ private:
+  int saved_;
+};
+
+// OpenMP's thread count for a scope (the calling thread's setting), e.g.
+// one thread for a direct solver, the caller's again inside its callbacks.
+class OmpThreads {
+ public:
+  explicit OmpThreads(int threads);
+  ~OmpThreads();
+  OmpThreads(const OmpThreads&) = delete;
+  OmpThreads& operator=(const OmpThreads&) = delete;
 
  private:
   int saved_;

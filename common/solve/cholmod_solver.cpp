@@ -35,19 +35,13 @@ namespace {
 // the caller's own parallel kernels keep their threads.
 class CholmodThreadScope {
  public:
-  CholmodThreadScope() : threads_(omp_get_max_threads()), dynamic_(omp_get_dynamic()) {
-    omp_set_num_threads(1);
-    omp_set_dynamic(1);
-  }
-  ~CholmodThreadScope() {
-    omp_set_dynamic(dynamic_);
-    omp_set_num_threads(threads_);
-  }
+  CholmodThreadScope() : dynamic_(omp_get_dynamic()) { omp_set_dynamic(1); }
+  ~CholmodThreadScope() { omp_set_dynamic(dynamic_); }
   CholmodThreadScope(const CholmodThreadScope&) = delete;
   CholmodThreadScope& operator=(const CholmodThreadScope&) = delete;
 
  private:
-  int threads_;
+  OmpThreads threads_{1};
   int dynamic_;
   SingleThreadedBlas blas_;  // OpenBLAS on one thread for the scope too
 };

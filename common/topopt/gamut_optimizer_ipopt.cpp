@@ -21,18 +21,6 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
-// OpenMP's thread count for a scope (the calling thread's setting).
-class OmpThreads {
- public:
-  explicit OmpThreads(int threads) : saved_(omp_get_max_threads()) { omp_set_num_threads(threads); }
-  ~OmpThreads() { omp_set_num_threads(saved_); }
-  OmpThreads(const OmpThreads&) = delete;
-  OmpThreads& operator=(const OmpThreads&) = delete;
-
- private:
-  int saved_;
-};
-
 // Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: per
 // design cell (when the space has a constraint) Phi and the Voigt bound's
 // conditions (rows r * per_cell_ + c), then the mass budget
@@ -146,7 +134,7 @@ class GamutProblem : public Ipopt::TNLP {
     }
     const MatX p = per_cell_ > 0 ? obj_.physical(as_q(n, x)) : MatX();
     MatX jac;
-    for (Eigen::Index r = 0; r < (per_cell_ > 0 ? rows_ : 0); ++r) {
+    for (Eigen::Index r = 0; per_cell_ > 0 && r < rows_; ++r) {
       cell_constraints(p.row(r).transpose(), &jac);
       for (Eigen::Index i = 0; i < per_cell_; ++i) {
         if (identity) {

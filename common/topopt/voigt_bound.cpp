@@ -66,11 +66,10 @@ VecX VoigtBound::evaluate(const MatX& C, double rho, const std::vector<MatX>* dC
     return d;
   };
   if (modes_ == VoigtBoundModes::cubic) {
-    for (int i = 0; i < n; ++i) {
-      const VecX& v = mode_vectors_[i];
-      g[i] = -v.dot(B * v) / mode_scale_[i];
-      if (jacobian)
-        for (int k = 0; k < params; ++k) (*jacobian)(i, k) = -v.dot(dB(k) * v) / mode_scale_[i];
+    for (int i = 0; i < n; ++i) g[i] = -mode_vectors_[i].dot(B * mode_vectors_[i]) / mode_scale_[i];
+    for (int k = 0; jacobian && k < params; ++k) {
+      const MatX D = dB(k);
+      for (int i = 0; i < n; ++i) (*jacobian)(i, k) = -mode_vectors_[i].dot(D * mode_vectors_[i]) / mode_scale_[i];
     }
     return g;
   }
