@@ -7,7 +7,13 @@
 //
 //   bench_cell_solver [--sizes 16,24,32,64] [--tolerances 1e-5,1e-6,1e-8]
 //                     [--degrees 2] [--kinds random,sphere,frame,cubic-random]
-//                     [--coarsest 64,512] [--no-direct]
+//                     [--coarsest 64,512] [--solvers multigrid,direct]
+//                     [--symmetries none,cyclic,mirror,both] [--no-direct]
+//
+// Symmetries: none solves the six cases on the whole cell, cyclic two
+// cases (cubic cells), mirror the cases on one octant (cells invariant
+// under the three reflections; the solver then runs on the octant), both
+// two cases on the octant. Modes a cell does not have are skipped.
 //
 // Prints a Markdown table. Timings are wall-clock with the OpenMP default
 // thread count (set OMP_NUM_THREADS).
@@ -75,6 +81,8 @@ int main(int argc, char** argv) {
   std::vector<int> degrees = {2};
   std::vector<int> coarsest = {PeriodicMultigridOptions{}.coarsest_nodes};
   std::vector<std::string> kinds = {"random", "sphere", "frame"};
+  std::vector<std::string> solvers = {"multigrid"};
+  std::vector<std::string> symmetries = {"none", "cyclic", "mirror", "both"};
   bool direct = true;
   for (int a = 1; a < argc; ++a) {
     const bool more = a + 1 < argc;
@@ -83,58 +91,73 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--degrees") && more) degrees = parse_list<int>(argv[++a]);
     else if (!std::strcmp(argv[a], "--coarsest") && more) coarsest = parse_list<int>(argv[++a]);
     else if (!std::strcmp(argv[a], "--kinds") && more) kinds = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--solvers") && more) solvers = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--symmetries") && more) symmetries = parse_list<std::string>(argv[++a]);
     else if (!std::strcmp(argv[a], "--no-direct")) direct = false;
     else {
-      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--no-direct]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--solvers L] [--symmetries L] [--no-direct]\n", argv[0]);
       return 2;
     }
   }
   const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(1e6, 0.45),
                                             std::make_shared<LinearIsotropic>(1e3, 0.45)};
-  std::printf("| cell | n | solver | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| cell | n | solver | domain | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& kind : kinds)
     for (int n : sizes) {
       const VoxelGrid cell = make_cell(kind, n);
       HomogenizationOptions reference_options;
       Mat6 C_ref;
       double direct_seconds = 0;
+      reference_options.use_symmetry = false;
+      reference_options.use_mirror_symmetry = false;
       if (direct && n <= 32) {
         reference_options.solver = "direct";
         const HomogenizationResult r = homogenize(cell, palette, reference_options);
         C_ref = r.C;
         direct_seconds = r.seconds;
-        std::printf("| %s | %d | direct | | | | %d | | %.3f | %.3g | (reference) | |\n", kind.c_str(), n,
-                    r.symmetric_cases ? 2 : 6, r.seconds, 1 / r.seconds);
+        std::printf("| %s | %d | direct | cell | | | | 6 | | %.3f | %.3g | (reference) | |\n", kind.c_str(), n,
+                    r.seconds, 1 / r.seconds);
       } else {
         reference_options.solver = "multigrid";
         reference_options.multigrid_tolerance = 1e-11;
         C_ref = homogenize(cell, palette, reference_options).C;
       }
       std::fflush(stdout);
-      // A cubic cell runs with six cases and with two (the symmetric solve).
-      const std::vector<bool> symmetries =
-          has_cubic_symmetry(cell) ? std::vector<bool>{false, true} : std::vector<bool>{false};
-      for (int degree : degrees)
-        for (double tolerance : tolerances)
-          for (int coarse : coarsest)
-            for (bool symmetry : symmetries) {
-              HomogenizationOptions o;
-              o.solver = "multigrid";
-              o.multigrid_tolerance = tolerance;
-              o.multigrid_smoother_degree = degree;
-              o.use_symmetry = symmetry;
-              o.multigrid_coarsest_nodes = coarse;
-              const HomogenizationResult r = homogenize(cell, palette, o);
-              std::printf("| %s | %d | multigrid | %.0e | %d | %d | %d | %d | %.3f | %.3g | %.1e |", kind.c_str(), n,
-                          tolerance, degree, coarse, r.symmetric_cases ? 2 : 6, r.iterations, r.seconds,
-                          1 / r.seconds, (r.C - C_ref).norm() / C_ref.norm());
-              if (direct_seconds > 0)
-                std::printf(" %.1f |\n", direct_seconds / r.seconds);
-              else
-                std::printf(" |\n");
-              std::fflush(stdout);
-            }
+      const bool cubic = has_cubic_symmetry(cell), mirrored = has_symmetry(cell, CellSymmetry::orthotropic);
+      for (const std::string& symmetry : symmetries) {
+        if ((symmetry == "cyclic" && !cubic) || (symmetry == "mirror" && !mirrored) ||
+            (symmetry == "both" && !(cubic && mirrored)))
+          continue;
+        for (const std::string& solver : solvers)
+          for (int degree : degrees)
+            for (double tolerance : tolerances)
+              for (int coarse : coarsest) {
+                if (solver == "direct" && (degree != degrees[0] || tolerance != tolerances[0] || coarse != coarsest[0]))
+                  continue;  // the direct solver has none of these knobs
+                HomogenizationOptions o;
+                o.solver = solver;
+                o.multigrid_tolerance = tolerance;
+                o.multigrid_smoother_degree = degree;
+                o.use_symmetry = symmetry == "cyclic" || symmetry == "both";
+                o.use_mirror_symmetry = symmetry == "mirror" || symmetry == "both";
+                o.multigrid_coarsest_nodes = coarse;
+                const HomogenizationResult r = homogenize(cell, palette, o);
+                std::printf("| %s | %d | %s | %s |", kind.c_str(), n, r.solver.c_str(), r.octant ? "octant" : "cell");
+                if (r.solver == "multigrid")
+                  std::printf(" %.0e | %d | %s |", tolerance, degree, r.octant ? "" : std::to_string(coarse).c_str());
+                else
+                  std::printf(" | | |");
+                std::printf(" %d | %s | %.3f | %.3g | %.1e |", r.symmetric_cases ? 2 : 6,
+                            r.solver == "multigrid" ? std::to_string(r.iterations).c_str() : "", r.seconds,
+                            1 / r.seconds, (r.C - C_ref).norm() / C_ref.norm());
+                if (direct_seconds > 0)
+                  std::printf(" %.1f |\n", direct_seconds / r.seconds);
+                else
+                  std::printf(" |\n");
+                std::fflush(stdout);
+              }
+      }
     }
   return 0;
 }

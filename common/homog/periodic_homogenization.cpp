@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "fem/hex_element.hpp"
+#include "homog/mirror_reduction.hpp"
 #include "solve/cholmod_solver.hpp"
 #include "solve/periodic_grid_multigrid.hpp"
 
@@ -284,13 +285,24 @@ HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const
   const std::int64_t cells = field.voxels();
   HomogenizationResult out;
   out.solver = homogenization_solver(nx, ny, nz, options.solver);
-  const Eigen::MatrixXd loads = strain_loads(field);
   const bool symmetric = options.use_symmetry && cyclic_invariant(field);
   const std::vector<int> cases = symmetric ? std::vector<int>{0, 3} : std::vector<int>{0, 1, 2, 3, 4, 5};
-  if (out.solver == "direct")
+  out.octant = options.use_mirror_symmetry && mirror_invariant(field);
+  if (out.octant) {
+    OctantSolverOptions octant;
+    octant.solver = options.solver;
+    octant.tolerance = options.multigrid_tolerance;
+    octant.smoother_degree = options.multigrid_smoother_degree;
+    octant.threads = options.threads;
+    const OctantSolveReport report = solve_on_octant(field, cases, octant, out.fluctuation);
+    out.solver = report.solver;
+    out.unknowns = report.unknowns;
+    out.iterations = report.iterations;
+  } else if (const Eigen::MatrixXd loads = strain_loads(field); out.solver == "direct") {
     solve_direct(field, loads, out, cases);
-  else
+  } else {
     solve_multigrid(field, loads, options, out, cases);
+  }
   if (symmetric)
     for (int m : {0, 3})
       for (int step = 0, from = m; step < 2; ++step, from = kCyclicCase[from])

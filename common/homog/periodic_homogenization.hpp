@@ -46,6 +46,11 @@ struct HomogenizationOptions {
   // cyclic_invariant) needs two cell problems, not six: the fluctuations of
   // yy and zz (xz and xy) are those of xx (yz) carried by the permutation.
   bool use_symmetry = true;
+  // A 3D cell invariant under the three reflections i -> n - 1 - i (every
+  // cubic and orthotropic gamut structure) is solved on one octant with
+  // mirror conditions (homog/mirror_reduction.hpp): an eighth of the
+  // unknowns, the same C^H. `solver` then picks the octant's solver.
+  bool use_mirror_symmetry = true;
 };
 
 // True when the field is invariant under the cyclic permutation of the axes
@@ -67,6 +72,7 @@ struct HomogenizationResult {
   std::string solver;             // "direct" or "multigrid"
   int iterations = 0;             // multigrid: CG iterations over the strain cases solved
   bool symmetric_cases = false;   // two cases solved, four carried by the cyclic permutation
+  bool octant = false;            // solved on one octant (mirror symmetry); unknowns are the octant's
   // Per Voigt strain: the periodic fluctuation at the nx*ny*nz lattice
   // nodes (3 per node, x fastest), zero at node 0.
   std::array<VecX, 6> fluctuation;

@@ -95,6 +95,7 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
   for (std::size_t i = 0; i < cells.size(); ++i) thin[i] = thin_feature_voxels(cells[i], o_.min_feature) > 0;
   HomogenizationOptions ho;
   ho.void_stiffness = o_.void_stiffness;
+  ho.use_symmetry = ho.use_mirror_symmetry = o_.use_symmetry;
   const std::vector<double> records = fan_out(report.tried, kHeader, [&](int i, double* r) {
     if (cells[i].count_solid() == 0 || thin[i]) return;
     const HomogenizationResult h = homogenize(cells[i], palette, ho);

@@ -24,6 +24,7 @@ density_radius: 0.1
 boundary_depth: 0.1
 decades: 4
 void_stiffness: 1.0e-6
+use_symmetry: true        # cell problems on the symmetric part (exact); false: six cases on the whole cell
 min_feature: 1            # the printer's smallest beam or gap, voxels (1: no limit)
 plot_every_cycle: true
 mode: sampler             # sampler | random (the benchmark's baseline)
@@ -73,6 +74,7 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.void_stiffness = config.get_or<double>("void_stiffness", o.void_stiffness);
   if (!(o.void_stiffness > 0 && o.void_stiffness < 1e-2)) config.fail("void_stiffness", "must be in (0, 0.01)");
 
+  o.use_symmetry = config.get_or<bool>("use_symmetry", o.use_symmetry);
   o.population = config.get_or<int>("population", o.population);
   if (o.population < 2) config.fail("population", "must be >= 2");
   o.cycles = config.get_or<int>("cycles", o.cycles);

@@ -21,6 +21,10 @@ struct SamplerOptions {
   bool soft_is_void = false;
   double decades = 4;            // log range of the moduli below the stiff E
   double void_stiffness = 1e-6;
+  // Cell problems solved on the cell's symmetric part: two strain cases for
+  // a cubic cell, one octant for a mirror-symmetric one (both exact);
+  // false: six cases on the whole cell (for comparison).
+  bool use_symmetry = true;
   // The printer's minimum feature size in voxels: structures with a thinner
   // beam or gap (thin_feature_voxels) are not added. 1: no limit.
   int min_feature = 1;

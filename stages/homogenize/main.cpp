@@ -40,6 +40,7 @@ layout:
   - {box: {min: [0.333, 0.333, 0], max: [0.667, 0.667, 1]}, id: 1}
 void_stiffness: 1.0e-6
 solver: auto
+use_symmetry: true
 )";
 
 // Batch mode: materials and cells come from the structures artifact.
@@ -47,6 +48,7 @@ constexpr const char* kBatchDefaults = R"(
 void_stiffness: 1.0e-6
 solver: auto
 refine: 1
+use_symmetry: true
 )";
 
 HomogenizationOptions read_solver_options(const Config& config) {
@@ -57,6 +59,9 @@ HomogenizationOptions read_solver_options(const Config& config) {
   options.multigrid_tolerance = config.get_or<double>("multigrid_tolerance", options.multigrid_tolerance);
   if (!(options.multigrid_tolerance > 0 && options.multigrid_tolerance < 1))
     config.fail("multigrid_tolerance", "must be in (0, 1)");
+  // Both exact reductions (two strain cases for a cubic cell, one octant
+  // for a mirror-symmetric one); false solves six cases on the whole cell.
+  options.use_symmetry = options.use_mirror_symmetry = config.get_or<bool>("use_symmetry", true);
   return options;
 }
 
@@ -127,11 +132,14 @@ int main(int argc, char** argv) {
     // 5. Artifact.
     write_homogenized(out, in, r, plane ? &*plane : nullptr, ctx.config.resolved_text(), ctx.command_line,
                       ctx.options.seed);
-    std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns, %s solver, %.3f s\n", in.cell.nx, in.cell.ny,
-                in.cell.nz, static_cast<long long>(r.unknowns), r.solver.c_str(), r.seconds);
+    std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns%s, %s solver, %.3f s\n", in.cell.nx, in.cell.ny,
+                in.cell.nz, static_cast<long long>(r.unknowns), r.octant ? " (one octant, mirror symmetry)" : "",
+                r.solver.c_str(), r.seconds);
+    const char* cases = r.symmetric_cases ? "2 strain cases (4 more by the cyclic symmetry)" : "the 6 strain cases";
     if (r.solver == "multigrid")
-      std::printf("  multigrid: %d CG iterations over %s\n", r.iterations,
-                  r.symmetric_cases ? "2 strain cases (4 more by the cyclic symmetry)" : "the 6 strain cases");
+      std::printf("  multigrid: %d CG iterations over %s\n", r.iterations, cases);
+    else
+      std::printf("  direct: %s\n", cases);
     std::printf("  solid fraction %.4f, pieces %d\n", 1.0 - r.volume_fraction[0], r.pieces);
     const double dev = cubic_deviation(r.C);
     if (plane) {

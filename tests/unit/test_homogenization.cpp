@@ -6,6 +6,8 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "gamut/structure_ops.hpp"
+#include "homog/mirror_reduction.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 
@@ -257,6 +259,80 @@ TEST(Homogenization, CyclicSymmetryTwoSolvesEqualSixSolves) {
   EXPECT_FALSE(homogenize(broken, pal).symmetric_cases);
   // Non-cubic grids never take the symmetric path.
   EXPECT_FALSE(homogenize(VoxelGrid(4, 4, 6, 0.25, 1), pal).symmetric_cases);
+}
+
+// Random ids (void included when `with_void`) mirrored into the three
+// reflections i -> n - 1 - i: an orthotropic gamut structure's symmetry,
+// not a cubic one (the grid need not be a cube).
+VoxelGrid mirrored_random_cell(int nx, int ny, int nz, std::uint64_t seed, bool with_void) {
+  std::mt19937_64 rng(seed);
+  VoxelGrid g(nx, ny, nz, 1.0 / nx, 1);
+  for (int& id : g.ids) id = with_void ? int(rng() % 3) : 1 + int(rng() % 2);
+  mirror_fundamental_domain(g, CellSymmetry::orthotropic);
+  return g;
+}
+
+TEST(Homogenization, MirrorSymmetricCellsSolvedOnOneOctantMatchTheWholeCell) {
+  // The octant with mirror conditions against the whole periodic cell
+  // (direct, no reduction): two phases with different Poisson ratios (two
+  // element bases), with and without void, a non-cubic grid, both octant
+  // solvers; and a cubic cell with the cyclic reduction on top.
+  const auto pal = two_phases(1e6, 0.3, 1e4, 0.45);
+  struct Case {
+    int nx, ny, nz;
+    bool with_void, cubic;
+  };
+  for (const Case c : {Case{8, 12, 16, false, false}, Case{8, 12, 16, true, false}, Case{12, 12, 12, false, true}}) {
+    VoxelGrid cell = mirrored_random_cell(c.nx, c.ny, c.nz, 5, c.with_void);
+    if (c.cubic) mirror_fundamental_domain(cell, CellSymmetry::cubic);
+    HomogenizationOptions whole;
+    whole.solver = "direct";
+    whole.use_symmetry = whole.use_mirror_symmetry = false;
+    const HomogenizationResult a = homogenize(cell, pal, whole);
+    EXPECT_FALSE(a.octant);
+    for (const std::string solver : {"direct", "multigrid"}) {
+      HomogenizationOptions o;
+      o.solver = solver;
+      o.multigrid_tolerance = 1e-12;
+      const HomogenizationResult b = homogenize(cell, pal, o);
+      const std::string what = solver + " " + std::to_string(c.nx) + "x" + std::to_string(c.ny) + "x" +
+                               std::to_string(c.nz) + (c.with_void ? " void" : "");
+      EXPECT_TRUE(b.octant) << what;
+      EXPECT_EQ(b.solver, solver) << what;
+      EXPECT_EQ(b.symmetric_cases, c.cubic) << what;
+      EXPECT_LT(b.unknowns, a.unknowns / 6) << what;
+      EXPECT_LT((a.C - b.C).norm(), 1e-10 * a.C.norm()) << what;
+      for (int m = 0; m < 6; ++m)
+        EXPECT_LT((a.fluctuation[m] - b.fluctuation[m]).norm(), 1e-8 * a.fluctuation[m].norm() + 1e-14)
+            << what << " case " << m;
+    }
+    // Orthotropic: the couplings between normal and shear strains vanish.
+    EXPECT_LT((a.C.topRightCorner<3, 3>().norm()), 1e-10 * a.C.norm());
+  }
+}
+
+TEST(Homogenization, CellsWithoutTheThreeMirrorsUseTheWholeCell) {
+  const auto pal = two_phases(1e6, 0.3, 1e4, 0.45);
+  VoxelGrid broken = mirrored_random_cell(8, 8, 8, 3, false);
+  broken.at(1, 2, 3) = broken.at(1, 2, 3) == 1 ? 2 : 1;
+  EXPECT_FALSE(homogenize(broken, pal).octant);
+  // 2D cells and odd dimensions keep the whole cell.
+  EXPECT_FALSE(homogenize(mirrored_random_cell(8, 8, 1, 3, false), pal).octant);
+  EXPECT_FALSE(homogenize(mirrored_random_cell(6, 6, 7, 3, false), pal).octant);
+  // A material that is not mirror-symmetric (a shear-normal coupling
+  // added to an isotropic element) keeps the whole cell too.
+  VoxelStiffnessField field;
+  field.nx = field.ny = field.nz = 4;
+  field.h = 0.25;
+  Mat24 K = voxel_stiffness(pal[1], 0.25);
+  const Mat24 isotropic = K;
+  K(0, 4) += 1e-3 * K(0, 0), K(4, 0) += 1e-3 * K(0, 0);
+  field.basis = {K};
+  field.weights.assign(64, 1.0);
+  EXPECT_FALSE(mirror_invariant(field));
+  field.basis = {isotropic};
+  EXPECT_TRUE(mirror_invariant(field));
+  EXPECT_TRUE(homogenize_elements(field).octant);
 }
 
 }  // namespace
