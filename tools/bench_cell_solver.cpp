@@ -9,6 +9,12 @@
 //                     [--degrees 2] [--kinds random,sphere,frame,cubic-random]
 //                     [--coarsest 64,512] [--solvers multigrid,direct]
 //                     [--symmetries none,cyclic,mirror,both] [--no-direct]
+//                     [--batch K]
+//
+// --batch K: instead of the table, the throughput a gamut sampler sees:
+// K different cells of each kind and size (seeds 1..K) homogenized with
+// the default options, one cell per thread on all threads, with the
+// symmetry reductions and without them, in the same run.
 //
 // Symmetries: none solves the six cases on the whole cell, cyclic two
 // cases (cubic cells), mirror the cases on one octant (cells invariant
@@ -17,7 +23,11 @@
 //
 // Prints a Markdown table. Timings are wall-clock with the OpenMP default
 // thread count (set OMP_NUM_THREADS).
+#include <omp.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <random>
@@ -54,15 +64,17 @@ std::vector<T> parse_list(const char* text) {
 // its fundamental domain mirrored (a gamut structure's symmetry). sphere,
 // frame and cubic-random are cubic, so they also run with two cell
 // problems instead of six (HomogenizationOptions::use_symmetry).
-VoxelGrid make_cell(const std::string& kind, int n) {
+// mirror-random: random mirrored into the three reflections only (an
+// orthotropic structure's symmetry: one octant, six cases).
+VoxelGrid make_cell(const std::string& kind, int n, unsigned seed = 7) {
   VoxelGrid g(n, n, n, 1.0 / n, 1);
-  std::mt19937 rng(7);
+  std::mt19937 rng(seed);
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
         const Vec3 x = g.voxel_center(i, j, k) - Vec3(0.5, 0.5, 0.5);
         int& id = g.at(i, j, k);
-        if (kind == "random" || kind == "cubic-random") id = 1 + int(rng() % 2);
+        if (kind == "random" || kind == "cubic-random" || kind == "mirror-random") id = 1 + int(rng() % 2);
         if (kind == "sphere") id = x.norm() < 0.3 ? 2 : 1;
         if (kind == "frame") {
           const double a = std::abs(x[0]), b = std::abs(x[1]), c = std::abs(x[2]), w = 1.0 / 6;
@@ -70,7 +82,14 @@ VoxelGrid make_cell(const std::string& kind, int n) {
         }
       }
   if (kind == "cubic-random") mirror_fundamental_domain(g);
+  if (kind == "mirror-random") mirror_fundamental_domain(g, CellSymmetry::orthotropic);
   return g;
+}
+
+std::string format_error(double e) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1e", e);
+  return text;
 }
 
 }  // namespace
@@ -83,6 +102,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> kinds = {"random", "sphere", "frame"};
   std::vector<std::string> solvers = {"multigrid"};
   std::vector<std::string> symmetries = {"none", "cyclic", "mirror", "both"};
+  int batch = 0;
   bool direct = true;
   for (int a = 1; a < argc; ++a) {
     const bool more = a + 1 < argc;
@@ -93,14 +113,47 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[a], "--kinds") && more) kinds = parse_list<std::string>(argv[++a]);
     else if (!std::strcmp(argv[a], "--solvers") && more) solvers = parse_list<std::string>(argv[++a]);
     else if (!std::strcmp(argv[a], "--symmetries") && more) symmetries = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--batch") && more) batch = std::atoi(argv[++a]);
     else if (!std::strcmp(argv[a], "--no-direct")) direct = false;
     else {
-      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--solvers L] [--symmetries L] [--no-direct]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--solvers L] [--symmetries L] [--batch K] [--no-direct]\n", argv[0]);
       return 2;
     }
   }
   const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(1e6, 0.45),
                                             std::make_shared<LinearIsotropic>(1e3, 0.45)};
+  if (batch > 0) {
+    std::printf("| cell | n | cells | threads | symmetry | seconds | cells/s | max rel. difference of C |\n|---|---|---|---|---|---|---|---|\n");
+    for (const std::string& kind : kinds)
+      for (int n : sizes) {
+        std::vector<VoxelGrid> cells;
+        for (int c = 0; c < batch; ++c) cells.push_back(make_cell(kind, n, 1 + c));
+        std::vector<Mat6> reference(batch);
+        // whole: six cases on the whole cell; cyclic: two cases on the whole
+        // cell (the default before the octant, cubic cells only); reduced: the default.
+        for (const std::string mode : {"whole", "cyclic", "reduced"}) {
+          if (mode == "cyclic" && !has_cubic_symmetry(cells[0])) continue;
+          HomogenizationOptions o;
+          o.threads = 1;
+          o.use_symmetry = mode != "whole";
+          o.use_mirror_symmetry = mode == "reduced";
+          std::vector<Mat6> C(batch);
+          const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(dynamic, 1)
+          for (int c = 0; c < batch; ++c) C[c] = homogenize(cells[c], palette, o).C;
+          const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+          double difference = 0;
+          for (int c = 0; c < batch; ++c)
+            if (mode == "whole") reference[c] = C[c];
+            else difference = std::max(difference, (C[c] - reference[c]).norm() / reference[c].norm());
+          const char* label = mode == "whole" ? "whole cell, 6 cases" : mode == "cyclic" ? "whole cell, 2 cases (cyclic)" : "default (octant; 2 cases if cubic)";
+          std::printf("| %s | %d | %d | %d | %s | %.3f | %.3g | %s |\n", kind.c_str(), n, batch, omp_get_max_threads(),
+                      label, seconds, batch / seconds, mode == "whole" ? "(reference)" : format_error(difference).c_str());
+          std::fflush(stdout);
+        }
+      }
+    return 0;
+  }
   std::printf("| cell | n | solver | domain | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& kind : kinds)
