@@ -6,7 +6,7 @@
 #                                              families among its nu > 0.3 structures and among its auxetic
 #                                              ones (if any)
 #   make -f Makefile.pipeline families-auxetic  auxetic families of the 3D gamut with directed min_nu pushes
-#                                              (gamut-auxetic-3d, ~6 min, then seconds)
+#                                              (gamut-auxetic-3d, ~2 min, then seconds)
 #
 # Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
 # a sweep of each family's first reduced parameter (*.family1.microstructures.h5).

@@ -174,7 +174,9 @@ void ContinuousCellProblem::homogenize_densities(Evaluation& e) const {
   field.weights.resize(2 * e.xp.size());
   for (std::size_t v = 0; v < e.xp.size(); ++v)
     field.weights[2 * v] = 1.0, field.weights[2 * v + 1] = std::pow(e.xp[v], options_.penalty);
-  e.r = homogenize_elements(field);
+  HomogenizationOptions solve;
+  solve.use_symmetry = solve.use_mirror_symmetry = options_.use_symmetry;
+  e.r = homogenize_elements(field, solve);
   const bool plane = nz_ == 1;
   const int m = plane ? 3 : 6;
   e.C.resize(m, m);

@@ -54,6 +54,9 @@ struct ContinuousOptions {
   // a directed push keeps only thresholds whose structure has none.
   int min_feature = 1;
   CellSymmetry symmetry = CellSymmetry::cubic;
+  // Cell problems on the symmetric part (one octant, two cases if cubic;
+  // exact); false: six cases on the whole cell, for comparison.
+  bool use_symmetry = true;
 };
 
 struct RefinementTarget {

@@ -122,8 +122,9 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.continuous.min_feature = o.min_feature;
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
+  o.continuous.use_symmetry = o.use_symmetry;
 
-  o.directed = o.continuous;  // min_feature, void_stiffness, symmetry
+  o.directed = o.continuous;  // min_feature, void_stiffness, symmetry, use_symmetry
   o.directed.max_iterations = 150;
   o.directed.projection_beta = 16;
   o.directed.filter_radius = 2.5;

@@ -22,6 +22,8 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
   f.write_attribute("/", "seconds", r.seconds);
   f.write_attribute("/", "solver", r.solver);
   f.write_attribute("/", "cg_iterations", r.iterations);
+  f.write_attribute("/", "domain", r.octant ? "octant" : "cell");
+  f.write_attribute("/", "strain_cases_solved", r.symmetric_cases ? 2 : 6);
   std::vector<std::int32_t> ids32(in.cell.ids.begin(), in.cell.ids.end());
   f.write_vector("/cell/ids", ids32);
   f.write_vector("/cell/size", std::vector<int>{in.cell.nx, in.cell.ny, in.cell.nz});

@@ -31,6 +31,11 @@ check "2D tensor written" -- bash -c "h5dump -H -d /C2 '$WORK/flat.h5' | grep -q
 expect_exit 0 "multigrid: [0-9]+ CG iterations" -- "$H" --set cell.size='[24, 24, 24]' --set solver=multigrid --out "$WORK/mg.h5"
 check "direct at 24^3" -- "$H" --set cell.size='[24, 24, 24]' --set solver=direct --out "$WORK/direct.h5" --quiet
 check "multigrid and direct tensors agree to 1e-2 Pa (C ~ 1e5 Pa)" -- h5diff -q --delta=1e-2 "$WORK/mg.h5" "$WORK/direct.h5" /C /C
+# The frame is mirror-symmetric: solved on one octant, the same tensor as the whole cell.
+check "the frame is solved on one octant" -- bash -c "h5dump -a /domain '$WORK/frame.h5' | grep -q octant"
+check "use_symmetry: false solves the whole cell" -- bash -c \
+  "'$H' --set use_symmetry=false --out '$WORK/whole.h5' --quiet && h5dump -a /domain '$WORK/whole.h5' | grep -q '\"cell\"'"
+check "octant and whole cell agree to 1e-3 Pa" -- h5diff -q --delta=1e-3 "$WORK/frame.h5" "$WORK/whole.h5" /C /C
 expect_exit 2 "solver multigrid needs every cell dimension even" -- "$H" --set cell.size='[12, 12, 9]' --set solver=multigrid --out "$WORK/bad.h5"
 
 # Batch mode: a small 3D set from the sampler, homogenized again.
