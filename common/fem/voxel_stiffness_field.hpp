@@ -7,6 +7,7 @@
 // K_soft). The form keeps a 64^3 cell at a few numbers per voxel, lets the
 // multigrid solver apply K without storing it, and makes its Galerkin
 // coarse operators linear in the weights.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,6 +27,19 @@ struct VoxelStiffnessField {
   double weight(std::int64_t v, int b) const { return weights[std::size_t(v) * basis.size() + b]; }
   Mat24 element(std::int64_t v) const;
 };
+
+// A point symmetry of the voxel that sends corner a to corner[a] and
+// displacement component r to sign[r] times component[r]: true when every
+// basis matrix maps onto itself under it (to 1e-12 of its largest entry).
+struct VoxelSymmetry {
+  std::array<int, 8> corner;
+  std::array<int, 3> component;
+  std::array<double, 3> sign;
+};
+bool basis_invariant(const VoxelStiffnessField& field, const VoxelSymmetry& symmetry);
+
+// True when voxels v and w carry the same weights (to 1e-12 relative).
+bool same_weights(const VoxelStiffnessField& field, std::int64_t v, std::int64_t w);
 
 // Throws InputError ("<what>: ...") for empty dimensions, a non-positive
 // voxel size, no basis, or a weight table of the wrong size or with a

@@ -179,31 +179,20 @@ int pin_group(int m) { return m < 3 ? 0 : m; }
 
 bool mirror_invariant(const VoxelStiffnessField& f) {
   const int n[3] = {f.nx, f.ny, f.nz};
-  for (int d = 0; d < 3; ++d)
+  for (int d = 0; d < 3; ++d) {
     if (n[d] < 2 || n[d] % 2 != 0) return false;
-  for (const Mat24& K : f.basis) {
-    const double tol = 1e-12 * K.cwiseAbs().maxCoeff();
-    for (int d = 0; d < 3; ++d)
-      for (int a = 0; a < 8; ++a)
-        for (int b = 0; b < 8; ++b)
-          for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) {
-              const double sign = (r == d ? -1.0 : 1.0) * (c == d ? -1.0 : 1.0);
-              const int ra = a ^ corner_bit(d), rb = b ^ corner_bit(d);
-              if (std::abs(sign * K(3 * ra + r, 3 * rb + c) - K(3 * a + r, 3 * b + c)) > tol) return false;
-            }
+    VoxelSymmetry mirror{{}, {0, 1, 2}, {1, 1, 1}};
+    for (int a = 0; a < 8; ++a) mirror.corner[a] = a ^ corner_bit(d);
+    mirror.sign[d] = -1;
+    if (!basis_invariant(f, mirror)) return false;
   }
-  const int B = f.basis_size();
   for (std::int64_t v = 0; v < f.voxels(); ++v) {
     const int at[3] = {static_cast<int>(v % n[0]), static_cast<int>((v / n[0]) % n[1]),
                        static_cast<int>(v / (std::int64_t(n[0]) * n[1]))};
     for (int d = 0; d < 3; ++d) {
       int image[3] = {at[0], at[1], at[2]};
       image[d] = n[d] - 1 - at[d];
-      const std::int64_t w = image[0] + std::int64_t(n[0]) * (image[1] + std::int64_t(n[1]) * image[2]);
-      for (int b = 0; b < B; ++b)
-        if (std::abs(f.weight(v, b) - f.weight(w, b)) > 1e-12 * std::max(std::abs(f.weight(v, b)), 1e-300))
-          return false;
+      if (!same_weights(f, v, image[0] + std::int64_t(n[0]) * (image[1] + std::int64_t(n[1]) * image[2]))) return false;
     }
   }
   return true;

@@ -255,22 +255,12 @@ void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& lo
 bool cyclic_invariant(const VoxelStiffnessField& f) {
   const int n = f.nx;
   if (f.ny != n || f.nz != n || n < 2) return false;
-  for (const Mat24& K : f.basis) {
-    const double tol = 1e-12 * K.cwiseAbs().maxCoeff();
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            if (std::abs(K(3 * cyclic_corner(a) + (r + 1) % 3, 3 * cyclic_corner(b) + (c + 1) % 3) -
-                         K(3 * a + r, 3 * b + c)) > tol)
-              return false;
-  }
-  const int B = f.basis_size();
+  VoxelSymmetry cyclic{{}, {1, 2, 0}, {1, 1, 1}};
+  for (int a = 0; a < 8; ++a) cyclic.corner[a] = cyclic_corner(a);
+  if (!basis_invariant(f, cyclic)) return false;
   for (std::int64_t v = 0; v < f.voxels(); ++v) {
     const int i = static_cast<int>(v % n), j = static_cast<int>((v / n) % n), k = static_cast<int>(v / (std::int64_t(n) * n));
-    const std::int64_t w = k + n * (i + std::int64_t(n) * j);
-    for (int b = 0; b < B; ++b)
-      if (std::abs(f.weight(v, b) - f.weight(w, b)) > 1e-12 * std::max(std::abs(f.weight(v, b)), 1e-300)) return false;
+    if (!same_weights(f, v, k + n * (i + std::int64_t(n) * j))) return false;
   }
   return true;
 }
