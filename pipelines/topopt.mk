@@ -11,8 +11,9 @@
 #                                                    configs/gamut/cubic3d_bar_dense.yaml: out/topopt/cubes.md
 #                                                    (tools/bench_cubes.sh, about 15 minutes)
 #
-# Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.{design,mapped}.h5
-# (the mapping with its STL surfaces and PNG slice stack for the bar and the
+# Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.design.h5,
+# S.structures.h5 (the gamut's structures plus those generated at the
+# design's uncovered targets, msfab-fill-targets), S.mapped.h5 (the mapping with its STL surfaces and PNG slice stack for the bar and the
 # gripper, the voxel model for all), and S.verify.h5, the thesis's comparison
 # (one hexahedron per cell). The bar adds bar.h4.verify.h5 (the homogenized
 # model with 4^3 hexahedra per cell: the homogenization's own error, without
@@ -32,35 +33,50 @@ $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.design.h5): $(OUT)/topopt/%.design.h5: conf
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@ --quiet
 
+# The gamut's structures plus structures generated at the design's targets
+# that the gamut does not cover (msfab-fill-targets); FILL_TARGETS=0 maps
+# on the gamut's structures alone. The targets fan out over MPI ranks with
+# FILL_MPIRUN="$(MPIRUN)" (RANKS, pipelines/ddfem.mk) or "srun" on a cluster.
+FILL_TARGETS ?= 1
+FILL_MPIRUN ?=
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.structures.h5): $(OUT)/topopt/%.structures.h5: $(OUT)/topopt/%.design.h5 \
+    $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-fill-targets
+ifeq ($(FILL_TARGETS),0)
+	cp $(BAR_GAMUT).microstructures.h5 $@.tmp && mv $@.tmp $@
+else
+	OMP_NUM_THREADS=$(THREADS) $(FILL_MPIRUN) $(BIN)/msfab-fill-targets --design $< --structures $(BAR_GAMUT).microstructures.h5 \
+	  --threads $(THREADS) --out $@
+endif
+
 # Exports: the voxel model always; STL surfaces and a PNG slice per voxel
 # layer for the smaller models.
 MAP_EXPORTS_bar := --set export.stl=true --set export.png=true
 MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.mapped.h5): $(OUT)/topopt/%.mapped.h5: $(OUT)/topopt/%.design.h5 \
-    $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(BAR_GAMUT).microstructures.h5 --seed $(SEED) \
+    $(OUT)/topopt/%.structures.h5 $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/$*.structures.h5 --seed $(SEED) \
 	  --set export.voxels=true $(MAP_EXPORTS_$*) --threads $(THREADS) --out $@ --quiet
 
 $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.verify.h5): $(OUT)/topopt/%.verify.h5: $(OUT)/topopt/%.mapped.h5 \
     $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
-	  --structures $(BAR_GAMUT).microstructures.h5 --threads $(THREADS) --out $@
+	  --structures $(OUT)/topopt/$*.structures.h5 --threads $(THREADS) --out $@
 
 $(OUT)/topopt/bar.h4.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(BAR_GAMUT).microstructures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
+	  --structures $(OUT)/topopt/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
 $(OUT)/topopt/bar.solid.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(BAR_GAMUT).microstructures.h5 --set fill=solid --threads $(THREADS) --out $@
+	  --structures $(OUT)/topopt/bar.structures.h5 --set fill=solid --threads $(THREADS) --out $@
 
-$(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(BAR_GAMUT).microstructures.h5 --seed $(SEED) --set tiling=2 \
+$(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(OUT)/topopt/bar.structures.h5 $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set tiling=2 \
 	  --threads $(THREADS) --out $@ --quiet
 
 $(OUT)/topopt/bar.t2.verify.h5: $(OUT)/topopt/bar.t2.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(BAR_GAMUT).microstructures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
+	  --structures $(OUT)/topopt/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
 $(CUBES_GAMUT).microstructures.h5: $(CUBES_GAMUT).gamut.h5
 	@test -s $@

@@ -39,6 +39,9 @@ void check_options(int nx, int ny, int nz, double h, const MaterialPtr& stiff, c
     throw InputError(
         "continuous step: need max_iterations >= 1, penalty >= 1, filter_radius >= 0, density_weight >= 0, "
         "0 <= start_offset < 0.5, void_stiffness > 0, 0 <= projection_beta <= 1024, min_feature >= 1");
+  if (options.threshold_levels.empty()) throw InputError("continuous step: no threshold level");
+  for (double level : options.threshold_levels)
+    if (!(level > 0 && level < 1)) throw InputError("continuous step: threshold levels must lie in (0, 1)");
 }
 
 }  // namespace
@@ -100,6 +103,20 @@ void ContinuousCellProblem::setup_cell(MaterialPtr stiff, MaterialPtr soft) {
         orbit_voxels_[it->second].push_back(static_cast<int>(probe.index(i, j, k)));
       }
 
+  if (!options.frozen_stiff.empty()) {
+    if (options.frozen_stiff.size() != probe.size())
+      throw InputError("continuous step: the frozen voxel mask has " + std::to_string(options.frozen_stiff.size()) +
+                       " entries for " + std::to_string(probe.size()) + " voxels");
+    frozen_orbit_.assign(orbit_voxels_.size(), 0);
+    for (std::size_t o = 0; o < orbit_voxels_.size(); ++o) {
+      int held = 0;
+      for (int v : orbit_voxels_[o]) held += options.frozen_stiff[std::size_t(v)] != 0;
+      if (held != 0 && held != int(orbit_voxels_[o].size()))
+        throw InputError("continuous step: the frozen voxel mask does not have the cell's symmetry");
+      frozen_orbit_[o] = held != 0;
+    }
+  }
+
   // Periodic cone filter, weights R - distance, rows normalized.
   const double R = options.filter_radius;
   const int reach = R > 1 ? static_cast<int>(std::ceil(R)) : 0;
@@ -136,7 +153,7 @@ std::vector<double> ContinuousCellProblem::start(const VoxelGrid& structure, int
   for (std::size_t o = 0; o < x.size(); ++o) {
     double stiff = 0;  // majority over the orbit (one value for a symmetric structure)
     for (int v : orbit_voxels_[o]) stiff += structure.ids[v] == stiff_id;
-    x[o] = 0.5 + (2 * stiff >= orbit_voxels_[o].size() ? 1 : -1) * options_.start_offset;
+    x[o] = frozen(int(o)) ? 1.0 : 0.5 + (2 * stiff >= orbit_voxels_[o].size() ? 1 : -1) * options_.start_offset;
   }
   return x;
 }
@@ -198,6 +215,22 @@ VecX ContinuousCellProblem::structure_unit_properties(const VoxelGrid& structure
   return properties_and_gradients(e, nullptr);
 }
 
+double ContinuousCellProblem::structure_objective(const VoxelGrid& structure, int stiff_id) const {
+  if (space_) throw std::logic_error("ContinuousCellProblem::structure_objective: not a target problem");
+  if (structure.nx != nx_ || structure.ny != ny_ || structure.nz != nz_)
+    throw InputError("continuous step: the structure's size differs from the problem's");
+  Evaluation e;
+  e.xp.resize(structure.ids.size());
+  for (std::size_t v = 0; v < e.xp.size(); ++v) e.xp[v] = structure.ids[v] == stiff_id ? 1.0 : 0.0;
+  homogenize_densities(e);
+  return target_objective(e);
+}
+
+double ContinuousCellProblem::target_objective(const Evaluation& e) const {
+  const MatX E = W_ * (e.C.inverse() - target_.G) * W_;
+  return E.squaredNorm() + options_.density_weight * (e.rho - target_.rho) * (e.rho - target_.rho);
+}
+
 double ContinuousCellProblem::floor_violation(const VecX& u) const {
   double worst = 0;
   for (const auto& [i, floor] : floors_) worst = std::max(worst, floor - u[i]);
@@ -213,6 +246,9 @@ const ContinuousCellProblem::Evaluation& ContinuousCellProblem::evaluate(const s
     e->xp.resize(e->xt.size());
     e->dxp.resize(e->xt.size());
     for (std::size_t v = 0; v < e->xt.size(); ++v) e->xp[v] = project(e->xt[v], &e->dxp[v]);
+    // Frozen voxels are stiff whatever the filter does around them.
+    for (std::size_t v = 0; v < options_.frozen_stiff.size(); ++v)
+      if (options_.frozen_stiff[v]) e->xp[v] = 1.0, e->dxp[v] = 0.0;
     homogenize_densities(*e);
     last_ = std::move(e);
   }
@@ -278,7 +314,7 @@ double ContinuousCellProblem::objective(const std::vector<double>& x, std::vecto
   }
   const MatX G = e.C.inverse();
   const MatX E = W_ * (G - target_.G) * W_;
-  const double f = E.squaredNorm() + options_.density_weight * (e.rho - target_.rho) * (e.rho - target_.rho);
+  const double f = target_objective(e);
   // df/dG = 2 W E W; df/dC = -G (df/dG) G (all symmetric).
   if (gradient)
     chain(e, -2.0 * G * (W_ * E * W_) * G, 2.0 * options_.density_weight * (e.rho - target_.rho), gradient);
@@ -357,7 +393,9 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
     const int budget = options.max_iterations * (stage + 1) / stages - options.max_iterations * stage / stages;
     if (budget < 1) continue;
     nlopt::opt opt(nlopt::LD_MMA, static_cast<unsigned>(problem.variables()));
-    opt.set_lower_bounds(0.0);
+    std::vector<double> lower(std::size_t(problem.variables()), 0.0);
+    for (int o = 0; o < problem.variables(); ++o) lower[std::size_t(o)] = problem.frozen(o) ? 1.0 : 0.0;
+    opt.set_lower_bounds(lower);
     opt.set_upper_bounds(1.0);
     opt.set_min_objective(objective, &data);
     for (auto& c : constraint_data) opt.add_inequality_constraint(constraint, &c, 0.0);
@@ -383,10 +421,26 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
     VoxelGrid g = problem.threshold(best, stiff_id, soft_id, level);
     mirror_fundamental_domain(g, options.symmetry);
     clean_structure(g);
+    // The connector stays even where the structure does not reach it: it
+    // joins the neighbour's.
+    for (std::size_t v = 0; v < options.frozen_stiff.size(); ++v)
+      if (options.frozen_stiff[v]) g.ids[v] = stiff_id;
     return g;
   };
-  if (!problem.directed()) {
-    result.structure = printable(0.5);
+  if (!problem.directed() && options.threshold_levels.size() == 1) {
+    result.structure = printable(options.threshold_levels.front());
+    result.threshold = options.threshold_levels.front();
+  } else if (!problem.directed()) {
+    // The level whose printable structure is closest to the target.
+    double best_score = HUGE_VAL;
+    result.structure = VoxelGrid(structure.nx, structure.ny, structure.nz, structure.voxel_size, soft_id);
+    result.found = false;
+    for (double level : options.threshold_levels) {
+      VoxelGrid g = printable(level);
+      if (g.count_solid() == 0 || thin_feature_voxels(g, options.min_feature) > 0) continue;
+      const double score = problem.structure_objective(g, stiff_id);
+      if (score < best_score) best_score = score, result.structure = std::move(g), result.threshold = level, result.found = true;
+    }
   } else {
     // The grey optimum is not the printable one: face-disconnected pieces
     // (a one-node hinge carries load in the grey model) are cleaned away

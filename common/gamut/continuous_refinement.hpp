@@ -26,6 +26,7 @@
 // conservative inner iterations compare objective values, and a filtered
 // sensitivity is not the gradient of any objective (docs/gamut.md).
 #include <Eigen/Eigenvalues>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -53,6 +54,16 @@ struct ContinuousOptions {
   // The printer's minimum feature size in voxels (thin_feature_voxels):
   // a directed push keeps only thresholds whose structure has none.
   int min_feature = 1;
+  // Target objective: the levels x~ is thresholded at; the printable
+  // structure (mirrored, cleaned, no feature below min_feature) whose own
+  // objective is lowest is kept. The gamut's continuous step uses 0.5
+  // alone; a structure generated at a design's target tries several,
+  // since the grey optimum and its thresholded structure differ.
+  std::vector<double> threshold_levels = {0.5};
+  // Per voxel (empty: none), 1 for voxels held stiff throughout: a face
+  // connector shared by neighbouring cells (face_connector). Must be
+  // invariant under the cell symmetry.
+  std::vector<std::uint8_t> frozen_stiff;
   CellSymmetry symmetry = CellSymmetry::cubic;
   // Cell problems on the symmetric part (one octant, two cases if cubic;
   // exact); false: six cases on the whole cell, for comparison.
@@ -90,6 +101,8 @@ class ContinuousCellProblem {
                         const MaterialSpace& space, const DirectedTarget& target, const ContinuousOptions& options);
 
   int variables() const { return static_cast<int>(orbit_voxels_.size()); }
+  // Whether design variable `orbit` is held at 1 (options.frozen_stiff).
+  bool frozen(int orbit) const { return !frozen_orbit_.empty() && frozen_orbit_[std::size_t(orbit)]; }
   // Densities of the voxels of a structure (stiff id -> 0.5 + offset, others 0.5 - offset), one per orbit.
   std::vector<double> start(const VoxelGrid& structure, int stiff_id) const;
   // Filtered per-voxel densities x~.
@@ -109,6 +122,9 @@ class ContinuousCellProblem {
   // the floors (0: none).
   VecX structure_unit_properties(const VoxelGrid& structure, int stiff_id) const;
   double floor_violation(const VecX& u) const;
+  // Target problems: the objective f of a black-and-white structure
+  // (stiff_id stiff, all else soft).
+  double structure_objective(const VoxelGrid& structure, int stiff_id) const;
   double directed_objective(const VecX& u) const { return -direction_.dot(u); }
   bool directed() const { return space_.has_value(); }
   // Voxel ids of the thresholded design: x~ >= level -> stiff_id, else soft_id.
@@ -127,6 +143,7 @@ class ContinuousCellProblem {
   ContinuousOptions options_;
   std::vector<int> orbit_of_voxel_;
   std::vector<std::vector<int>> orbit_voxels_;
+  std::vector<std::uint8_t> frozen_orbit_;  // per orbit, options.frozen_stiff
   // Filter rows: per voxel, (neighbour voxel, weight / row sum).
   std::vector<std::vector<std::pair<int, double>>> filter_;
   // The last design evaluated: NLopt asks for the objective and each
@@ -137,6 +154,7 @@ class ContinuousCellProblem {
   double project(double xt, double* derivative) const;
   void setup_cell(MaterialPtr stiff, MaterialPtr soft);
   void homogenize_densities(Evaluation& e) const;  // e.xp -> e.r, e.C, e.rho
+  double target_objective(const Evaluation& e) const;  // f of a target problem
   const Evaluation& evaluate(const std::vector<double>& x, bool with_sensitivities) const;
   // d(property)/dC of the plane block or the 6 x 6 tensor, and the unit-cube properties.
   VecX properties_and_gradients(const Evaluation& e, std::vector<MatX>* dudC) const;
@@ -149,7 +167,7 @@ struct ContinuousResult {
   double start_objective = 0, best_objective = 0;
   int evaluations = 0;
   double threshold = 0.5;            // the level x~ was thresholded at
-  bool found = true;                 // directed: false when no level gave a printable structure
+  bool found = true;                 // false when no level gave a printable structure (directed, or several target levels)
   std::vector<double> history;       // f per evaluation
 };
 

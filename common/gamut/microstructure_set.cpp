@@ -26,6 +26,7 @@ const char* step_name(SampleStep step) {
     case SampleStep::continuous: return "continuous";
     case SampleStep::void_variant: return "void_variant";
     case SampleStep::directed: return "directed";
+    case SampleStep::targeted: return "targeted";
   }
   return "?";
 }
@@ -109,7 +110,7 @@ void write_microstructure_set(H5File& f, const std::string& g, const Microstruct
   f.write_attribute(at(g, "C"), "order", "Voigt xx, yy, zz, yz, xz, xy; engineering shear; 2D cells: plane strain");
   f.write_vector(at(g, "cycle"), cycle);
   f.write_vector(at(g, "step"), step);
-  f.write_attribute(at(g, "step"), "meaning", "0 initial, 1 discrete, 2 continuous, 3 void variant");
+  f.write_attribute(at(g, "step"), "meaning", "0 initial, 1 discrete, 2 continuous, 3 void variant, 4 directed, 5 targeted");
   f.write_vector(at(g, "parent"), parent);
 }
 
@@ -159,7 +160,7 @@ MicrostructureSet read_microstructure_set(const H5File& f, const std::string& g)
     for (int r = 0; r < 6; ++r)
       for (int c = 0; c < 6; ++c) m.C(r, c) = C.values[i * 36 + 6 * r + c];
     m.cycle = cycle[i];
-    if (step[i] < 0 || step[i] > 4) bad(f, at(g, "step"), "value " + std::to_string(step[i]) + " is not 0..4");
+    if (step[i] < 0 || step[i] > 5) bad(f, at(g, "step"), "value " + std::to_string(step[i]) + " is not 0..5");
     m.step = static_cast<SampleStep>(step[i]);
     m.parent = parent[i];
   }

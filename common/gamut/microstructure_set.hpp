@@ -21,7 +21,8 @@ inline constexpr const char* kMicrostructuresSchema = "msfab.microstructures";
 inline constexpr int kMicrostructuresSchemaVersion = 1;
 
 // Which step of the sampler produced a structure.
-enum class SampleStep : int { initial = 0, discrete = 1, continuous = 2, void_variant = 3, directed = 4 };
+// targeted: generated at a design cell's target by msfab-fill-targets.
+enum class SampleStep : int { initial = 0, discrete = 1, continuous = 2, void_variant = 3, directed = 4, targeted = 5 };
 const char* step_name(SampleStep step);
 
 struct Microstructure {

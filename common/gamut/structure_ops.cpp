@@ -1,6 +1,8 @@
 #include "gamut/structure_ops.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
 #include <map>
 #include <vector>
 
@@ -123,6 +125,29 @@ int paint_beam(VoxelGrid& c, const Vec3& a, const Vec3& b, double radius, int id
         }
       }
   return changed;
+}
+
+std::vector<std::uint8_t> face_connector(const VoxelGrid& c, int half_width, int depth) {
+  const bool flat = is_2d(c);
+  if (c.nx != c.ny || (!flat && c.nz != c.nx))
+    throw InputError("face connector: the cell must be cubic (or square in 2D)");
+  const int n = c.nx;
+  if (half_width < 1 || depth < 1 || 2 * half_width > n || 2 * depth > n)
+    throw InputError("face connector: need half_width >= 1, depth >= 1, both at most half the cell (" +
+                     std::to_string(n) + " voxels)");
+  // |2i + 1 - n| < 2w: the 2w central indices (odd n: 2w - 1).
+  auto central = [&](int i) { return std::abs(2 * i + 1 - n) < 2 * half_width; };
+  auto outer = [&](int i) { return i < depth || i >= n - depth; };
+  std::vector<std::uint8_t> mask(c.size(), 0);
+  for (int k = 0; k < c.nz; ++k)
+    for (int j = 0; j < c.ny; ++j)
+      for (int i = 0; i < c.nx; ++i) {
+        const bool on = flat ? (outer(i) && central(j)) || (outer(j) && central(i))
+                             : (outer(i) && central(j) && central(k)) || (outer(j) && central(i) && central(k)) ||
+                                   (outer(k) && central(i) && central(j));
+        mask[c.index(i, j, k)] = on;
+      }
+  return mask;
 }
 
 CleanupReport clean_structure(VoxelGrid& c) {

@@ -7,6 +7,7 @@
 // connectivity and wrapping are in the plane.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "fem/voxel_grid.hpp"
 
@@ -36,6 +37,15 @@ bool has_symmetry(const VoxelGrid& cell, CellSymmetry symmetry);
 // segment a-b (cell coordinates: voxel units, voxel (i, j, k) centred at
 // (i + 0.5, j + 0.5, k + 0.5)). Returns the number of voxels changed.
 int paint_beam(VoxelGrid& cell, const Vec3& a, const Vec3& b, double radius, int id);
+
+// A face connector: per voxel, 1 for the voxels within `depth` layers of a
+// cell face whose other coordinates lie in the face's central square of
+// half-width `half_width` voxels (2D: the central segment of each edge).
+// Invariant under the cubic and orthotropic symmetries; two cells carrying
+// it meet across every shared face on the same solid patch. InputError for
+// a cell that is not cubic/square, half_width < 1, depth < 1, or a patch
+// wider than the face.
+std::vector<std::uint8_t> face_connector(const VoxelGrid& cell, int half_width, int depth);
 
 struct CleanupReport {
   int removed_voxels = 0;  // solid voxels in pieces that do not wrap around the cell

@@ -57,6 +57,15 @@ std::vector<Neighbour> brute_force_within(const MatX& points, const double* q, d
 struct CandidateOptions {
   int k = 16;           // nearest structures per cell (>= 1)
   double radius = 0;    // > 0: also every structure within this distance
+  // Distances over the moduli and Poisson ratios only, the density (the
+  // space's last coordinate) left out: a cell then gets the structures
+  // whose stiffness matches, whatever their mass (design_candidates).
+  bool stiffness_only = false;
+  // > 0: of a cell's candidates keep those whose property gap (relative,
+  // Frobenius norm of C) is at most max(max_gap, the cell's smallest gap),
+  // so the boundary descent cannot trade the stiffness away for a better
+  // fit of the faces (design_candidates).
+  double max_gap = 0;
 };
 
 // Candidates of every cell in compressed rows: cell c's are entries

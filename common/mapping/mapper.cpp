@@ -15,7 +15,46 @@ std::string joined(const std::vector<std::string>& names) {
   return s;
 }
 
+// The candidates of each cell whose property gap is at most max(limit, the
+// cell's smallest), in their order.
+CellCandidates keep_within_gap(const CellCandidates& in, const Design& design, const MicrostructureSet& set,
+                               double limit) {
+  const MaterialSpace space(MaterialSpace::parse_kind(set.space), set.E_stiff, set.decades);
+  const std::int64_t cells = in.cells();
+  std::vector<std::vector<std::uint8_t>> keep(static_cast<std::size_t>(cells));
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::int64_t c = 0; c < cells; ++c) {
+    const std::int64_t n = in.count(c);
+    if (n == 0) continue;
+    const VecX target = design.raw.row(c).transpose();
+    std::vector<double> gap(static_cast<std::size_t>(n));
+    for (std::int64_t i = 0; i < n; ++i)
+      gap[std::size_t(i)] =
+          relative_stiffness_gap(space, set.items[std::size_t(in.structure[in.offsets[c] + i])].properties, target);
+    const double bound = std::max(limit, *std::min_element(gap.begin(), gap.end()));
+    keep[std::size_t(c)].resize(std::size_t(n));
+    for (std::int64_t i = 0; i < n; ++i) keep[std::size_t(c)][std::size_t(i)] = gap[std::size_t(i)] <= bound;
+  }
+  CellCandidates out;
+  out.offsets.assign(std::size_t(cells) + 1, 0);
+  for (std::int64_t c = 0; c < cells; ++c) {
+    for (std::int64_t i = 0; i < in.count(c); ++i)
+      if (keep[std::size_t(c)][std::size_t(i)]) {
+        out.structure.push_back(in.structure[in.offsets[c] + i]);
+        out.distance.push_back(in.distance[in.offsets[c] + i]);
+      }
+    out.offsets[c + 1] = std::int64_t(out.structure.size());
+  }
+  return out;
+}
+
 }  // namespace
+
+bool read_stiffness_only(const Config& config) {
+  const std::string match = config.get_or<std::string>("match", std::string("all"));
+  if (match != "all" && match != "stiffness") config.fail("match", "must be 'all' or 'stiffness', not '" + match + "'");
+  return match == "stiffness";
+}
 
 void check_mapping_inputs(const Design& design, const std::string& design_path, const MicrostructureSet& set,
                           const std::string& structures_path) {
@@ -51,11 +90,14 @@ void check_mapping_inputs(const Design& design, const std::string& design_path, 
 
 CellCandidates design_candidates(const Design& design, const MicrostructureSet& set,
                                  const CandidateOptions& options) {
-  MatX points(Eigen::Index(set.items.size()), design.unit.cols());
-  for (std::size_t i = 0; i < set.items.size(); ++i) points.row(Eigen::Index(i)) = set.items[i].unit.transpose();
+  const Eigen::Index d = design.unit.cols() - (options.stiffness_only ? 1 : 0);
+  MatX points(Eigen::Index(set.items.size()), d);
+  for (std::size_t i = 0; i < set.items.size(); ++i) points.row(Eigen::Index(i)) = set.items[i].unit.head(d).transpose();
   std::vector<bool> wanted(std::size_t(design.cells()));
   for (std::size_t c = 0; c < wanted.size(); ++c) wanted[c] = design.roles[c] == CellRole::design;
-  return find_candidates(design.unit, wanted, points, options);
+  CellCandidates found = find_candidates(design.unit.leftCols(d), wanted, points, options);
+  if (options.max_gap > 0) found = keep_within_gap(found, design, set, options.max_gap);
+  return found;
 }
 
 MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "gamut/material_space.hpp"
+#include "io/config.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapped_artifact.hpp"
@@ -25,6 +26,11 @@ struct MapperOptions {
   bool half_shift = true;     // also offer each candidate translated by half a cell
   double max_distance = 0.1;  // warn about cells whose nearest candidate is farther (normalized units)
 };
+
+// The `match` key of msfab-map and msfab-fill-targets: "all" (every
+// property of the space, the thesis's choice) or "stiffness" (the density
+// left out: CandidateOptions::stiffness_only). Default "all".
+bool read_stiffness_only(const Config& config);
 
 // InputError naming the offending file for inputs that cannot be paired:
 // a design space that is not a gamut space, different spaces or property

@@ -32,6 +32,8 @@ namespace {
 
 constexpr const char* kDefaults = R"(
 candidates: 16          # nearest structures per cell
+match: all              # candidates by all properties, or by stiffness (moduli and Poisson ratios, not the density)
+# max_gap: 0.2          # keep only candidates whose property gap is at most this (or the cell's smallest)
 half_shift: true        # also offer every candidate translated by half a cell
 max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
 tiling: 1               # copies of its structure per cell edge (each cell holds tiling^3 smaller copies)
@@ -57,6 +59,8 @@ Settings read_settings(const Config& config) {
   Settings s;
   s.mapper.candidates.k = config.get_or<int>("candidates", 16);
   if (s.mapper.candidates.k < 1 || s.mapper.candidates.k > 4096) config.fail("candidates", "must be 1..4096");
+  s.mapper.candidates.stiffness_only = read_stiffness_only(config);
+  if (config.has("max_gap")) s.mapper.candidates.max_gap = config.require_positive("max_gap", "property gap bound");
   if (config.has("radius")) s.mapper.candidates.radius = config.require_positive("radius", "candidate radius");
   s.mapper.half_shift = config.get_or<bool>("half_shift", true);
   s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
@@ -160,6 +164,18 @@ int main(int argc, char** argv) {
                 settings.mapper.max_distance);
     std::printf("  property gap |C(structure) - C(target)| / |C(target)|: max %.4g, mean %.4g\n", distances.max_gap,
                 distances.mean_gap);
+    // The mass the structures bring against the design's (the density is
+    // the space's last property).
+    double design_rho = 0, mapped_rho = 0;
+    for (std::int64_t c = 0; c < design.cells(); ++c) {
+      if (mapped.structure[std::size_t(c)] < 0) continue;
+      const Microstructure& m = set.items[std::size_t(mapped.structure[std::size_t(c)])];
+      design_rho += design.raw(c, design.raw.cols() - 1);
+      mapped_rho += m.properties[m.properties.size() - 1];
+    }
+    if (design_rho > 0)
+      std::printf("  material in the mapped cells: %+.1f%% against the design's (match: %s)\n",
+                  100.0 * (mapped_rho / design_rho - 1), settings.mapper.candidates.stiffness_only ? "stiffness" : "all");
     std::printf("  artifact: %s\n", out.c_str());
 
     // Exports of the voxel model, each streamed layer by layer.
