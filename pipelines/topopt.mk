@@ -37,15 +37,20 @@ $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.design.h5): $(OUT)/topopt/%.design.h5: conf
 # that the gamut does not cover (msfab-fill-targets); FILL_TARGETS=0 maps
 # on the gamut's structures alone. The targets fan out over MPI ranks with
 # FILL_MPIRUN="$(MPIRUN)" (RANKS, pipelines/ddfem.mk) or "srun" on a cluster.
+# MATCH and FILL_ARGS: candidates by stiffness, and a face connector 6
+# voxels wide on every structure (docs/mapping.md, "Face connectors";
+# the bridge's check in docs/BENCHMARKS.md).
 FILL_TARGETS ?= 1
 FILL_MPIRUN ?=
+MATCH ?= stiffness
+FILL_ARGS ?= --set connector.half_width=3 --set refine.density_weight=0.1
 $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.structures.h5): $(OUT)/topopt/%.structures.h5: $(OUT)/topopt/%.design.h5 \
     $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-fill-targets
 ifeq ($(FILL_TARGETS),0)
 	cp $(BAR_GAMUT).microstructures.h5 $@.tmp && mv $@.tmp $@
 else
 	OMP_NUM_THREADS=$(THREADS) $(FILL_MPIRUN) $(BIN)/msfab-fill-targets --design $< --structures $(BAR_GAMUT).microstructures.h5 \
-	  --threads $(THREADS) --out $@
+	  --set match=$(MATCH) $(FILL_ARGS) --threads $(THREADS) --out $@
 endif
 
 # Exports: the voxel model always; STL surfaces and a PNG slice per voxel
@@ -54,7 +59,7 @@ MAP_EXPORTS_bar := --set export.stl=true --set export.png=true
 MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.mapped.h5): $(OUT)/topopt/%.mapped.h5: $(OUT)/topopt/%.design.h5 \
     $(OUT)/topopt/%.structures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/$*.structures.h5 --seed $(SEED) \
+	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
 	  --set export.voxels=true $(MAP_EXPORTS_$*) --threads $(THREADS) --out $@ --quiet
 
 $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.verify.h5): $(OUT)/topopt/%.verify.h5: $(OUT)/topopt/%.mapped.h5 \
@@ -71,7 +76,7 @@ $(OUT)/topopt/bar.solid.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar
 	  --structures $(OUT)/topopt/bar.structures.h5 --set fill=solid --threads $(THREADS) --out $@
 
 $(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(OUT)/topopt/bar.structures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set tiling=2 \
+	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
 	  --threads $(THREADS) --out $@ --quiet
 
 $(OUT)/topopt/bar.t2.verify.h5: $(OUT)/topopt/bar.t2.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map

@@ -204,26 +204,25 @@ void ContinuousCellProblem::homogenize_densities(Evaluation& e) const {
   e.rho /= e.xp.size();
 }
 
-VecX ContinuousCellProblem::structure_unit_properties(const VoxelGrid& structure, int stiff_id) const {
-  if (!space_) throw std::logic_error("ContinuousCellProblem::structure_unit_properties: not a directed problem");
+ContinuousCellProblem::Evaluation ContinuousCellProblem::homogenize_structure(const VoxelGrid& structure,
+                                                                              int stiff_id) const {
   if (structure.nx != nx_ || structure.ny != ny_ || structure.nz != nz_)
     throw InputError("continuous step: the structure's size differs from the problem's");
   Evaluation e;
   e.xp.resize(structure.ids.size());
   for (std::size_t v = 0; v < e.xp.size(); ++v) e.xp[v] = structure.ids[v] == stiff_id ? 1.0 : 0.0;
   homogenize_densities(e);
-  return properties_and_gradients(e, nullptr);
+  return e;
+}
+
+VecX ContinuousCellProblem::structure_unit_properties(const VoxelGrid& structure, int stiff_id) const {
+  if (!space_) throw std::logic_error("ContinuousCellProblem::structure_unit_properties: not a directed problem");
+  return properties_and_gradients(homogenize_structure(structure, stiff_id), nullptr);
 }
 
 double ContinuousCellProblem::structure_objective(const VoxelGrid& structure, int stiff_id) const {
   if (space_) throw std::logic_error("ContinuousCellProblem::structure_objective: not a target problem");
-  if (structure.nx != nx_ || structure.ny != ny_ || structure.nz != nz_)
-    throw InputError("continuous step: the structure's size differs from the problem's");
-  Evaluation e;
-  e.xp.resize(structure.ids.size());
-  for (std::size_t v = 0; v < e.xp.size(); ++v) e.xp[v] = structure.ids[v] == stiff_id ? 1.0 : 0.0;
-  homogenize_densities(e);
-  return target_objective(e);
+  return target_objective(homogenize_structure(structure, stiff_id));
 }
 
 double ContinuousCellProblem::target_objective(const Evaluation& e) const {

@@ -155,6 +155,7 @@ class ContinuousCellProblem {
   void setup_cell(MaterialPtr stiff, MaterialPtr soft);
   void homogenize_densities(Evaluation& e) const;  // e.xp -> e.r, e.C, e.rho
   double target_objective(const Evaluation& e) const;  // f of a target problem
+  Evaluation homogenize_structure(const VoxelGrid& structure, int stiff_id) const;  // black and white
   const Evaluation& evaluate(const std::vector<double>& x, bool with_sensitivities) const;
   // d(property)/dC of the plane block or the 6 x 6 tensor, and the unit-cube properties.
   VecX properties_and_gradients(const Evaluation& e, std::vector<MatX>* dudC) const;
