@@ -1,5 +1,7 @@
 #include "gamut/microstructure_set.hpp"
 
+#include "material/linear_isotropic.hpp"
+
 #include <algorithm>
 #include <sstream>
 
@@ -29,6 +31,18 @@ const char* step_name(SampleStep step) {
     case SampleStep::targeted: return "targeted";
   }
   return "?";
+}
+
+std::vector<MaterialPtr> base_palette(const MicrostructureSet& set) {
+  std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(set.stiff.E, set.stiff.nu)};
+  if (!set.soft_is_void) palette.push_back(std::make_shared<LinearIsotropic>(set.soft.E, set.soft.nu));
+  return palette;
+}
+
+std::uint64_t voxel_hash(const std::vector<int>& ids) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (int v : ids) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ULL;
+  return h;
 }
 
 int bits_per_voxel(int max_id) {

@@ -14,6 +14,7 @@
 #include "core/types.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "io/hdf5_file.hpp"
+#include "material/material.hpp"
 
 namespace msfab {
 
@@ -48,6 +49,13 @@ struct MicrostructureSet {
   bool soft_is_void = true;          // no id 2; cuts leave void
   std::vector<Microstructure> items;
 };
+
+// The set's base materials as a palette: [0] void, [1] stiff, [2] soft
+// (absent when the second phase is void).
+std::vector<MaterialPtr> base_palette(const MicrostructureSet& set);
+// FNV-1a of a structure's voxel ids: how the sampler and msfab-fill-targets
+// recognize a structure the set already holds.
+std::uint64_t voxel_hash(const std::vector<int>& ids);
 
 std::vector<std::uint8_t> pack_voxels(const std::vector<int>& ids, int bits);
 std::vector<int> unpack_voxels(const std::uint8_t* bytes, std::size_t voxels, int bits);

@@ -8,7 +8,6 @@
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
 #include "gamut/material_space.hpp"
-#include "material/linear_isotropic.hpp"
 #include "solve/sparse_ops.hpp"
 
 namespace msfab {
@@ -32,8 +31,7 @@ BatchReport homogenize_set(MicrostructureSet& set, const BatchOptions& options) 
   const int NX = set.nx * r, NY = set.ny * r, NZ = set.nz * rz;
   if (std::max({NX, NY, NZ}) > 4096) throw InputError("refine: the refined cell would exceed 4096 voxels per axis");
   const MaterialSpace space(MaterialSpace::parse_kind(set.space), set.E_stiff, set.decades);
-  std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(set.stiff.E, set.stiff.nu)};
-  if (!set.soft_is_void) palette.push_back(std::make_shared<LinearIsotropic>(set.soft.E, set.soft.nu));
+  const std::vector<MaterialPtr> palette = base_palette(set);
 
   BatchReport report;
   report.structures = static_cast<int>(set.items.size());

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <string>
 #include <unordered_set>
 
@@ -13,7 +12,6 @@
 #include "homog/periodic_homogenization.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapper.hpp"
-#include "material/linear_isotropic.hpp"
 
 namespace msfab {
 namespace {
@@ -41,12 +39,6 @@ std::vector<std::pair<double, std::int32_t>> by_gap(const MaterialSpace& space, 
     out.emplace_back(relative_stiffness_gap(space, set.items[std::size_t(s)].properties, raw), s);
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   return out;
-}
-
-std::uint64_t hash_ids(const std::vector<int>& ids) {
-  std::uint64_t h = 1469598103934665603ull;  // FNV-1a
-  for (int v : ids) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ull;
-  return h;
 }
 
 }  // namespace
@@ -140,11 +132,9 @@ GeneratedStructure generate_at_target(const MicrostructureSet& set, const FillTa
   ContinuousOptions o = options;
   o.void_stiffness = void_stiffness;
   o.symmetry = space.kind() == MaterialSpaceKind::orthotropic2d ? CellSymmetry::orthotropic : CellSymmetry::cubic;
-  const MaterialPtr stiff = std::make_shared<LinearIsotropic>(set.stiff.E, set.stiff.nu);
-  const MaterialPtr soft = set.soft_is_void ? nullptr : std::make_shared<LinearIsotropic>(set.soft.E, set.soft.nu);
+  const std::vector<MaterialPtr> palette = base_palette(set);
+  const MaterialPtr stiff = palette[1], soft = set.soft_is_void ? nullptr : palette[2];
   const int soft_id = set.soft_is_void ? 0 : 2;
-  const std::vector<MaterialPtr> palette =
-      set.soft_is_void ? std::vector<MaterialPtr>{nullptr, stiff} : std::vector<MaterialPtr>{nullptr, stiff, soft};
   HomogenizationOptions ho;
   ho.void_stiffness = void_stiffness;
   ho.use_symmetry = ho.use_mirror_symmetry = options.use_symmetry;
@@ -214,12 +204,12 @@ int append_generated(MicrostructureSet& set, const std::vector<FillTarget>& targ
   if (targets.size() != generated.size()) throw std::invalid_argument("append_generated: one result per target");
   const MaterialSpace space = space_of(set);
   std::unordered_set<std::uint64_t> known;
-  for (const Microstructure& m : set.items) known.insert(hash_ids(m.ids));
+  for (const Microstructure& m : set.items) known.insert(voxel_hash(m.ids));
   int added = 0;
   for (std::size_t t = 0; t < targets.size(); ++t) {
     const GeneratedStructure& g = generated[t];
     if (!g.found || !(g.gap < targets[t].gap)) continue;
-    if (!known.insert(hash_ids(g.ids)).second) continue;
+    if (!known.insert(voxel_hash(g.ids)).second) continue;
     Microstructure m;
     m.ids = g.ids;
     m.C = g.C;

@@ -32,12 +32,6 @@ std::uint64_t stream(std::uint64_t seed, int cycle, std::int64_t item, int purpo
                   (static_cast<std::uint64_t>(item) << 8 | static_cast<std::uint64_t>(purpose)));
 }
 
-std::uint64_t hash_ids(const std::vector<int>& ids) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (int v : ids) h = (h ^ static_cast<std::uint64_t>(v)) * 1099511628211ULL;
-  return h;
-}
-
 constexpr int kHeader = 2 + 36;  // ok, rho, C
 
 }  // namespace
@@ -104,7 +98,7 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
     for (int k = 0; k < 36; ++k) r[2 + k] = h.C(k / 6, k % 6);
   });
   std::unordered_set<std::uint64_t> known;
-  for (const Microstructure& m : state.set.items) known.insert(hash_ids(m.ids));
+  for (const Microstructure& m : state.set.items) known.insert(voxel_hash(m.ids));
   for (int i = 0; i < report.tried; ++i) {
     const double* r = &records[static_cast<std::size_t>(i) * kHeader];
     if (thin[i]) {
@@ -115,7 +109,7 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
       ++report.failed;
       continue;
     }
-    const std::uint64_t h = hash_ids(cells[i].ids);
+    const std::uint64_t h = voxel_hash(cells[i].ids);
     if (known.count(h)) {
       ++report.duplicates;
       continue;
