@@ -10,6 +10,8 @@
 //    (bisection on the volume multiplier, move limit, damping 1/2), for
 //    single-parameter spaces with a volume budget: the baseline.
 //  * optimize_mma (topopt/simp_mma.hpp): NLopt's MMA on the same problem.
+//  * optimize_cell_mma (topopt/cell_mma.hpp): MMA whose subproblem
+//    separates over the cells, for every space; the large problems.
 #include <string>
 #include <vector>
 
@@ -25,6 +27,7 @@ struct OptimizerSettings {
   bool mass_limit = false;           // add the constraint sum rho_i V_i <= mass_budget
   double mass_budget = 0;
   double oc_move = 0.2;              // OC only
+  double mma_move = 0.2;             // cell MMA: largest step per iteration, in unit parameters
   // OC and MMA: stop when no design variable changes by this much in an
   // iteration (0: never; run max_iterations).
   double change_tolerance = 0.01;
@@ -40,6 +43,7 @@ struct OptimizationResult {
   int iterations = 0, evaluations = 0;
   double max_violation = 0;          // max_i of Phi(p_i) and the Voigt bound's conditions (or the mass excess) at q
   double seconds = 0;
+  double update_seconds = 0;         // time outside the objective's evaluations (cell MMA: the subproblems)
 };
 
 OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings);

@@ -9,7 +9,8 @@
 //      (coarse-to-fine continuation, §3.6.3)
 //   4. minimize S(p, u) s.t. K(p) u = f (adjoint), Phi(p_i) <= 0 and the
 //      Voigt bound C(p_i) <= rho_i C_stiff per cell, with Ipopt
-//      (limited-memory Hessian); SIMP by optimality criteria or MMA
+//      (limited-memory Hessian) or, for large grids, MMA with a subproblem
+//      that separates over the cells; SIMP by optimality criteria or MMA
 //   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
 #include <spdlog/spdlog.h>
 
@@ -20,6 +21,7 @@
 #include "design_start.hpp"
 #include "design_report.hpp"
 #include "gamut/gamut_artifact.hpp"
+#include "topopt/cell_mma.hpp"
 #include "topopt/simp_mma.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
@@ -97,7 +99,7 @@ int main(int argc, char** argv) {
 
     OptimizerSettings os;
     const std::string optimizer =
-        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma"}) : "auto";
+        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma", "cell-mma"}) : "auto";
     os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
     if (os.max_iterations < 1) config.fail("optimizer.max_iterations", "must be >= 1");
     os.tolerance = config.get_or<double>("optimizer.tolerance", os.tolerance);
@@ -109,10 +111,16 @@ int main(int argc, char** argv) {
       config.fail("optimizer.change_tolerance", "must be in [0, 1) (0: run max_iterations)");
     const bool use_oc = optimizer == "oc" || (optimizer == "auto" && model->parameters() == 1);
     const bool use_mma = optimizer == "mma";
-    const std::string chosen = use_oc ? "oc" : use_mma ? "mma" : "ipopt";
+    const bool use_cell_mma = optimizer == "cell-mma";
+    const std::string chosen = use_oc ? "oc" : use_mma ? "mma" : use_cell_mma ? "cell-mma" : "ipopt";
+    if (config.has("optimizer.move")) {
+      if (!use_cell_mma) config.fail("optimizer.move", "is read by the cell-mma optimizer only");
+      os.mma_move = config.get<double>("optimizer.move");
+      if (!(os.mma_move > 0 && os.mma_move <= 1)) config.fail("optimizer.move", "must be in (0, 1]");
+    }
     if ((use_oc || use_mma) && model->parameters() != 1)
       config.fail("optimizer.name", chosen + " is for the simp spaces (simp2d, simp3d); space " + space + " has " +
-                                        std::to_string(model->parameters()) + " parameters per cell (use ipopt)");
+                                        std::to_string(model->parameters()) + " parameters per cell (use ipopt or cell-mma)");
     const CellGrid& grid = scene.setup.grid;
     os.mass_limit = scene.volume_fraction > 0;
     os.mass_budget = scene.volume_fraction * grid.cell_volume() * double(grid.cells());
@@ -127,7 +135,12 @@ int main(int argc, char** argv) {
 
     TopologySetup setup = scene.setup;
     setup.solver_options.threads = ctx.options.threads;
+    // cell-mma regularizes as the thesis does, by smoothing the gradient
+    // (topopt/cell_mma.hpp): its cells' parameters are the physical ones.
+    const double smoothing_radius = use_cell_mma ? setup.filter_radius : 0.0;
+    if (use_cell_mma) setup.filter_radius = 0;
     TopologyObjective objective(setup, *model);
+    const CellFilter smoothing(grid, objective.design_cells(), smoothing_radius);
     const MatX q0 = start.rows(objective.design_cells());
     spdlog::info("{}D grid {} x {} x {} ({} design cells, {} unknowns), space {} ({} parameters), {} load case(s), "
                  "solver {}, optimizer {}",
@@ -137,9 +150,10 @@ int main(int argc, char** argv) {
 
     // 4. Optimize.
     os.log_every = 10;
-    const OptimizationResult r = use_oc    ? optimize_oc(objective, q0, os)
-                                 : use_mma ? optimize_mma(objective, q0, os)
-                                           : optimize_in_gamut(objective, q0, os);
+    const OptimizationResult r = use_oc         ? optimize_oc(objective, q0, os)
+                                 : use_mma      ? optimize_mma(objective, q0, os)
+                                 : use_cell_mma ? optimize_cell_mma(objective, q0, os, smoothing)
+                                                : optimize_in_gamut(objective, q0, os);
 
     // 5. Report and artifact.
     const Design design = make_design(objective, r, gamut.E_stiff > 0 ? gamut.E_stiff : scene.E0, scene.decades);
@@ -154,6 +168,9 @@ int main(int argc, char** argv) {
       std::printf("  load case %s: %s %.6e\n", setup.loads[l].name.c_str(),
                   setup.loads[l].objective == ElasticObjective::compliance ? "compliance" : "target error",
                   r.value.per_load[l]);
+    if (r.update_seconds > 0)
+      std::printf("  optimizer's own work (subproblems): %.2f s of %.2f s (%.3f s per iteration)\n", r.update_seconds,
+                  r.seconds, r.update_seconds / std::max(1, r.iterations));
     std::printf("  mass fraction %.4f, max constraint %.3e\n",
                 objective.mass(r.q) / (grid.cell_volume() * double(grid.cells())), r.max_violation);
     const double per = 1.0 / std::max(1, st.factorizations);
