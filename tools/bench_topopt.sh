@@ -4,6 +4,7 @@
 #     half of the bottom) in every material space that needs no sampled gamut,
 #     plus cubic2d / orthotropic2d / isotropic2d when gamut artifacts are given:
 #       CUBIC2D=out/gamut/cubic2d.gamut.h5 ORTHO2D=out/gamut/orthotropic2d.gamut.h5 tools/bench_topopt.sh
+#     (CANTILEVER_ONLY=1 stops after this table)
 #  2. time per FEM solve on 3D grids (bench_grid_solver: cholmod, pcg-mg and
 #     matrix-free side by side; LARGEST="nx ny nz" adds a matrix-free row for
 #     a bigger grid) and per optimizer step (STEP_LARGE=1 adds 320x160x80).
@@ -25,7 +26,7 @@ row() {  # name, extra args...
   it=$(grep -oE "after [0-9]+ iterations" <<<"$out" | awk '{print $2}')
   t=$(grep -oE "evaluations\), [0-9.]+ s" <<<"$out" | awk '{print $2}')
   v=$(grep -oE "max constraint [0-9.e+-]+" <<<"$out" | awk '{print $3}')
-  st=$(grep -oE "^msfab-topopt: [a-z ]+ after" <<<"$out" | sed -E 's/^msfab-topopt: (.*) after/\1/')
+  st=$(grep -E "^msfab-topopt: .* after [0-9]+ iterations" <<<"$out" | sed -E 's/^msfab-topopt: (.*) after [0-9]+ iterations.*/\1/')
   printf "| %s | %s | %s | %s | %s | %s |\n" "$name" "$c" "$it" "$st" "$t" "$v"
 }
 # A 2D gamut's structures are homogenized in plane strain: its rows compare
@@ -48,6 +49,17 @@ fi
 [ -n "${CUBIC2D:-}" ] && row cubic-no-bound --set space=cubic2d --set gamut="$CUBIC2D" --set gamut_bound=none "${long[@]}"
 [ -n "${CUBIC2D:-}" ] && row isotropic --set space=isotropic2d --set gamut="$CUBIC2D" "${long[@]}"
 [ -n "${ORTHO2D:-}" ] && row orthotropic --set space=orthotropic2d --set gamut="$ORTHO2D" "${long[@]}"
+# Fig. 3-16's order with one optimizer and one regularization for every
+# space: cell MMA, which smooths the gradient (docs/topopt.md).
+if [ -n "${CUBIC2D:-}${ORTHO2D:-}" ]; then
+  cm=(--set optimizer.name=cell-mma "${long[@]}" "${strain[@]}")
+  row simp-p3-cell-mma --set space=simp2d --set material.penalty=3 "${cm[@]}"
+  row simp-p1-cell-mma --set space=simp2d --set material.penalty=1 "${cm[@]}"
+  [ -n "${CUBIC2D:-}" ] && row cubic-cell-mma --set space=cubic2d --set gamut="$CUBIC2D" "${cm[@]}"
+  [ -n "${CUBIC2D:-}" ] && row isotropic-cell-mma --set space=isotropic2d --set gamut="$CUBIC2D" "${cm[@]}"
+  [ -n "${ORTHO2D:-}" ] && row orthotropic-cell-mma --set space=orthotropic2d --set gamut="$ORTHO2D" "${cm[@]}"
+fi
+[ -n "${CANTILEVER_ONLY:-}" ] && exit 0
 echo
 echo "### Time per FEM solve on 3D grids (SIMP cantilever)"
 echo

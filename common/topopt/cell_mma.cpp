@@ -37,6 +37,7 @@ constexpr int kBudgetSearches = 60;
 // The objective-stall stop (the Ipopt path's "acceptable" test).
 constexpr double kStallChange = 1e-4;
 constexpr int kStallWindow = 5;
+constexpr int kStepHalvings = 20;
 
 // The cell constraints' approximations are made conservative as in GCMMA
 // (Svanberg 2002): where a constraint at the subproblem's solution is
@@ -104,10 +105,25 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
 
   for (int it = 0;; ++it) {
     // 1. The objective and its gradient at the iterate.
+    // A step can leave the space's stable region where the gamut's level
+    // set, padded and extrapolated, allows it (an orthotropic cell with
+    // nu_xy^2 >= Ex / Ey has no positive definite stiffness): the step is
+    // then halved towards the last iterate, as a line search would.
     MatX g;
-    const ObjectiveValue v = objective.evaluate(x, &g);
-    ++result.evaluations;
-    if (!std::isfinite(v.total)) throw NumericalError("cell MMA: the objective is not finite at iteration " + std::to_string(it));
+    ObjectiveValue v;
+    for (int halving = 0;; ++halving) {
+      try {
+        v = objective.evaluate(x, &g);
+        ++result.evaluations;
+        if (!std::isfinite(v.total)) throw NumericalError("the objective is not finite");
+        break;
+      } catch (const NumericalError& e) {
+        if (it == 0 || halving == kStepHalvings)
+          throw NumericalError("cell MMA, iteration " + std::to_string(it) + ": " + e.what());
+        spdlog::debug("cell MMA iteration {}: {}; step halved", it, e.what());
+        x = 0.5 * (x + x_old1);
+      }
+    }
     // 2. The cells' constraints and their gradients.
     MatX cval(N, m), cjac(N * m, d);  // cell i's gradients: rows i m .. i m + m - 1
 #pragma omp parallel for schedule(static)

@@ -48,6 +48,10 @@ check "cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-
 check "the gamut stores its base materials for the Voigt bound" -- h5ls "$WORK/set.gamut.h5/bound/stiff"
 check "the design maps to microstructures" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
   --structures "$WORK/set.microstructures.h5" --out "$WORK/cubic.mapped.h5" --quiet
+out=$("$T" --config "$WORK/cubic.yaml" --set optimizer.name=cell-mma --set filter.radius=1.5 \
+  --out "$WORK/cellmma.design.h5" --quiet 2>&1)
+check "cell-mma: cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-0[4-9]|0\.000)" <<<"$out"
+check "cell-mma: mass fraction within the budget" -- grep -Eq "mass fraction 0\.(4[89][0-9]|500)" <<<"$out"
 check "coarse-to-fine continuation" -- "$T" --config "$WORK/cubic.yaml" --set 'grid.size=[24,12]' \
   --set "initial.design=$WORK/cubic.design.h5" --set 'loads=[{objective: compliance, forces: [{node: [24, 0], force: [0, -1]}]}]' \
   --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' --set optimizer.max_iterations=20 --out "$WORK/fine.design.h5" --quiet
@@ -75,6 +79,8 @@ expect_exit 2 "gamut_bound.*one of" -- "$T" --config "$WORK/cubic.yaml" --set ga
 expect_exit 2 "material.plane.*applies to 2D grids only" -- "$T" --set space=simp3d --set 'grid.size=[4,2,2]' \
   --set material.plane=strain "${D[@]}"
 expect_exit 2 "mma is for the simp spaces" -- "$T" --set space=analytic2d --set optimizer.name=mma "${D[@]}"
+expect_exit 2 "optimizer.move.*read by the cell-mma optimizer only" -- "$T" --set optimizer.move=0.1 "${D[@]}"
+expect_exit 2 "optimizer.move.*must be in" -- "$T" --set optimizer.name=cell-mma --set optimizer.move=2 "${D[@]}"
 expect_exit 2 "optimizer.change_tolerance.*must be in" -- "$T" --set optimizer.change_tolerance=-1 "${D[@]}"
 expect_exit 2 "unknown key 'fitler'" -- "$T" --set fitler.radius=2 "${D[@]}"
 check "nothing written on bad input" -- test ! -e "$WORK/bad.design.h5"
