@@ -291,17 +291,22 @@ filter: {radius: )" + std::to_string(rmin) + "}\n");
   return sc;
 }
 
+// The 88-line code's settings on the beam: volume fraction 0.5.
+OptimizerSettings mbb_settings(int iterations) {
+  OptimizerSettings os;
+  os.max_iterations = iterations;
+  os.log_every = 0;
+  os.mass_limit = true;
+  os.mass_budget = 0.5 * 60 * 20;
+  return os;
+}
+
 double run_mbb(double rmin, int* iterations) {
   TopoptScene sc = mbb(rmin);
   CellMaterialSettings ms{"simp2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
   const auto model = make_cell_material_model(ms);
   TopologyObjective obj(sc.setup, *model);
-  OptimizerSettings os;
-  os.max_iterations = 500;
-  os.log_every = 0;
-  os.mass_limit = true;
-  os.mass_budget = 0.5 * 60 * 20;
-  os.log_every = 0;
+  const OptimizerSettings os = mbb_settings(500);
   const OptimizationResult r = optimize_oc(obj, MatX::Constant(1200, 1, 0.5), os);
   *iterations = r.iterations;
   EXPECT_TRUE(r.converged);
@@ -328,11 +333,7 @@ TEST(TopoptSimp, MmaMatchesOcOnTheMbbBeam) {
   CellMaterialSettings ms{"simp2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
   const auto model = make_cell_material_model(ms);
   TopologyObjective obj(sc.setup, *model);
-  OptimizerSettings os;
-  os.max_iterations = 300;
-  os.log_every = 0;
-  os.mass_limit = true;
-  os.mass_budget = 0.5 * 60 * 20;
+  const OptimizerSettings os = mbb_settings(300);
   const OptimizationResult r = optimize_mma(obj, MatX::Constant(1200, 1, 0.5), os);
   // 233.50 against OC's 233.71. (At radius 1.5 MMA settles in another
   // local optimum, 3.7% below OC's: docs/BENCHMARKS.md.)
@@ -371,46 +372,8 @@ TEST(TopoptSimp, MmaRefusesNonSimpSpacesAndMissingBudgets) {
 
 // ---------------------------------------------------------------- gamut problem
 
-TEST(TopoptGamut, CantileverConvergesInsideTheGamut) {
-  const GamutLevelSet cubic = synthetic_gamut(4, 8);
-  TopoptScene sc = small_scene(R"(
-grid: {size: [16, 8]}
-space: cubic2d
-material: {E: 1.0e6}
-supports: [{box: {min: [0, 0], max: [0, 8]}}]
-loads: [{objective: compliance, forces: [{box: {min: [8, 0], max: [16, 0]}, force: [0, -1]}]}]
-)");
-  CellMaterialSettings ms{"cubic2d", 1e6, 4, 0.3, 3, 1e-9, &cubic};
-  const auto model = make_cell_material_model(ms);
-  TopologyObjective obj(sc.setup, *model);
-  MatX q0(obj.design_cells().size(), 4);
-  for (Eigen::Index r = 0; r < q0.rows(); ++r) q0.row(r) = model->initial_point(0.5).transpose();
-  OptimizerSettings os;
-  os.max_iterations = 500;
-  os.log_every = 0;
-  os.mass_limit = true;
-  os.mass_budget = 0.5 * 16 * 8;
-  const OptimizationResult r = optimize_in_gamut(obj, q0, os);
-  EXPECT_TRUE(r.converged) << r.status;
-  EXPECT_LE(r.max_violation, 1e-3);
-  ASSERT_GE(r.history.size(), 3u);
-  const double first = r.history.front().elastic;
-  EXPECT_LT(r.value.elastic, 0.8 * first);
-  // An interior-point method trades objective for feasibility on the way,
-  // so the objective is not monotone; it must end at (within 2% of) the
-  // best feasible iterate it visited, below where it started.
-  double best_feasible = std::numeric_limits<double>::infinity();
-  for (const DesignHistoryEntry& h : r.history)
-    if (h.max_violation <= 1e-3) best_feasible = std::min(best_feasible, h.elastic);
-  EXPECT_LE(r.value.elastic, 1.02 * best_feasible);
-  const MatX p = obj.physical(r.q);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) EXPECT_LE(model->constraint(p.row(i).transpose(), nullptr), 1e-3);
-}
-
-// ---------------------------------------------------------------- cell MMA
-
-// The cubic2d cantilever of CantileverConvergesInsideTheGamut without a
-// filter (so that Ipopt and cell MMA solve the same problem).
+// A cubic2d cantilever in a synthetic gamut, without a filter (so that
+// Ipopt and cell MMA solve the same problem), budget half the cells.
 struct GamutCantilever {
   GamutLevelSet cubic = synthetic_gamut(4, 8);
   TopoptScene scene = small_scene(R"(
@@ -439,6 +402,31 @@ loads: [{objective: compliance, forces: [{box: {min: [8, 0], max: [16, 0]}, forc
     return os;
   }
 };
+
+TEST(TopoptGamut, CantileverConvergesInsideTheGamut) {
+  GamutCantilever c;
+  const auto& model = c.model;
+  TopologyObjective obj(c.scene.setup, *model);
+  const MatX q0 = c.start(obj);
+  const OptimizerSettings os = c.settings(500);
+  const OptimizationResult r = optimize_in_gamut(obj, q0, os);
+  EXPECT_TRUE(r.converged) << r.status;
+  EXPECT_LE(r.max_violation, 1e-3);
+  ASSERT_GE(r.history.size(), 3u);
+  const double first = r.history.front().elastic;
+  EXPECT_LT(r.value.elastic, 0.8 * first);
+  // An interior-point method trades objective for feasibility on the way,
+  // so the objective is not monotone; it must end at (within 2% of) the
+  // best feasible iterate it visited, below where it started.
+  double best_feasible = std::numeric_limits<double>::infinity();
+  for (const DesignHistoryEntry& h : r.history)
+    if (h.max_violation <= 1e-3) best_feasible = std::min(best_feasible, h.elastic);
+  EXPECT_LE(r.value.elastic, 1.02 * best_feasible);
+  const MatX p = obj.physical(r.q);
+  for (Eigen::Index i = 0; i < p.rows(); ++i) EXPECT_LE(model->constraint(p.row(i).transpose(), nullptr), 1e-3);
+}
+
+// ---------------------------------------------------------------- cell MMA
 
 // Same problem, two optimizers: cell MMA ends feasible, within the budget,
 // at a compliance no worse than Ipopt's (it finds 0.001601 in 64
@@ -491,11 +479,7 @@ TEST(TopoptCellMma, SimpBeamMatchesNloptMma) {
   CellMaterialSettings ms{"simp2d", 1.0, 4, 0.3, 3.0, 1e-9, nullptr};
   const auto model = make_cell_material_model(ms);
   TopologyObjective obj(sc.setup, *model);
-  OptimizerSettings os;
-  os.max_iterations = 300;
-  os.log_every = 0;
-  os.mass_limit = true;
-  os.mass_budget = 0.5 * 60 * 20;
+  const OptimizerSettings os = mbb_settings(300);
   const MatX x0 = MatX::Constant(1200, 1, 0.5);
   const OptimizationResult ref = optimize_mma(obj, x0, os);
   const CellFilter none(obj.grid(), obj.design_cells(), 0.0);
