@@ -44,8 +44,8 @@ constexpr int kStepHalvings = 20;
 // above its approximation, the approximation's curvature term raa grows by
 // what was missing at that point (plus 10%; GCMMA's cap of 10x per round
 // is left out: the constraints' gradients span five decades, and from the
-// base 1e-5 it took up to eight rounds) and the subproblem is solved again. This costs no FEM
-// solve (the constraints are cheap) and keeps the iterates inside the
+// base 1e-5 it took up to eight rounds) and the cell is solved again. This
+// costs no FEM solve (the constraints are cheap) and keeps the iterates in the
 // gamut where its boundary curves faster than MMA's approximation (the
 // Voigt bound's hydrostatic condition grows as 1 / (1 - 2 nu)); the
 // objective keeps plain MMA's approximation.

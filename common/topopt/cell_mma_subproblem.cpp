@@ -116,8 +116,9 @@ double projected_gradient(const DualPoint& d, const CellMmaConstraintVec& lambda
 // relative to the first one: row by row, since a multiplier on its slack
 // has curvature 1 beside others of 1e-4; the shift vanishes at the
 // solution (Newton's fast convergence is kept where the block is regular)
-// and bounds the step elsewhere. A row no free variable answers to at all gets the curvature
-// the clamped variables would give it: the length at which they come free.
+// and bounds the step elsewhere. A row no free variable answers to at all
+// gets the curvature the clamped variables would give it: the length at
+// which they come free.
 CellMmaSquare regularized_block(const DualPoint& d, double projected,
                                 const Eigen::Matrix<int, Eigen::Dynamic, 1, 0, kCellMmaMaxConstraints, 1>& rows) {
   const int k = int(rows.size());
