@@ -54,8 +54,7 @@ constexpr double kRaaDecay = 0.5;
 
 struct CellState {
   CellMmaApproximation approx;
-  CellMmaConstraintVec lambda;
-  CellMmaSolution solution;
+  CellMmaSolution solution;  // its multipliers start the next solve
   CellMmaConstraintVec raa;  // the cell constraints' curvature terms
 };
 
@@ -128,15 +127,9 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
     MatX cval(N, m), cjac(N * m, d);  // cell i's gradients: rows i m .. i m + m - 1
 #pragma omp parallel for schedule(static)
     for (Eigen::Index i = 0; i < (m > 0 ? N : 0); ++i) {
-      const VecX p = x.row(i).transpose();
-      VecX grad;
-      cval(i, 0) = model.constraint(p, &grad);
-      cjac.row(i * m) = grad.transpose();
-      if (m > 1) {
-        MatX bj;
-        cval.row(i).tail(m - 1) = model.bound_constraints(p, &bj).transpose();
-        cjac.middleRows(i * m + 1, m - 1) = bj;
-      }
+      MatX jac;
+      cval.row(i) = cell_gamut_conditions(model, x.row(i).transpose(), &jac).transpose();
+      cjac.middleRows(i * m, m) = jac;
     }
     double violation = m > 0 ? cval.maxCoeff() : -1.0;
     if (settings.mass_limit)
@@ -226,8 +219,7 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
 #pragma omp parallel for schedule(dynamic, 256)
       for (Eigen::Index i = 0; i < N; ++i) {
         CellState& s = cells[std::size_t(i)];
-        s.solution = solve_cell_mma(s.approx, at, s.lambda, kSlackPrice, kDualTolerance);
-        s.lambda = s.solution.lambda;
+        s.solution = solve_cell_mma(s.approx, at, s.solution.lambda, kSlackPrice, kDualTolerance);
       }
       mass = 0, slope = 0;  // summed in cell order: the same for any thread count
       for (const CellState& s : cells) mass += s.solution.mass, slope += s.solution.mass_derivative;
@@ -301,10 +293,7 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
                       ((a.upper[k] - xn[k]) * (xn[k] - a.lower[k]) * range[k]);
         }
         if (!(distance > 0)) continue;
-        const VecX p = xn;
-        VecX values(m);
-        values[0] = model.constraint(p, nullptr);
-        if (m > 1) values.tail(m - 1) = model.bound_constraints(p, nullptr);
+        const VecX values = cell_gamut_conditions(model, VecX(xn), nullptr);
         for (int c = 0; c < m; ++c) {
           double approx = -a.b[c];
           for (int k = 0; k < d; ++k) approx += a.p(c, k) / (a.upper[k] - xn[k]) + a.q(c, k) / (xn[k] - a.lower[k]);
@@ -314,8 +303,7 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
           raised[std::size_t(i)] = 1;
         }
         if (raised[std::size_t(i)]) {
-          st.solution = solve_cell_mma(st.approx, mu, st.lambda, kSlackPrice, kDualTolerance);
-          st.lambda = st.solution.lambda;
+          st.solution = solve_cell_mma(st.approx, mu, st.solution.lambda, kSlackPrice, kDualTolerance);
         }
       }
       long count = 0;

@@ -175,21 +175,8 @@ class GamutProblem : public Ipopt::TNLP {
   }
 
  private:
-  // Phi and the Voigt bound's conditions of one cell at physical p, with
-  // their gradients as rows of `jacobian`.
-  VecX cell_constraints(const VecX& p, MatX* jacobian) const {
-    VecX c(per_cell_);
-    VecX grad;
-    c[0] = model_.constraint(p, jacobian ? &grad : nullptr);
-    MatX bound_jac;
-    if (per_cell_ > 1) c.tail(per_cell_ - 1) = model_.bound_constraints(p, jacobian ? &bound_jac : nullptr);
-    if (jacobian) {
-      jacobian->resize(per_cell_, d_);
-      jacobian->row(0) = grad.transpose();
-      if (per_cell_ > 1) jacobian->bottomRows(per_cell_ - 1) = bound_jac;
-    }
-    return c;
-  }
+  // Phi and the Voigt bound's conditions of one cell at physical p.
+  VecX cell_constraints(const VecX& p, MatX* jacobian) const { return cell_gamut_conditions(model_, p, jacobian); }
   MatX as_q(Index n, const Number* x) const {
     MatX q(rows_, d_);
     for (Index i = 0; i < n; ++i) q(i / d_, i % d_) = x[i];

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "core/timing.hpp"
 #include "core/errors.hpp"
@@ -13,14 +14,26 @@ namespace msfab {
 namespace {
 }  // namespace
 
+VecX cell_gamut_conditions(const CellMaterialModel& model, const VecX& p, MatX* jacobian) {
+  if (!model.has_constraint()) return VecX();
+  const int m = 1 + model.bound_conditions();
+  VecX c(m), grad;
+  c[0] = model.constraint(p, jacobian ? &grad : nullptr);
+  MatX bound_jac;
+  if (m > 1) c.tail(m - 1) = model.bound_constraints(p, jacobian ? &bound_jac : nullptr);
+  if (jacobian) {
+    jacobian->resize(m, p.size());
+    jacobian->row(0) = grad.transpose();
+    if (m > 1) jacobian->bottomRows(m - 1) = bound_jac;
+  }
+  return c;
+}
+
 double max_gamut_violation(const CellMaterialModel& model, const MatX& p) {
   if (!model.has_constraint()) return -1.0;
   double worst = -std::numeric_limits<double>::infinity();
-  for (Eigen::Index r = 0; r < p.rows(); ++r) {
-    worst = std::max(worst, model.constraint(p.row(r).transpose(), nullptr));
-    if (model.bound_conditions() > 0)
-      worst = std::max(worst, model.bound_constraints(p.row(r).transpose(), nullptr).maxCoeff());
-  }
+  for (Eigen::Index r = 0; r < p.rows(); ++r)
+    worst = std::max(worst, cell_gamut_conditions(model, p.row(r).transpose(), nullptr).maxCoeff());
   return worst;
 }
 

@@ -50,6 +50,11 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
 // Requires a one-parameter space (simp*) and settings.mass_limit.
 OptimizationResult optimize_oc(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings);
 
+// A cell's conditions at parameters p: Phi first, then the Voigt bound's
+// (model.bound_conditions() of them); with `jacobian`, their gradients as
+// rows. Empty for a model without a constraint.
+VecX cell_gamut_conditions(const CellMaterialModel& model, const VecX& p, MatX* jacobian);
+
 // Largest Phi, or Voigt-bound condition, over the design cells at filtered
 // parameters p.
 double max_gamut_violation(const CellMaterialModel& model, const MatX& p);
