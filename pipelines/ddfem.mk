@@ -8,6 +8,7 @@
 #   make -f Makefile.pipeline ddfem-table-centre    periodic sampling and a fitted centre point, its own section
 #   make -f Makefile.pipeline ddfem-table-void      periodic sampling with void in the palette, its own section
 #   make -f Makefile.pipeline ddfem-table-adaptive  adaptive coarsening (--target-error): speed against error, PNG
+#   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -33,7 +34,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive
+        ddfem-table-adaptive ddfem-table-floor
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -54,6 +55,14 @@ ddfem-table-centre: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
 	BENCH_SECTION=ddfem-centre DATABASE2=$(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-centre docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5
+
+# What limits coarsening (docs/ddfem.md, "Error floor and the homogenized
+# reference"): every scene at both levels, naive, homogenized and DDFEM
+# against the floor no coarse model can beat.
+ddfem-table-floor: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
+                   $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
+	bash tools/bench_ddfem_floor.sh $(BIN) $(OUT)/bench/ddfem-floor docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
 
 # Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
 # children fitted, periodic sampling at both levels.

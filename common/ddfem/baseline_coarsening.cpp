@@ -3,8 +3,16 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+
 #include "core/errors.hpp"
+#include "homog/elastic_tensor.hpp"
+#include "homog/periodic_homogenization.hpp"
+#include "material/green_anisotropic.hpp"
+#include "material/material_sum.hpp"
 #include "material/neo_hookean.hpp"
+#include "material/voigt.hpp"
 
 namespace msfab {
 namespace {
@@ -84,7 +92,38 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
   return QuadratureMaterials{{std::make_shared<NeoHookean>(E, nu)}};
 }
 
+QuadratureMaterials homogenized_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
+  if (std::find(ids.begin(), ids.end(), 0) != ids.end()) return naive_block(palette, ids, n);
+  VoxelGrid cell(n, n, n, 1.0, 0);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      for (int c = 0; c < n; ++c) cell.at(a, b, c) = ids[(a * n + b) * n + c];
+  for (int id : ids) palette_material(palette, id);  // a clear error for an unknown id
+  HomogenizationOptions options;
+  options.solver = "direct";
+  options.threads = 1;
+  return QuadratureMaterials{{homogenized_block_material(to_material_voigt_order(homogenize(cell, palette, options).C))}};
+}
+
 }  // namespace
+
+MaterialPtr homogenized_block_material(const Mat6& C) {
+  double mu = 0, lambda = 0;
+  isotropic_projection(C, &mu, &lambda);
+  Mat6 iso = Mat6::Zero();
+  iso.topLeftCorner<3, 3>().setConstant(lambda);
+  iso.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
+  iso.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
+  // The largest t with C - t iso >= 0: the smallest generalized eigenvalue.
+  const double t =
+      std::clamp(Eigen::GeneralizedSelfAdjointEigenSolver<Mat6>(C, iso, Eigen::EigenvaluesOnly).eigenvalues()[0], 0.0, 1.0);
+  Eigen::SelfAdjointEigenSolver<Mat6> rest(C - t * iso);
+  const Mat6 remainder =
+      rest.eigenvectors() * rest.eigenvalues().cwiseMax(0.0).asDiagonal() * rest.eigenvectors().transpose();
+  auto green = std::make_shared<GreenAnisotropic>(0.5 * (remainder + remainder.transpose()));
+  if (!(t * mu > 0)) return green;
+  return std::make_shared<MaterialSum>(std::vector<MaterialPtr>{NeoHookean::from_lame(t * mu, t * lambda), green});
+}
 
 void average_lame(const std::vector<MaterialPtr>& palette, const std::vector<int>& fine_ids, double* mu,
                   double* lambda) {
@@ -119,6 +158,17 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
   if (level1.level != 1) throw InputError("averaged level-2 coarsening needs a level-1 grid");
   return [palette, combos = level1.combinations](const ChildIds& child) {
     return averaged_block(palette, block_level2(child, combos));
+  };
+}
+
+CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette) {
+  return [palette](const ChildIds& child) { return homogenized_block(palette, block_level1(child), 2); };
+}
+
+CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1) {
+  if (level1.level != 1) throw InputError("homogenized level-2 coarsening needs a level-1 grid");
+  return [palette, combos = level1.combinations](const ChildIds& child) {
+    return homogenized_block(palette, block_level2(child, combos), 4);
   };
 }
 

@@ -15,6 +15,20 @@
 // are the volume averages over all fine voxels of the block, void counting as
 // mu = lambda = 0 (a half-void block is half as stiff).
 //
+// Homogenized (not in the thesis; a reference for what a coarse material
+// can do): the block's voxels taken as a periodic cell and homogenized
+// (homog/periodic_homogenization.hpp), and every quadrature point gets that
+// C^H as an isotropic Neo-Hookean part t C_iso plus an anisotropic St.
+// Venant-Kirchhoff part C^H - t C_iso (material/green_anisotropic.hpp), with
+// C_iso the isotropic projection of C^H and t the largest factor that leaves
+// the second part positive semidefinite. So the element's small-strain
+// stiffness is exactly C^H, large rotations store no energy, and the
+// Neo-Hookean part keeps it stable in compression. This is what periodic
+// in-situ sampling of a block would converge to at small strain with a
+// model that can represent any anisotropy. Blocks with void children are
+// coarsened naively (a periodic cell of a partly-void block is not the
+// block in a body).
+//
 // Palette: index = fine material id, [0] (void) unused; the Lame parameters
 // are those reported by Material::shear_modulus() / lame_lambda().
 #include <vector>
@@ -32,6 +46,13 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
 // (build_coarse_mesh's default at level 2).
 CoarseMaterialLookup naive_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
+
+CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette);
+CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
+
+// The material the homogenized coarsening gives a block of stiffness C^H
+// (Voigt order of material/voigt.hpp).
+MaterialPtr homogenized_block_material(const Mat6& C);
 
 // Volume-averaged Lame parameters of the fine voxels in `fine_ids` (void = 0).
 void average_lame(const std::vector<MaterialPtr>& palette, const std::vector<int>& fine_ids, double* mu,

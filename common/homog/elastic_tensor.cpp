@@ -57,4 +57,13 @@ double cubic_deviation(const Mat6& C) {
   return (C - cubic_tensor(m.C11, m.C12, m.C44)).cwiseAbs().maxCoeff() / std::abs(m.C11);
 }
 
+Mat6 to_material_voigt_order(const Mat6& C) {
+  // Material index i holds homogenization index from[i]: xy <- 5, yz <- 3, zx <- 4.
+  static constexpr int from[6] = {0, 1, 2, 5, 3, 4};
+  Mat6 out;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) out(i, j) = C(from[i], from[j]);
+  return out;
+}
+
 }  // namespace msfab

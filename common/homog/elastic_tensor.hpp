@@ -12,6 +12,11 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 // The strain tensor of a Voigt strain vector (shear halved).
 Mat3 strain_tensor(const Vec6& voigt);
 
+// The same tensor in the shear order of material/voigt.hpp (xx, yy, zz, xy,
+// yz, zx), which the constitutive models (LinearAnisotropic,
+// GreenAnisotropic) take.
+Mat6 to_material_voigt_order(const Mat6& C);
+
 // Isotropic tensor from Young's modulus and Poisson's ratio.
 Mat6 isotropic_tensor(double E, double nu);
 

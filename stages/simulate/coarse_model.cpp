@@ -11,8 +11,9 @@ namespace msfab {
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request) {
   if (request.level < 1 || request.level > 2)
     throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
-  if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged")
-    throw InputError("--coarse-material: expected ddfem, naive or averaged, got '" + request.material + "'");
+  if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
+      request.material != "homogenized")
+    throw InputError("--coarse-material: expected ddfem, naive, averaged or homogenized, got '" + request.material + "'");
   CoarseModel m;
   if (request.material == "ddfem") {
     if (request.database.empty())
@@ -33,6 +34,9 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
   else if (request.material == "averaged")
     lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
                                 : averaged_coarsening(scene.material_by_id);
+  else if (request.material == "homogenized")
+    lookup = request.level == 2 ? homogenized_coarsening(scene.material_by_id, m.level1)
+                                : homogenized_coarsening(scene.material_by_id);
   else {
     // Blocks the database holds no fit for (void children in a database
     // built without them, blocks that could not be fitted) are coarsened naively.

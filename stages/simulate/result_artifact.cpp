@@ -96,6 +96,13 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
       f.write_attribute("/coarsening", "error_definition",
                         "mean fine-vertex distance of the trilinearly interpolated coarse displacement to the "
                         "fine one, over the longest rest bounding-box side (thesis 2.5.2)");
+      if (r.has_error_floor) {
+        f.write_attribute("/coarsening", "error_floor", r.error_floor);
+        f.write_attribute("/coarsening", "error_floor_lower_bound", r.error_floor_lower_bound);
+        f.write_attribute("/coarsening", "error_floor_definition",
+                          "the smallest error_vs_fine of any displacement field on this coarse mesh (the best "
+                          "trilinear fit of the fine displacements; no coarse material can do better)");
+      }
     }
   }
   writer.commit();

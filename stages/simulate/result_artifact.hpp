@@ -36,6 +36,10 @@ struct SimulationRecord {
   // With --compare-fine: the fine reference run and the §2.5.2 error.
   bool compared = false;
   double fine_seconds = 0, error_vs_fine = 0;
+  // Uniform coarsening only: the smallest error any model on this coarse
+  // mesh can have (ddfem/coarsening_error.hpp), and its certified lower bound.
+  bool has_error_floor = false;
+  double error_floor = 0, error_floor_lower_bound = 0;
 };
 
 // A fine run read back for comparison: displacements (3 per node of `fine`)

@@ -20,6 +20,17 @@ naive=$(error_of naive)
 echo "errors: ddfem $ddfem, naive $naive"
 check "ddfem error below 0.02" -- awk -v e="$ddfem" 'BEGIN { exit !(e > 0 && e < 0.02) }'
 check "ddfem error below a third of naive" -- awk -v d="$ddfem" -v n="$naive" 'BEGIN { exit !(d < n / 3) }'
+# The error floor (best trilinear fit of the fine field) is the same for
+# every coarse model of the scene and below each model's error.
+attr_of() { h5dump -a "/coarsening/$2" "$WORK/$1.h5" | sed -n 's/.*(0): *//p'; }
+homogenized=$(error_of homogenized)
+floor=$(attr_of ddfem error_floor)
+echo "error floor $floor (certified >= $(attr_of ddfem error_floor_lower_bound)), homogenized $homogenized"
+check "error floor is one number per scene" -- awk -v a="$floor" -v b="$(attr_of naive error_floor)" \
+  -v c="$(attr_of homogenized error_floor)" 'BEGIN { exit !(a == b && a == c) }'
+check "error floor below every model and above its certificate" -- awk -v f="$floor" \
+  -v l="$(attr_of ddfem error_floor_lower_bound)" -v d="$ddfem" -v n="$naive" -v h="$homogenized" \
+  'BEGIN { exit !(f > 0 && l <= f && l >= 0.99 * f && f <= d && f <= n && f <= h) }'
 
 # A compressed database (64 of 256 materials) still beats naive coarsening.
 check "compressed database" -- "$BIN/msfab-ddfem-compress" --database "$WORK/db.h5" --set representatives=64 --out "$WORK/k64.h5"
@@ -86,6 +97,7 @@ expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
   "$SIM" --config "$BAR" --target-error 0.01 --database "$WORK/db.h5" --out "$WORK/o.h5"
 
 # Bad requests.
+expect_exit 2 "coarse-material" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material homogenised --out "$WORK/o.h5"
 expect_exit 2 "needs --database" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material ddfem --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db.h5" --out "$WORK/o.h5"

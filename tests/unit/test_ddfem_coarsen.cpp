@@ -1,6 +1,7 @@
 // DDFEM online coarsening: coarse grid, baseline coarsenings, error metric.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -11,6 +12,9 @@
 #include "ddfem/coarse_grid.hpp"
 #include "ddfem/coarsening_error.hpp"
 #include "fem/elastic_assembler.hpp"
+#include "homog/elastic_tensor.hpp"
+#include "homog/periodic_homogenization.hpp"
+#include "material/voigt.hpp"
 #include "material/neo_hookean.hpp"
 #include "scene/scene.hpp"
 #include "solve/newton.hpp"
@@ -198,6 +202,42 @@ TEST(DdfemCoarsenBaselines, AveragedUsesVolumeMeanOfLameParameters) {
   EXPECT_EQ(m.at_point[7], palette[2]);
 }
 
+TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain) {
+  const auto palette = soft_stiff_palette();
+  const auto homogenized = homogenized_coarsening(palette);
+  const Eigen::Matrix<double, 6, 9> B = voigt_strain_operator();
+  // A homogeneous block: exactly its palette material (no anisotropic part).
+  const QuadratureMaterials same = homogenized(ChildIds{2, 2, 2, 2, 2, 2, 2, 2});
+  ASSERT_EQ(same.at_point.size(), 1u);
+  EXPECT_NEAR(same[0].shear_modulus(), palette[2]->shear_modulus(), 1e-8 * palette[2]->shear_modulus());
+  EXPECT_LE((same[0].stress_derivative(Mat3::Identity()) - palette[2]->stress_derivative(Mat3::Identity())).norm(),
+            1e-8 * palette[2]->stress_derivative(Mat3::Identity()).norm());
+  // Layers normal to x (children 0-3 soft, 4-7 stiff): the tangent at rest
+  // is B^T C^H B, with the laminate's series modulus across the layers and
+  // the parallel one along them.
+  const QuadratureMaterials layered = homogenized(ChildIds{1, 1, 1, 1, 2, 2, 2, 2});
+  VoxelGrid cell(2, 2, 2, 1.0, 1);
+  for (int q = 4; q < 8; ++q) cell.at(1, q >> 1 & 1, q & 1) = 2;
+  HomogenizationOptions options;
+  options.solver = "direct";
+  // Material Voigt order (xx, yy, zz, xy, yz, zx), checked on the physics:
+  const Mat6 C = to_material_voigt_order(homogenize(cell, palette, options).C);
+  EXPECT_LE((layered[0].stress_derivative(Mat3::Identity()) - B.transpose() * C * B).norm(), 1e-8 * C.norm());
+  const double mu1 = palette[1]->shear_modulus(), mu2 = palette[2]->shear_modulus();
+  EXPECT_NEAR(C(4, 4), 0.5 * (mu1 + mu2), 1e-6 * mu2);            // yz, in the layer plane: parallel
+  EXPECT_NEAR(C(3, 3), 2 * mu1 * mu2 / (mu1 + mu2), 1e-6 * mu1);  // xy, across the layers: series
+  EXPECT_NEAR(C(5, 5), C(3, 3), 1e-9 * mu1);                      // zx, likewise
+  // Pure shear yz stores the parallel modulus in the element's energy.
+  Mat3 F = Mat3::Identity();
+  F(1, 2) = 1e-4;
+  EXPECT_NEAR(layered[0].energy(F), 0.5 * C(4, 4) * 1e-8, 1e-3 * C(4, 4) * 1e-8);
+  // Rotations store no energy; a block with void falls back to naive.
+  const Mat3 R = Eigen::AngleAxisd(0.9, Vec3(1, -1, 2).normalized()).toRotationMatrix();
+  EXPECT_LE(layered[0].energy(R), 1e-12 * mu2);
+  EXPECT_EQ(homogenized(ChildIds{0, 2, 1, 2, 2, 2, 2, 2}).at_point.size(), 8u);
+  EXPECT_THROW(homogenized(ChildIds{3, 1, 1, 1, 1, 1, 1, 1}), InputError);
+}
+
 namespace {
 
 struct ErrorFixture {
@@ -259,6 +299,52 @@ TEST(DdfemCoarsenError, ConstantOffsetGivesItsLengthOverLongestDimension) {
   other.voxel_size = 0.2;
   EXPECT_THROW(mean_vertex_error(other, f.fine, uf, f.coarse, f.coarse_mesh, uc), InputError);
   EXPECT_THROW(mean_vertex_error(f.grid, f.fine, uf, f.coarse, f.coarse_mesh, uc.head(6)), InputError);
+}
+
+TEST(DdfemCoarsenError, FloorOfARepresentableFieldIsZero) {
+  Mat3 A;
+  A << 0.1, -0.2, 0.05, 0.3, 0.02, -0.1, 0.07, 0.11, -0.3;
+  for (int levels : {1, 2}) {
+    const ErrorFixture f = make_error_fixture(8, 6, 4, levels);
+    const VecX uc = affine_field(f.coarse_mesh.mesh, A, Vec3(0.01, 0, -0.02));
+    const VecX uf = interpolate_to_fine(f.grid, f.fine, f.coarse, f.coarse_mesh, uc);
+    const CoarseErrorFloor floor = coarse_error_floor(f.grid, f.fine, uf, f.coarse, f.coarse_mesh);
+    EXPECT_LE(floor.error, 1e-12);
+    EXPECT_LE(floor.lower_bound, floor.error);
+  }
+}
+
+TEST(DdfemCoarsenError, FloorIsTheMinimumOverCoarseFields) {
+  // A field no coarse mesh represents: smooth plus voxel-scale wiggles.
+  const ErrorFixture f = make_error_fixture(8, 6, 6, 1);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  VecX uf(f.fine.mesh.num_dofs());
+  for (int n = 0; n < f.fine.mesh.num_nodes(); ++n) {
+    const Vec3 x = f.fine.mesh.nodes.row(n).transpose();
+    uf.segment<3>(3 * n) = Vec3(std::sin(4 * x[1]), x[0] * x[2], std::cos(3 * x[0])) * 0.01 +
+                           0.002 * Vec3(noise(rng), noise(rng), noise(rng));
+  }
+  const CoarseErrorFloor floor = coarse_error_floor(f.grid, f.fine, uf, f.coarse, f.coarse_mesh);
+  ASSERT_EQ(floor.coarse_displacement.size(), f.coarse_mesh.mesh.num_dofs());
+  // The returned field has the returned error.
+  EXPECT_NEAR(mean_vertex_error(f.grid, f.fine, uf, f.coarse, f.coarse_mesh, floor.coarse_displacement), floor.error,
+              1e-12 * floor.error);
+  // Certified to the requested gap, and the certificate is below every coarse field's error.
+  EXPECT_LE(floor.lower_bound, floor.error);
+  EXPECT_GE(floor.lower_bound, (1 - 1e-3) * floor.error);
+  std::uniform_int_distribution<int> pick(0, int(floor.coarse_displacement.size()) - 1);
+  for (int trial = 0; trial < 50; ++trial) {
+    VecX uc = floor.coarse_displacement;
+    for (int k = 0; k < 3; ++k) uc[pick(rng)] += 1e-4 * noise(rng);
+    EXPECT_GE(mean_vertex_error(f.grid, f.fine, uf, f.coarse, f.coarse_mesh, uc), floor.lower_bound);
+  }
+  // Least squares alone (one iteration) is not the minimum of a mean of norms.
+  CoarseErrorFloorOptions one;
+  one.max_iterations = 1;
+  const CoarseErrorFloor least_squares = coarse_error_floor(f.grid, f.fine, uf, f.coarse, f.coarse_mesh, one);
+  EXPECT_GT(least_squares.error, floor.error);
+  EXPECT_THROW(coarse_error_floor(f.grid, f.fine, uf.head(9), f.coarse, f.coarse_mesh), InputError);
 }
 
 namespace {
@@ -324,6 +410,13 @@ TEST(DdfemCoarsenEndToEnd, LayeredBarNaiveAndAveragedAgainstFine) {
                   aligned ? "aligned" : "offset", names[b], err[b], uf.u.maxCoeff(), ucs.u.maxCoeff(), ucs.dofs, uf.dofs, c.seconds,
                   stats.seconds, stats.distinct_combinations);
     }
+    // No coarse model does better than the best trilinear fit of the fine field.
+    const CoarseErrorFloor floor = coarse_error_floor(s.grid, fine, uf.u, c, build_coarse_mesh(c, naive_coarsening(s.material_by_id)));
+    EXPECT_LE(floor.lower_bound, floor.error);
+    EXPECT_LE(floor.error, std::min(err[0], err[1]));
+    EXPECT_GT(floor.lower_bound, 0.05 * floor.error);  // a certificate that says something
+    std::printf("layered bar (%s layers): best possible error on the coarse mesh %.3e (certified >= %.3e, %d iterations)\n",
+                aligned ? "aligned" : "offset", floor.error, floor.lower_bound, floor.iterations);
     if (aligned) {
       // Homogeneous blocks: both baselines are the exact material layout.
       EXPECT_NEAR(err[0], err[1], 1e-9 * err[0]);

@@ -12,6 +12,7 @@
 
 #include "core/errors.hpp"
 #include "material/anisotropic_spring.hpp"
+#include "material/green_anisotropic.hpp"
 #include "material/linear_anisotropic.hpp"
 #include "material/linear_isotropic.hpp"
 #include "material/material_sum.hpp"
@@ -89,6 +90,9 @@ std::vector<NamedMaterial> all_models() {
       {"neo_hookean", nh},
       {"anisotropic_spring", spring},
       {"neo_hookean+spring", std::make_shared<MaterialSum>(std::vector<MaterialPtr>{nh, spring})},
+      {"green_anisotropic", std::make_shared<GreenAnisotropic>(orthotropic_test_C())},
+      {"neo_hookean+green_anisotropic",
+       std::make_shared<MaterialSum>(std::vector<MaterialPtr>{nh, std::make_shared<GreenAnisotropic>(orthotropic_test_C())})},
   };
 }
 
@@ -522,6 +526,33 @@ TEST(MaterialParameters, BadValuesThrowInputErrorNamingTheParameter) {
   EXPECT_EQ(AnisotropicSpring(1.0, Vec3(0, 0, 5)).direction(), Vec3::UnitZ());
   EXPECT_THROW(MaterialSum(std::vector<MaterialPtr>{}), InputError);
   EXPECT_THROW(MaterialSum(std::vector<MaterialPtr>{nullptr}), InputError);
+}
+
+TEST(GreenAnisotropic, LinearizesToItsStiffnessAndIgnoresRotations) {
+  const Mat6 C = orthotropic_test_C();
+  const GreenAnisotropic green(C);
+  const LinearAnisotropic linear(C);
+  // Same tangent at the rest state, same energy to second order.
+  EXPECT_LE((green.stress_derivative(Mat3::Identity()) - linear.stress_derivative(Mat3::Identity())).norm(),
+            1e-12 * linear.stress_derivative(Mat3::Identity()).norm());
+  Mat3 G;
+  G << 1, -2, 0.5, 0.3, 0.7, -1, 2, 0.1, -0.4;
+  for (double t : {1e-3, 1e-4}) {
+    const Mat3 F = Mat3::Identity() + t * G;
+    EXPECT_NEAR(green.energy(F) / linear.energy(F), 1.0, 20 * t);
+  }
+  // A rotation changes nothing (the small-strain model would store energy).
+  const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Mat3 F = Mat3::Identity() + 0.05 * G;
+  EXPECT_NEAR(green.energy(R * F), green.energy(F), 1e-12 * green.energy(F));
+  EXPECT_LE(green.energy(R), 1e-20 * C.norm());
+  EXPECT_GT(linear.energy(R), 1e-3 * C.norm());
+  // Semidefinite stiffness is accepted, indefinite is not.
+  Mat6 rank_one = Mat6::Zero();
+  rank_one(0, 0) = 1e6;
+  EXPECT_NO_THROW(GreenAnisotropic{rank_one});
+  rank_one(1, 1) = -1e3;
+  EXPECT_THROW(GreenAnisotropic{rank_one}, InputError);
 }
 
 }  // namespace
