@@ -11,6 +11,7 @@
 #include "gamut/particle_scoring.hpp"
 #include "gamut/structure_evolution.hpp"
 #include "gamut/structure_ops.hpp"
+#include "homog/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 #include "parallel/fan_out.hpp"
@@ -133,6 +134,38 @@ StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<V
   return report;
 }
 
+std::vector<VoxelGrid> GamutSampler::initial_set_cells() const {
+  if (o_.initial_set.empty()) return {};
+  const std::string& path = o_.initial_set;
+  MicrostructureSet seeds;
+  try {
+    seeds = read_microstructures_artifact(path);
+  } catch (const InputError& e) {
+    throw InputError(std::string("initial_set.path: ") + e.what());
+  }
+  const int r = o_.initial_refine, rz = seeds.nz == 1 ? 1 : r;
+  const bool planar = voxels_per_side_z() == 1;
+  const auto same = [](double a, double b) { return std::abs(a - b) <= 1e-12 * std::abs(b); };
+  const std::string where = "initial_set.path " + path + ": ";
+  if ((seeds.nz == 1) != planar)
+    throw InputError(where + "holds " + (seeds.nz == 1 ? "2D" : "3D") + " cells, the " + o_.space + " space samples " +
+                     (planar ? "2D" : "3D") + " ones");
+  if (seeds.nx * r != o_.resolution || seeds.ny * r != o_.resolution || seeds.nz * rz != voxels_per_side_z())
+    throw InputError(where + "cells of " + std::to_string(seeds.nx) + " voxels per side, refined " + std::to_string(r) +
+                     " times, are not the sampler's resolution " + std::to_string(o_.resolution) +
+                     " (set initial_set.refine)");
+  if (!same(seeds.stiff.E, o_.stiff.E) || !same(seeds.stiff.nu, o_.stiff.nu) || seeds.soft_is_void != o_.soft_is_void ||
+      (!o_.soft_is_void && (!same(seeds.soft.E, o_.soft.E) || !same(seeds.soft.nu, o_.soft.nu))))
+    throw InputError(where + "its base materials (stiff E " + std::to_string(seeds.stiff.E) + ", nu " +
+                     std::to_string(seeds.stiff.nu) + (seeds.soft_is_void ? ", void" : ", a soft material") +
+                     ") are not the sampler's");
+  std::vector<VoxelGrid> cells;
+  cells.reserve(seeds.items.size());
+  for (const Microstructure& m : seeds.items)
+    cells.push_back(cell_with(r == 1 ? m.ids : refine_ids(m.ids, seeds.nx, seeds.ny, seeds.nz, r)));
+  return cells;
+}
+
 SamplerState GamutSampler::initialize(StepReport* report) const {
   SamplerState state;
   MicrostructureSet& set = state.set;
@@ -148,6 +181,7 @@ SamplerState GamutSampler::initialize(StepReport* report) const {
 
   std::vector<VoxelGrid> cells = {solid_cell()};
   for (VoxelGrid& c : random_cuts(0, o_.population)) cells.push_back(std::move(c));
+  for (VoxelGrid& c : initial_set_cells()) cells.push_back(std::move(c));
   *report = add_structures(state, cells, std::vector<std::int64_t>(cells.size(), -1), 0, SampleStep::initial, palette_);
   if (state.set.items.empty())
     throw NumericalError("gamut sampler: no initial structure lies inside the material space's box");

@@ -71,6 +71,9 @@ class GamutSampler {
   // `count` structures cut from the solid cell by up to initial_beams beams
   // (the initial distribution, and the random baseline's draws).
   std::vector<VoxelGrid> random_cuts(int cycle, int count) const;
+  // The cells of options.initial_set, refined; InputError naming the file
+  // if they do not fit this sampler (dimension, resolution, materials).
+  std::vector<VoxelGrid> initial_set_cells() const;
   // Homogenizes `cells` (ids into `palette`) across ranks; appends the new, valid, unique ones.
   StepReport add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
                             const std::vector<std::int64_t>& parents, int cycle, SampleStep step,

@@ -1,6 +1,7 @@
 #include "sampler_options.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "core/errors.hpp"
 
@@ -175,6 +176,15 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.void_variants = config.get_or<bool>("void_variants", o.void_variants);
   if (o.void_variants && o.soft_is_void) config.fail("void_variants", "needs a soft material to remove (materials.soft)");
   if (config.has("mode")) o.random_baseline = config.one_of("mode", {"sampler", "random"}) == "random";
+  if (config.has("initial_set")) {
+    const Config seeds = config.child("initial_set");
+    o.initial_set = seeds.get_path("path");
+    if (std::error_code ec; !std::filesystem::is_regular_file(o.initial_set, ec))
+      seeds.fail("path", o.initial_set + ": no such file (a microstructures artifact)");
+    o.initial_refine = seeds.get_or<int>("refine", 1);
+    if (o.initial_refine < 1 || o.initial_refine > 8) seeds.fail("refine", "must be in 1..8");
+    seeds.check_no_unknown_keys();
+  }
   return o;
 }
 

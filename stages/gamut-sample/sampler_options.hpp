@@ -29,6 +29,14 @@ struct SamplerOptions {
   // beam or gap (thin_feature_voxels) are not added. 1: no limit.
   int min_feature = 1;
 
+  // Structures of an earlier set added to the initial population
+  // (initial_set.path, a microstructures artifact of the same base
+  // materials), each voxel split into initial_set.refine^d: a 16^3 gamut as
+  // the start of a 32^3 one, or a cubic set inside an orthotropic space
+  // that contains every cubic material. Homogenized again in this space.
+  std::string initial_set;
+  int initial_refine = 1;
+
   int population = 24;           // particles
   int cycles = 6;                // discrete + continuous cycles after the initial population
   int initial_beams = 8;         // beams cut from the solid cell for the initial population

@@ -60,6 +60,29 @@ check "void variants: 1 and 3 ranks agree" -- bash -c "h5diff -q '$WORK/v.void.m
 expect_exit 2 "void_variants.*needs a soft material" -- "$SAMPLE" --config "$TINY" --set void_variants=true \
   --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' --out "$WORK/bad.gamut.h5"
 
+# An earlier set as part of the initial population: every structure of
+# `one` (8 x 8) is added again, as is, or with each voxel split into 2 x 2
+# for a 16 x 16 gamut.
+count_of() { h5dump -H -d /voxels "$1" | sed -n 's/.*DATASPACE *SIMPLE { ( \([0-9]*\),.*/\1/p'; }
+initial_of() { sed -n 's/.* structures (\([0-9]*\) initial.*/\1/p' <<<"$1"; }
+n_one=$(count_of "$WORK/one.microstructures.h5")
+out=$("$SAMPLE" --config "$TINY" --seed 7 --set initial_set="{path: $WORK/one.microstructures.h5}" --set cycles=1 \
+  --out "$WORK/seeded.gamut.h5" 2>&1)
+echo "seeded: $(initial_of "$out") initial structures from a set of $n_one"
+check "seeded run adds every structure of the set" -- test "$(initial_of "$out")" -ge "$n_one"
+out=$("$SAMPLE" --config "$TINY" --seed 7 --set resolution=16 --set initial_set="{path: $WORK/one.microstructures.h5, refine: 2}" \
+  --set cycles=1 --set continuous.per_cycle=0 --set directed.per_cycle=0 --out "$WORK/seeded16.gamut.h5" 2>&1)
+check "refined seeds start a 16 x 16 gamut" -- test "$(initial_of "$out")" -ge "$n_one"
+check "its cells are 16 x 16" -- bash -c "h5dump -H -d /voxels '$WORK/seeded16.microstructures.h5' | grep -q ', 64 )'"
+expect_exit 2 "initial_set.path .*one.microstructures.h5: cells of 8 voxels per side, refined 1 times, are not the sampler's resolution 16" -- \
+  "$SAMPLE" --config "$TINY" --set resolution=16 --set initial_set="{path: $WORK/one.microstructures.h5}" --out "$WORK/bad.gamut.h5"
+expect_exit 2 "initial_set.path .*base materials" -- "$SAMPLE" --config "$TINY" --set materials.stiff.E=2e6 \
+  --set initial_set="{path: $WORK/one.microstructures.h5}" --out "$WORK/bad.gamut.h5"
+expect_exit 2 "initial_set.refine.*must be in 1..8" -- "$SAMPLE" --config "$TINY" \
+  --set initial_set="{path: $WORK/one.microstructures.h5, refine: 0}" --out "$WORK/bad.gamut.h5"
+expect_exit 2 "initial_set.*missing.h5" -- "$SAMPLE" --config "$TINY" --set initial_set="{path: $WORK/missing.h5}" \
+  --out "$WORK/bad.gamut.h5"
+
 # Bad settings.
 expect_exit 2 "population.*must be >= 2" -- "$SAMPLE" --config "$TINY" --set population=1 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "space" -- "$SAMPLE" --config "$TINY" --set space=cubic4d --out "$WORK/bad.gamut.h5"
