@@ -101,7 +101,7 @@ CoarseGrid coarsen_grid(const CoarseGrid& coarse) {
 }
 
 VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& lookup, int points_per_axis,
-                            CoarseMeshStats* stats) {
+                            CoarseMeshStats* stats, bool enhanced_modes) {
   const auto t0 = Clock::now();
   if (!lookup) throw InputError("coarse mesh: no material lookup given");
   if (points_per_axis == 0) points_per_axis = std::min(4, grid.fine_per_cell());
@@ -134,7 +134,7 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   for (int c = 0; c < 8; ++c) cube.row(c) = grid.cell_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
   // Geometry 0: the Gauss rule; geometry 1, where a material has a centre
   // point (ddfem/coarse_fit.hpp): the rule and the element centre.
-  mesh.geometries.assign(1, hex8::element_geometry(cube, rule));
+  mesh.geometries.assign(1, enhanced_modes ? hex8::enhanced_element_geometry(cube, rule) : hex8::element_geometry(cube, rule));
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int m = mesh.element_tag[e] - 1;
     mesh.element_material[e] = m;

@@ -74,8 +74,10 @@ struct CoarseMeshStats {
 // the same child combination share one QuadratureMaterials entry; element_tag
 // is combination index + 1. `element_voxel` / `voxel_element` of the result
 // index coarse cells.
+// enhanced_modes: elements with the three condensed bubble modes of
+// hex8::enhanced_element_geometry (no bending locking), for every material.
 VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& lookup, int points_per_axis = 0,
-                            CoarseMeshStats* stats = nullptr);
+                            CoarseMeshStats* stats = nullptr, bool enhanced_modes = false);
 
 // Trilinear interpolation from coarse nodes to fine nodes as an
 // (fine nodes) x (coarse nodes) matrix; rows sum to 1. Each fine node is

@@ -90,11 +90,27 @@ ElementGeometry element_geometry(const NodeMatrix& X, const QuadratureRule& rule
   return g;
 }
 
+ElementGeometry enhanced_element_geometry(const NodeMatrix& X, const QuadratureRule& rule) {
+  ElementGeometry g = element_geometry(X, rule);
+  const Mat3 J0 = X.transpose() * shape_gradients(Vec3::Zero());
+  const double det0 = J0.determinant();
+  const Mat3 J0_inverse = J0.inverse();
+  g.enhanced.resize(rule.size());
+  for (int q = 0; q < rule.size(); ++q) {
+    const double detJ = (X.transpose() * shape_gradients(rule.points[q])).determinant();
+    // d(1 - chi_k^2)/dchi = -2 chi_k e_k; spatial: J0^-T of it, row k.
+    for (int k = 0; k < 3; ++k)
+      g.enhanced[q].row(k) = (det0 / detJ) * (-2.0 * rule.points[q][k]) * J0_inverse.row(k);
+  }
+  return g;
+}
+
 ElementGeometry with_centre_point(const ElementGeometry& geo, const NodeMatrix& X) {
   const ElementGeometry centre = element_geometry(X, gauss_rule(1));
   ElementGeometry g = geo;
   g.dNdX.push_back(centre.dNdX[0]);
   g.weight.push_back(centre.weight[0]);
+  if (g.has_enhanced_modes()) g.enhanced.push_back(Mat3::Zero());  // the bubbles' gradients vanish there
   return g;
 }
 

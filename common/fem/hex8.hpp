@@ -41,9 +41,21 @@ QuadratureRule gauss_rule(int points_per_axis);
 struct ElementGeometry {
   std::vector<NodeMatrix> dNdX;
   std::vector<double> weight;
+  // Empty for the plain trilinear element. Otherwise the element has three
+  // incompatible bubble modes 1 - chi_k^2 per displacement component
+  // (Wilson; Taylor's form that passes the patch test), whose 9 amplitudes
+  // A are condensed inside the element: F_q = F_q(x) + A G_q^T with
+  // row k of enhanced[q] the spatial gradient of bubble k at point q
+  // (hex_element.hpp). A point without bubbles (the centre) has zeros.
+  std::vector<Mat3> enhanced;
   int size() const { return static_cast<int>(weight.size()); }
+  bool has_enhanced_modes() const { return !enhanced.empty(); }
 };
 ElementGeometry element_geometry(const NodeMatrix& X, const QuadratureRule& rule);
+// The same with the bubble modes: G_q = (detJ_0 / detJ_q) J_0^{-T}-mapped
+// gradients of 1 - chi_k^2 (J_0 the Jacobian at the centre), so that they
+// integrate to zero over the element and constant strains stay exact.
+ElementGeometry enhanced_element_geometry(const NodeMatrix& X, const QuadratureRule& rule);
 // `geo` with one more point: the element centre, weighted by the element's
 // volume. A material placed there sees the centre's deformation gradient, as
 // the volumetric point of selective reduced integration does; DDFEM coarse

@@ -1,11 +1,138 @@
 #include "fem/hex_element.hpp"
 
+#include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 
 namespace msfab {
+namespace {
+
+using Mat9x24 = Eigen::Matrix<double, 9, 24>;
+using Mat24x9 = Eigen::Matrix<double, 24, 9>;
+
+// flat(A G^T) = bubble_map(G) flat(A), column-major flattening: entry
+// (i + 3j, i + 3l) = G(j, l).
+Mat9 bubble_map(const Mat3& G) {
+  Mat9 M = Mat9::Zero();
+  for (int j = 0; j < 3; ++j)
+    for (int l = 0; l < 3; ++l)
+      for (int i = 0; i < 3; ++i) M(i + 3 * j, i + 3 * l) = G(j, l);
+  return M;
+}
+
+Mat3 point_gradient(const hex8::ElementGeometry& geo, const hex8::NodeMatrix& x, int q, const Mat3& A) {
+  Mat3 F = hex8::deformation_gradient(x, geo.dNdX[q]);
+  if (geo.has_enhanced_modes()) F.noalias() += A * geo.enhanced[q].transpose();
+  return F;
+}
+
+// H B for the 9x24 map B from nodal positions to flat F (three non-zeros
+// per column of B: dF(a, c)/dx_i(a) = dN_i/dX_c).
+Mat9x24 times_b(const Mat9& H, const hex8::NodeMatrix& D) {
+  Mat9x24 HB;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a)
+      HB.col(3 * i + a) = H.col(a) * D(i, 0) + H.col(a + 3) * D(i, 1) + H.col(a + 6) * D(i, 2);
+  return HB;
+}
+
+// The element with bubble amplitudes A: energy, and optionally the
+// gradient and Hessian in the nodal positions and the blocks that couple
+// them with A (r_A = dE/dA, K_AA, K_Au).
+struct EnhancedTerms {
+  Vec9 r_A = Vec9::Zero();
+  Mat9 K_AA = Mat9::Zero();
+  Eigen::Matrix<double, 9, 24> K_Au = Eigen::Matrix<double, 9, 24>::Zero();
+};
+
+double evaluate_with(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                     const Mat3& A, Vec24* gradient, Mat24* hessian, EnhancedTerms* bubbles) {
+  double e = 0;
+  if (gradient) gradient->setZero();
+  if (hessian) hessian->setZero();
+  if (bubbles) *bubbles = EnhancedTerms{};
+  const bool need_P = gradient || bubbles, need_H = hessian || bubbles;
+  Mat3 P;
+  Mat9 H;
+  for (int q = 0; q < geo.size(); ++q) {
+    const hex8::NodeMatrix& D = geo.dNdX[q];
+    const Mat3 F = point_gradient(geo, x, q, A);
+    double psi;
+    mat[q].evaluate(F, &psi, need_P ? &P : nullptr, need_H ? &H : nullptr);
+    if (!std::isfinite(psi)) return kInfiniteEnergy;
+    const double w = geo.weight[q];
+    e += w * psi;
+    if (gradient) {
+      // dE/dx_i = w P dN_i/dX
+      const Eigen::Matrix<double, 3, 8> G = w * P * D.transpose();
+      for (int i = 0; i < 8; ++i) gradient->segment<3>(3 * i) += G.col(i);
+    }
+    if (!hessian && !bubbles) continue;
+    // With B three non-zeros per column, w B^T H B costs ~2.4k flops per
+    // point instead of ~7k.
+    const Mat9x24 HB = times_b(H, D);
+    if (hessian)
+      for (int j = 0; j < 8; ++j) {
+        const double d0 = w * D(j, 0), d1 = w * D(j, 1), d2 = w * D(j, 2);
+        for (int b = 0; b < 3; ++b)
+          hessian->row(3 * j + b) += d0 * HB.row(b) + d1 * HB.row(b + 3) + d2 * HB.row(b + 6);
+      }
+    if (bubbles) {
+      const Mat9 M = bubble_map(geo.enhanced[q]);
+      bubbles->r_A.noalias() += w * M.transpose() * flat(P);
+      bubbles->K_AA.noalias() += w * M.transpose() * H * M;
+      bubbles->K_Au.noalias() += w * M.transpose() * HB;
+    }
+  }
+  return e;
+}
+
+// K_AA factored, made definite by a shift if it is not (a bubble mode
+// without stiffness, or a state past a material instability).
+Eigen::LDLT<Mat9> definite_factor(const Mat9& K) {
+  Eigen::LDLT<Mat9> f(K);
+  const double scale = std::max(K.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  for (double shift = 1e-10 * scale; f.info() != Eigen::Success || !f.isPositive() ||
+                                     f.vectorD().minCoeff() <= 1e-14 * scale;
+       shift *= 10) {
+    f.compute(K + shift * Mat9::Identity());
+    if (shift > scale) break;
+  }
+  return f;
+}
+
+// The bubble amplitudes that minimize the element energy at nodal
+// positions x: Newton with backtracking from A = 0. Returns false if the
+// element is inverted at A = 0.
+bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                      Mat3& A, double& energy) {
+  A.setZero();
+  EnhancedTerms t;
+  energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+  if (!std::isfinite(energy)) return false;
+  const double r0 = t.r_A.norm();
+  for (int it = 0; it < 30 && t.r_A.norm() > 1e-12 * r0; ++it) {
+    const Vec9 step = -definite_factor(t.K_AA).solve(t.r_A);
+    const double slope = t.r_A.dot(step);
+    double s = 1.0, trial = kInfiniteEnergy;
+    Mat3 B;
+    for (int k = 0; k < 40; ++k, s *= 0.5) {
+      B = A + s * Eigen::Map<const Mat3>(step.data());
+      trial = evaluate_with(geo, mat, x, B, nullptr, nullptr, nullptr);
+      if (std::isfinite(trial) && trial <= energy + 1e-4 * s * slope) break;
+    }
+    if (!(std::isfinite(trial) && trial <= energy)) break;  // round-off: no decrease left
+    A = B;
+    energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+  }
+  return true;
+}
+
+}  // namespace
 
 double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
                   const hex8::NodeMatrix& x) {
+  if (geo.has_enhanced_modes()) return hex_evaluate(geo, mat, x, nullptr, nullptr);
   double e = 0;
   for (int q = 0; q < geo.size(); ++q) {
     double psi;
@@ -18,40 +145,20 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
 
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
                     const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian) {
-  double e = 0;
-  if (gradient) gradient->setZero();
-  if (hessian) hessian->setZero();
-  Mat3 P;
-  Mat9 H;
-  for (int q = 0; q < geo.size(); ++q) {
-    const hex8::NodeMatrix& D = geo.dNdX[q];
-    const Mat3 F = hex8::deformation_gradient(x, D);
-    double psi;
-    mat[q].evaluate(F, &psi, gradient ? &P : nullptr, hessian ? &H : nullptr);
-    if (!std::isfinite(psi)) return kInfiniteEnergy;
-    const double w = geo.weight[q];
-    e += w * psi;
-    if (gradient) {
-      // dE/dx_i = w P dN_i/dX
-      const Eigen::Matrix<double, 3, 8> G = w * P * D.transpose();
-      for (int i = 0; i < 8; ++i) gradient->segment<3>(3 * i) += G.col(i);
-    }
-    if (hessian) {
-      // dF(a, c)/dx_i(a) = dN_i/dX_c, so with B the 9x24 map from nodal
-      // displacements to flat F, K += w B^T H B. B has three non-zeros per
-      // column; exploiting that costs ~2.4k flops per point instead of ~7k.
-      Eigen::Matrix<double, 9, 24> HB;
-      for (int i = 0; i < 8; ++i)
-        for (int a = 0; a < 3; ++a)
-          HB.col(3 * i + a) = H.col(a) * D(i, 0) + H.col(a + 3) * D(i, 1) + H.col(a + 6) * D(i, 2);
-      for (int j = 0; j < 8; ++j) {
-        const double d0 = w * D(j, 0), d1 = w * D(j, 1), d2 = w * D(j, 2);
-        for (int b = 0; b < 3; ++b)
-          hessian->row(3 * j + b) += d0 * HB.row(b) + d1 * HB.row(b + 3) + d2 * HB.row(b + 6);
-      }
-    }
-  }
-  return e;
+  if (!geo.has_enhanced_modes()) return evaluate_with(geo, mat, x, Mat3::Zero(), gradient, hessian, nullptr);
+  Mat3 A;
+  double energy;
+  if (!condense_bubbles(geo, mat, x, A, energy)) return kInfiniteEnergy;
+  if (!gradient && !hessian) return energy;
+  EnhancedTerms t;
+  energy = evaluate_with(geo, mat, x, A, gradient, hessian, &t);
+  // Static condensation: E(x) = min_A E(x, A), so dE/dx = E_x - K_xA K_AA^-1 r_A
+  // (r_A ~ 0 at the minimum) and d2E/dx2 = K_xx - K_xA K_AA^-1 K_Ax.
+  const Eigen::LDLT<Mat9> K_AA = definite_factor(t.K_AA);
+  const Mat24x9 coupling = t.K_Au.transpose();
+  if (gradient) gradient->noalias() -= coupling * K_AA.solve(t.r_A);
+  if (hessian) hessian->noalias() -= coupling * K_AA.solve(t.K_Au);
+  return energy;
 }
 
 }  // namespace msfab

@@ -50,7 +50,7 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
                                 : database_coarsening(*m.database, counted);
   }
-  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats);
+  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, request.element == "enhanced");
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   return m;

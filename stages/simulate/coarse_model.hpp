@@ -15,6 +15,7 @@ struct CoarseningRequest {
   int level = 0;                     // 0 = fine, 1, 2
   std::string material = "ddfem";    // ddfem | naive | averaged
   std::string database;              // coarse_db path (ddfem)
+  std::string element = "trilinear"; // trilinear | enhanced (condensed bubble modes)
 };
 
 struct CoarseModel {

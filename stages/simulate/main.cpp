@@ -63,6 +63,10 @@ int main(int argc, char** argv) {
       .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged or homogenized")
       ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized"}));
   app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
+  app.cli()
+      .add_option("--coarse-element", coarsening.element,
+                  "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking)")
+      ->check(CLI::IsMember({"trilinear", "enhanced"}));
   app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
   double target_error = 0;
   auto* target_option = app.cli().add_option(
@@ -91,6 +95,8 @@ int main(int argc, char** argv) {
         throw InputError("--target-error: must be a finite number > 0 (the mean-vertex error), got " +
                          fmt::format("{}", target_error));
       if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
+      if (coarsening.element != "trilinear")
+        throw InputError("--coarse-element enhanced: not available with --target-error (mixed meshes are trilinear)");
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
       if (scene.newton.linear_solver == "pcg-mg")
@@ -99,6 +105,8 @@ int main(int argc, char** argv) {
                          "several sizes (use auto, cholmod or pcg)");
       coarsening.level = 2;
     }
+    if (coarsening.level == 0 && coarsening.element != "trilinear")
+      throw InputError("--coarse-element enhanced: needs --coarsen 1 or 2 (the fine mesh is trilinear)");
     CoarseModel coarse;
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
     const bool coarsened = coarsening.level > 0;
@@ -193,6 +201,7 @@ int main(int argc, char** argv) {
     if (coarsened) {
       record.coarsen_level = coarsening.level;
       record.coarse_material = coarsening.material;
+      record.coarse_element = coarsening.element;
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();
@@ -223,8 +232,8 @@ int main(int argc, char** argv) {
                   adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2], fine.mesh.num_elements(),
                   uniform_seconds);
     else if (coarsened)
-      std::printf("  coarsening: level %d, %s materials, %d -> %d elements, %.3f ms\n", coarsening.level,
-                  coarsening.material.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
+      std::printf("  coarsening: level %d, %s materials, %s elements, %d -> %d elements, %.3f ms\n", coarsening.level,
+                  coarsening.material.c_str(), coarsening.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
                   1e3 * coarse.seconds);
     std::printf("  time: setup %.3f s, assembly %.3f s, solve %.3f s, line search %.3f s (%.3f s per iteration)\n",
                 setup, result.timings.assembly, result.timings.solve, result.timings.line_search,

@@ -78,6 +78,7 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
     f.create_group("/coarsening");
     f.write_attribute("/coarsening", "level", r.coarsen_level);
     f.write_attribute("/coarsening", "material", r.coarse_material);
+    f.write_attribute("/coarsening", "element", r.coarse_element);
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);
     f.write_attribute("/coarsening", "fine_elements", r.fine_elements);

@@ -68,6 +68,79 @@ TEST(Assembly, ElementGradientAndHessianMatchFiniteDifferences) {
   EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm());
 }
 
+TEST(EnhancedElement, GradientAndHessianOfTheCondensedEnergyMatchFiniteDifferences) {
+  hex8::NodeMatrix X;
+  for (int i = 0; i < 8; ++i) X.row(i) = 0.5 * (hex8::natural_node(i).transpose() + Eigen::RowVector3d::Ones());
+  X(7, 0) += 0.1;  // not a parallelepiped
+  for (int points : {2, 4}) {
+    auto geo = hex8::enhanced_element_geometry(X, hex8::gauss_rule(points));
+    if (points == 2) geo = hex8::with_centre_point(geo, X);  // the centre carries no bubble
+    std::vector<MaterialPtr> per_point;
+    for (int q = 0; q < geo.size(); ++q) per_point.push_back(std::make_shared<NeoHookean>(1e3 * (1 + q % 3), 0.4));
+    const QuadratureMaterials mat{per_point};
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.08, 0.08);
+    hex8::NodeMatrix x = X;
+    for (int i = 0; i < 8; ++i)
+      for (int a = 0; a < 3; ++a) x(i, a) += u(rng);
+    Vec24 g;
+    Mat24 K;
+    const double e = hex_evaluate(geo, mat, x, &g, &K);
+    EXPECT_NEAR(e, hex_energy(geo, mat, x), 1e-12 * e);
+    // The bubbles lower the energy: the condensed element is softer.
+    auto plain = geo;
+    plain.enhanced.clear();
+    EXPECT_LT(e, hex_energy(plain, mat, x));
+    const double h = 1e-6;
+    for (int k = 0; k < 24; ++k) {
+      hex8::NodeMatrix xp = x, xm = x;
+      xp(k / 3, k % 3) += h;
+      xm(k / 3, k % 3) -= h;
+      const double fd = (hex_energy(geo, mat, xp) - hex_energy(geo, mat, xm)) / (2 * h);
+      EXPECT_NEAR(g[k], fd, 1e-6 * (1 + std::abs(fd))) << points << " points, entry " << k;
+      Vec24 gp, gm;
+      hex_evaluate(geo, mat, xp, &gp, nullptr);
+      hex_evaluate(geo, mat, xm, &gm, nullptr);
+      const Vec24 col = (gp - gm) / (2 * h);
+      EXPECT_LT((K.col(k) - col).norm(), 1e-5 * (1 + col.norm())) << points << " points, column " << k;
+    }
+    EXPECT_LT((K - K.transpose()).norm(), 1e-10 * K.norm());
+  }
+}
+
+TEST(EnhancedElement, PassesThePatchTestAndBendsExactly) {
+  // A 2 x 1 x 0.5 box (lengths a, b, c along x, y, z), linear material with nu = 0.
+  const double a = 2.0, b = 1.0, c = 0.5, E = 1e6;
+  hex8::NodeMatrix X;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 n = hex8::natural_node(i);
+    X.row(i) << 0.5 * a * (n[0] + 1), 0.5 * b * (n[1] + 1), 0.5 * c * (n[2] + 1);
+  }
+  X.rowwise() += Eigen::RowVector3d(0.3, -0.2, 0.1);
+  const auto enhanced = hex8::enhanced_element_geometry(X, hex8::gauss_rule(2));
+  const auto plain = hex8::element_geometry(X, hex8::gauss_rule(2));
+  const QuadratureMaterials linear{{std::make_shared<LinearIsotropic>(E, 0.0)}};
+  // Affine deformations: the bubbles stay at rest, the energies agree.
+  Mat3 G;
+  G << 0.01, -0.02, 0.005, 0.003, 0.02, -0.01, 0.007, 0.011, -0.03;
+  const hex8::NodeMatrix affine = X + X * G.transpose();
+  EXPECT_NEAR(hex_energy(enhanced, linear, affine), hex_energy(plain, linear, affine), 1e-10 * hex_energy(plain, linear, affine));
+  // Pure bending about y: u_x = -k (x - xc)(z - zc), u_z = k (x - xc)^2 / 2 at
+  // the nodes. The exact energy is E k^2 I a / 2, I = b c^3 / 12; the
+  // trilinear element adds parasitic shear, the enhanced one is exact.
+  const double k = 1e-3;
+  const Vec3 centre = X.colwise().mean().transpose();
+  hex8::NodeMatrix bent = X;
+  for (int i = 0; i < 8; ++i) {
+    const double dx = X(i, 0) - centre[0], dz = X(i, 2) - centre[2];
+    bent(i, 0) += -k * dx * dz;
+    bent(i, 2) += 0.5 * k * dx * dx;
+  }
+  const double exact = 0.5 * E * k * k * (b * c * c * c / 12) * a;
+  EXPECT_NEAR(hex_energy(enhanced, linear, bent), exact, 1e-9 * exact);
+  EXPECT_GT(hex_energy(plain, linear, bent), 2 * exact);  // locks: (a/c)^2 worth of shear
+}
+
 TEST(Assembly, GlobalGradientAndHessianMatchFiniteDifferences) {
   const VoxelMesh vm = build_voxel_mesh(small_mixed_grid(), two_material_palette());
   ElasticAssembler asmb(vm.mesh);
