@@ -1,10 +1,9 @@
 #include "ddfem/baseline_coarsening.hpp"
 
-#include <cstdlib>
-#include <sstream>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cstdlib>
+#include <sstream>
 
 #include "core/errors.hpp"
 #include "homog/elastic_tensor.hpp"
