@@ -1,7 +1,5 @@
 #include "ddfem/coarsening_error.hpp"
 
-#include <Eigen/SparseCholesky>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "solve/cholmod_solver.hpp"
 
 namespace msfab {
 namespace {
@@ -77,7 +76,9 @@ CoarseErrorFloor coarse_error_floor(const SpMat& P, const VoxelMesh& fine_mesh, 
   const double floor_norm = 1e-9 * mean_norm + 1e-300;
 
   const SpMat Pt = P.transpose();
-  Eigen::SimplicialLLT<SpMat> cholesky;
+  LinearSolverOptions solver_options;
+  solver_options.threads = 1;  // deterministic, and the factor is small
+  CholmodSolver cholesky(solver_options);
   VecX weight = VecX::Ones(n);
   CoarseErrorFloor best;
   best.error = std::numeric_limits<double>::infinity();
@@ -89,10 +90,10 @@ CoarseErrorFloor coarse_error_floor(const SpMat& P, const VoxelMesh& fine_mesh, 
     SpMat normal = Pt * weight.asDiagonal() * P;
     const double shift = 1e-14 * normal.diagonal().maxCoeff();
     for (int c = 0; c < normal.cols(); ++c) normal.coeffRef(c, c) += shift;
-    if (it == 1) cholesky.analyzePattern(normal);
-    cholesky.factorize(normal);
-    if (cholesky.info() != Eigen::Success) throw NumericalError("coarse error floor: weighted normal equations not definite");
-    U = cholesky.solve(Pt * (weight.asDiagonal() * F));
+    if (it == 1) cholesky.analyze(normal);
+    if (!cholesky.factorize(normal))
+      throw NumericalError("coarse error floor: weighted normal equations not definite");
+    U = cholesky.solve_columns(MatX(Pt * (weight.asDiagonal() * F)));
     R = F - P * U;
     // Primal value, and the dual certificate L = W R, which satisfies
     // P^T L = 0 by the normal equations; scaled into ||L_n|| <= 1.
