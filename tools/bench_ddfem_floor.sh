@@ -8,12 +8,14 @@
 # DDFEM reached what the mesh allows, 0 that it did no better than naive.
 # The last two columns repeat naive and homogenized coarsening with the
 # enhanced coarse element (--coarse-element enhanced: condensed bubble
-# modes, no bending locking); the databases are fitted on trilinear
-# elements, so DDFEM keeps the trilinear one.
+# modes, no bending locking). DDFEM uses the element its database was
+# fitted for (fit.element).
 #
 #   tools/bench_ddfem_floor.sh BIN OUTDIR BENCHMARKS.md DATABASE1 DATABASE2 [scene ...]
-# DATABASE1/2: level-1 and level-2 coarse_db of the scenes' palette. The
-# section `ddfem-floor` of BENCHMARKS.md is written (BENCH_SECTION overrides).
+# DATABASE1/2: level-1 and level-2 coarse_db of the scenes' palette
+# (DATABASE2 may be "-" with LEVELS=1). The section `ddfem-floor` of
+# BENCHMARKS.md is written (BENCH_SECTION overrides); LEVELS="1" runs level 1
+# only (default "1 2").
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB1=$4 DB2=$5
 shift 5
@@ -21,7 +23,12 @@ SCENES=("$@")
 [ ${#SCENES[@]} -gt 0 ] || SCENES=(layers1 checker random3 sole fibers skeleton holes3 pushing bending bending_uniform twisting buckling bridge bridge_arch)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
-for f in "$DB1" "$DB2"; do [ -f "$f" ] || { echo "bench: no database $f" >&2; exit 2; }; done
+LEVELS=${LEVELS:-1 2}
+for level in $LEVELS; do
+  f=$DB1
+  [ "$level" = 2 ] && f=$DB2
+  [ -f "$f" ] || { echo "bench: no database $f" >&2; exit 2; }
+done
 source "$SRC/tools/simulate_bench_lib.sh"
 
 rows=""
@@ -30,7 +37,7 @@ for scene in "${SCENES[@]}"; do
   fine="$OUTDIR/$scene-L0.h5"
   echo "bench: $scene fine ..." >&2
   run "$fine" --config "$cfg" || continue
-  for level in 1 2; do
+  for level in $LEVELS; do
     db=$DB1
     [ "$level" = 2 ] && db=$DB2
     declare -A err=()
@@ -38,8 +45,11 @@ for scene in "${SCENES[@]}"; do
     for m in naive homogenized ddfem naive-enhanced homogenized-enhanced; do
       out="$OUTDIR/$scene-L$level-$m.h5"
       echo "bench: $scene level $level $m ..." >&2
+      # DDFEM uses the element its database was fitted for.
+      element=(--coarse-element "$([ "$m" = "${m%-enhanced}" ] && echo trilinear || echo enhanced)")
+      [ "$m" = ddfem ] && element=()
       if run "$out" --config "$cfg" --coarsen "$level" --coarse-material "${m%-enhanced}" ${db:+--database "$db"} \
-        --coarse-element "$([ "$m" = "${m%-enhanced}" ] && echo trilinear || echo enhanced)" --reference "$fine"; then
+        "${element[@]}" --reference "$fine"; then
         err[$m]=$(attr "$out" /coarsening error_vs_fine)
         floor=$(attr "$out" /coarsening error_floor) lower=$(attr "$out" /coarsening error_floor_lower_bound)
       else
@@ -58,7 +68,7 @@ for scene in "${SCENES[@]}"; do
 done
 
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores"
-table="Measured $(date -u +%Y-%m-%d) on $machine, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB1") (level 1) and $(basename "$DB2") (level 2).
+table="Measured $(date -u +%Y-%m-%d) on $machine, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB1") (level 1)$([ "$LEVELS" = 1 ] || echo " and $(basename "$DB2") (level 2)").
 
 | scene | level | floor (certified ≥) | floor / naive | naive | homogenized | DDFEM | DDFEM / naive | room used | naive, enhanced element | homogenized, enhanced element |
 |---|---|---|---|---|---|---|---|---|---|---|

@@ -85,9 +85,14 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
   MatX centre(K, 2);
   VecX residual(K), heldout(K), heldout_energy(K), seconds(K);
   std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
+  // One element for the whole database; unfitted entries carry no parameters.
+  bool enhanced = false;
+  for (const CoarseMaterialFit& fit : entries) enhanced = enhanced || (fit.fitted && fit.enhanced);
   for (std::int64_t e = 0; e < K; ++e) {
     const CoarseMaterialFit& fit = entries[e];
     if (fit.points() != P) throw std::invalid_argument("write_coarse_db: entries differ in their point count");
+    if (fit.fitted && fit.enhanced != enhanced)
+      throw std::invalid_argument("write_coarse_db: entries were fitted for different elements");
     for (int k = 0; k < 8; ++k) entry_ids(e, k) = fit.material_ids[k];
     for (int k = 0; k < P; ++k) {
       mu(e, k) = fit.mu[k], lambda(e, k) = fit.lambda[k], C(e, k) = fit.C[k];
@@ -114,6 +119,8 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
                     "mu, lambda, C: Pa (energy densities, Eq. 2.7 per quadrature point); v: unit; "
                     "centre: mu_c, lambda_c in Pa (Neo-Hookean term at the element centre)");
   f.write_attribute(g, "points", P);
+  // The element the fits are for; databases without the attribute are trilinear.
+  f.write_attribute(g, "element", std::string(enhanced ? "enhanced" : "trilinear"));
   f.write_vector(g + "/residual", residual);
   f.write_vector(g + "/heldout_error", heldout);
   f.write_vector(g + "/heldout_energy_error", heldout_energy);
@@ -253,9 +260,14 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
   shape_ok(path, g + "/heldout_energy_error", heldout_energy.size(), 1, K, 1);
   shape_ok(path, g + "/samples_train", train.size(), 1, K, 1);
   shape_ok(path, g + "/samples_heldout", held.size(), 1, K, 1);
+  std::string element = "trilinear";
+  if (f.has_attribute(g, "element")) element = f.read_string_attribute(g, "element");
+  if (element != "trilinear" && element != "enhanced")
+    bad(path, g + " attribute element is '" + element + "', expected trilinear or enhanced");
   std::vector<CoarseMaterialFit> entries(K, CoarseMaterialFit(P));
   for (std::int64_t e = 0; e < K; ++e) {
     CoarseMaterialFit& fit = entries[e];
+    fit.enhanced = element == "enhanced";
     for (int k = 0; k < 8; ++k) {
       fit.material_ids[k] = entry_ids(e, k);
       if (fit.material_ids[k] < min_id || fit.material_ids[k] > max_id)

@@ -55,6 +55,13 @@ struct CoarseDatabase {
   Level2Hierarchy hierarchy;
 
   int num_materials() const { return static_cast<int>(materials.size()); }
+  // Whether the stored fits are for the coarse element with bubble modes
+  // (the online coarse mesh must use that element).
+  bool enhanced_element() const {
+    for (const CoarseMaterialFit& fit : entries)
+      if (fit.fitted) return fit.enhanced;
+    return false;
+  }
   bool compressed() const { return entries.size() < entry_of.size(); }
   // Digits per child: n, or n + 1 with void children.
   int digits() const { return num_materials() + (void_children ? 1 : 0); }

@@ -45,10 +45,12 @@ void CoarseMaterialFit::resize(int points) {
 }
 
 bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
-                         const std::vector<Vec3>& v, CoarseEnergyBasis& out) {
+                         const std::vector<Vec3>& v, CoarseEnergyBasis& out, const Mat3& bubbles) {
   if (static_cast<int>(v.size()) != coarse.size())
     throw std::invalid_argument("coarse_energy_basis: one direction per quadrature point needed");
-  const auto F = coarse_deformation_gradients(coarse, X, u);
+  auto F = coarse_deformation_gradients(coarse, X, u);
+  if (coarse.has_enhanced_modes())
+    for (int k = 0; k < coarse.size(); ++k) F[k].noalias() += bubbles * coarse.enhanced[k].transpose();
   const int points = coarse.size();
   out.a.resize(points), out.b.resize(points), out.s.resize(points);
   for (int k = 0; k < points; ++k) {
@@ -73,12 +75,55 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
   return true;
 }
 
+hex8::ElementGeometry coarse_fit_geometry(const hex8::NodeMatrix& X, int points, bool enhanced) {
+  int per_axis = 1;
+  while (per_axis * per_axis * per_axis < points) ++per_axis;
+  if (per_axis * per_axis * per_axis != points)
+    throw std::invalid_argument("coarse_fit_geometry: the point count must be a cube (8 or 64)");
+  const hex8::QuadratureRule rule = hex8::gauss_rule(per_axis);
+  return enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule);
+}
+
+namespace {
+
+// The fit's materials whether or not it is marked fitted (the fit itself
+// evaluates its intermediate parameters).
+QuadratureMaterials fit_materials(const CoarseMaterialFit& fit) {
+  QuadratureMaterials q;
+  for (int k = 0; k < fit.points(); ++k) {
+    MaterialPtr nh = NeoHookean::from_lame(fit.mu[k], fit.lambda[k]);
+    if (fit.C[k] > 0.0)
+      q.at_point.push_back(std::make_shared<MaterialSum>(
+          std::vector<MaterialPtr>{nh, std::make_shared<AnisotropicSpring>(fit.C[k], fit.v[k])}));
+    else
+      q.at_point.push_back(nh);
+  }
+  if (fit.mu_centre > 0.0 || fit.lambda_centre > 0.0)
+    q.at_point.push_back(NeoHookean::from_lame(fit.mu_centre, fit.lambda_centre));
+  return q;
+}
+
+hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
+  hex8::NodeMatrix x = X;
+  for (int n = 0; n < 8; ++n) x.row(n) += u.segment<3>(3 * n).transpose();
+  return x;
+}
+
+}  // namespace
+
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
                      const Vec24& u) {
   CoarseEnergyBasis e;
   if (fit.points() != coarse.size())
     throw std::invalid_argument("coarse_energy: the fit and the geometry have different point counts");
-  if (!coarse_energy_basis(coarse, X, u, fit.v, e)) return kInfiniteEnergy;
+  if (fit.enhanced != coarse.has_enhanced_modes())
+    throw std::invalid_argument("coarse_energy: the geometry's bubble modes do not match the fit's element");
+  Mat3 A = Mat3::Zero();
+  if (fit.enhanced) {
+    const QuadratureMaterials m = fit_materials(fit);
+    if (!hex_condensed_bubbles(coarse_element_geometry(coarse, X, m), m, deformed(X, u), A)) return kInfiniteEnergy;
+  }
+  if (!coarse_energy_basis(coarse, X, u, fit.v, e, A)) return kInfiniteEnergy;
   double V = 0;
   for (int k = 0; k < fit.points(); ++k) V += fit.mu[k] * e.a[k] + fit.lambda[k] * e.b[k] + fit.C[k] * e.s[k];
   return V + fit.mu_centre * e.a_centre + fit.lambda_centre * e.b_centre;
@@ -91,8 +136,8 @@ bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& 
   CoarseMaterialFit naive = fit;
   for (int k = 0; k < fit.points(); ++k) naive.mu[k] = fit.mu0[k], naive.lambda[k] = fit.lambda0[k], naive.C[k] = 0.0;
   naive.mu_centre = naive.lambda_centre = 0.0;
-  const hex8::ElementGeometry geo = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const hex8::ElementGeometry geo = coarse_fit_geometry(X, fit.points(), fit.enhanced);
   constexpr int kVoigt[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};  // xx yy zz yz xz xy
   for (const auto& [a, b] : kVoigt) {
     Mat3 eps = Mat3::Zero();
@@ -123,11 +168,13 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     fit.lambda0[k] = block.point_lambda0[k];
   }
   // Basis energies of the samples the coarse element can represent.
-  const hex8::ElementGeometry coarse = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const hex8::ElementGeometry coarse = coarse_fit_geometry(X, points, options.enhanced_element);
+  fit.enhanced = options.enhanced_element;
   std::vector<CoarseEnergyBasis> basis;
   std::vector<double> V0;
   std::vector<ForceKind> kind;
+  std::vector<const Vec24*> corners;
   for (const ForceSample& s : set.samples) {
     CoarseEnergyBasis e;
     if (!coarse_energy_basis(coarse, X, s.corner_displacement, fit.v, e) || !(s.energy > 0.0)) {
@@ -137,6 +184,26 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     basis.push_back(e);
     V0.push_back(s.energy);
     kind.push_back(set.patterns[s.pattern].kind);
+    corners.push_back(&s.corner_displacement);
+  }
+  // Enhanced element: the basis at the bubble amplitudes that the current
+  // parameters choose, sample by sample (a sample whose condensed state
+  // cannot be evaluated keeps its previous amplitudes).
+  auto update_bubbles = [&]() {
+    const QuadratureMaterials m = fit_materials(fit);
+    const hex8::ElementGeometry geo = coarse_element_geometry(coarse, X, m);
+    for (size_t s = 0; s < basis.size(); ++s) {
+      Mat3 A;
+      CoarseEnergyBasis e;
+      if (!hex_condensed_bubbles(geo, m, deformed(X, *corners[s]), A)) continue;
+      if (!coarse_energy_basis(coarse, X, *corners[s], fit.v, e, A)) continue;
+      basis[s] = e;
+    }
+  };
+  if (options.enhanced_element) {
+    // Start from the fine materials at their points, as the regularizer does.
+    for (int k = 0; k < points; ++k) fit.mu[k] = fit.mu0[k], fit.lambda[k] = fit.lambda0[k];
+    update_bubbles();
   }
   const int ns = static_cast<int>(V0.size());
   const std::vector<char> held = heldout_mask(ns, options.heldout_fraction, options.split_seed);
@@ -201,22 +268,26 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   const int rows = fit.samples_train + np;
   MatX A = MatX::Zero(rows, np);
   VecX b = VecX::Zero(rows);
-  int r = 0;
-  for (int s = 0; s < ns; ++s) {
-    if (held[s]) continue;
-    const double w = std::sqrt(weight[s]) / V0[s];
-    for (int k = 0; k < points; ++k) {
-      A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
-      A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
-      if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
+  auto fill_data_rows = [&]() {
+    int r = 0;
+    for (int s = 0; s < ns; ++s) {
+      if (held[s]) continue;
+      const double w = std::sqrt(weight[s]) / V0[s];
+      for (int k = 0; k < points; ++k) {
+        A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
+        A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
+        if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
+      }
+      if (options.centre_point) {
+        A(r, centre) = w * basis[s].a_centre * scale[centre];
+        A(r, centre + 1) = w * basis[s].b_centre * scale[centre + 1];
+      }
+      b[r] = w * V0[s];
+      ++r;
     }
-    if (options.centre_point) {
-      A(r, centre) = w * basis[s].a_centre * scale[centre];
-      A(r, centre + 1) = w * basis[s].b_centre * scale[centre + 1];
-    }
-    b[r] = w * V0[s];
-    ++r;
-  }
+    return r;
+  };
+  int r = fill_data_rows();
   // lambda is Eq. 2.9's for the 8 points of a level-1 element; with more
   // points (64 at level 2) each weighs 8 / points, so the regularizer's pull
   // on a uniform relative change of the material is the same at every level.
@@ -225,19 +296,42 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     A(r, j) = reg;
     b[r] = reg * target[j];
   }
-  const NnlsResult sol = solve_nnls(A, b);
+  NnlsResult sol = solve_nnls(A, b);
+  auto unpack = [&](const NnlsResult& x) {
+    for (int k = 0; k < points; ++k) {
+      fit.mu[k] = x.x[per_point * k] * scale[per_point * k];
+      fit.lambda[k] = x.x[per_point * k + 1] * scale[per_point * k + 1];
+      fit.C[k] = options.anisotropic ? x.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
+    }
+    if (options.centre_point) {
+      fit.mu_centre = x.x[centre] * scale[centre];
+      fit.lambda_centre = x.x[centre + 1] * scale[centre + 1];
+    }
+  };
+  if (sol.converged) unpack(sol);
+  // Enhanced element: alternate bubbles for the parameters and parameters
+  // for the bubbles until the scaled parameters move less than 1e-3. The
+  // basis left behind is always that of the final parameters' own bubbles,
+  // so the errors below are those of the element used online.
+  if (options.enhanced_element && sol.converged) {
+    for (fit.bubble_rounds = 1;; ++fit.bubble_rounds) {
+      update_bubbles();
+      if (fit.bubble_rounds >= options.bubble_rounds) break;
+      fill_data_rows();
+      const NnlsResult next = solve_nnls(A, b);
+      if (!next.converged) break;
+      const double moved = (next.x - sol.x).cwiseAbs().maxCoeff();
+      sol = next;
+      unpack(sol);
+      if (moved <= 1e-3 * std::max(1.0, sol.x.cwiseAbs().maxCoeff())) {
+        update_bubbles();
+        break;
+      }
+    }
+  }
   if (!sol.converged) {
     fit.not_fitted_reason = "NNLS did not converge";
     return fit;
-  }
-  for (int k = 0; k < points; ++k) {
-    fit.mu[k] = sol.x[per_point * k] * scale[per_point * k];
-    fit.lambda[k] = sol.x[per_point * k + 1] * scale[per_point * k + 1];
-    fit.C[k] = options.anisotropic ? sol.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
-  }
-  if (options.centre_point) {
-    fit.mu_centre = sol.x[centre] * scale[centre];
-    fit.lambda_centre = sol.x[centre + 1] * scale[centre + 1];
   }
   // A block whose samples all cost (almost) nothing, e.g. void children
   // that leave the solid ones hinged, fits to no stiffness at all: a coarse
@@ -309,18 +403,7 @@ CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOpt
 
 QuadratureMaterials coarse_quadrature_materials(const CoarseMaterialFit& fit) {
   if (!fit.fitted) throw std::invalid_argument("coarse_quadrature_materials: the block was not fitted");
-  QuadratureMaterials q;
-  for (int k = 0; k < fit.points(); ++k) {
-    MaterialPtr nh = NeoHookean::from_lame(fit.mu[k], fit.lambda[k]);
-    if (fit.C[k] > 0.0)
-      q.at_point.push_back(std::make_shared<MaterialSum>(
-          std::vector<MaterialPtr>{nh, std::make_shared<AnisotropicSpring>(fit.C[k], fit.v[k])}));
-    else
-      q.at_point.push_back(nh);
-  }
-  if (fit.mu_centre > 0.0 || fit.lambda_centre > 0.0)
-    q.at_point.push_back(NeoHookean::from_lame(fit.mu_centre, fit.lambda_centre));
-  return q;
+  return fit_materials(fit);
 }
 
 hex8::ElementGeometry coarse_element_geometry(const hex8::ElementGeometry& gauss, const hex8::NodeMatrix& X,

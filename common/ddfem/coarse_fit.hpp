@@ -24,6 +24,14 @@
 // Gauss points but not at its centre, so the fit can move stiffness there
 // instead of softening every point to offset locking (docs/ddfem.md,
 // "Centre point").
+//
+// Optionally (CoarseFitOptions::enhanced_element) the fit is for the coarse
+// element with three condensed bubble modes (hex8::enhanced_element_geometry),
+// whose energy min_A V^1(u, A) is no longer linear in p. The fit then
+// alternates: bubble amplitudes A_s of every sample for the current
+// parameters, then the linear fit of p with the A_s held fixed, starting from
+// the fine materials at their points (docs/ddfem.md, "Fit on the enhanced
+// element"). The online coarse mesh must use the same element.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -39,6 +47,8 @@ struct CoarseFitOptions {
   AnisotropyOptions anisotropy;
   bool anisotropic = true;        // fit C_k (else C_k = 0 and no direction solves)
   bool centre_point = false;      // fit mu_c, lambda_c (else both 0)
+  bool enhanced_element = false;  // fit the element with condensed bubble modes
+  int bubble_rounds = 8;          // enhanced: most alternations of bubbles and parameters
   double regularization = 0.02;   // lambda of Eq. 2.9, on the scaled problem, per 8 points
   double heldout_fraction = 0.2;  // samples kept out of the fit for validation
   // Weight of each force kind in the fit, indexed by ForceKind (stretch,
@@ -58,6 +68,8 @@ struct CoarseMaterialFit {
   std::vector<double> mu, lambda, C;
   std::vector<Vec3> v;                        // spring directions (unit)
   double mu_centre = 0, lambda_centre = 0;    // mu_c, lambda_c (energy densities), 0 without the centre point
+  bool enhanced = false;                      // fitted for (and used on) the element with bubble modes
+  int bubble_rounds = 0;                      // enhanced: alternations run
   std::vector<double> mu0, lambda0;           // fine parameters at each point (Eq. 2.9's p^0)
   // Relative energy errors (V1 - V0) / V0, RMS with the fit's kind weights.
   double residual = 0;             // over the training samples
@@ -78,16 +90,25 @@ struct CoarseMaterialFit {
 
 // The per-point basis energies of V^1 for corner displacements u: a_k, b_k,
 // s_k already multiplied by w_k det J_k, and the centre's a_c, b_c
-// multiplied by V_e. Returns false if the coarse element is inverted at a
-// point or at its centre.
+// multiplied by V_e. With bubble modes in `coarse`, F_k includes
+// `bubbles` A (A G_k^T; the centre has no bubble gradient). Returns false if
+// the coarse element is inverted at a point or at its centre.
 struct CoarseEnergyBasis {
   std::vector<double> a, b, s;
   double a_centre = 0, b_centre = 0;
 };
 bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const Vec24& u,
-                         const std::vector<Vec3>& v, CoarseEnergyBasis& out);
+                         const std::vector<Vec3>& v, CoarseEnergyBasis& out, const Mat3& bubbles = Mat3::Zero());
 
-// V^1 of a fit at corner displacements u (+inf if inverted).
+// The Gauss-rule geometry of a coarse element X with `points` quadrature
+// points (8 or 64), with bubble modes if `enhanced`: what a fit with that
+// `enhanced` flag is evaluated on.
+hex8::ElementGeometry coarse_fit_geometry(const hex8::NodeMatrix& X, int points, bool enhanced);
+
+// V^1 of a fit at corner displacements u (+inf if inverted); for an
+// enhanced fit the condensed energy min_A V^1(u, A). `coarse` must be
+// coarse_fit_geometry(X, fit.points(), fit.enhanced) (std::invalid_argument
+// if its bubble modes do not match the fit's).
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
                      const hex8::NodeMatrix& X, const Vec24& u);
 

@@ -46,11 +46,12 @@ std::vector<SmoothDeformation> smooth_deformations(double length, int count, dou
 std::vector<Mat24> level1_rest_stiffness(const std::vector<CoarseMaterialFit>& level1, double child_size) {
   FineBlock element;  // geometry of one level-1 element (edge 2 voxels = child_size)
   element.voxel_size = 0.5 * child_size;
-  const hex8::ElementGeometry geo = element.coarse_geometry();
   const hex8::NodeMatrix X = element.coarse_rest_positions();
+  const hex8::ElementGeometry trilinear = coarse_fit_geometry(X, 8, false), enhanced = coarse_fit_geometry(X, 8, true);
   std::vector<Mat24> K(level1.size());
   for (std::size_t e = 0; e < level1.size(); ++e) {
     const QuadratureMaterials m = coarse_quadrature_materials(level1[e]);
+    const hex8::ElementGeometry& geo = level1[e].enhanced ? enhanced : trilinear;
     hex_evaluate(coarse_element_geometry(geo, X, m), m, X, nullptr, &K[e]);
     if (!K[e].allFinite()) throw InputError("level 2: level-1 coarse material " + std::to_string(e) + " has a non-finite stiffness");
   }

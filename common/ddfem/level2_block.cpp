@@ -51,6 +51,11 @@ FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFi
     mesh.materials.push_back(children[c] ? coarse_quadrature_materials(*children[c]) : QuadratureMaterials{});
   // Children fitted with a centre term need the element centre as a ninth
   // point: geometry 1 (all elements are the same cube).
+  // Children fitted for the element with bubble modes are that element here too.
+  bool enhanced = false;
+  for (int c = 0; c < 8; ++c) enhanced = enhanced || (children[c] && children[c]->enhanced);
+  if (enhanced)
+    mesh.geometries.at(0) = hex8::enhanced_element_geometry(mesh.element_rest_positions(0), hex8::gauss_rule(2));
   const hex8::ElementGeometry gauss = mesh.geometries.at(0);
   mesh.geometries.push_back(hex8::with_centre_point(gauss, mesh.element_rest_positions(0)));
   for (int e = 0; e < mesh.num_elements(); ++e) {

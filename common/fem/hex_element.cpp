@@ -161,4 +161,12 @@ double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials&
   return energy;
 }
 
+bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
+                           const hex8::NodeMatrix& x, Mat3& A) {
+  A.setZero();
+  if (!geo.has_enhanced_modes()) return std::isfinite(hex_energy(geo, mat, x));
+  double energy;
+  return condense_bubbles(geo, mat, x, A, energy);
+}
+
 }  // namespace msfab

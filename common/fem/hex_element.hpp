@@ -29,4 +29,13 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
                     const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian);
 
+// For an element with bubble modes (geo.has_enhanced_modes()): the 3 x 3
+// amplitudes A (row i: displacement component i, column k: bubble
+// 1 - chi_k^2) that minimize its energy at nodal positions x, found as
+// hex_evaluate finds them. False if the element is inverted at A = 0. The
+// DDFEM fit on the enhanced element holds A fixed while it solves for the
+// material parameters (ddfem/coarse_fit.hpp).
+bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
+                           const hex8::NodeMatrix& x, Mat3& A);
+
 }  // namespace msfab

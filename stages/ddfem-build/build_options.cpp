@@ -88,6 +88,11 @@ BuildOptions read_build_options(const Config& config) {
     o.fit.split_seed = f.get_or<std::uint64_t>("split_seed", o.fit.split_seed);
     o.fit.anisotropic = f.get_or<bool>("anisotropic", o.fit.anisotropic);
     o.fit.centre_point = f.get_or<bool>("centre_point", o.fit.centre_point);
+    const std::string element = f.get_or<std::string>("element", o.fit.enhanced_element ? "enhanced" : "trilinear");
+    if (element != "trilinear" && element != "enhanced") f.fail("element", "must be trilinear or enhanced");
+    o.fit.enhanced_element = element == "enhanced";
+    o.fit.bubble_rounds = f.get_or<int>("bubble_rounds", o.fit.bubble_rounds);
+    if (o.fit.bubble_rounds < 1 || o.fit.bubble_rounds > 100) f.fail("bubble_rounds", "must be in 1..100");
     o.fit.kind_weight[int(ForceKind::pinch)] = f.get_or<double>("pinch_weight", o.fit.kind_weight[4]);
     if (!(o.fit.kind_weight[4] >= 0)) f.fail("pinch_weight", "must be >= 0");
     for (ForceKind kind : {ForceKind::stretch, ForceKind::shear, ForceKind::bend, ForceKind::twist}) {

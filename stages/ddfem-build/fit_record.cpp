@@ -23,6 +23,8 @@ void pack_fit(const CoarseMaterialFit& fit, double* row) {
   *p++ = fit.seconds;
   *p++ = fit.mu_centre;
   *p++ = fit.lambda_centre;
+  *p++ = fit.enhanced;
+  *p++ = fit.bubble_rounds;
 }
 
 CoarseMaterialFit unpack_fit(const double* row, int points) {
@@ -46,6 +48,8 @@ CoarseMaterialFit unpack_fit(const double* row, int points) {
   fit.seconds = *p++;
   fit.mu_centre = *p++;
   fit.lambda_centre = *p++;
+  fit.enhanced = *p++ != 0;
+  fit.bubble_rounds = static_cast<int>(*p++);
   return fit;
 }
 

@@ -7,8 +7,8 @@
 
 namespace msfab {
 
-// 8 ids, then mu, lambda, C, mu0, lambda0 and v (3) per point, then 13 scalars.
-constexpr int fit_record_size(int points) { return 8 + 8 * points + 13; }
+// 8 ids, then mu, lambda, C, mu0, lambda0 and v (3) per point, then 15 scalars.
+constexpr int fit_record_size(int points) { return 8 + 8 * points + 15; }
 void pack_fit(const CoarseMaterialFit& fit, double* row);  // fit_record_size(fit.points()) values
 CoarseMaterialFit unpack_fit(const double* row, int points);
 

@@ -24,7 +24,14 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
                        " database cannot coarsen to level " + std::to_string(request.level));
     std::set<int> used(scene.grid.ids.begin(), scene.grid.ids.end());
     check_scene_palette(*m.database, request.database, scene.material_by_id, std::vector<int>(used.begin(), used.end()));
+    // A fit is only right on the element it was fitted for.
+    const std::string fitted_for = m.database->enhanced_element() ? "enhanced" : "trilinear";
+    if (!request.element.empty() && request.element != fitted_for)
+      throw InputError(request.database + ": fitted for the " + fitted_for + " coarse element; --coarse-element " +
+                       request.element + " would put its materials on another element");
+    m.element = fitted_for;
   }
+  if (!request.element.empty()) m.element = request.element;
   const auto t0 = std::chrono::steady_clock::now();
   m.level1 = coarsen_grid(scene.grid);
   m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
@@ -50,7 +57,7 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
                                 : database_coarsening(*m.database, counted);
   }
-  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, request.element == "enhanced");
+  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   return m;

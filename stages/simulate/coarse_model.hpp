@@ -15,7 +15,9 @@ struct CoarseningRequest {
   int level = 0;                     // 0 = fine, 1, 2
   std::string material = "ddfem";    // ddfem | naive | averaged
   std::string database;              // coarse_db path (ddfem)
-  std::string element = "trilinear"; // trilinear | enhanced (condensed bubble modes)
+  // trilinear | enhanced (condensed bubble modes); empty: the database's
+  // element for ddfem, trilinear otherwise.
+  std::string element;
 };
 
 struct CoarseModel {
@@ -26,11 +28,12 @@ struct CoarseModel {
   double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
   int fallback_blocks = 0;           // ddfem: distinct combinations without a fit, coarsened naively
   std::shared_ptr<CoarseDatabase> database;
+  std::string element = "trilinear"; // the coarse element used (request resolved)
 };
 
 // InputError for a bad request: unknown material, ddfem without a database
 // or with a database of another level, a database whose palette disagrees
-// with the scene.
+// with the scene, an element other than the one the database was fitted for.
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request);
 
 }  // namespace msfab

@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
   app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
   app.cli()
       .add_option("--coarse-element", coarsening.element,
-                  "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking)")
+                  "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking); "
+                  "default: the database's element for ddfem, trilinear otherwise")
       ->check(CLI::IsMember({"trilinear", "enhanced"}));
   app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
   double target_error = 0;
@@ -95,7 +96,7 @@ int main(int argc, char** argv) {
         throw InputError("--target-error: must be a finite number > 0 (the mean-vertex error), got " +
                          fmt::format("{}", target_error));
       if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
-      if (coarsening.element != "trilinear")
+      if (coarsening.element == "enhanced")
         throw InputError("--coarse-element enhanced: not available with --target-error (mixed meshes are trilinear)");
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
@@ -105,10 +106,13 @@ int main(int argc, char** argv) {
                          "several sizes (use auto, cholmod or pcg)");
       coarsening.level = 2;
     }
-    if (coarsening.level == 0 && coarsening.element != "trilinear")
-      throw InputError("--coarse-element enhanced: needs --coarsen 1 or 2 (the fine mesh is trilinear)");
+    if (coarsening.level == 0 && !coarsening.element.empty())
+      throw InputError("--coarse-element: needs --coarsen 1 or 2 (the fine mesh is trilinear)");
     CoarseModel coarse;
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
+    if (adaptive && coarse.element == "enhanced")
+      throw InputError(coarsening.database + ": fitted for the enhanced coarse element, which --target-error does not "
+                       "support (mixed meshes are trilinear)");
     const bool coarsened = coarsening.level > 0;
     AdaptiveModel adapted;
     double uniform_seconds = 0;  // adaptive: the two uniform solves the estimate comes from
@@ -201,7 +205,7 @@ int main(int argc, char** argv) {
     if (coarsened) {
       record.coarsen_level = coarsening.level;
       record.coarse_material = coarsening.material;
-      record.coarse_element = coarsening.element;
+      record.coarse_element = coarse.element;
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();
@@ -233,7 +237,7 @@ int main(int argc, char** argv) {
                   uniform_seconds);
     else if (coarsened)
       std::printf("  coarsening: level %d, %s materials, %s elements, %d -> %d elements, %.3f ms\n", coarsening.level,
-                  coarsening.material.c_str(), coarsening.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
+                  coarsening.material.c_str(), coarse.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
                   1e3 * coarse.seconds);
     std::printf("  time: setup %.3f s, assembly %.3f s, solve %.3f s, line search %.3f s (%.3f s per iteration)\n",
                 setup, result.timings.assembly, result.timings.solve, result.timings.line_search,

@@ -107,6 +107,21 @@ check "enhanced element beats the trilinear one, above the floor" -- awk -v e="$
   'BEGIN { exit !(e < n && e >= f) }'
 check "result records the element" -- bash -c "h5dump -a /coarsening/element '$WORK/naive_enhanced.h5' | grep -q enhanced"
 
+# A database fitted for the enhanced element (fit.element): simulate takes
+# the element from the database, records it, and refuses the other one.
+check "tiny database for the enhanced element" -- "$BIN/msfab-ddfem-build" --config "$SRC/configs/ddfem/tiny.yaml" \
+  --set fit.element=enhanced --out "$WORK/db_enhanced.h5" --quiet
+"$SIM" --config "$BAR" --coarsen 1 --database "$WORK/db_enhanced.h5" --reference "$WORK/fine.h5" \
+  --out "$WORK/ddfem_enhanced.h5" --quiet >/dev/null
+ddfem_enhanced=$(attr_of ddfem_enhanced error_vs_fine)
+echo "ddfem fitted for the enhanced element: $ddfem_enhanced (trilinear fit $ddfem, naive enhanced $enhanced)"
+check "the enhanced fit runs on the enhanced element" -- \
+  bash -c "h5dump -a /coarsening/element '$WORK/ddfem_enhanced.h5' | grep -q enhanced"
+check "the enhanced fit beats naive coarsening on either element, above the floor" -- \
+  awk -v d="$ddfem_enhanced" -v n="$naive" -v e="$enhanced" -v f="$floor" 'BEGIN { exit !(d < n && d < e && d >= f) }'
+expect_exit 2 "fitted for the enhanced coarse element" -- "$SIM" --config "$BAR" --coarsen 1 \
+  --database "$WORK/db_enhanced.h5" --coarse-element trilinear --out "$WORK/o.h5"
+
 # Bad requests.
 expect_exit 2 "coarse-element" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-element quadratic --out "$WORK/o.h5"
 expect_exit 2 "needs --coarsen 1 or 2" -- "$SIM" --config "$BAR" --coarse-element enhanced --out "$WORK/o.h5"

@@ -71,8 +71,8 @@ inline CoarseMaterialFit neo_hookean_level1(double mu, double lambda) {
 inline ForceSampleSet samples_of_coarse_material(const CoarseMaterialFit& truth, const FineBlock& block, int count,
                                                  double amplitude, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
-  const hex8::ElementGeometry geo = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const hex8::ElementGeometry geo = coarse_fit_geometry(X, truth.points(), truth.enhanced);
   ForceSampleSet set;
   set.patterns.resize(1);
   for (int i = 0; i < count; ++i) {

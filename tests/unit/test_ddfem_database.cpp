@@ -104,6 +104,17 @@ TEST(DdfemDatabase, CombinationCodesRoundTripAndArtifactReadsBack) {
   }
   EXPECT_EQ(back.find(BlockMaterials{1, 2, 1, 1, 1, 1, 1, 1}), &back.entries[2]);
   EXPECT_EQ(back.find(BlockMaterials{0, 2, 1, 1, 1, 1, 1, 1}), nullptr);
+  EXPECT_FALSE(back.enhanced_element());
+
+  // The element the fits are for reads back; fits for two elements in one
+  // database are refused.
+  for (CoarseMaterialFit& fit : db.entries) fit.enhanced = true;
+  write_coarse_db(path, db, "palette: []\n", "test", 1, "msfab-test");
+  EXPECT_TRUE(read_coarse_db(path).enhanced_element());
+  for (const CoarseMaterialFit& fit : read_coarse_db(path).entries) EXPECT_TRUE(fit.enhanced);
+  db.entries[3].enhanced = false;
+  EXPECT_THROW(write_coarse_db(path, db, "palette: []\n", "test", 1, "msfab-test"), std::invalid_argument);
+  db.entries[3].enhanced = true;
 
   // Palette checks against a scene.
   const std::vector<MaterialPtr> scene = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
