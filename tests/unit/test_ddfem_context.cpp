@@ -176,6 +176,7 @@ TEST(DdfemContext, LayeredBlockMovesTowardVoigtAlongTheLayers) {
   const double M_stiff = pal[2]->lame_lambda() + 2 * pal[2]->shear_modulus();
   const double voigt = 0.5 * (M_soft + M_stiff), reuss = 2.0 / (1.0 / M_soft + 1.0 / M_stiff);
   CoarseFitOptions options = ddfem_test::small_fit_options();
+  options.sampling.magnitudes = 1;  // patch sampling is the slow mode; one magnitude shows the move
   const FineBlock alone = make_fine_block(layered_ids(), pal, kVoxel);
   const FineBlock in_context = make_fine_block(layered_ids(), pal, kVoxel, 2, 1);
   const CoarseMaterialFit fit_alone = fit_coarse_material(alone, options);
