@@ -7,6 +7,8 @@
 namespace msfab {
 
 ElasticAssembler::ElasticAssembler(const HexMesh& mesh) : mesh_(mesh) {
+  for (const auto& geo : mesh.geometries)
+    if (geo.has_enhanced_modes()) bubbles_.assign(mesh.num_elements(), Mat3::Zero());
   const int n = mesh.num_nodes();
   std::vector<std::vector<int>> adjacent(n);
   for (const auto& el : mesh.elements)
@@ -165,7 +167,8 @@ double ElasticAssembler::evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hes
         const int e = color[c];
         const auto& geo = mesh_.geometries[mesh_.element_geometry[e]];
         const auto& mat = mesh_.materials[mesh_.element_material[e]];
-        const double E = hex_evaluate(geo, mat, gather(x, e), gradient ? &ge : nullptr, hessian ? &Ke : nullptr);
+        const double E = hex_evaluate(geo, mat, gather(x, e), gradient ? &ge : nullptr, hessian ? &Ke : nullptr,
+                                      bubbles_.empty() ? nullptr : &bubbles_[e]);
         element_energy[e] = E;
         if (!std::isfinite(E)) continue;
         const auto& el = mesh_.elements[e];

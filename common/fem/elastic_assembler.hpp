@@ -42,6 +42,11 @@ class ElasticAssembler {
 
   // x holds deformed positions, node-major (3*n + a). Energies are +inf as
   // soon as one element is inverted.
+  //
+  // Elements with bubble modes keep their last bubble amplitudes as the
+  // warm start of the next evaluation (hex_evaluate), so one assembler must
+  // not be evaluated from two threads at once; its results do not depend on
+  // the thread count (each element's amplitudes follow its own evaluations).
   double energy(const VecX& x) const;
   // Any of gradient / hessian may be nullptr. `hessian` must carry the
   // pattern returned by pattern(). Returns the energy; if it is +inf the
@@ -73,6 +78,10 @@ class ElasticAssembler {
   SpMat dof_map_, dof_map_t_, reduced_pattern_;
   std::vector<int> reduce_from_, reduce_to_;
   std::vector<double> reduce_weight_;
+  // Per element: the bubble amplitudes of its last evaluation (empty when
+  // no element has bubble modes). A cache: it changes no result beyond
+  // round-off, only the cost.
+  mutable std::vector<Mat3> bubbles_;
 };
 
 }  // namespace msfab

@@ -116,19 +116,33 @@ Eigen::LDLT<Mat9> definite_factor(const Mat9& K) {
 }
 
 // The bubble amplitudes that minimize the element energy at nodal
-// positions x: Newton with backtracking from A = 0. Returns false if the
+// positions x: Newton with backtracking from the amplitudes A passed in
+// (from A = 0 if the element is inverted there). Stops when the residual
+// has fallen 1e-12 of its start or the Newton decrement (the decrease a
+// full step predicts) is below 1e-14 of the energy. The second test is the
+// one that usually ends it: below it the line search compares energies
+// that differ by their round-off and backtracked 40 times before giving up
+// (measured: 7 iterations per condensation on the sole scene, 4.5 with the
+// test, 2.8 with warm starts); it also means the same from a warm start
+// that begins near the minimum. The gradient error it leaves is of the
+// order of the decrement (the condensed gradient is corrected to first
+// order in r_A), the energy's below 1e-14 of itself. Returns false if the
 // element is inverted at A = 0.
 bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
                       Mat3& A, double& energy) {
-  A.setZero();
   EnhancedTerms t;
   t.coupling = false;
   energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+  if (!std::isfinite(energy) && !A.isZero(0.0)) {
+    A.setZero();
+    energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+  }
   if (!std::isfinite(energy)) return false;
   const double r0 = t.r_A.norm();
   for (int it = 0; it < 30 && t.r_A.norm() > 1e-12 * r0; ++it) {
     const Vec9 step = -definite_factor(t.K_AA).solve(t.r_A);
     const double slope = t.r_A.dot(step);
+    if (-slope <= 1e-14 * std::abs(energy)) break;
     double s = 1.0, trial = kInfiniteEnergy;
     Mat3 B;
     for (int k = 0; k < 40; ++k, s *= 0.5) {
@@ -159,11 +173,12 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
 }
 
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                    const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian) {
+                    const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian, Mat3* bubbles) {
   if (!geo.has_enhanced_modes()) return evaluate_with(geo, mat, x, Mat3::Zero(), gradient, hessian, nullptr);
-  Mat3 A;
+  Mat3 A = bubbles ? *bubbles : Mat3::Zero();
   double energy;
   if (!condense_bubbles(geo, mat, x, A, energy)) return kInfiniteEnergy;
+  if (bubbles) *bubbles = A;
   if (!gradient && !hessian) return energy;
   EnhancedTerms t;
   energy = evaluate_with(geo, mat, x, A, gradient, hessian, &t);
