@@ -40,12 +40,13 @@ MatX energy_features(const std::vector<CoarseMaterialFit>& entries, const std::v
   std::vector<MaterialPtr> one{nullptr};
   FineBlock unit;
   unit.voxel_size = voxel_size;
-  const hex8::ElementGeometry geo = unit.coarse_geometry();
   const hex8::NodeMatrix X = unit.coarse_rest_positions();
+  // Each fit on the element it was fitted for.
+  const hex8::ElementGeometry trilinear = coarse_fit_geometry(X, 8, false), enhanced = coarse_fit_geometry(X, 8, true);
   MatX features(entries.size(), deformations.size());
   for (std::size_t e = 0; e < entries.size(); ++e)
     for (std::size_t s = 0; s < deformations.size(); ++s) {
-      const double V = coarse_energy(entries[e], geo, X, deformations[s]);
+      const double V = coarse_energy(entries[e], entries[e].enhanced ? enhanced : trilinear, X, deformations[s]);
       if (!(V > 0) || !std::isfinite(V)) {
         std::ostringstream os;
         os << "compression: coarse material " << e << " has energy " << V << " at common deformation " << s

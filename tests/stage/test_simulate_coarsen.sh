@@ -127,6 +127,11 @@ check "the enhanced fit beats naive trilinear coarsening, above the floor" -- \
   awk -v d="$ddfem_enhanced" -v n="$naive" -v f="$floor" 'BEGIN { exit !(d < 0.8 * n && d >= f) }'
 expect_exit 2 "fitted for the enhanced coarse element" -- "$SIM" --config "$BAR" --coarsen 1 \
   --database "$WORK/db_enhanced.h5" --coarse-element trilinear --out "$WORK/o.h5"
+# Compression compares enhanced fits on their own element.
+check "compressed enhanced database" -- "$BIN/msfab-ddfem-compress" --database "$WORK/db_enhanced.h5" \
+  --set representatives=64 --out "$WORK/k64_enhanced.h5"
+check "the compressed enhanced database keeps its element" -- \
+  bash -c "h5dump -a /fit/element '$WORK/k64_enhanced.h5' | grep -q enhanced"
 
 # Bad requests.
 expect_exit 2 "coarse-element" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-element quadratic --out "$WORK/o.h5"
