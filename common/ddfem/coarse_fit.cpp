@@ -36,6 +36,13 @@ double weighted_rms(const std::vector<double>& rel, const std::vector<double>& w
   return w > 0 ? std::sqrt(s / w) : 0.0;
 }
 
+// Node positions of the coarse element X displaced by corner values u.
+hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
+  hex8::NodeMatrix x = X;
+  for (int n = 0; n < 8; ++n) x.row(n) += u.segment<3>(3 * n).transpose();
+  return x;
+}
+
 }  // namespace
 
 void CoarseMaterialFit::resize(int points) {
@@ -64,9 +71,7 @@ bool coarse_energy_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMa
     out.s[k] = w * (l - 1.0) * (l - 1.0);
   }
   const hex8::ElementGeometry centre = hex8::element_geometry(X, hex8::gauss_rule(1));
-  hex8::NodeMatrix x = X;
-  for (int n = 0; n < 8; ++n) x.row(n) += u.segment<3>(3 * n).transpose();
-  const Mat3 Fc = hex8::deformation_gradient(x, centre.dNdX[0]);
+  const Mat3 Fc = hex8::deformation_gradient(deformed(X, u), centre.dNdX[0]);
   const double Jc = Fc.determinant();
   if (!(Jc > 0.0)) return false;
   const double logJc = std::log(Jc);
@@ -101,12 +106,6 @@ QuadratureMaterials fit_materials(const CoarseMaterialFit& fit) {
   if (fit.mu_centre > 0.0 || fit.lambda_centre > 0.0)
     q.at_point.push_back(NeoHookean::from_lame(fit.mu_centre, fit.lambda_centre));
   return q;
-}
-
-hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
-  hex8::NodeMatrix x = X;
-  for (int n = 0; n < 8; ++n) x.row(n) += u.segment<3>(3 * n).transpose();
-  return x;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
+#include "ddfem/periodic_samples.hpp"
 #include "material/neo_hookean.hpp"
 #include "scene/scene.hpp"
 
@@ -83,5 +84,21 @@ inline ForceSampleSet samples_of_coarse_material(const CoarseMaterialFit& truth,
   }
   return set;
 }
+
+// A homogeneous nearly incompressible (nu = 0.45) block, its periodic
+// samples of every force family under small_fit_options() (with the
+// anisotropic term off): the case where the trilinear element's locking
+// shows most in a fit.
+struct NearlyIncompressibleBlock {
+  std::vector<MaterialPtr> palette = {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)};
+  FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, palette, kVoxel);
+  CoarseFitOptions options = [] {
+    CoarseFitOptions o = small_fit_options();
+    o.anisotropic = false;
+    return o;
+  }();
+  ForceSampleSet samples = sample_periodic(block, options.sampling);
+  std::vector<Vec3> directions = std::vector<Vec3>(8, Vec3::UnitX());
+};
 
 }  // namespace msfab::ddfem_test

@@ -113,12 +113,12 @@ TEST(DdfemCentre, RecoversAKnownCoarseMaterialWithACentreTerm) {
 // lambda at every point; with it, compressibility moves to the centre and
 // the held-out error drops.
 TEST(DdfemCentre, NearlyIncompressibleBlockMovesItsVolumetricStiffnessToTheCentre) {
-  const std::vector<MaterialPtr> pal = {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)};
-  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel);
-  CoarseFitOptions o = ddfem_test::small_fit_options();
-  const ForceSampleSet samples = sample_periodic(block, o.sampling);
-  const std::vector<Vec3> v(8, Vec3::UnitX());
-  o.anisotropic = false;
+  const ddfem_test::NearlyIncompressibleBlock b;
+  const auto& pal = b.palette;
+  const FineBlock& block = b.block;
+  const ForceSampleSet& samples = b.samples;
+  const std::vector<Vec3>& v = b.directions;
+  CoarseFitOptions o = b.options;
   const CoarseMaterialFit without = fit_from_samples(block, samples, v, o);
   o.centre_point = true;
   const CoarseMaterialFit with = fit_from_samples(block, samples, v, o);

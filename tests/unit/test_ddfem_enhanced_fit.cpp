@@ -78,15 +78,12 @@ TEST(DdfemEnhancedFit, RecoversAKnownMaterialOnTheEnhancedElement) {
 // enhanced element bends without locking, so its fit stays near the block's
 // own material and matches the held-out samples better.
 TEST(DdfemEnhancedFit, NearlyIncompressibleBlockKeepsItsMaterial) {
-  const std::vector<MaterialPtr> pal = {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)};
-  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel);
-  CoarseFitOptions o = ddfem_test::small_fit_options();
-  const ForceSampleSet samples = sample_periodic(block, o.sampling);
-  const std::vector<Vec3> v(8, Vec3::UnitX());
-  o.anisotropic = false;
-  const CoarseMaterialFit trilinear = fit_from_samples(block, samples, v, o);
+  const ddfem_test::NearlyIncompressibleBlock b;
+  const auto& pal = b.palette;
+  CoarseFitOptions o = b.options;
+  const CoarseMaterialFit trilinear = fit_from_samples(b.block, b.samples, b.directions, o);
   o.enhanced_element = true;
-  const CoarseMaterialFit enhanced = fit_from_samples(block, samples, v, o);
+  const CoarseMaterialFit enhanced = fit_from_samples(b.block, b.samples, b.directions, o);
   ASSERT_TRUE(trilinear.fitted && enhanced.fitted);
   const double mu = pal[1]->shear_modulus(), lambda = pal[1]->lame_lambda();
   double mu_t = 0, mu_e = 0, lambda_t = 0, lambda_e = 0;
@@ -143,14 +140,13 @@ TEST(DdfemEnhancedFit, OnlineElementIsTheFittedElement) {
 // little). This is the gap every fit of a homogeneous block closes
 // (docs/ddfem.md, "Fit on the enhanced element").
 TEST(DdfemEnhancedFit, OwnMaterialIsExactInUniformStrainAndCloserInBending) {
-  const std::vector<MaterialPtr> pal = {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)};
-  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, pal, kVoxel);
-  const CoarseFitOptions o = ddfem_test::small_fit_options();
-  const ForceSampleSet samples = sample_periodic(block, o.sampling);
+  const ddfem_test::NearlyIncompressibleBlock b;
+  const auto& pal = b.palette;
+  const ForceSampleSet& samples = b.samples;
   CoarseMaterialFit own;
   own.fitted = true;
   for (int k = 0; k < 8; ++k) own.mu[k] = pal[1]->shear_modulus(), own.lambda[k] = pal[1]->lame_lambda();
-  const hex8::NodeMatrix X = block.coarse_rest_positions();
+  const hex8::NodeMatrix X = b.block.coarse_rest_positions();
   double bend[2] = {0, 0};
   int bends = 0;
   for (int enhanced = 0; enhanced < 2; ++enhanced) {
