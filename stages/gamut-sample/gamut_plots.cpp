@@ -2,11 +2,31 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "io/chart.hpp"
 
 namespace msfab {
+
+namespace {
+const Rgb kStepColors[4] = {{150, 150, 150}, {40, 90, 200}, {220, 40, 40}, {30, 160, 60}};
+
+// Structures as points coloured by the step that found them.
+void plot_structures(Chart& chart, const MicrostructureSet& set,
+                     const std::function<std::pair<double, double>(const Microstructure&)>& at) {
+  for (int step = 0; step < 4; ++step) {
+    std::vector<double> x, y;
+    for (const Microstructure& m : set.items)
+      if (static_cast<int>(m.step) == step) {
+        const auto [a, b] = at(m);
+        x.push_back(a), y.push_back(b);
+      }
+    chart.points(x, y, kStepColors[step], 2.0);
+  }
+  chart.legend({{"INITIAL", kStepColors[0]}, {"DISCRETE", kStepColors[1]}, {"CONTINUOUS", kStepColors[2]}});
+}
+}  // namespace
 
 void plot_gamut_projection(const std::string& path, const MicrostructureSet& set, const GamutLevelSet& gamut,
                            const MaterialSpace& space, const std::string& title) {
@@ -51,15 +71,42 @@ void plot_gamut_projection(const std::string& path, const MicrostructureSet& set
       },
       {0, 0, 0});
 
-  const Rgb colors[4] = {{150, 150, 150}, {40, 90, 200}, {220, 40, 40}, {30, 160, 60}};
-  for (int step = 0; step < 4; ++step) {
-    std::vector<double> x, y;
-    for (const Microstructure& m : set.items)
-      if (static_cast<int>(m.step) == step) x.push_back(m.properties[inu]), y.push_back(std::log10(m.properties[iE] / set.E_stiff));
-    chart.points(x, y, colors[step], 2.0);
-  }
-  chart.legend({{"INITIAL", colors[0]}, {"DISCRETE", colors[1]}, {"CONTINUOUS", colors[2]}});
+  plot_structures(chart, set, [&](const Microstructure& m) {
+    return std::make_pair(m.properties[inu], std::log10(m.properties[iE] / set.E_stiff));
+  });
   chart.write(path);
+}
+
+
+void plot_shear_projections(const std::string& stem, const MicrostructureSet& set, const MaterialSpace& space) {
+  if (space.kind() == MaterialSpaceKind::orthotropic2d) return;
+  const double nu_hi = space.kind() == MaterialSpaceKind::cubic3d ? 0.5 : 1.0;
+  auto g_ratio = [](const Microstructure& m) { return 2 * (1 + m.properties[1]) * m.properties[2] / m.properties[0]; };
+  double top = 1;
+  for (const Microstructure& m : set.items) top = std::max(top, g_ratio(m));
+  const double g_hi = std::ceil(1.05 * top);
+  {
+    ChartAxes axes;
+    axes.x0 = 0, axes.x1 = g_hi, axes.y0 = -set.decades, axes.y1 = 0.25;
+    axes.x_label = "RELATIVE SHEAR MODULUS G' = 2(1+NU)G/E";
+    axes.y_label = "LOG10 E/E_STIFF";
+    axes.title = "E AGAINST G', " + std::to_string(set.items.size()) + " STRUCTURES";
+    Chart chart(720, 560, axes);
+    plot_structures(chart, set, [&](const Microstructure& m) {
+      return std::make_pair(g_ratio(m), std::log10(m.properties[0] / set.E_stiff));
+    });
+    chart.write(stem + "_E_G.png");
+  }
+  {
+    ChartAxes axes;
+    axes.x0 = -1, axes.x1 = nu_hi, axes.y0 = 0, axes.y1 = g_hi;
+    axes.x_label = "POISSON RATIO NU";
+    axes.y_label = "RELATIVE SHEAR MODULUS G'";
+    axes.title = "G' AGAINST NU, " + std::to_string(set.items.size()) + " STRUCTURES";
+    Chart chart(720, 560, axes);
+    plot_structures(chart, set, [&](const Microstructure& m) { return std::make_pair(m.properties[1], g_ratio(m)); });
+    chart.write(stem + "_nu_G.png");
+  }
 }
 
 void plot_coverage(const std::string& path, const std::vector<GamutCycle>& history) {

@@ -152,6 +152,8 @@ int main(int argc, char** argv) {
     // 3. Cycles.
     int this_run = 0;
     for (int cycle = state.cycles_done + 1; cycle <= options.cycles; ++cycle) {
+      // Checked from the history, so a resumed run stops where the whole run would.
+      if (coverage_converged(state.history, options.stop_coverage_growth, options.stop_window)) break;
       if (max_cycles > 0 && this_run == max_cycles) {
         if (rank == 0)
           std::printf("msfab-gamut-sample: stopped after cycle %d of %d (%zu structures); continue with --resume\n",
@@ -205,6 +207,7 @@ int main(int argc, char** argv) {
       write_gamut_artifact(out, g, "msfab-gamut-sample", run_text, {structures_path}, ctx.options.seed);
       plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
                             options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
+      plot_shear_projections(plots_dir + "/gamut", state.set, sampler.space());
       plot_coverage(plots_dir + "/coverage.png", state.history);
       if (options.void_variants) {
         log_step("void variants", void_report);
@@ -231,8 +234,18 @@ int main(int argc, char** argv) {
       std::printf(
           "msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous, %d directed) after %d cycles\n",
           options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], by_step[4],
-          options.cycles);
+          state.cycles_done);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
+      if (options.stop_coverage_growth > 0) {
+        const std::size_t w = std::min<std::size_t>(options.stop_window, state.history.size() - 1);
+        const double before = state.history[state.history.size() - 1 - w].coverage;
+        const double growth = before > 0 ? state.history.back().coverage / before - 1 : 0;
+        std::printf("  %s: coverage grew %.2f%% over the last %zu cycle(s) (stop.coverage_growth %.2f%%)\n",
+                    coverage_converged(state.history, options.stop_coverage_growth, options.stop_window)
+                        ? "converged"
+                        : "not converged, stopped at the cycle limit",
+                    100 * growth, w, 100 * options.stop_coverage_growth);
+      }
       const std::vector<std::string> names = sampler.space().names();
       for (std::size_t a = 0; a < names.size(); ++a) {
         double lo = HUGE_VAL, hi = -HUGE_VAL;

@@ -14,7 +14,8 @@ materials:
   stiff: {E: 1.0e6, nu: 0.3}
   soft:  {E: 1.0e4, nu: 0.45}   # leave out for stiff material and void
 population: 24
-cycles: 6
+cycles: 6                 # the most; stop earlier once the coverage stops growing:
+stop: {coverage_growth: 0, window: 3}   # relative growth over `window` cycles below which the run ends (0: off)
 initial_beams: 8
 beams: {max: 3, min_radius: 0.5, max_radius: 2.0}
 continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3, projection_beta: 0}
@@ -43,6 +44,12 @@ BaseMaterial read_base(const Config& m) {
 const std::vector<std::string> kDirectedObjectives = {"min_nu", "max_nu", "min_shear", "max_shear"};
 
 }  // namespace
+
+bool coverage_converged(const std::vector<GamutCycle>& history, double growth, int window) {
+  if (!(growth > 0) || window < 1 || static_cast<int>(history.size()) <= window) return false;
+  const double now = history.back().coverage, before = history[history.size() - 1 - window].coverage;
+  return now - before < growth * before;
+}
 
 VecX directed_direction(const MaterialSpace& space, const std::string& objective) {
   VecX d = VecX::Zero(space.dimension());
@@ -80,6 +87,15 @@ SamplerOptions read_sampler_options(const Config& config) {
   if (o.population < 2) config.fail("population", "must be >= 2");
   o.cycles = config.get_or<int>("cycles", o.cycles);
   if (o.cycles < 0) config.fail("cycles", "must be >= 0");
+  if (config.has("stop")) {
+    const Config st = config.child("stop");
+    o.stop_coverage_growth = st.get_or<double>("coverage_growth", o.stop_coverage_growth);
+    if (!(o.stop_coverage_growth >= 0 && o.stop_coverage_growth < 1))
+      st.fail("coverage_growth", "must be in [0, 1) (relative growth; 0 runs all cycles)");
+    o.stop_window = st.get_or<int>("window", o.stop_window);
+    if (o.stop_window < 1 || o.stop_window > 1000) st.fail("window", "must be in 1..1000 (cycles)");
+    st.check_no_unknown_keys();
+  }
   o.initial_beams = config.get_or<int>("initial_beams", o.initial_beams);
   if (o.initial_beams < 1) config.fail("initial_beams", "must be >= 1");
   if (config.has("beams")) {

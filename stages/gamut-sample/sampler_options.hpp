@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "gamut/continuous_refinement.hpp"
+#include "gamut/gamut_artifact.hpp"
 #include "gamut/level_set.hpp"
 #include "gamut/material_space.hpp"
 #include "gamut/microstructure_set.hpp"
@@ -38,7 +39,12 @@ struct SamplerOptions {
   int initial_refine = 1;
 
   int population = 24;           // particles
-  int cycles = 6;                // discrete + continuous cycles after the initial population
+  int cycles = 6;                // discrete + continuous cycles after the initial population (the most)
+  // Stop before `cycles` once the gamut has converged: its coverage grew by
+  // less than `stop_coverage_growth` (relative) over the last
+  // `stop_window` cycles. 0: run all `cycles`.
+  double stop_coverage_growth = 0;
+  int stop_window = 3;
   int initial_beams = 8;         // beams cut from the solid cell for the initial population
   BeamMoveOptions move;          // the discrete step's move
 
@@ -69,6 +75,12 @@ struct SamplerOptions {
   // number of homogenizations, no evolution, scoring or continuous step.
   bool random_baseline = false;
 };
+
+// True when the coverage of the last cycle in `history` (cycle 0 first)
+// exceeds the coverage `window` cycles earlier by less than `growth`
+// times the latter: the gamut stopped growing. False while there are fewer
+// than `window` cycles after cycle 0, or when growth is 0.
+bool coverage_converged(const std::vector<GamutCycle>& history, double growth, int window);
 
 // The direction in `space`'s unit cube of a named directed objective;
 // InputError naming the choices for an unknown name.

@@ -1,7 +1,8 @@
 #!/bin/bash
 # msfab-gamut-sample on a tiny 2D gamut: artifacts and plots are written;
 # the result (directed pushes included) is identical for 1 and 3 MPI ranks, for 1 and 2 threads, and
-# after a stop and --resume; bad settings exit 2 naming the key.
+# after a stop and --resume; a run to convergence stops where the coverage
+# stops growing; bad settings exit 2 naming the key.
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 SAMPLE="$BIN/msfab-gamut-sample"
@@ -83,7 +84,31 @@ expect_exit 2 "initial_set.refine.*must be in 1..8" -- "$SAMPLE" --config "$TINY
 expect_exit 2 "initial_set.*missing.h5" -- "$SAMPLE" --config "$TINY" --set initial_set="{path: $WORK/missing.h5}" \
   --out "$WORK/bad.gamut.h5"
 
+# Runs to convergence: `stop` ends the run once the coverage grew by less
+# than coverage_growth over `window` cycles; `cycles` is then the most. On
+# this seed the coverage per cycle is 0.0059, 0.0080, 0.0141, 0.0140: +36%
+# in cycle 1 is below a 50% threshold, so that run stops after cycle 1; over
+# two cycles +139% and then +75%, so a 90% threshold stops after cycle 3,
+# also when the run is stopped after cycle 2 and resumed.
+expect_exit 0 "converged: coverage grew 35.59% over the last 1 cycle" -- "$SAMPLE" --config "$TINY" --seed 7 \
+  --set cycles=3 --set stop='{coverage_growth: 0.5, window: 1}' --out "$WORK/conv1.gamut.h5"
+check "converged run stopped after cycle 1" -- bash -c "h5dump -d /history/cycle '$WORK/conv1.gamut.h5' | grep -q '(0): 0, 1\$'"
+expect_exit 0 "after 1 cycles" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycles=1 --out "$WORK/cyc1.gamut.h5"
+check "the converged run is the one-cycle run" -- same_run "$WORK/conv1" "$WORK/cyc1"
+STOP2='{coverage_growth: 0.9, window: 2}'
+expect_exit 0 "stopped after cycle 2 of 4" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycles=4 --set stop="$STOP2" \
+  --out "$WORK/convpart.gamut.h5" --max-cycles 2
+expect_exit 0 "after 3 cycles" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycles=4 --set stop="$STOP2" \
+  --out "$WORK/convpart.gamut.h5" --resume
+check "resumed, it converges after cycle 3 like the uninterrupted run" -- same_run "$WORK/one" "$WORK/convpart"
+expect_exit 0 "not converged, stopped at the cycle limit" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycles=2 \
+  --set stop="$STOP2" --out "$WORK/limit.gamut.h5"
+check "cubic gamuts draw E and nu against G'" -- bash -c "for f in gamut_E_G gamut_nu_G; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
+
 # Bad settings.
+expect_exit 2 "stop.coverage_growth.*must be in \[0, 1\)" -- "$SAMPLE" --config "$TINY" --set stop.coverage_growth=1.5 \
+  --out "$WORK/bad.gamut.h5"
+expect_exit 2 "stop.window.*must be in 1..1000" -- "$SAMPLE" --config "$TINY" --set stop.window=0 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "population.*must be >= 2" -- "$SAMPLE" --config "$TINY" --set population=1 --out "$WORK/bad.gamut.h5"
 expect_exit 2 "space" -- "$SAMPLE" --config "$TINY" --set space=cubic4d --out "$WORK/bad.gamut.h5"
 expect_exit 2 "materials.soft.*E must be below" -- "$SAMPLE" --config "$TINY" --set materials.soft.E=2e6 --out "$WORK/bad.gamut.h5"
