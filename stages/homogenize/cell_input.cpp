@@ -3,7 +3,9 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "gamut/microstructure_set.hpp"
 #include "io/input_file.hpp"
+#include "material/neo_hookean.hpp"
 
 namespace msfab {
 
@@ -41,10 +43,50 @@ VoxelGrid read_voxel_text(const std::string& path, double voxel_size) {
   return g;
 }
 
+namespace {
+
+// Structure `index` of a microstructures artifact, with the set's base
+// materials as Neo-Hookean (C^H is the same for any model linearized at
+// rest; the finite-strain check needs a hyperelastic one).
+CellInput read_set_structure(const Config& config, const Config& c) {
+  if (config.has("materials")) config.fail("materials", "come from cell.structures (the set's base materials); drop it");
+  if (config.has("layout")) config.fail("layout", "the cell comes from cell.structures; drop the layout");
+  if (c.has("size") || c.has("voxels")) c.fail("structures", "give one of structures, voxels or size + layout");
+  const std::string path = c.get_path("structures");
+  const MicrostructureSet set = read_microstructures_artifact(path);
+  if (set.items.empty()) c.fail("structures", path + " holds no structures");
+  const int index = c.get<int>("index");
+  if (index < 0 || index >= static_cast<int>(set.items.size()))
+    c.fail("index", "must be in 0.." + std::to_string(set.items.size() - 1) + " (" + path + " holds " +
+                        std::to_string(set.items.size()) + " structures)");
+  CellInput in;
+  in.cell = VoxelGrid(set.nx, set.ny, set.nz, 1.0, 0);
+  in.cell.ids = set.items[index].ids;
+  in.material_by_id.assign(set.soft_is_void ? 2 : 3, nullptr);
+  auto add = [&](int id, const char* name, const BaseMaterial& b) {
+    PaletteEntry e;
+    e.id = id, e.name = name, e.model = "neo-hookean", e.E = b.E, e.nu = b.nu;
+    e.material = std::make_shared<NeoHookean>(b.E, b.nu);
+    in.material_by_id[id] = e.material;
+    in.palette.push_back(e);
+  };
+  add(1, "stiff", set.stiff);
+  if (!set.soft_is_void) add(2, "soft", set.soft);
+  return in;
+}
+
+}  // namespace
+
 CellInput read_cell_input(const Config& config) {
+  const Config c = config.child("cell");
+  if (c.has("structures")) {
+    CellInput in = read_set_structure(config, c);
+    in.cell.voxel_size = c.get_or<double>("voxel_size", 1.0 / in.cell.nx);
+    if (!(in.cell.voxel_size > 0)) c.fail("voxel_size", "must be > 0");
+    return in;
+  }
   CellInput in;
   in.palette = read_materials(config, &in.material_by_id);
-  const Config c = config.child("cell");
   const bool has_voxels = c.has("voxels"), has_layout = config.has("layout");
   if (has_voxels == has_layout) config.fail("layout", "give either cell.voxels (a voxel file) or a layout, not both");
   if (has_voxels) {

@@ -1,7 +1,9 @@
 #pragma once
 // The voxel cell of msfab-homogenize: a `cell` section with its size and
 // either a `layout` (the scene painting of docs/scenes.md, in cell
-// coordinates [0, size * voxel_size]) or a `voxels` text file.
+// coordinates [0, size * voxel_size]) or a `voxels` text file; or one
+// structure of a microstructures artifact (`structures`, `index`) with the
+// set's base materials as Neo-Hookean.
 #include <vector>
 
 #include "fem/voxel_grid.hpp"

@@ -5,7 +5,8 @@
 namespace msfab {
 
 void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
-                       const PlaneStrainResult* plane, const std::string& config_text,
+                       const PlaneStrainResult* plane, const FiniteStrainCheck* finite_strain,
+                       const std::string& config_text,
                        const std::string& command_line, std::uint64_t seed) {
   ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, {}, seed);
   H5File& f = out.file();
@@ -47,6 +48,30 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
     f.write_attribute("/C2", "nu_xy", m.nu_xy);
     f.write_attribute("/C2", "G", m.G);
     f.write_matrix("/G2", plane->G);
+  }
+  if (finite_strain) {
+    const std::size_t n = finite_strain->points.size();
+    MatX stretch(n, 3), nu(n, 2);
+    std::vector<double> strain(n), stress(n);
+    for (std::size_t p = 0; p < n; ++p) {
+      const UniaxialStrainPoint& q = finite_strain->points[p];
+      strain[p] = q.strain, stress[p] = q.nominal_stress;
+      stretch.row(p) = q.stretch.transpose();
+      nu(p, 0) = q.nu[0], nu(p, 1) = q.nu[1];
+    }
+    f.write_vector("/finite_strain/strain", strain);
+    f.write_attribute("/finite_strain/strain", "meaning", "engineering strain along the axis (stretch - 1)");
+    f.write_matrix("/finite_strain/stretch", stretch);
+    f.write_attribute("/finite_strain/stretch", "meaning", "macroscopic stretches x, y, z (lateral ones stress-free)");
+    f.write_matrix("/finite_strain/nu", nu);
+    f.write_attribute("/finite_strain/nu", "meaning",
+                      "secant Poisson ratios -(lateral stretch - 1) / strain, the two lateral axes after the axis, cyclically");
+    f.write_vector("/finite_strain/nominal_stress", stress);
+    f.write_attribute("/finite_strain/nominal_stress", "meaning", "axial first Piola-Kirchhoff stress (force per reference area)");
+    f.write_attribute("/finite_strain", "axis", std::string(1, "xyz"[finite_strain->axis]));
+    f.write_attribute("/finite_strain", "linear_nu",
+                      std::vector<double>{finite_strain->linear_nu[0], finite_strain->linear_nu[1]});
+    f.write_attribute("/finite_strain", "linear_E", finite_strain->linear_E);
   }
   out.commit();
 }

@@ -7,7 +7,9 @@
 //   3. solve the six periodic cell problems, one per unit Voigt strain
 //   4. C^H by the energy form, G = (C^H)^-1, volume fractions, and for a
 //      cubic tensor E, nu, G and the shear-modulus ratio G'
-//   5. write `msfab.homogenized`
+//   5. optionally, the cell under finite uniaxial stress (Neo-Hookean)
+//      against the uniaxial response of C^H (thesis §3.3)
+//   6. write `msfab.homogenized`
 //
 // Batch mode (--structures X.microstructures.h5): steps 2-4 for every
 // structure of a gamut's set, optionally refined, written as a new
@@ -22,6 +24,7 @@
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "homog/periodic_homogenization.hpp"
+#include "finite_strain_check.hpp"
 #include "homogenized_artifact.hpp"
 
 using namespace msfab;
@@ -116,6 +119,8 @@ int main(int argc, char** argv) {
     const CellInput in = read_cell_input(ctx.config);
     HomogenizationOptions options = read_solver_options(ctx.config);
     options.threads = ctx.options.threads;
+    std::optional<FiniteStrainCheck> finite_strain = read_finite_strain_check(ctx.config);
+    if (finite_strain && in.cell.nz < 2) ctx.config.fail("finite_strain", "needs a 3D cell (this one is 2D)");
     ctx.config.check_no_unknown_keys();
     ctx.check_out_folder();
     spdlog::info("cell {} x {} x {}, {} materials", in.cell.nx, in.cell.ny, in.cell.nz, in.palette.size());
@@ -129,9 +134,6 @@ int main(int argc, char** argv) {
       spdlog::warn("the cell has {} disconnected pieces; floating ones carry no load (void_stiffness holds them)",
                    r.pieces);
 
-    // 5. Artifact.
-    write_homogenized(out, in, r, plane ? &*plane : nullptr, ctx.config.resolved_text(), ctx.command_line,
-                      ctx.options.seed);
     std::printf("msfab-homogenize: %d x %d x %d cell, %lld unknowns%s, %s solver, %.3f s\n", in.cell.nx, in.cell.ny,
                 in.cell.nz, static_cast<long long>(r.unknowns), r.octant ? " (one octant, mirror symmetry)" : "",
                 r.solver.c_str(), r.seconds);
@@ -151,6 +153,13 @@ int main(int argc, char** argv) {
     } else {
       std::printf("  not cubic (deviation %.2e): C11 %.6g C22 %.6g C33 %.6g\n", dev, r.C(0, 0), r.C(1, 1), r.C(2, 2));
     }
+
+    // 5. Optionally, the cell under finite uniaxial stress against C^H.
+    if (finite_strain) run_finite_strain_check(*finite_strain, in, r.C);
+
+    // 6. Artifact.
+    write_homogenized(out, in, r, plane ? &*plane : nullptr, finite_strain ? &*finite_strain : nullptr,
+                      ctx.config.resolved_text(), ctx.command_line, ctx.options.seed);
     std::printf("  artifact: %s\n", out.c_str());
   });
 }

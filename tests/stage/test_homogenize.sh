@@ -1,7 +1,7 @@
 #!/bin/bash
 # msfab-homogenize: the default cubic frame, a voxel file, thread-count
 # independence, the multigrid solver, batch mode over a microstructures
-# artifact, and bad input (exit 2 naming the problem).
+# artifact, the finite-strain check, and bad input (exit 2 naming the problem).
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 H="$BIN/msfab-homogenize"
@@ -66,6 +66,33 @@ expect_exit 2 "batch mode .* drop it" -- "$H" --structures "$WORK/set.microstruc
 expect_exit 2 "refine.*must be 1..16" -- "$H" --structures "$WORK/set.microstructures.h5" --set refine=0 --out "$WORK/bad.h5"
 expect_exit 2 "missing.h5" -- "$H" --structures "$WORK/missing.h5" --out "$WORK/bad.h5"
 expect_exit 2 "msfab.microstructures" -- "$H" --structures "$WORK/frame.h5" --out "$WORK/bad.h5"
+
+# The finite-strain check: a Neo-Hookean frame of bars (void between) under
+# uniaxial stress; at 1e-4 strain its Poisson ratio is C^H's.
+cat > "$WORK/nh.yaml" <<'Y'
+materials:
+  - {id: 1, model: neo-hookean, E: 1.0e6, nu: 0.3}
+cell: {size: [12, 12, 12]}
+layout:
+  - {box: {min: [0, 0.333, 0.333], max: [1, 0.667, 0.667]}, id: 1}
+  - {box: {min: [0.333, 0, 0.333], max: [0.667, 1, 0.667]}, id: 1}
+  - {box: {min: [0.333, 0.333, 0], max: [0.667, 0.667, 1]}, id: 1}
+finite_strain: {strains: [0.0001, -0.07, 0.07], axis: y}
+Y
+expect_exit 0 "finite strain, uniaxial stress along y" -- "$H" --config "$WORK/nh.yaml" --out "$WORK/nh.h5"
+check "at strain 1e-4 nu is C^H's (0.0% off)" -- bash -c "'$H' --config '$WORK/nh.yaml' --out '$WORK/nh2.h5' | grep -E '^ +\+0\.0001 .* 0\.0%'"
+check "finite-strain results stored" -- bash -c "h5dump -H -d /finite_strain/nu '$WORK/nh.h5' | grep -q '( 3, 2 )'"
+expect_exit 2 "finite_strain.strains.*nonzero" -- "$H" --config "$WORK/nh.yaml" --set 'finite_strain.strains=[0]' --out "$WORK/bad.h5"
+expect_exit 2 "finite_strain.*needs a 3D cell" -- "$H" --config "$WORK/flat.yaml" --set 'finite_strain={strains: [0.01]}' \
+  --out "$WORK/bad.h5"
+# One structure of a gamut's set as the cell, with the set's material as Neo-Hookean.
+cat > "$WORK/member.yaml" <<Y
+cell: {structures: $WORK/set.microstructures.h5, index: 0}
+finite_strain: {strains: [-0.05]}
+Y
+expect_exit 0 "finite strain, uniaxial stress along x" -- "$H" --config "$WORK/member.yaml" --out "$WORK/member.h5"
+expect_exit 2 "cell.index.*must be in 0\.\." -- "$H" --config "$WORK/member.yaml" --set cell.index=100000 --out "$WORK/bad.h5"
+expect_exit 2 "materials.*come from cell.structures" -- "$H" --config "$WORK/member.yaml" --set 'materials=[]' --out "$WORK/bad.h5"
 
 # Bad input.
 { echo "2 2 2"; echo "1 1 1 1 1 1 1"; } > "$WORK/short.txt"
