@@ -8,6 +8,9 @@
 #   make -f Makefile.pipeline gamut-auxetic-3d  3D cubic void gamut at 16^3 with min_nu pushes, ~2 min
 #   make -f Makefile.pipeline gamut-auxetic-3d-32  the same at 32^3 (lengths in voxels doubled), ~10 min
 #   make -f Makefile.pipeline gamut-3d       3D cubic gamut, one material + void, 16^3 cells; hours on 2 cores, use RANKS
+#   make -f Makefile.pipeline gamut-converge-2d  2D cubic, orthotropic (stiff + soft and one material + void) run
+#                                             until the coverage stops growing (out/gamut/converged/), tens of minutes
+#   make -f Makefile.pipeline gamut-converge-3d  the same for the 3D cubic void gamut; hours on 2 cores, use RANKS
 #   make -f Makefile.pipeline gamut-bench    sampler vs random sampling, docs/BENCHMARKS.md section
 #
 # Each run writes out/gamut/<name>.gamut.h5, <name>.microstructures.h5 and
@@ -15,10 +18,26 @@
 # on n MPI ranks; an interrupted run resumes from its checkpoint when the
 # target is made again. SEED=<n> picks the random streams.
 SEED ?= 1
+# Runs to convergence: stop once the coverage grew by less than
+# CONVERGE_GROWTH (relative) over CONVERGE_WINDOW cycles, at most
+# CONVERGE_CYCLES cycles (docs/gamut.md, "Runs to convergence").
+CONVERGE_GROWTH ?= 0.01
+CONVERGE_WINDOW ?= 5
+CONVERGE_CYCLES ?= 300
 
 $(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume
+
+$(OUT)/gamut/converged/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume \
+	  --set cycles=$(CONVERGE_CYCLES) --set plot_every_cycle=false \
+	  --set stop='{coverage_growth: $(CONVERGE_GROWTH), window: $(CONVERGE_WINDOW)}'
+
+.PHONY: gamut-converge-2d gamut-converge-3d
+gamut-converge-2d: build $(addprefix $(OUT)/gamut/converged/,cubic2d.gamut.h5 orthotropic2d.gamut.h5 cubic2d_void.gamut.h5 orthotropic2d_void.gamut.h5)
+gamut-converge-3d: build $(OUT)/gamut/converged/cubic3d_void.gamut.h5
 
 .PHONY: gamut-2d gamut-ortho gamut-2d-void gamut-auxetic-2d gamut-auxetic-2d-printable gamut-auxetic-3d gamut-auxetic-3d-32 gamut-3d gamut-bench
 gamut-2d: build $(OUT)/gamut/cubic2d.gamut.h5

@@ -187,19 +187,36 @@ double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient,
 
 namespace {
 
-// Newton on z at axial stretch s from the start z; returns the iterations.
+// Factorizes H, or H + shift I with the smallest shift of 1e-12 ... 1e2
+// times H's largest diagonal entry that is positive definite; returns the
+// shift used (0 for none). Two cases need one. Voxels that share only a
+// node or an edge hinge about it at no energy: without ersatz void H is
+// singular along that mechanism, but the energy does not depend on it
+// either, and a tiny shift only damps it. A structure that buckles
+// (slender beams in compression) has an indefinite H past the bifurcation:
+// a larger shift gives a descent direction (Levenberg-Marquardt), and
+// Newton continues into the buckled state, where H is positive again.
+double factorize_shifted(CholmodSolver& solver, const SpMat& H, double s) {
+  if (solver.factorize(H)) return 0;
+  double scale = 0;
+  for (int k = 0; k < H.outerSize(); ++k) scale = std::max(scale, H.coeff(k, k));
+  for (double factor = 1e-12; factor <= 1e2; factor *= 100)
+    if (solver.factorize(H, factor * scale)) return factor * scale;
+  throw NumericalError("finite-strain cell: at axial strain " + std::to_string(s - 1) +
+                       " the stiffness is not positive definite even shifted by 100 times its diagonal");
+}
+
+// Newton on z at axial stretch s from the start z; returns the iterations
+// and counts the shifted factorizations in `shifted`.
 int relax(const PeriodicFiniteStrainCell& cell, double s, VecX& z, CholmodSolver& solver, bool& analyzed,
-          const FiniteStrainOptions& options, double tolerance) {
+          const FiniteStrainOptions& options, double tolerance, int& shifted) {
   VecX g;
   SpMat H;
   double E = cell.energy(s, z, &g, &H);
   if (!std::isfinite(E)) throw NumericalError("finite-strain cell: the start of an increment is inverted");
   for (int it = 1; it <= options.max_newton_iterations; ++it) {
     if (!analyzed) solver.analyze(H), analyzed = true;
-    if (!solver.factorize(H))
-      throw NumericalError(
-          "finite-strain cell: the stiffness is not positive definite (a solid that does not span the cell "
-          "periodically, or an instability of the structure)");
+    if (factorize_shifted(solver, H, s) > 0) ++shifted;
     const VecX dz = -solver.solve(g);
     const double decrement = -g.dot(dz);
     if (decrement <= tolerance) {
@@ -252,7 +269,7 @@ std::vector<UniaxialStrainPoint> uniaxial_finite_strain(const VoxelGrid& cell, c
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return std::abs(strains[a]) < std::abs(strains[b]); });
     VecX z = model.rest(), z_previous = z;
     double reached = 0, step_before = 0;
-    int iterations = 0;
+    int iterations = 0, shifted = 0;
     for (const std::size_t p : order) {
       const double target = strains[p];
       const int increments = std::max(1, static_cast<int>(std::ceil(std::abs(target - reached) / options.max_step - 1e-9)));
@@ -264,7 +281,7 @@ std::vector<UniaxialStrainPoint> uniaxial_finite_strain(const VoxelGrid& cell, c
         z_previous = z;
         z = start;
         if (!std::isfinite(model.energy(1 + reached + step, z, nullptr, nullptr))) z = z_previous;
-        iterations += relax(model, 1 + reached + step, z, solver, analyzed, options, tolerance);
+        iterations += relax(model, 1 + reached + step, z, solver, analyzed, options, tolerance, shifted);
         reached += step;
         step_before = step;
       }
@@ -277,6 +294,7 @@ std::vector<UniaxialStrainPoint> uniaxial_finite_strain(const VoxelGrid& cell, c
       model.energy(1 + target, z, nullptr, nullptr, &dE_ds);
       out.nominal_stress = dE_ds / model.volume();  // axial force times length, over length times section
       out.newton_iterations = iterations;
+      out.shifted_factorizations = shifted;
     }
   }
   return points;

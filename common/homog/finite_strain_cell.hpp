@@ -78,12 +78,18 @@ struct UniaxialStrainPoint {
   double nu[2] = {0, 0};          // secant Poisson ratios -(lateral stretch - 1) / strain, lateral axes in order
   double nominal_stress = 0;      // axial force per reference cross-section (first Piola-Kirchhoff)
   int newton_iterations = 0;      // over the increments that reached this strain
+  // Of those iterations, how many needed a shifted Hessian: the solid has
+  // a zero-energy mechanism (voxels hinged at a shared node or edge), or
+  // it buckled on the way to this strain.
+  int shifted_factorizations = 0;
 };
 
 // Uniaxial stress at the engineering strains `strains` (nonzero, > -1),
 // each reached by continuation from rest in steps of at most max_step;
 // results in the order given. NumericalError when Newton does not converge
-// or the stiffness is singular (a solid that does not span the cell).
+// or the stiffness is not positive definite even with a shift of 100 times
+// its diagonal. A singular or indefinite stiffness (a hinge, a buckling
+// beam) is shifted until it is positive definite.
 std::vector<UniaxialStrainPoint> uniaxial_finite_strain(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
                                                         int axis, const std::vector<double>& strains,
                                                         const FiniteStrainOptions& options = {});

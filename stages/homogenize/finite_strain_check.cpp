@@ -47,8 +47,9 @@ void run_finite_strain_check(FiniteStrainCheck& check, const CellInput& in, cons
   for (const UniaxialStrainPoint& p : check.points) {
     const double rel = 0.5 * (std::abs(p.nu[0] - check.linear_nu[0]) / std::max(std::abs(check.linear_nu[0]), 1e-12) +
                               std::abs(p.nu[1] - check.linear_nu[1]) / std::max(std::abs(check.linear_nu[1]), 1e-12));
-    std::printf("    %+.4f   %+.4f   %+.4f   %6.1f%%     %.4f                %d\n", p.strain, p.nu[0], p.nu[1],
-                100 * rel, p.nominal_stress / p.strain / check.linear_E, p.newton_iterations);
+    std::printf("    %+.4f   %+.4f   %+.4f   %6.1f%%     %.4f                %d%s\n", p.strain, p.nu[0], p.nu[1],
+                100 * rel, p.nominal_stress / p.strain / check.linear_E, p.newton_iterations,
+                p.shifted_factorizations > 0 ? " (Hessian shifted: a hinge, or buckled)" : "");
   }
 }
 

@@ -53,9 +53,10 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
     const std::size_t n = finite_strain->points.size();
     MatX stretch(n, 3), nu(n, 2);
     std::vector<double> strain(n), stress(n);
+    std::vector<int> shifted(n);
     for (std::size_t p = 0; p < n; ++p) {
       const UniaxialStrainPoint& q = finite_strain->points[p];
-      strain[p] = q.strain, stress[p] = q.nominal_stress;
+      strain[p] = q.strain, stress[p] = q.nominal_stress, shifted[p] = q.shifted_factorizations;
       stretch.row(p) = q.stretch.transpose();
       nu(p, 0) = q.nu[0], nu(p, 1) = q.nu[1];
     }
@@ -68,6 +69,9 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
                       "secant Poisson ratios -(lateral stretch - 1) / strain, the two lateral axes after the axis, cyclically");
     f.write_vector("/finite_strain/nominal_stress", stress);
     f.write_attribute("/finite_strain/nominal_stress", "meaning", "axial first Piola-Kirchhoff stress (force per reference area)");
+    f.write_vector("/finite_strain/shifted_factorizations", shifted);
+    f.write_attribute("/finite_strain/shifted_factorizations", "meaning",
+                      "Newton iterations whose Hessian needed a shift: a zero-energy hinge, or the structure buckled");
     f.write_attribute("/finite_strain", "axis", std::string(1, "xyz"[finite_strain->axis]));
     f.write_attribute("/finite_strain", "linear_nu",
                       std::vector<double>{finite_strain->linear_nu[0], finite_strain->linear_nu[1]});
