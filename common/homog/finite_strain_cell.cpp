@@ -200,8 +200,8 @@ double factorize_shifted(CholmodSolver& solver, const SpMat& H, double s) {
   if (solver.factorize(H)) return 0;
   double scale = 0;
   for (int k = 0; k < H.outerSize(); ++k) scale = std::max(scale, H.coeff(k, k));
-  for (double factor = 1e-12; factor <= 1e2; factor *= 100)
-    if (solver.factorize(H, factor * scale)) return factor * scale;
+  for (int exponent = -12; exponent <= 2; exponent += 2)
+    if (const double shift = std::pow(10.0, exponent) * scale; solver.factorize(H, shift)) return shift;
   throw NumericalError("finite-strain cell: at axial strain " + std::to_string(s - 1) +
                        " the stiffness is not positive definite even shifted by 100 times its diagonal");
 }

@@ -30,7 +30,8 @@ class PeriodicFiniteStrainCell {
  public:
   // palette[id] is the material of voxel id (palette[0], void, ignored).
   // InputError for an all-void cell, an id without a material, or a solid
-  // of more than one piece; axis in 0..2.
+  // of more than one piece; axis in 0..2. Keeps references to `cell` and
+  // `palette`, which must outlive it.
   PeriodicFiniteStrainCell(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette, int axis);
 
   // Unknowns z: the fluctuation at every node touched by the solid but the
