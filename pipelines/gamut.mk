@@ -18,11 +18,11 @@
 # on n MPI ranks; an interrupted run resumes from its checkpoint when the
 # target is made again. SEED=<n> picks the random streams.
 SEED ?= 1
-# Runs to convergence: stop once the coverage grew by less than
+# Runs to convergence: stop once the best coverage so far grew by less than
 # CONVERGE_GROWTH (relative) over CONVERGE_WINDOW cycles, at most
 # CONVERGE_CYCLES cycles (docs/gamut.md, "Runs to convergence").
 CONVERGE_GROWTH ?= 0.01
-CONVERGE_WINDOW ?= 5
+CONVERGE_WINDOW ?= 10
 CONVERGE_CYCLES ?= 300
 
 $(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample

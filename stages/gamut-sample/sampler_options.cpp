@@ -15,7 +15,7 @@ materials:
   soft:  {E: 1.0e4, nu: 0.45}   # leave out for stiff material and void
 population: 24
 cycles: 6                 # the most; stop earlier once the coverage stops growing:
-stop: {coverage_growth: 0, window: 3}   # relative growth over `window` cycles below which the run ends (0: off)
+stop: {coverage_growth: 0, window: 3}   # relative growth of the best coverage over `window` cycles below which the run ends (0: off)
 initial_beams: 8
 beams: {max: 3, min_radius: 0.5, max_radius: 2.0}
 continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3, projection_beta: 0}
@@ -45,9 +45,16 @@ const std::vector<std::string> kDirectedObjectives = {"min_nu", "max_nu", "min_s
 
 }  // namespace
 
+double best_coverage(const std::vector<GamutCycle>& history, std::size_t through) {
+  double best = 0;
+  for (std::size_t c = 0; c <= through && c < history.size(); ++c) best = std::max(best, history[c].coverage);
+  return best;
+}
+
 bool coverage_converged(const std::vector<GamutCycle>& history, double growth, int window) {
   if (!(growth > 0) || window < 1 || static_cast<int>(history.size()) <= window) return false;
-  const double now = history.back().coverage, before = history[history.size() - 1 - window].coverage;
+  const double now = best_coverage(history, history.size() - 1);
+  const double before = best_coverage(history, history.size() - 1 - window);
   return now - before < growth * before;
 }
 

@@ -76,10 +76,17 @@ struct SamplerOptions {
   bool random_baseline = false;
 };
 
-// True when the coverage of the last cycle in `history` (cycle 0 first)
-// exceeds the coverage `window` cycles earlier by less than `growth`
-// times the latter: the gamut stopped growing. False while there are fewer
-// than `window` cycles after cycle 0, or when growth is 0.
+// The largest coverage of cycles 0..through of `history` (cycle 0 first).
+// The coverage itself is not monotone in the samples: the Zhu-Bridson
+// function of the level set averages the samples near a point, so a new
+// sample inside the gamut can pull the boundary inward (±3% from cycle to
+// cycle on the 2D gamuts).
+double best_coverage(const std::vector<GamutCycle>& history, std::size_t through);
+
+// True when the best coverage so far exceeds the best coverage until
+// `window` cycles earlier by less than `growth` times the latter: the gamut
+// stopped growing. False while there are fewer than `window` cycles after
+// cycle 0, or when growth is 0.
 bool coverage_converged(const std::vector<GamutCycle>& history, double growth, int window);
 
 // The direction in `space`'s unit cube of a named directed objective;
