@@ -7,6 +7,10 @@
 #                                              ones (if any)
 #   make -f Makefile.pipeline families-auxetic  auxetic families of the 3D gamut with directed min_nu pushes
 #                                              (gamut-auxetic-3d, ~2 min, then seconds)
+#   make -f Makefile.pipeline families-auxetic-32  the same on the 32^3 gamut (gamut-auxetic-3d-32, ~15 min;
+#                                              families of >= 3 members: it holds 7 auxetic structures)
+#   make -f Makefile.pipeline families-auxetic-check  every member of the first auxetic family (16^3) under
+#                                              finite uniaxial stress, Neo-Hookean, against linear C^H; a minute
 #
 # Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
 # a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
@@ -33,8 +37,18 @@ $(OUT)/families/auxetic_directed.families.h5: configs/families/auxetic_directed.
 	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_auxetic.microstructures.h5 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
-.PHONY: families-demo families-gamut families-auxetic
+$(OUT)/families/auxetic_directed_32.families.h5: configs/families/auxetic_directed.yaml \
+    $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5 $(BIN)/msfab-families
+	@mkdir -p $(@D)
+	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_auxetic_32.microstructures.h5 \
+	  --set min_members=3 --seed $(SEED) --threads $(THREADS) --out $@
+
+.PHONY: families-demo families-gamut families-auxetic families-auxetic-32 families-auxetic-check
 families-auxetic: build $(OUT)/families/auxetic_directed.families.h5
+families-auxetic-32: build $(OUT)/families/auxetic_directed_32.families.h5
+families-auxetic-check: build $(OUT)/families/auxetic_directed.families.h5
+	bash tools/bench_finite_strain.sh $(BIN) $(OUT)/gamut/cubic3d_auxetic.microstructures.h5 \
+	  $(OUT)/families/auxetic_directed.families.h5 0 $(OUT)/families/finite_strain
 families-demo: build $(OUT)/families/two.families.h5 $(OUT)/families/two.family1.microstructures.h5
 families-gamut: build $(OUT)/families/stiff_nu.families.h5
 	@# The auxetic selection of the same set (an input error when it holds none).
