@@ -10,21 +10,27 @@
 namespace msfab {
 
 namespace {
-const Rgb kStepColors[4] = {{150, 150, 150}, {40, 90, 200}, {220, 40, 40}, {30, 160, 60}};
+// One colour per SampleStep (initial, discrete, continuous, void variant, directed, targeted).
+const Rgb kStepColors[6] = {{150, 150, 150}, {40, 90, 200}, {220, 40, 40}, {140, 60, 170}, {30, 160, 60}, {230, 140, 20}};
+const char* const kStepLabels[6] = {"INITIAL", "DISCRETE", "CONTINUOUS", "VOID VARIANT", "DIRECTED", "TARGETED"};
 
-// Structures as points coloured by the step that found them.
+// Structures as points coloured by the step that found them; the legend
+// lists the steps present.
 void plot_structures(Chart& chart, const MicrostructureSet& set,
                      const std::function<std::pair<double, double>(const Microstructure&)>& at) {
-  for (int step = 0; step < 4; ++step) {
+  std::vector<std::pair<std::string, Rgb>> legend;
+  for (int step = 0; step < 6; ++step) {
     std::vector<double> x, y;
     for (const Microstructure& m : set.items)
       if (static_cast<int>(m.step) == step) {
         const auto [a, b] = at(m);
         x.push_back(a), y.push_back(b);
       }
+    if (x.empty()) continue;
     chart.points(x, y, kStepColors[step], 2.0);
+    legend.emplace_back(kStepLabels[step], kStepColors[step]);
   }
-  chart.legend({{"INITIAL", kStepColors[0]}, {"DISCRETE", kStepColors[1]}, {"CONTINUOUS", kStepColors[2]}});
+  chart.legend(legend);
 }
 }  // namespace
 
@@ -88,9 +94,9 @@ void plot_shear_projections(const std::string& stem, const MicrostructureSet& se
   {
     ChartAxes axes;
     axes.x0 = 0, axes.x1 = g_hi, axes.y0 = -set.decades, axes.y1 = 0.25;
-    axes.x_label = "RELATIVE SHEAR MODULUS G' = 2(1+NU)G/E";
+    axes.x_label = "RELATIVE SHEAR MODULUS 2(1+NU)G/E";
     axes.y_label = "LOG10 E/E_STIFF";
-    axes.title = "E AGAINST G', " + std::to_string(set.items.size()) + " STRUCTURES";
+    axes.title = "E AGAINST RELATIVE SHEAR MODULUS, " + std::to_string(set.items.size()) + " STRUCTURES";
     Chart chart(720, 560, axes);
     plot_structures(chart, set, [&](const Microstructure& m) {
       return std::make_pair(g_ratio(m), std::log10(m.properties[0] / set.E_stiff));
@@ -101,8 +107,8 @@ void plot_shear_projections(const std::string& stem, const MicrostructureSet& se
     ChartAxes axes;
     axes.x0 = -1, axes.x1 = nu_hi, axes.y0 = 0, axes.y1 = g_hi;
     axes.x_label = "POISSON RATIO NU";
-    axes.y_label = "RELATIVE SHEAR MODULUS G'";
-    axes.title = "G' AGAINST NU, " + std::to_string(set.items.size()) + " STRUCTURES";
+    axes.y_label = "RELATIVE SHEAR MODULUS 2(1+NU)G/E";
+    axes.title = "RELATIVE SHEAR MODULUS AGAINST NU, " + std::to_string(set.items.size()) + " STRUCTURES";
     Chart chart(720, 560, axes);
     plot_structures(chart, set, [&](const Microstructure& m) { return std::make_pair(m.properties[1], g_ratio(m)); });
     chart.write(stem + "_nu_G.png");

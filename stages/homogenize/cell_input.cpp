@@ -60,6 +60,7 @@ CellInput read_set_structure(const Config& config, const Config& c) {
     c.fail("index", "must be in 0.." + std::to_string(set.items.size() - 1) + " (" + path + " holds " +
                         std::to_string(set.items.size()) + " structures)");
   CellInput in;
+  in.source = path;
   in.cell = VoxelGrid(set.nx, set.ny, set.nz, 1.0, 0);
   in.cell.ids = set.items[index].ids;
   in.material_by_id.assign(set.soft_is_void ? 2 : 3, nullptr);

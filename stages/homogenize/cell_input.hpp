@@ -4,6 +4,7 @@
 // coordinates [0, size * voxel_size]) or a `voxels` text file; or one
 // structure of a microstructures artifact (`structures`, `index`) with the
 // set's base materials as Neo-Hookean.
+#include <string>
 #include <vector>
 
 #include "fem/voxel_grid.hpp"
@@ -16,6 +17,7 @@ struct CellInput {
   VoxelGrid cell;
   std::vector<PaletteEntry> palette;
   std::vector<MaterialPtr> material_by_id;  // [0] = void
+  std::string source;  // the microstructures artifact the cell came from (an input of the result), or empty
 };
 
 // InputError naming the key (or the voxel file and line) on bad input.

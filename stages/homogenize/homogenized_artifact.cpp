@@ -8,7 +8,9 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
                        const PlaneStrainResult* plane, const FiniteStrainCheck* finite_strain,
                        const std::string& config_text,
                        const std::string& command_line, std::uint64_t seed) {
-  ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, {}, seed);
+  std::vector<std::string> inputs;
+  if (!in.source.empty()) inputs.push_back(in.source);
+  ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "command_line", command_line);
   f.write_matrix("/C", r.C);

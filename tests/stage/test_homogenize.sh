@@ -91,6 +91,7 @@ cell: {structures: $WORK/set.microstructures.h5, index: 0}
 finite_strain: {strains: [-0.05]}
 Y
 expect_exit 0 "finite strain, uniaxial stress along x" -- "$H" --config "$WORK/member.yaml" --out "$WORK/member.h5"
+check "the member's result names the set as its input" -- bash -c "h5dump -a /inputs '$WORK/member.h5' | grep -q set.microstructures.h5"
 expect_exit 2 "cell.index.*must be in 0\.\." -- "$H" --config "$WORK/member.yaml" --set cell.index=100000 --out "$WORK/bad.h5"
 expect_exit 2 "materials.*come from cell.structures" -- "$H" --config "$WORK/member.yaml" --set 'materials=[]' --out "$WORK/bad.h5"
 
