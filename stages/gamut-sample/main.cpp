@@ -176,6 +176,9 @@ int main(int argc, char** argv) {
                      h.coverage, h.seconds);
         log_step("discrete", discrete);
         log_step("continuous", continuous);
+        if (continuous.tried > 0)
+          spdlog::info("  continuous: step {:.3f}, {} of {} pushes expanded the gamut", continuous.step,
+                       continuous.expanded, continuous.tried);
         if (options.directed_per_cycle > 0) log_step("directed", directed);
         write_sampler_checkpoint(ckpt, run_text, state);
         if (options.plot_every_cycle) {

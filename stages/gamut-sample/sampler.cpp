@@ -255,11 +255,13 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   for (const auto& [distance, i] : order) starts.push_back(i), state.refined[i] |= 1;
 
   const int soft_id = o_.soft_is_void ? 0 : 2;
-  return add_refined(state, starts, cycle, SampleStep::continuous, [&](int i) -> std::optional<VoxelGrid> {
+  const double step = state.push_step > 0 ? state.push_step : o_.continuous_step;
+  const std::size_t before = state.set.items.size();
+  StepReport report = add_refined(state, starts, cycle, SampleStep::continuous, [&](int i) -> std::optional<VoxelGrid> {
     const Microstructure& start = state.set.items[starts[i]];
     VecX g = gamut.gradient(start.unit);
     if (!(g.norm() > 1e-12)) return std::nullopt;
-    VecX q = start.unit + o_.continuous_step * g / g.norm();
+    VecX q = start.unit + step * g / g.norm();
     for (int a = 0; a < q.size(); ++a) q[a] = std::clamp(q[a], 0.005, 0.995);
     const VecX raw = space_.denormalize(q);
     RefinementTarget target;
@@ -270,6 +272,15 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
                             o_.continuous)
         .structure;
   });
+  report.step = step;
+  for (std::size_t i = before; i < state.set.items.size(); ++i) report.expanded += gamut.value(state.set.items[i].unit) > 0;
+  state.push_step = step;
+  if (o_.continuous_adaptive && report.tried > 0) {
+    const double progress = double(report.expanded) / report.tried;
+    if (progress >= 0.5) state.push_step = std::min(1.5 * step, 4 * o_.continuous_step);
+    else if (progress < 0.25) state.push_step = std::max(step / 1.5, o_.continuous_step / 4);
+  }
+  return report;
 }
 
 StepReport GamutSampler::directed_step(SamplerState& state, int cycle) const {

@@ -22,12 +22,15 @@ struct SamplerState {
   std::vector<std::uint8_t> refined;
   std::vector<GamutCycle> history;
   int cycles_done = -1;                  // -1: not initialized; 0: initial population only
+  double push_step = 0;                  // the level-set push's step now (0: continuous.step)
 };
 
 struct StepReport {
   int tried = 0, added = 0;
   // rejected: already in the set, outside the space's box, a feature below min_feature, no result
   int duplicates = 0, outside = 0, thin = 0, failed = 0;
+  int expanded = 0;      // level-set pushes: added structures outside the gamut they were pushed from
+  double step = 0;       // level-set pushes: the step they used
 };
 
 class GamutSampler {

@@ -16,6 +16,7 @@ void write_sampler_checkpoint(const std::string& path, const std::string& run_te
     f.write_attribute("/", "schema", "msfab.gamut.checkpoint");
     f.write_attribute("/", "config", run_text);
     f.write_attribute("/", "cycles_done", static_cast<std::int32_t>(s.cycles_done));
+    f.write_attribute("/", "push_step", s.push_step);
     write_microstructure_set(f, "/set", s.set);
     f.write_vector("/population", s.population);
     f.write_vector("/refined", s.refined);
@@ -37,6 +38,7 @@ SamplerState read_sampler_checkpoint(const std::string& path, const std::string&
     throw InputError(path + ": checkpoint was written with a different configuration or seed; delete it or rerun without --resume");
   SamplerState s;
   s.cycles_done = f.read_attribute<std::int32_t>("/", "cycles_done");
+  if (f.has_attribute("/", "push_step")) s.push_step = f.read_attribute<double>("/", "push_step");
   s.set = read_microstructure_set(f, "/set");
   s.population = f.read_vector<std::int64_t>("/population");
   s.refined = f.read_vector<std::uint8_t>("/refined");

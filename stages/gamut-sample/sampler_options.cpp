@@ -18,7 +18,7 @@ cycles: 6                 # the most; stop earlier once the coverage stops growi
 stop: {coverage_growth: 0, window: 3}   # relative growth of the best coverage over `window` cycles below which the run ends (0: off)
 initial_beams: 8
 beams: {max: 3, min_radius: 0.5, max_radius: 2.0}
-continuous: {per_cycle: 4, step: 0.1, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3, projection_beta: 0}
+continuous: {per_cycle: 4, step: 0.1, adaptive_step: false, max_iterations: 30, penalty: 3, filter_radius: 1.5, density_weight: 1.0, start_offset: 0.3, projection_beta: 0}
 # Pushes along named objectives (min_nu | max_nu | min_shear | max_shear); per_cycle 0: none.
 directed: {objectives: [min_nu], per_cycle: 0, modulus_drop: 0.25, max_iterations: 150, projection_beta: 16, filter_radius: 2.5}
 level_set: {cells: 16, margin: 0.1, smoothing_steps: 2}
@@ -125,6 +125,7 @@ SamplerOptions read_sampler_options(const Config& config) {
     if (o.continuous_per_cycle < 0) c.fail("per_cycle", "must be >= 0");
     o.continuous_step = c.get_or<double>("step", o.continuous_step);
     if (!(o.continuous_step > 0 && o.continuous_step <= 1)) c.fail("step", "must be in (0, 1]");
+    o.continuous_adaptive = c.get_or<bool>("adaptive_step", o.continuous_adaptive);
     ContinuousOptions& k = o.continuous;
     k.max_iterations = c.get_or<int>("max_iterations", k.max_iterations);
     if (k.max_iterations < 1) c.fail("max_iterations", "must be >= 1");

@@ -49,7 +49,11 @@ struct SamplerOptions {
   BeamMoveOptions move;          // the discrete step's move
 
   int continuous_per_cycle = 4;  // boundary structures refined per cycle (0: discrete only)
-  double continuous_step = 0.1;  // |q - p| in the unit cube
+  double continuous_step = 0.1;  // |q - p| in the unit cube (the first step when adaptive)
+  // Adapt the step to progress: after a cycle in which at least half of
+  // the pushes expanded the gamut the step grows 1.5x, after one in which
+  // fewer than a quarter did it shrinks 1.5x, within [step / 4, 4 step].
+  bool continuous_adaptive = false;
   ContinuousOptions continuous;
 
   // Directed pushes (docs/gamut.md, "Directed objectives"): per cycle and

@@ -104,6 +104,15 @@ expect_exit 0 "after 3 cycles" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycl
 check "resumed, it converges after cycle 3 like the uninterrupted run" -- same_run "$WORK/one" "$WORK/convpart"
 expect_exit 0 "not converged, stopped at the cycle limit" -- "$SAMPLE" --config "$TINY" --seed 7 --set cycles=2 \
   --set stop="$STOP2" --out "$WORK/limit.gamut.h5"
+# An adaptive push step: it changes with the pushes' progress, and is
+# kept in the checkpoint (stopped and resumed, the same run).
+expect_exit 0 "continuous: step 0\.0(67|44)" -- "$SAMPLE" --config "$TINY" --seed 7 \
+  --set continuous.adaptive_step=true --out "$WORK/adapt.gamut.h5"
+expect_exit 0 "stopped after cycle 1 of 3" -- "$SAMPLE" --config "$TINY" --seed 7 --set continuous.adaptive_step=true \
+  --out "$WORK/adaptpart.gamut.h5" --max-cycles 1
+expect_exit 0 "resuming after cycle 1" -- "$SAMPLE" --config "$TINY" --seed 7 --set continuous.adaptive_step=true \
+  --out "$WORK/adaptpart.gamut.h5" --resume
+check "an adaptive run stopped and resumed is the same run" -- same_run "$WORK/adapt" "$WORK/adaptpart"
 check "cubic gamuts draw E and nu against G'" -- bash -c "for f in gamut_E_G gamut_nu_G; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
 
 # Bad settings.
