@@ -49,6 +49,12 @@ std::array<bool, 3> spans_periodically(const VoxelGrid& cell) {
   return spans;
 }
 
+// The lattice node at corner a (bits x, y, z as in voxel_corners) of voxel (i, j, k), wrapped periodically.
+std::size_t corner_node(const VoxelGrid& cell, int i, int j, int k, int a) {
+  return ((i + (a >> 2 & 1)) % cell.nx) +
+         std::size_t(cell.nx) * (((j + (a >> 1 & 1)) % cell.ny) + std::size_t(cell.ny) * ((k + (a & 1)) % cell.nz));
+}
+
 }  // namespace
 
 PeriodicFiniteStrainCell::PeriodicFiniteStrainCell(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,
@@ -70,9 +76,7 @@ PeriodicFiniteStrainCell::PeriodicFiniteStrainCell(const VoxelGrid& cell, const 
           throw InputError("finite-strain cell: voxel id " + std::to_string(id) + " has no material");
         mu_max = std::max(mu_max, palette[id]->shear_modulus());
         solid_.push_back(cell.index(i, j, k));
-        for (int a = 0; a < 8; ++a)
-          used[((i + (a >> 2 & 1)) % cell.nx) + std::size_t(cell.nx) * (((j + (a >> 1 & 1)) % cell.ny) +
-                                                                        std::size_t(cell.ny) * ((k + (a & 1)) % cell.nz))] = 1;
+        for (int a = 0; a < 8; ++a) used[corner_node(cell, i, j, k, a)] = 1;
       }
   if (solid_.empty()) throw InputError("finite-strain cell: the cell is all void");
   if (const int pieces = count_periodic_pieces(cell); pieces > 1)
@@ -83,7 +87,7 @@ PeriodicFiniteStrainCell::PeriodicFiniteStrainCell(const VoxelGrid& cell, const 
     if (!spans[a])
       throw InputError(std::string("finite-strain cell: the solid does not reach its periodic copy along ") + "xyz"[a] +
                        ", so the cell carries no stress there");
-  node_unknown_.assign(nodes, -1);
+  std::vector<int> node_unknown(nodes, -1);
   bool held = false;
   for (std::size_t n = 0; n < nodes; ++n) {
     if (!used[n]) continue;
@@ -91,7 +95,14 @@ PeriodicFiniteStrainCell::PeriodicFiniteStrainCell(const VoxelGrid& cell, const 
       held = true;  // the first node holds the translation
       continue;
     }
-    node_unknown_[n] = 3 * free_nodes_++;
+    node_unknown[n] = 3 * free_nodes_++;
+  }
+  element_unknowns_.resize(solid_.size());
+  for (std::size_t e = 0; e < solid_.size(); ++e) {
+    const std::size_t v = solid_[e];
+    const int i = static_cast<int>(v % cell.nx), j = static_cast<int>((v / cell.nx) % cell.ny),
+              k = static_cast<int>(v / (std::size_t(cell.nx) * cell.ny));
+    for (int a = 0; a < 8; ++a) element_unknowns_[e][a] = node_unknown[corner_node(cell, i, j, k, a)];
   }
   const double h = cell.voxel_size;
   corners_ = voxel_corners(h);
@@ -119,7 +130,7 @@ double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient,
   const int n = unknowns(), l0 = n - 2, l1 = n - 1;
   const Vec3 S = stretches(s, z);
   const double h = cell_.voxel_size;
-  const int nx = cell_.nx, ny = cell_.ny, nz = cell_.nz;
+  const int nx = cell_.nx, ny = cell_.ny;
   if (gradient) gradient->setZero(n);
   if (dE_ds) *dE_ds = 0;
   std::vector<Eigen::Triplet<double>> triplets;
@@ -129,15 +140,13 @@ double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient,
   Mat24 H;
   QuadratureMaterials mat;
   mat.at_point.resize(1);
-  for (const std::size_t v : solid_) {
+  for (std::size_t el = 0; el < solid_.size(); ++el) {
+    const std::size_t v = solid_[el];
     const int i = static_cast<int>(v % nx), j = static_cast<int>((v / nx) % ny), k = static_cast<int>(v / (std::size_t(nx) * ny));
+    const std::array<int, 8>& unknown = element_unknowns_[el];
     hex8::NodeMatrix X, x;
-    int unknown[8];
     for (int a = 0; a < 8; ++a) {
       X.row(a) = corners_.row(a) + h * Vec3(i, j, k).transpose();
-      const std::size_t node = ((i + (a >> 2 & 1)) % nx) +
-                               std::size_t(nx) * (((j + (a >> 1 & 1)) % ny) + std::size_t(ny) * ((k + (a & 1)) % nz));
-      unknown[a] = node_unknown_[node];
       for (int c = 0; c < 3; ++c) x(a, c) = S[c] * X(a, c) + (unknown[a] >= 0 ? z[unknown[a] + c] : 0.0);
     }
     mat.at_point[0] = palette_[cell_.ids[v]];
@@ -227,11 +236,15 @@ int relax(const PeriodicFiniteStrainCell& cell, double s, VecX& z, CholmodSolver
     double alpha = 1;
     for (int tries = 0;; ++tries) {
       if (tries == 40) throw NumericalError("finite-strain cell: line search failed");
-      VecX trial = z + alpha * dz, g_trial;
-      const double E_trial = cell.energy(s, trial, &g_trial, nullptr);
+      const VecX trial = z + alpha * dz;
+      const double E_trial = cell.energy(s, trial, nullptr, nullptr);
       const double round_off = 1e-12 * std::abs(E) + 1e-300;
-      const bool descent = E_trial <= E - 1e-4 * alpha * decrement ||
-                           (std::isfinite(E_trial) && std::abs(E_trial - E) <= round_off && g_trial.dot(dz) <= 0);
+      bool descent = E_trial <= E - 1e-4 * alpha * decrement;
+      if (!descent && std::isfinite(E_trial) && std::abs(E_trial - E) <= round_off) {
+        VecX g_trial;  // energies within round-off: the directional derivative decides
+        cell.energy(s, trial, &g_trial, nullptr);
+        descent = g_trial.dot(dz) <= 0;
+      }
       if (descent) {
         z = trial;
         break;

@@ -17,6 +17,7 @@
 // must be one piece that spans the cell periodically. Materials are used
 // as given: Neo-Hookean for the finite-strain check; a linear material
 // reproduces the linear C^H's Poisson ratio at any strain.
+#include <array>
 #include <vector>
 
 #include "core/types.hpp"
@@ -58,8 +59,9 @@ class PeriodicFiniteStrainCell {
   int axis_;
   int lateral_[2];
   int free_nodes_ = 0;
-  std::vector<int> node_unknown_;  // lattice node -> first of its 3 unknowns, -1 for void and the held node
   std::vector<std::size_t> solid_;  // voxel indices with material
+  // Per solid voxel, its corners' first unknowns (-1: the held node).
+  std::vector<std::array<int, 8>> element_unknowns_;
   hex8::NodeMatrix corners_;       // one voxel's corners at the origin
   hex8::ElementGeometry geometry_;
   double volume_ = 0, energy_scale_ = 0;

@@ -1,6 +1,7 @@
 #include "gamut_plots.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -12,7 +13,13 @@ namespace msfab {
 namespace {
 // One colour per SampleStep (initial, discrete, continuous, void variant, directed, targeted).
 const Rgb kStepColors[6] = {{150, 150, 150}, {40, 90, 200}, {220, 40, 40}, {140, 60, 170}, {30, 160, 60}, {230, 140, 20}};
-const char* const kStepLabels[6] = {"INITIAL", "DISCRETE", "CONTINUOUS", "VOID VARIANT", "DIRECTED", "TARGETED"};
+
+// The step's name as the chart font writes it (capitals, no underscores).
+std::string step_label(int step) {
+  std::string label = step_name(static_cast<SampleStep>(step));
+  for (char& ch : label) ch = ch == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+  return label;
+}
 
 // Structures as points coloured by the step that found them; the legend
 // lists the steps present.
@@ -28,7 +35,7 @@ void plot_structures(Chart& chart, const MicrostructureSet& set,
       }
     if (x.empty()) continue;
     chart.points(x, y, kStepColors[step], 2.0);
-    legend.emplace_back(kStepLabels[step], kStepColors[step]);
+    legend.emplace_back(step_label(step), kStepColors[step]);
   }
   chart.legend(legend);
 }

@@ -240,10 +240,8 @@ int main(int argc, char** argv) {
           state.cycles_done);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
       if (options.stop_coverage_growth > 0) {
-        const std::size_t last = state.history.size() - 1;
-        const std::size_t w = std::min<std::size_t>(options.stop_window, last);
-        const double before = best_coverage(state.history, last - w);
-        const double growth = before > 0 ? best_coverage(state.history, last) / before - 1 : 0;
+        const std::size_t w = std::min<std::size_t>(options.stop_window, state.history.size() - 1);
+        const double growth = best_coverage_growth(state.history, options.stop_window);
         std::printf("  %s: best coverage grew %.2f%% over the last %zu cycle(s) (stop.coverage_growth %.2f%%)\n",
                     coverage_converged(state.history, options.stop_coverage_growth, options.stop_window)
                         ? "converged"

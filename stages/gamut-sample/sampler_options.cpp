@@ -51,11 +51,17 @@ double best_coverage(const std::vector<GamutCycle>& history, std::size_t through
   return best;
 }
 
+double best_coverage_growth(const std::vector<GamutCycle>& history, int window) {
+  if (history.empty() || window < 1) return 0;
+  const std::size_t last = history.size() - 1;
+  const double before = best_coverage(history, last - std::min<std::size_t>(window, last));
+  return before > 0 ? best_coverage(history, last) / before - 1 : 0;
+}
+
 bool coverage_converged(const std::vector<GamutCycle>& history, double growth, int window) {
   if (!(growth > 0) || window < 1 || static_cast<int>(history.size()) <= window) return false;
-  const double now = best_coverage(history, history.size() - 1);
   const double before = best_coverage(history, history.size() - 1 - window);
-  return now - before < growth * before;
+  return before > 0 && best_coverage_growth(history, window) < growth;
 }
 
 VecX directed_direction(const MaterialSpace& space, const std::string& objective) {

@@ -87,6 +87,10 @@ struct SamplerOptions {
 // cycle on the 2D gamuts).
 double best_coverage(const std::vector<GamutCycle>& history, std::size_t through);
 
+// The best coverage so far over the best until `window` cycles earlier
+// (fewer when the history is shorter), less one; 0 when that is 0.
+double best_coverage_growth(const std::vector<GamutCycle>& history, int window);
+
 // True when the best coverage so far exceeds the best coverage until
 // `window` cycles earlier by less than `growth` times the latter: the gamut
 // stopped growing. False while there are fewer than `window` cycles after
