@@ -10,6 +10,7 @@
 #   make -f Makefile.pipeline ddfem-table-adaptive  adaptive coarsening (--target-error): speed against error, PNG
 #   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
+#   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -38,7 +39,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-floor ddfem-table-enhanced
+        ddfem-table-adaptive ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -73,6 +74,14 @@ ddfem-table-floor: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
 ddfem-table-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5
 	LEVELS=1 BENCH_SECTION=ddfem-enhanced bash tools/bench_ddfem_floor.sh $(BIN) $(OUT)/bench/ddfem-enhanced \
 	  docs/BENCHMARKS.md $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5 -
+
+# Mixed blocks (docs/ddfem.md, "Galerkin element", "Affine samples on
+# the enhanced element"): naive and Galerkin coarsening on both elements at both levels,
+# DDFEM of the enhanced database fitted on affine samples
+# at level 1, its blocks without a fit naive or Galerkin.
+ddfem-table-mixed: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5
+	bash tools/bench_ddfem_mixed.sh $(BIN) $(OUT)/bench/ddfem-mixed docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 -
 
 # Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
 # children fitted, periodic sampling at both levels.

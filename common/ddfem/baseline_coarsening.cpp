@@ -91,6 +91,17 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
   return QuadratureMaterials{{std::make_shared<NeoHookean>(E, nu)}};
 }
 
+// Each voxel's material (none for void) at its 8 points of the composite rule.
+QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
+  static const MaterialPtr no_material = NeoHookean::from_lame(0.0, 0.0);
+  if (std::all_of(ids.begin(), ids.end(), [](int id) { return id == 0; }))
+    throw InputError("coarsening baseline: every voxel of the block is void");
+  QuadratureMaterials m;
+  m.at_point.reserve(8 * ids.size());
+  for (int id : ids) m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material(palette, id));
+  return m;
+}
+
 QuadratureMaterials homogenized_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
   if (std::find(ids.begin(), ids.end(), 0) != ids.end()) return naive_block(palette, ids, n);
   VoxelGrid cell(n, n, n, 1.0, 0);
@@ -157,6 +168,17 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
   if (level1.level != 1) throw InputError("averaged level-2 coarsening needs a level-1 grid");
   return [palette, combos = level1.combinations](const ChildIds& child) {
     return averaged_block(palette, block_level2(child, combos));
+  };
+}
+
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette) {
+  return [palette](const ChildIds& child) { return galerkin_block(palette, block_level1(child)); };
+}
+
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1) {
+  if (level1.level != 1) throw InputError("Galerkin level-2 coarsening needs a level-1 grid");
+  return [palette, combos = level1.combinations](const ChildIds& child) {
+    return galerkin_block(palette, block_level2(child, combos));
   };
 }
 

@@ -15,6 +15,18 @@
 // are the volume averages over all fine voxels of the block, void counting as
 // mu = lambda = 0 (a half-void block is half as stiff).
 //
+// Galerkin (not in the thesis; the coarse operator of geometric multigrid):
+// every fine voxel integrated by its own 2 x 2 x 2 Gauss points over the
+// coarse element's field (hex8::composite_gauss_rule(2^level, 2): 64 points
+// at level 1, 512 at level 2), void voxels with no material. The coarse
+// element's energy is then exactly the fine mesh's energy of the coarse
+// field interpolated to the fine nodes: each material sits where it is in
+// the block, with its own lever arm in bending, where naive coarsening moves
+// a child's stiffness to one Gauss point. Being a restriction of the fine
+// model to the coarse space, it is stiffer than the fine model (it locks
+// where the trilinear space locks); on the enhanced element the bubbles
+// relax that.
+//
 // Homogenized (not in the thesis; a reference for what a coarse material
 // can do): the block's voxels taken as a periodic cell and homogenized
 // (homog/periodic_homogenization.hpp), and every quadrature point gets that
@@ -46,6 +58,10 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
 // (build_coarse_mesh's default at level 2).
 CoarseMaterialLookup naive_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
+
+// Galerkin: one material per point of hex8::composite_gauss_rule(2^level, 2).
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette);
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette);
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);

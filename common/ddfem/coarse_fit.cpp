@@ -1,5 +1,7 @@
 #include "ddfem/coarse_fit.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -247,6 +249,11 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   // relative error.
   for (double w : options.kind_weight)
     if (!(w >= 0.0) || !std::isfinite(w)) throw InputError("coarse fit: kind weights must be finite and >= 0");
+  std::array<double, 5> kind_weight = options.kind_weight;
+  const bool uniform = std::all_of(block.material_ids.begin(), block.material_ids.end(),
+                                   [&](int id) { return id != 0 && id == block.material_ids[0]; });
+  if (options.mixed_blocks_affine_only && !uniform)
+    for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) kind_weight[int(k)] = 0.0;
   std::vector<double> weight(ns, 0.0);
   for (int split = 0; split < 2; ++split) {
     std::array<int, 5> count{};
@@ -255,7 +262,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     double total = 0;
     for (int s = 0; s < ns; ++s)
       if (held[s] == split) {
-        weight[s] = options.kind_weight[int(kind[s])] / count[int(kind[s])];
+        weight[s] = kind_weight[int(kind[s])] / count[int(kind[s])];
         total += weight[s];
       }
     for (int s = 0; s < ns; ++s)

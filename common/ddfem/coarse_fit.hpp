@@ -56,6 +56,14 @@ struct CoarseFitOptions {
   // load at two corners that a coarse element inside a body rarely sees,
   // weighs a tenth (see docs/ddfem.md, "Fitting"). Zero drops a kind.
   std::array<double, 5> kind_weight{1.0, 1.0, 1.0, 1.0, 0.1};
+  // Fit blocks whose children are not all one material on the stretch and
+  // shear samples only. A periodic sample of a non-uniform deformation
+  // (bend, twist, pinch) gives every copy of the block the same
+  // fluctuation; that is exact for a block of one material (no fluctuation)
+  // but over-constrains a mixed block, whose neighbours in a bent body
+  // deform differently, and the fit stiffens it (docs/ddfem.md, "Mixed
+  // blocks: affine samples"). Level 1; meant for periodic sampling.
+  bool mixed_blocks_affine_only = false;
   std::uint64_t split_seed = 11;
 };
 

@@ -1,5 +1,6 @@
 #include "ddfem/coarse_grid.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -105,7 +106,19 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   const auto t0 = Clock::now();
   if (!lookup) throw InputError("coarse mesh: no material lookup given");
   if (points_per_axis == 0) points_per_axis = std::min(4, grid.fine_per_cell());
-  const hex8::QuadratureRule rule = hex8::gauss_rule(points_per_axis);
+  // The rules an element may carry, told apart by its number of materials:
+  // the Gauss rule (or one material for all its points), the Gauss rule and
+  // the centre (ddfem/coarse_fit.hpp), or one point set per fine voxel (the
+  // Galerkin element of ddfem/baseline_coarsening.hpp).
+  const hex8::QuadratureRule gauss = hex8::gauss_rule(points_per_axis);
+  const hex8::QuadratureRule composite = hex8::composite_gauss_rule(grid.fine_per_cell(), 2);
+  enum Rule { kGauss, kGaussCentre, kComposite, kRules };
+  auto rule_of = [&](int n) {
+    if (n == 1 || n == gauss.size()) return kGauss;
+    if (n == gauss.size() + 1) return kGaussCentre;
+    if (n == composite.size()) return kComposite;
+    return kRules;
+  };
 
   // The node lattice, elements and colouring are those of a voxel mesh of the
   // cell grid; a temporary palette is used for meshing and the lookups then set every element's materials.
@@ -119,11 +132,11 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   for (size_t c = 0; c < grid.combinations.size(); ++c) {
     QuadratureMaterials m = lookup(grid.combinations[c]);
     const int n = static_cast<int>(m.at_point.size());
-    if (n != 1 && n != rule.size() && n != rule.size() + 1) {
+    if (rule_of(n) == kRules) {
       std::ostringstream msg;
       msg << "coarse mesh: the material lookup returned " << n << " materials for combination " << c
-          << "; expected 1, " << rule.size() << " (one per quadrature point) or " << rule.size() + 1
-          << " (and one at the centre)";
+          << "; expected 1, " << gauss.size() << " (one per quadrature point), " << gauss.size() + 1
+          << " (and one at the centre) or " << composite.size() << " (8 per fine voxel)";
       throw InputError(msg.str());
     }
     for (const MaterialPtr& p : m.at_point)
@@ -132,17 +145,21 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   }
   hex8::NodeMatrix cube;
   for (int c = 0; c < 8; ++c) cube.row(c) = grid.cell_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
-  // Geometry 0: the Gauss rule; geometry 1, where a material has a centre
-  // point (ddfem/coarse_fit.hpp): the rule and the element centre.
-  mesh.geometries.assign(1, enhanced_modes ? hex8::enhanced_element_geometry(cube, rule) : hex8::element_geometry(cube, rule));
+  auto geometry = [&](const hex8::QuadratureRule& rule) {
+    return enhanced_modes ? hex8::enhanced_element_geometry(cube, rule) : hex8::element_geometry(cube, rule);
+  };
+  // Geometry 0 is the Gauss rule; the others are added as elements need them.
+  mesh.geometries.assign(1, geometry(gauss));
+  std::array<int, kRules> index{0, -1, -1};
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int m = mesh.element_tag[e] - 1;
     mesh.element_material[e] = m;
-    mesh.element_geometry[e] = 0;
-    if (static_cast<int>(mesh.materials[m].at_point.size()) == rule.size() + 1) {
-      if (mesh.geometries.size() == 1) mesh.geometries.push_back(hex8::with_centre_point(mesh.geometries[0], cube));
-      mesh.element_geometry[e] = 1;
+    const Rule r = rule_of(static_cast<int>(mesh.materials[m].at_point.size()));
+    if (index[r] < 0) {
+      index[r] = static_cast<int>(mesh.geometries.size());
+      mesh.geometries.push_back(r == kGaussCentre ? hex8::with_centre_point(mesh.geometries[0], cube) : geometry(composite));
     }
+    mesh.element_geometry[e] = index[r];
   }
 
   if (stats) {

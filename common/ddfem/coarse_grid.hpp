@@ -76,6 +76,10 @@ struct CoarseMeshStats {
 // index coarse cells.
 // enhanced_modes: elements with the three condensed bubble modes of
 // hex8::enhanced_element_geometry (no bending locking), for every material.
+// An element's rule follows its number of materials: 1 or one per Gauss
+// point, one more with the centre point (ddfem/coarse_fit.hpp), or 8 per
+// fine voxel for hex8::composite_gauss_rule(fine_per_cell(), 2) (the
+// Galerkin element, ddfem/baseline_coarsening.hpp), so lookups may mix them.
 VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& lookup, int points_per_axis = 0,
                             CoarseMeshStats* stats = nullptr, bool enhanced_modes = false);
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "core/errors.hpp"
 
@@ -66,6 +67,23 @@ QuadratureRule gauss_rule(int n) {
       for (int k = 0; k < n; ++k) {
         rule.points.emplace_back(x[i], x[j], x[k]);
         rule.weights.push_back(w[i] * w[j] * w[k]);
+      }
+  return rule;
+}
+
+QuadratureRule composite_gauss_rule(int cells, int n) {
+  if (cells < 1) throw InputError("composite Gauss rule: cells per axis must be >= 1, got " + std::to_string(cells));
+  const QuadratureRule unit = gauss_rule(n);
+  const double half = 1.0 / cells;
+  QuadratureRule rule;
+  for (int a = 0; a < cells; ++a)
+    for (int b = 0; b < cells; ++b)
+      for (int c = 0; c < cells; ++c) {
+        const Vec3 centre = Vec3(2 * a + 1, 2 * b + 1, 2 * c + 1) * half - Vec3::Ones();
+        for (int q = 0; q < unit.size(); ++q) {
+          rule.points.push_back(centre + half * unit.points[q]);
+          rule.weights.push_back(unit.weights[q] * half * half * half);
+        }
       }
   return rule;
 }

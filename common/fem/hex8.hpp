@@ -33,6 +33,13 @@ struct QuadratureRule {
   int size() const { return static_cast<int>(points.size()); }
 };
 QuadratureRule gauss_rule(int points_per_axis);
+// The element cut into cells_per_axis^3 equal sub-cubes, each with its own
+// points_per_axis Gauss rule: cell-major, cells and the points inside each in
+// the bit order of gauss_rule (first coordinate slowest). With 2^level cells
+// the sub-cubes are the fine voxels of a coarse block, so a piecewise-constant
+// material is integrated exactly over a polynomial field: the Galerkin coarse
+// element (ddfem/baseline_coarsening.hpp).
+QuadratureRule composite_gauss_rule(int cells_per_axis, int points_per_axis);
 
 // Precomputed reference-configuration data of one element for one rule:
 // spatial shape gradients dN/dX at each quadrature point and the weights

@@ -101,6 +101,7 @@ BuildOptions read_build_options(const Config& config) {
       w = f.get_or<double>(key, w);
       if (!(w >= 0)) f.fail(key, "must be >= 0");
     }
+    o.fit.mixed_blocks_affine_only = f.get_or<bool>("mixed_affine_only", o.fit.mixed_blocks_affine_only);
     f.check_no_unknown_keys();
   }
   if (config.has("void_children")) {

@@ -12,8 +12,9 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
   if (request.level < 1 || request.level > 2)
     throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
   if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
-      request.material != "homogenized")
-    throw InputError("--coarse-material: expected ddfem, naive, averaged or homogenized, got '" + request.material + "'");
+      request.material != "homogenized" && request.material != "galerkin")
+    throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized or galerkin, got '" +
+                     request.material + "'");
   CoarseModel m;
   if (request.material == "ddfem") {
     if (request.database.empty())
@@ -41,18 +42,27 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
   else if (request.material == "averaged")
     lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
                                 : averaged_coarsening(scene.material_by_id);
+  else if (request.material == "galerkin")
+    lookup = request.level == 2 ? galerkin_coarsening(scene.material_by_id, m.level1)
+                                : galerkin_coarsening(scene.material_by_id);
   else if (request.material == "homogenized")
     lookup = request.level == 2 ? homogenized_coarsening(scene.material_by_id, m.level1)
                                 : homogenized_coarsening(scene.material_by_id);
   else {
     // Blocks the database holds no fit for (void children in a database
-    // built without them, blocks that could not be fitted) are coarsened naively.
-    const CoarseMaterialLookup naive = request.level == 2 ? naive_coarsening(scene.material_by_id, m.level1)
-                                                          : naive_coarsening(scene.material_by_id);
+    // built without them, blocks that could not be fitted) are coarsened
+    // naively or by the Galerkin element.
+    if (request.fallback != "naive" && request.fallback != "galerkin")
+      throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
+    const bool galerkin = request.fallback == "galerkin";
+    const CoarseMaterialLookup fallback =
+        request.level == 2 ? (galerkin ? galerkin_coarsening(scene.material_by_id, m.level1)
+                                       : naive_coarsening(scene.material_by_id, m.level1))
+                           : (galerkin ? galerkin_coarsening(scene.material_by_id) : naive_coarsening(scene.material_by_id));
     int* fallbacks = &m.fallback_blocks;
-    const CoarseMaterialLookup counted = [naive, fallbacks](const ChildIds& ids) {
+    const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
       ++*fallbacks;
-      return naive(ids);
+      return fallback(ids);
     };
     lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
                                 : database_coarsening(*m.database, counted);

@@ -13,8 +13,11 @@ namespace msfab {
 
 struct CoarseningRequest {
   int level = 0;                     // 0 = fine, 1, 2
-  std::string material = "ddfem";    // ddfem | naive | averaged
+  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin
   std::string database;              // coarse_db path (ddfem)
+  // ddfem: how blocks without a fit in the database are coarsened (naive |
+  // galerkin); blocks with void children are the usual ones.
+  std::string fallback = "naive";
   // trilinear | enhanced (condensed bubble modes); empty: the database's
   // element for ddfem, trilinear otherwise.
   std::string element;
@@ -26,7 +29,7 @@ struct CoarseModel {
   StaticConditions conditions;
   CoarseMeshStats stats;
   double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
-  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit, coarsened naively
+  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit (coarsened by request.fallback)
   std::shared_ptr<CoarseDatabase> database;
   std::string element = "trilinear"; // the coarse element used (request resolved)
 };

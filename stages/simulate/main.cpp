@@ -60,9 +60,14 @@ int main(int argc, char** argv) {
       .add_option("--coarsen", coarsening.level, "coarsening levels: 0 (fine), 1 (2x2x2 blocks), 2 (4x4x4)")
       ->check(CLI::Range(0, 2));
   app.cli()
-      .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged or homogenized")
-      ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized"}));
+      .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged, homogenized or galerkin")
+      ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized", "galerkin"}));
   app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
+  app.cli()
+      .add_option("--coarse-fallback", coarsening.fallback,
+                  "ddfem: blocks the database holds no fit for (e.g. with void children) are coarsened naive "
+                  "(default) or galerkin (each fine voxel integrated over the coarse field, void empty)")
+      ->check(CLI::IsMember({"naive", "galerkin"}));
   app.cli()
       .add_option("--coarse-element", coarsening.element,
                   "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking); "
@@ -146,8 +151,8 @@ int main(int argc, char** argv) {
       spdlog::info("coarsened to level {} with {} materials: {} -> {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, fine.mesh.num_elements(), vm.mesh.num_elements(),
                    coarse.stats.distinct_combinations, 1e3 * coarse.seconds,
-                   coarse.fallback_blocks ? fmt::format(" ({} block kinds without a database fit coarsened naively)",
-                                                        coarse.fallback_blocks)
+                   coarse.fallback_blocks ? fmt::format(" ({} block kinds without a database fit coarsened {})",
+                                                        coarse.fallback_blocks, coarsening.fallback)
                                           : std::string());
 
     // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice

@@ -202,6 +202,59 @@ TEST(DdfemCoarsenBaselines, AveragedUsesVolumeMeanOfLameParameters) {
   EXPECT_EQ(m.at_point[7], palette[2]);
 }
 
+// The Galerkin element is the fine mesh restricted to the coarse field: its
+// energy and gradient are the fine ones of the interpolated field (the
+// gradient through the transpose of the interpolation), on a random
+// three-phase grid with void, at both levels; naive coarsening is not.
+TEST(DdfemCoarsenBaselines, GalerkinElementIsTheFineEnergyOfTheInterpolatedField) {
+  const auto palette = soft_stiff_palette();
+  for (int level : {1, 2}) {
+    VoxelGrid grid(level == 1 ? 4 : 8, 6, 4, 0.1, 1);
+    std::mt19937 rng(3 + level);
+    std::uniform_int_distribution<int> draw(0, 5);  // void one time in six, soft and stiff alike
+    for (int k = 0; k < grid.nz; ++k)
+      for (int j = 0; j < grid.ny; ++j)
+        for (int i = 0; i < grid.nx; ++i) {
+          const int v = draw(rng);
+          grid.at(i, j, k) = v == 0 ? 0 : (v < 3 ? 1 : 2);
+        }
+    const VoxelMesh fine = build_voxel_mesh(grid, palette);
+    const CoarseGrid l1 = coarsen_grid(grid);
+    const CoarseGrid c = level == 1 ? l1 : coarsen_grid(l1);
+    const hex8::QuadratureRule rule = hex8::composite_gauss_rule(c.fine_per_cell(), 2);
+    ASSERT_EQ(rule.size(), level == 1 ? 64 : 512);
+    const VoxelMesh galerkin =
+        build_coarse_mesh(c, level == 1 ? galerkin_coarsening(palette) : galerkin_coarsening(palette, l1));
+    const VoxelMesh naive = build_coarse_mesh(c, level == 1 ? naive_coarsening(palette) : naive_coarsening(palette, l1));
+
+    const VecX xc = random_positions(galerkin.mesh, 0.004, 11);
+    VecX u_coarse(xc.size());
+    for (int n = 0; n < galerkin.mesh.num_nodes(); ++n)
+      for (int a = 0; a < 3; ++a) u_coarse[3 * n + a] = xc[3 * n + a] - galerkin.mesh.nodes(n, a);
+    const VecX u_fine = interpolate_to_fine(grid, fine, c, galerkin, u_coarse);
+    VecX xf(u_fine.size());
+    for (int n = 0; n < fine.mesh.num_nodes(); ++n)
+      for (int a = 0; a < 3; ++a) xf[3 * n + a] = fine.mesh.nodes(n, a) + u_fine[3 * n + a];
+
+    VecX gc, gf;
+    const double ec = ElasticAssembler(galerkin.mesh).evaluate(xc, &gc, nullptr);
+    const double ef = ElasticAssembler(fine.mesh).evaluate(xf, &gf, nullptr);
+    ASSERT_GT(ef, 0);
+    EXPECT_NEAR(ec, ef, 1e-11 * ef) << "level " << level;
+    const SpMat P = coarse_to_fine_interpolation(grid, fine, c, galerkin);
+    VecX restricted = VecX::Zero(gc.size());
+    for (int a = 0; a < 3; ++a) {
+      VecX ga(fine.mesh.num_nodes());
+      for (int n = 0; n < fine.mesh.num_nodes(); ++n) ga[n] = gf[3 * n + a];
+      const VecX ra = P.transpose() * ga;
+      for (int m = 0; m < galerkin.mesh.num_nodes(); ++m) restricted[3 * m + a] = ra[m];
+    }
+    EXPECT_LE((restricted - gc).norm(), 1e-10 * gc.norm()) << "level " << level;
+    // Naive coarsening puts each voxel's stiffness at one point: not the same energy.
+    EXPECT_GT(std::abs(ElasticAssembler(naive.mesh).energy(xc) - ef), 1e-3 * ef) << "level " << level;
+  }
+}
+
 TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain) {
   const auto palette = soft_stiff_palette();
   const auto homogenized = homogenized_coarsening(palette);

@@ -306,5 +306,38 @@ TEST(DdfemContext, Level2BlockInContextAndPeriodic) {
   }
 }
 
+// fit.mixed_affine_only: a mixed block is fitted on its stretch and shear
+// samples alone (as with zero bend, twist and pinch weights), a block of one
+// material on all of them (as without the option), on identical samples.
+TEST(DdfemPeriodic, MixedBlocksAffineOnlyDropsTheNonAffineSamplesOfMixedBlocks) {
+  const auto pal = two_materials(1e5, 1e7);
+  CoarseFitOptions options = ddfem_test::small_fit_options();
+  options.sampling.mode = ForceSamplingOptions::Mode::periodic;
+  CoarseFitOptions flagged = options;
+  flagged.mixed_blocks_affine_only = true;
+  CoarseFitOptions affine = options;
+  for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) affine.kind_weight[int(k)] = 0.0;
+  auto parameters = [](const CoarseMaterialFit& f) {
+    std::vector<double> p;
+    for (int k = 0; k < f.points(); ++k) p.insert(p.end(), {f.mu[k], f.lambda[k], f.C[k]});
+    return p;
+  };
+  for (const BlockMaterials& ids : {ddfem_test::layered_ids(), BlockMaterials{2, 2, 2, 2, 2, 2, 2, 2}}) {
+    const bool mixed = ids[0] != ids[1];
+    const FineBlock b = make_fine_block(ids, pal, kVoxel);
+    const ForceSampleSet samples = sample_periodic(b, options.sampling);
+    const std::vector<Vec3> directions = estimate_anisotropy(b, options.anisotropy).direction;
+    const CoarseMaterialFit with_flag = fit_from_samples(b, samples, directions, flagged);
+    const CoarseMaterialFit all = fit_from_samples(b, samples, directions, options);
+    const CoarseMaterialFit affine_only = fit_from_samples(b, samples, directions, affine);
+    ASSERT_TRUE(with_flag.fitted && all.fitted && affine_only.fitted);
+    EXPECT_EQ(parameters(with_flag), parameters(mixed ? affine_only : all)) << (mixed ? "mixed" : "uniform");
+    double largest_change = 0;
+    const auto a = parameters(all), f = parameters(affine_only);
+    for (size_t i = 0; i < a.size(); ++i) largest_change = std::max(largest_change, std::abs(a[i] - f[i]) / pal[1]->shear_modulus());
+    EXPECT_GT(largest_change, 1e-3) << "the non-affine samples must matter for the test to mean anything";
+  }
+}
+
 }  // namespace
 }  // namespace msfab
