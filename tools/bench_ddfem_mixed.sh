@@ -10,8 +10,8 @@
 #
 #   tools/bench_ddfem_mixed.sh BIN OUTDIR BENCHMARKS.md DATABASE1 [DATABASE2|-] [scene ...]
 # DATABASE2 "-" leaves DDFEM out at level 2 (LEVELS=1 leaves level 2 out). Writes the section
-# `ddfem-mixed` of BENCHMARKS.md (BENCH_SECTION overrides). Newton seconds
-# of each run are in OUTDIR/*.log; fine references are reused from OUTDIR.
+# `ddfem-mixed` of BENCHMARKS.md (BENCH_SECTION overrides): errors, then the
+# Newton seconds of the same runs against the fine solve's.
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB1=$4 DB2=${5:--}
 shift $(( $# < 5 ? $# : 5 ))
@@ -26,15 +26,18 @@ done
 source "$SRC/tools/simulate_bench_lib.sh"
 
 MODELS=(naive naive-enhanced galerkin galerkin-enhanced ddfem ddfem-galerkin)
-rows=""
+rows="" times=""
 for scene in "${SCENES[@]}"; do
   cfg="$SRC/configs/scenes/$scene.yaml"
   fine="$OUTDIR/$scene-L0.h5"
-  [ -f "$fine" ] || { echo "bench: $scene fine ..." >&2; run "$fine" --config "$cfg" || continue; }
+  echo "bench: $scene fine ..." >&2
+  run "$fine" --config "$cfg" || continue
+  fine_seconds=$(attr "$fine" /timings newton_total)
   for level in $LEVELS; do
     db=$DB1
     [ "$level" = 2 ] && db=$DB2
     row="| $scene | $level |"
+    time_row="| $scene | $level | $(printf %.3f "$fine_seconds") |"
     naive=""
     for m in "${MODELS[@]}"; do
       out="$OUTDIR/$scene-L$level-$m.h5"
@@ -50,15 +53,17 @@ for scene in "${SCENES[@]}"; do
       esac
       e=failed
       if [ "$db" = - ] && [ "${m#ddfem}" != "$m" ]; then
-        row+=" — |"
+        row+=" — |" time_row+=" — |"
         continue
       fi
-      run "$out" --config "$cfg" "${args[@]}" && e=$(attr "$out" /coarsening error_vs_fine)
+      t=""
+      run "$out" --config "$cfg" "${args[@]}" && e=$(attr "$out" /coarsening error_vs_fine) && t=$(attr "$out" /timings newton_total)
+      time_row+=$(awk -v t="$t" -v f="$fine_seconds" 'BEGIN { if (t == "") printf " — |"; else printf " %.3f (%.1f×) |", t, f / t }')
       [ "$m" = naive ] && naive=$e
       row+=$(awk -v e="$e" -v n="$naive" 'BEGIN { if (e == "failed") printf " failed |"; else if (n == "failed" || n == "") printf " %.2e |", e;
                                                     else printf " %.2e (%.2f) |", e, e / n }')
     done
-    rows+="$row"$'\n'
+    rows+="$row"$'\n' times+="$time_row"$'\n'
   done
 done
 
@@ -67,6 +72,11 @@ table="Measured $(date -u +%Y-%m-%d) on $machine, revision $(git -C "$SRC" rev-p
 
 | scene | level | naive | naive, enhanced | Galerkin | Galerkin, enhanced | DDFEM | DDFEM, Galerkin fallback |
 |---|---|---|---|---|---|---|---|
-${rows}"
+${rows}
+Newton seconds of the same runs (2 threads; in brackets the speedup over the fine solve):
+
+| scene | level | fine | naive | naive, enhanced | Galerkin | Galerkin, enhanced | DDFEM | DDFEM, Galerkin fallback |
+|---|---|---|---|---|---|---|---|---|
+${times}"
 python3 "$SRC/tools/replace_bench_section.py" "$DOC" "${BENCH_SECTION:-ddfem-mixed}" "$table"
 echo "bench: table written to $DOC" >&2

@@ -9,12 +9,17 @@
 namespace msfab {
 
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request) {
+  if (request.fallback != "naive" && request.fallback != "galerkin")
+    throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
   if (request.level < 1 || request.level > 2)
     throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
   if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
       request.material != "homogenized" && request.material != "galerkin")
     throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized or galerkin, got '" +
                      request.material + "'");
+  if (request.fallback != "naive" && request.material != "ddfem")
+    throw InputError("--coarse-fallback " + request.fallback + ": applies to --coarse-material ddfem only (got " +
+                     request.material + ")");
   CoarseModel m;
   if (request.material == "ddfem") {
     if (request.database.empty())
@@ -52,8 +57,6 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     // Blocks the database holds no fit for (void children in a database
     // built without them, blocks that could not be fitted) are coarsened
     // naively or by the Galerkin element.
-    if (request.fallback != "naive" && request.fallback != "galerkin")
-      throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
     const bool galerkin = request.fallback == "galerkin";
     const CoarseMaterialLookup fallback =
         request.level == 2 ? (galerkin ? galerkin_coarsening(scene.material_by_id, m.level1)

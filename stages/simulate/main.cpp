@@ -103,6 +103,9 @@ int main(int argc, char** argv) {
       if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
       if (coarsening.element == "enhanced")
         throw InputError("--coarse-element enhanced: not available with --target-error (mixed meshes are trilinear)");
+      if (coarsening.fallback != "naive")
+        throw InputError("--coarse-fallback " + coarsening.fallback +
+                         ": not available with --target-error (mixed meshes coarsen blocks without a fit naively)");
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
       if (scene.newton.linear_solver == "pcg-mg")

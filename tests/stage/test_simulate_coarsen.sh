@@ -139,6 +139,10 @@ expect_exit 2 "needs --coarsen 1 or 2" -- "$SIM" --config "$BAR" --coarse-elemen
 expect_exit 2 "not available with --target-error" -- "$SIM" --config "$BAR" --target-error 0.01 --coarse-element enhanced \
   --database "$WORK/db2.h5" --out "$WORK/o.h5"
 expect_exit 2 "coarse-material" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material homogenised --out "$WORK/o.h5"
+expect_exit 2 "coarse-fallback galerkin: applies to --coarse-material ddfem only" -- "$SIM" --config "$BAR" --coarsen 1 \
+  --coarse-material naive --coarse-fallback galerkin --out "$WORK/o.h5"
+expect_exit 2 "coarse-fallback galerkin: not available with --target-error" -- "$SIM" --config "$BAR" --target-error 0.01 \
+  --coarse-fallback galerkin --database "$WORK/db2.h5" --out "$WORK/o.h5"
 expect_exit 2 "needs --database" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material ddfem --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db.h5" --out "$WORK/o.h5"
