@@ -77,11 +77,12 @@ ddfem-table-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5
 
 # Mixed blocks (docs/ddfem.md, "Galerkin element", "Affine samples on
 # the enhanced element"): naive and Galerkin coarsening on both elements at both levels,
-# DDFEM of the enhanced database fitted on affine samples
-# at level 1, its blocks without a fit naive or Galerkin.
-ddfem-table-mixed: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5
+# DDFEM of the enhanced databases fitted on affine samples (both levels),
+# its blocks without a fit naive or Galerkin.
+ddfem-table-mixed: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
+                   $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 	bash tools/bench_ddfem_mixed.sh $(BIN) $(OUT)/bench/ddfem-mixed docs/BENCHMARKS.md \
-	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 -
+	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 
 # Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
 # children fitted, periodic sampling at both levels.

@@ -61,8 +61,8 @@ struct CoarseFitOptions {
   // (bend, twist, pinch) gives every copy of the block the same
   // fluctuation; that is exact for a block of one material (no fluctuation)
   // but over-constrains a mixed block, whose neighbours in a bent body
-  // deform differently, and the fit stiffens it (docs/ddfem.md, "Mixed
-  // blocks: affine samples"). Level 1; meant for periodic sampling.
+  // deform differently, and the fit stiffens it (docs/ddfem.md, "Affine
+  // samples on the enhanced element"). Level 1; meant for periodic sampling.
   bool mixed_blocks_affine_only = false;
   std::uint64_t split_seed = 11;
 };
