@@ -41,27 +41,23 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
   const auto t0 = std::chrono::steady_clock::now();
   m.level1 = coarsen_grid(scene.grid);
   m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
+  // A baseline of ddfem/baseline_coarsening.hpp by name, at the requested level.
+  auto baseline = [&](const std::string& name) -> CoarseMaterialLookup {
+    const auto& palette = scene.material_by_id;
+    const bool two = request.level == 2;
+    if (name == "naive") return two ? naive_coarsening(palette, m.level1) : naive_coarsening(palette);
+    if (name == "averaged") return two ? averaged_coarsening(palette, m.level1) : averaged_coarsening(palette);
+    if (name == "galerkin") return two ? galerkin_coarsening(palette, m.level1) : galerkin_coarsening(palette);
+    return two ? homogenized_coarsening(palette, m.level1) : homogenized_coarsening(palette);
+  };
   CoarseMaterialLookup lookup;
-  if (request.material == "naive")
-    lookup = request.level == 2 ? naive_coarsening(scene.material_by_id, m.level1) : naive_coarsening(scene.material_by_id);
-  else if (request.material == "averaged")
-    lookup = request.level == 2 ? averaged_coarsening(scene.material_by_id, m.level1)
-                                : averaged_coarsening(scene.material_by_id);
-  else if (request.material == "galerkin")
-    lookup = request.level == 2 ? galerkin_coarsening(scene.material_by_id, m.level1)
-                                : galerkin_coarsening(scene.material_by_id);
-  else if (request.material == "homogenized")
-    lookup = request.level == 2 ? homogenized_coarsening(scene.material_by_id, m.level1)
-                                : homogenized_coarsening(scene.material_by_id);
-  else {
+  if (request.material != "ddfem") {
+    lookup = baseline(request.material);
+  } else {
     // Blocks the database holds no fit for (void children in a database
     // built without them, blocks that could not be fitted) are coarsened
     // naively or by the Galerkin element.
-    const bool galerkin = request.fallback == "galerkin";
-    const CoarseMaterialLookup fallback =
-        request.level == 2 ? (galerkin ? galerkin_coarsening(scene.material_by_id, m.level1)
-                                       : naive_coarsening(scene.material_by_id, m.level1))
-                           : (galerkin ? galerkin_coarsening(scene.material_by_id) : naive_coarsening(scene.material_by_id));
+    const CoarseMaterialLookup fallback = baseline(request.fallback);
     int* fallbacks = &m.fallback_blocks;
     const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
       ++*fallbacks;
