@@ -214,6 +214,10 @@ int main(int argc, char** argv) {
       record.coarsen_level = coarsening.level;
       record.coarse_material = coarsening.material;
       record.coarse_element = coarse.element;
+      if (coarsening.material == "ddfem") {
+        record.coarse_fallback = coarsening.fallback;
+        record.fallback_blocks = coarse.fallback_blocks;
+      }
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();

@@ -79,6 +79,10 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
     f.write_attribute("/coarsening", "level", r.coarsen_level);
     f.write_attribute("/coarsening", "material", r.coarse_material);
     f.write_attribute("/coarsening", "element", r.coarse_element);
+    if (!r.coarse_fallback.empty()) {
+      f.write_attribute("/coarsening", "fallback", r.coarse_fallback);
+      f.write_attribute("/coarsening", "fallback_blocks", r.fallback_blocks);
+    }
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);
     f.write_attribute("/coarsening", "fine_elements", r.fine_elements);

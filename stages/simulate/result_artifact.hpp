@@ -23,7 +23,9 @@ struct SimulationRecord {
   std::uint64_t seed = 0;
   // Coarsened runs (level > 0): the mesh is the coarse one.
   int coarsen_level = 0;
-  std::string coarse_material;       // ddfem | naive | averaged | homogenized
+  std::string coarse_material;       // ddfem | naive | averaged | homogenized | galerkin
+  std::string coarse_fallback;       // ddfem: naive | galerkin, for blocks without a fit
+  int fallback_blocks = 0;           // ddfem: distinct blocks coarsened by the fallback
   std::string coarse_element = "trilinear";  // trilinear | enhanced
   std::string database;              // ddfem: the coarse_db path
   double coarsening_seconds = 0;

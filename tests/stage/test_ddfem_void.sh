@@ -47,8 +47,10 @@ echo "level-1 errors: not fitted with the Galerkin fallback $novoid_galerkin, Ga
 check "Galerkin fallback below the naive fallback" -- \
   awk -v g="$novoid_galerkin" -v n="$novoid" 'BEGIN { exit !(g > 0 && g < n) }'
 check "Galerkin coarsening below naive" -- awk -v g="$galerkin" -v n="$naive" 'BEGIN { exit !(g > 0 && g < n) }'
-check "the run names the fallback" -- bash -c "'$SIM' --config '$BAR' --coarsen 1 --database '$WORK/nv.h5' \
-  --coarse-fallback galerkin --out '$WORK/run.h5' 2>&1 | grep -q 'without a database fit coarsened galerkin'"
+check "Galerkin fallback run" -- bash -c "'$SIM' --config '$BAR' --coarsen 1 --database '$WORK/nv.h5' \
+  --coarse-fallback galerkin --out '$WORK/run.h5' > '$WORK/fallback.log' 2>&1"
+check "the run names the fallback" -- grep -q 'without a database fit coarsened galerkin' "$WORK/fallback.log"
+check "the result records the fallback" -- bash -c "h5dump -a /coarsening/fallback '$WORK/run.h5' | grep -q galerkin"
 
 # Level 2 over the compressed database (compression keeps the fitted blocks).
 expect_exit 2 "not fitted.*compress it first" -- "$BUILD" --config "$SRC/configs/ddfem/tiny_level2.yaml" \
