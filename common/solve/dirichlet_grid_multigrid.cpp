@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -11,6 +12,8 @@
 #include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "solve/chebyshev_kernels.hpp"
+#include "solve/component_multigrid.hpp"
+#include "solve/material_components.hpp"
 #include "solve/hex_lattice.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/multigrid_solver.hpp"
@@ -95,7 +98,7 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
                 if (!(m >> d & 1)) coarse_reached_[std::size_t(3 * C + d)] = 1;
             }
       }
-  build_coarse_pattern();
+  if (!options_.material_coarse_space) build_coarse_pattern();
 }
 
 void DirichletGridMultigrid::build_coarse_pattern() {
@@ -139,7 +142,10 @@ void DirichletGridMultigrid::set_field(VoxelStiffnessField field) {
   field_ = std::move(field);
   has_field_ = false;
   build_fine_smoother();
-  assemble_coarse();
+  if (options_.material_coarse_space)
+    assemble_material_coarse();
+  else
+    assemble_coarse();
   has_field_ = true;
   stats_.analyze_seconds = seconds_since(start);
   stats_.factorize_seconds = stats_.analyze_seconds;
@@ -150,7 +156,8 @@ void DirichletGridMultigrid::build_fine_smoother() {
   const int B = field_.basis_size();
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
   const std::int64_t nodes = fine_.nodes();
-  diagonal_.assign(9 * std::size_t(nodes), 0.0);
+  // The blocks themselves are needed only here: 72 bytes per node.
+  std::vector<double> diagonal(9 * std::size_t(nodes), 0.0);
   // Unmasked diagonal blocks, and (sum, count) of the free unknowns' diagonal entries.
   const Eigen::Vector2d sum = chunked_reduce(nodes, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
     Eigen::Vector2d s = Eigen::Vector2d::Zero();
@@ -165,7 +172,7 @@ void DirichletGridMultigrid::build_fine_smoother() {
         for (int b = 0; b < B; ++b)
           if (const double w = field_.weight(e, b); w != 0.0) D += w * field_.basis[b].block<3, 3>(3 * a, 3 * a);
       }
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal_.data() + 9 * p) = D;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal.data() + 9 * p) = D;
       for (int d = 0; d < 3; ++d)
         if (!(node_mask_[std::size_t(p)] >> d & 1)) s += Eigen::Vector2d(D(d, d), 1.0);
     }
@@ -175,18 +182,18 @@ void DirichletGridMultigrid::build_fine_smoother() {
   if (!(fixed_scale_ > 0) || !std::isfinite(fixed_scale_))
     throw NumericalError("matrix-free multigrid: the free unknowns have no positive stiffness");
   for (std::int64_t d : fixed_list_) {
-    double* m = diagonal_.data() + 9 * std::size_t(d / 3);
+    double* m = diagonal.data() + 9 * std::size_t(d / 3);
     const int c = static_cast<int>(d % 3);
     for (int t = 0; t < 3; ++t) m[3 * c + t] = m[3 * t + c] = 0.0;
     m[4 * c] = fixed_scale_;
   }
-  const int bad = chebyshev::invert_diagonal_blocks(static_cast<int>(nodes), diagonal_.data(), inverse_, options_.threads);
+  const int bad = chebyshev::invert_diagonal_blocks(static_cast<int>(nodes), diagonal.data(), inverse_, options_.threads);
   if (bad != 0)
     throw NumericalError("matrix-free multigrid: " + std::to_string(bad) +
                          " nodes have a diagonal stiffness block that is not positive definite (nodes that only "
                          "cells without stiffness touch)");
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      static_cast<int>(nodes), diagonal_.data(), inverse_.data(),
+      static_cast<int>(nodes), diagonal.data(), inverse_.data(),
       [this](int i, const double*, double out[3]) {
         const double* y = product_.data() + 3 * std::size_t(i);
         out[0] = y[0], out[1] = y[1], out[2] = y[2];
@@ -288,6 +295,100 @@ void DirichletGridMultigrid::assemble_coarse() {
                          " elements) is not positive definite: part of the body is not held by a support");
 }
 
+void DirichletGridMultigrid::assemble_material_coarse() {
+  const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
+  const int B = field_.basis_size();
+  std::vector<char> solid(std::size_t(field_.voxels()), 0);
+  for (std::int64_t e = 0; e < field_.voxels(); ++e)
+    for (int b = 0; b < B && !solid[std::size_t(e)]; ++b) solid[std::size_t(e)] = field_.weight(e, b) != 0.0;
+  if (!components_ || solid != components_solid_) {
+    const auto start = std::chrono::steady_clock::now();
+    component_solver_.reset();
+    components_ = std::make_shared<MaterialComponents>(nx, ny, nz, solid, std::max(1, options_.coarse_unknowns / 3),
+                                                       options_.threads);
+    components_solid_ = std::move(solid);
+    component_solver_ = std::make_unique<ComponentMultigrid>(components_, options_.smoother_degree, options_.threads);
+    std::string copies;
+    for (const ComponentLevel& level : components_->levels())
+      copies += (copies.empty() ? "" : ", ") + std::to_string(level.copies());
+    spdlog::debug("matrix-free multigrid: node copies per level {} ({:.2f} s)", copies, seconds_since(start));
+  }
+  std::vector<Mat24> P(8), galerkin(8 * std::size_t(B));
+  for (int pos = 0; pos < 8; ++pos) {
+    P[pos] = interpolation(pos);
+    for (int b = 0; b < B; ++b) galerkin[std::size_t(pos) * B + b] = P[pos].transpose() * field_.basis[b] * P[pos];
+  }
+  BlockMatrix& M = component_solver_->level1();
+  std::fill(M.values.begin(), M.values.end(), 0.0);
+  const auto slot = [&M](int row, int column) {
+    const auto begin = M.column.begin() + M.row_start[std::size_t(row)];
+    const auto end = M.column.begin() + M.row_start[std::size_t(row) + 1];
+    return static_cast<std::size_t>(std::lower_bound(begin, end, column) - M.column.begin());
+  };
+  const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
+  const int team = resolve_thread_count(options_.threads);
+  // Level-1 elements of one parity colour share no lattice point, hence no copy.
+  for (int colour = 0; colour < 8; ++colour) {
+    const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
+    const int hx = (NX - ci + 1) / 2, hy = (NY - cj + 1) / 2, hz = (NZ - ck + 1) / 2;
+    const std::int64_t count = std::int64_t(hx) * hy * hz;
+#pragma omp parallel for schedule(static) num_threads(team)
+    for (std::int64_t t = 0; t < count; ++t) {
+      const int I = ci + 2 * static_cast<int>(t % hx), J = cj + 2 * static_cast<int>((t / hx) % hy),
+                K = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+      // Voxels whose pieces meet the element's corners in the same copies
+      // share one coarse element matrix.
+      std::array<int, 8> copies[8];
+      Mat24 KE[8];
+      int groups = 0;
+      for (int pos = 0; pos < 8; ++pos) {
+        const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
+        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
+        if (!components_solid_[std::size_t(e)]) continue;
+        std::array<int, 8> c;
+        for (int a = 0; a < 8; ++a) c[std::size_t(a)] = components_->element_copy(i, j, k, a);
+        int g = 0;
+        while (g < groups && copies[g] != c) ++g;
+        if (g == groups) {
+          copies[g] = c;
+          KE[g].setZero();
+          ++groups;
+        }
+        std::uint8_t masked = 0;
+        for (int a = 0; a < 8; ++a)
+          masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+        if (!masked) {
+          for (int b = 0; b < B; ++b)
+            if (const double w = field_.weight(e, b); w != 0.0) KE[g].noalias() += w * galerkin[std::size_t(pos) * B + b];
+          continue;
+        }
+        Mat24 Ke = field_.element(e);
+        for (int a = 0; a < 8; ++a) {
+          const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+          for (int d = 0; d < 3; ++d)
+            if (m >> d & 1) {
+              Ke.row(3 * a + d).setZero();
+              Ke.col(3 * a + d).setZero();
+            }
+        }
+        KE[g].noalias() += P[pos].transpose() * Ke * P[pos];
+      }
+      for (int g = 0; g < groups; ++g)
+        for (int a = 0; a < 8; ++a)
+          for (int b = 0; b < 8; ++b) {
+            double* block = M.values.data() + 9 * slot(copies[g][std::size_t(a)], copies[g][std::size_t(b)]);
+            for (int r = 0; r < 3; ++r)
+              for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
+          }
+    }
+  }
+  (void)nz;
+  if (!component_solver_->factorize())
+    throw NumericalError("matrix-free multigrid: a coarse operator that follows the material (" +
+                         dims_text(coarse_.n) + " elements and below) is not positive definite: part of the body "
+                         "is not held by a support");
+}
+
 void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
   const Eigen::Index n = 3 * Eigen::Index(fine_.nodes());
@@ -343,6 +444,25 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
 }
 
 void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) const {
+  if (components_) {
+    const ComponentTransfer& t = components_->transfers()[0];
+    const int copies = t.coarse_copies();
+    coarse.resize(3 * Eigen::Index(copies));
+    parallel_row_ranges(copies, resolve_thread_count(options_.threads), [&](int begin, int end) {
+      for (int C = begin; C < end; ++C) {
+        double sum[3] = {0, 0, 0};
+        for (int s = t.child_start[std::size_t(C)]; s < t.child_start[std::size_t(C) + 1]; ++s) {
+          const std::int64_t f = t.child[std::size_t(s)];
+          const double w = t.child_weight[std::size_t(s)];
+          const std::uint8_t m = node_mask_[std::size_t(f)];
+          for (int d = 0; d < 3; ++d)
+            if (!(m >> d & 1)) sum[d] += w * fine[3 * f + d];
+        }
+        for (int d = 0; d < 3; ++d) coarse[3 * Eigen::Index(C) + d] = sum[d];
+      }
+    });
+    return;
+  }
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
   const int NX = coarse_.n[0], NY = coarse_.n[1];
   const std::int64_t nodes = coarse_.nodes();
@@ -368,6 +488,24 @@ void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) c
 }
 
 void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) const {
+  if (components_) {
+    const ComponentTransfer& t = components_->transfers()[0];
+    parallel_row_ranges(t.fine_rows(), resolve_thread_count(options_.threads), [&](int begin, int end) {
+      for (int p = begin; p < end; ++p) {
+        const std::uint8_t m = node_mask_[std::size_t(p)];
+        if (m == 7) continue;
+        double sum[3] = {0, 0, 0};
+        for (int s = t.parent_start[std::size_t(p)]; s < t.parent_start[std::size_t(p) + 1]; ++s) {
+          const Eigen::Index C = t.parent[std::size_t(s)];
+          const double w = t.parent_weight[std::size_t(s)];
+          for (int d = 0; d < 3; ++d) sum[d] += w * coarse[3 * C + d];
+        }
+        for (int d = 0; d < 3; ++d)
+          if (!(m >> d & 1)) fine[3 * std::int64_t(p) + d] += sum[d];
+      }
+    });
+    return;
+  }
   const int nx = fine_.n[0], ny = fine_.n[1];
   const std::int64_t nodes = fine_.nodes();
   parallel_row_ranges(static_cast<int>(nodes), resolve_thread_count(options_.threads), [&](int begin, int end) {
@@ -403,7 +541,10 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
   apply(z);
   chebyshev::residual(rows, row_product, r, z, residual_, threads);
   restrict_residual(residual_, coarse_rhs_);
-  coarse_solution_ = coarse_solver_->apply_preconditioner(coarse_rhs_);
+  if (component_solver_)
+    component_solver_->cycle(coarse_rhs_, coarse_solution_);
+  else
+    coarse_solution_ = coarse_solver_->apply_preconditioner(coarse_rhs_);
   add_prolongation(coarse_solution_, z);
   chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
                     false, step_, next_, threads);
@@ -449,6 +590,7 @@ VecX DirichletGridMultigrid::solve(const VecX& b) {
 }
 
 int DirichletGridMultigrid::num_levels() const {
+  if (component_solver_) return 1 + component_solver_->num_levels();
   return 1 + (coarse_solver_ ? coarse_solver_->num_levels() : 0);
 }
 
@@ -472,9 +614,28 @@ SpMat DirichletGridMultigrid::fine_operator() const {
   return A;
 }
 
-SpMat DirichletGridMultigrid::coarse_operator() const { return coarse_matrix_; }
+SpMat DirichletGridMultigrid::coarse_operator() const {
+  if (!component_solver_) return coarse_matrix_;
+  if (component_solver_->level_matrix(0).values.empty())
+    throw std::logic_error("DirichletGridMultigrid::coarse_operator: level 1 was released after set-up (large grid)");
+  SpMat S = sparse_pattern(component_solver_->level_matrix(0));
+  copy_to_sparse(component_solver_->level_matrix(0), S);
+  return S;
+}
 
 SpMat DirichletGridMultigrid::prolongation() const {
+  if (components_) {
+    const ComponentTransfer& t = components_->transfers()[0];
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (int p = 0; p < t.fine_rows(); ++p)
+      for (int s = t.parent_start[std::size_t(p)]; s < t.parent_start[std::size_t(p) + 1]; ++s)
+        for (int d = 0; d < 3; ++d)
+          if (!is_fixed(3 * std::int64_t(p) + d))
+            triplets.emplace_back(3 * p + d, 3 * t.parent[std::size_t(s)] + d, t.parent_weight[std::size_t(s)]);
+    SpMat P(3 * t.fine_rows(), 3 * t.coarse_copies());
+    P.setFromTriplets(triplets.begin(), triplets.end());
+    return P;
+  }
   const int nx = fine_.n[0], ny = fine_.n[1];
   std::vector<Eigen::Triplet<double>> triplets;
   for (std::int64_t p = 0; p < fine_.nodes(); ++p) {

@@ -35,6 +35,8 @@
 
 namespace msfab {
 
+class ComponentMultigrid;
+class MaterialComponents;
 class MultigridSolver;
 
 struct DirichletMultigridOptions {
@@ -43,6 +45,12 @@ struct DirichletMultigridOptions {
   int smoother_degree = 2;   // Chebyshev degree on the grid (matrix products per smoothing)
   int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
   int threads = 0;           // 0: the OpenMP default
+  // Coarse spaces that follow the material (solve/material_components.hpp):
+  // one copy of a coarse node per connected piece of material in its
+  // support, from level 1 down. For voxel models of printed structures
+  // (void without stiffness, gaps and thin members); the hierarchy is
+  // rebuilt when set_field() changes which voxels have stiffness.
+  bool material_coarse_space = false;
 };
 
 class DirichletGridMultigrid {
@@ -92,6 +100,7 @@ class DirichletGridMultigrid {
   void build_fine_smoother();
   void build_coarse_pattern();
   void assemble_coarse();
+  void assemble_material_coarse();
   void cycle(const VecX& r, VecX& z);
   void restrict_residual(const VecX& fine, VecX& coarse) const;
   void add_prolongation(const VecX& coarse, VecX& fine) const;
@@ -108,8 +117,8 @@ class DirichletGridMultigrid {
   double fixed_scale_ = 1.0;
   LinearSolveStats stats_;
 
-  // Grid level: diagonal blocks of A and their inverses, Chebyshev bound, workspace.
-  std::vector<double> diagonal_, inverse_;
+  // Grid level: inverses of A's diagonal blocks, Chebyshev bound, workspace.
+  std::vector<double> inverse_;
   double max_eigenvalue_ = 0.0;
   VecX product_, step_, next_, residual_, coarse_rhs_, coarse_solution_;
 
@@ -120,6 +129,12 @@ class DirichletGridMultigrid {
   SpMat coarse_matrix_;
   std::unique_ptr<MultigridSolver> coarse_solver_;
   bool coarse_analyzed_ = false;
+
+  // With material_coarse_space: the node copies, which voxels they were
+  // built for, and the assembled hierarchy from level 1 down.
+  std::shared_ptr<const MaterialComponents> components_;
+  std::vector<char> components_solid_;
+  std::unique_ptr<ComponentMultigrid> component_solver_;
 };
 
 }  // namespace msfab

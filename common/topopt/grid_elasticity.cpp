@@ -59,7 +59,7 @@ VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs) {
 }
 
 GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
-                               const LinearSolverOptions& options)
+                               const LinearSolverOptions& options, bool material_coarse_space)
     : grid_(grid), fixed_(std::move(fixed)), options_(options) {
   if (std::int64_t(fixed_.size()) != grid_.unknowns())
     throw std::invalid_argument("GridElasticity: one fixed flag per unknown");
@@ -87,6 +87,7 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
     mg.smoother_degree = options_.mg_smoother_degree;
     mg.coarse_unknowns = options_.mg_coarse_unknowns;
     mg.threads = options_.threads;
+    mg.material_coarse_space = material_coarse_space;
     matrix_free_ = std::make_unique<DirichletGridMultigrid>(grid_.nx(), grid_.ny(), grid_.nz(), fixed_, mg);
     return;
   }

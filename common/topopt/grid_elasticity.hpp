@@ -47,9 +47,11 @@ class GridElasticity {
   // `fixed`: one flag per unknown. solver: "cholmod" | "pcg-mg" (3D only) |
   // "matrix-free" (3D, even dimensions) | "auto" (cholmod in 2D; in 3D
   // matrix-free above 30k unknowns where the dimensions are even, pcg-mg
-  // above 300k where they are not, else cholmod).
+  // above 300k where they are not, else cholmod). material_coarse_space:
+  // the matrix-free solver's coarse spaces follow the material
+  // (DirichletMultigridOptions), for voxel models of printed structures.
   GridElasticity(const CellGrid& grid, std::vector<char> fixed, const std::string& solver,
-                 const LinearSolverOptions& options);
+                 const LinearSolverOptions& options, bool material_coarse_space = false);
   ~GridElasticity();
 
   const CellGrid& grid() const { return grid_; }

@@ -45,6 +45,8 @@ fill: mapped             # mapped | solid (every non-empty cell solid in both mo
                          # | tile (every design cell holds structure tile_structure, unshifted: a periodic tiling)
 tile_structure: 0        # fill: tile: index into the microstructure set
 solver: auto             # full-resolution model: auto | cholmod | pcg-mg | matrix-free
+coarse_space: material   # matrix-free solver: material (coarse nodes copied per piece of material in
+                         # their support) | lattice (trilinear hat functions across gaps)
 homogenized_solver: auto # the design grid
 homogenized_elements: 1  # hexahedra per cell edge in the homogenized model (> 1: without most of the coarse mesh's stiffness)
 tolerance: 1.0e-8        # iterative solvers: relative residual
@@ -57,6 +59,7 @@ struct Settings {
   std::string fill_name = "mapped";
   int tile_structure = -1;  // fill: tile
   std::string solver = "auto", homogenized_solver = "auto";
+  bool material_coarse_space = true;
   int homogenized_elements = 1;
   double tolerance = 1e-8;
 };
@@ -76,6 +79,7 @@ Settings read_settings(const Config& config, const std::string& solver_option) {
   s.solver = config.get_or<std::string>("solver", "auto");
   if (!solver_option.empty()) s.solver = solver_option;
   s.homogenized_solver = config.get_or<std::string>("homogenized_solver", "auto");
+  s.material_coarse_space = config.one_of("coarse_space", {"material", "lattice"}) == "material";
   s.homogenized_elements = config.get_or<int>("homogenized_elements", 1);
   if (s.homogenized_elements < 1 || s.homogenized_elements > 64) config.fail("homogenized_elements", "must be 1..64");
   s.tolerance = config.get_or<double>("tolerance", 1e-8);
@@ -195,9 +199,9 @@ void remove_void_from_voxels(const CellRefinement& refinement, const std::vector
 // GridElasticity, with a bad solver name reported against its config key.
 std::unique_ptr<GridElasticity> make_model(const CellGrid& grid, const std::vector<char>& fixed,
                                            const std::string& solver, const std::string& key,
-                                           const LinearSolverOptions& options) {
+                                           const LinearSolverOptions& options, bool material_coarse_space = false) {
   try {
-    return std::make_unique<GridElasticity>(grid, fixed, solver, options);
+    return std::make_unique<GridElasticity>(grid, fixed, solver, options, material_coarse_space);
   } catch (const InputError& e) {
     throw InputError(key + " = " + solver + ": " + e.what());
   }
@@ -334,7 +338,8 @@ int main(int argc, char** argv) {
                  report.voxels,
                  100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
                  fine.unknowns(), report.inactive_nodes_full);
-    const auto full_model = make_model(fine, supports.fixed, settings.solver, "solver", solver_options);
+    const auto full_model = make_model(fine, supports.fixed, settings.solver, "solver", solver_options,
+                                       settings.material_coarse_space);
     GridElasticity& full = *full_model;
     if (full.solver_name() == "matrix-free") {
       VoxelStiffnessField field = voxel_field(fine, voxels, materials);
@@ -346,6 +351,7 @@ int main(int argc, char** argv) {
       full.set_stiffness(pairs);
     }
     report.solver_full = full.solver_name();
+    if (report.solver_full == "matrix-free") report.coarse_space_full = settings.material_coarse_space ? "material" : "lattice";
     report.unknowns_full = fine.unknowns();
     report.seconds_factorize_full = full.stats().assemble_seconds + full.stats().factorize_seconds;
     spdlog::info("stiffness: homogenized {} ({:.3f} s), full {} ({:.3f} s)", report.solver_homogenized,

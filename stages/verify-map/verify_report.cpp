@@ -33,6 +33,7 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "homogenized_elements", static_cast<std::int32_t>(r.homogenized_elements));
   f.write_attribute("/", "solver_homogenized", r.solver_homogenized);
   f.write_attribute("/", "solver_full", r.solver_full);
+  f.write_attribute("/", "coarse_space_full", r.coarse_space_full);
   f.write_attribute("/", "unknowns_homogenized", r.unknowns_homogenized);
   f.write_attribute("/", "unknowns_full", r.unknowns_full);
   f.write_attribute("/", "point_supports", r.point_supports);

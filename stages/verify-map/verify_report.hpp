@@ -42,6 +42,7 @@ struct VerifyReport {
                inactive_nodes_homogenized = 0;
   int homogenized_elements = 1;  // hexahedra per cell edge in the homogenized model
   std::string solver_homogenized, solver_full;  // as resolved by GridElasticity
+  std::string coarse_space_full = "none";      // matrix-free: material | lattice
   std::int64_t unknowns_homogenized = 0, unknowns_full = 0;
   std::int64_t point_supports = 0, moved_point_supports = 0, lost_point_supports = 0;
   double seconds_model = 0;  // voxel model, stiffness and the transfer of supports

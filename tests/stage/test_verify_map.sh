@@ -117,6 +117,15 @@ for c in bend stretch; do
     check "(b) $c: matrix-free and cholmod agree ($k)" -- close "$(percent $c "$out" $k)" "$(percent $c "$free" $k)" 0.01
   done
 done
+# The trilinear coarse space gives the same model's answer.
+sattr() { h5dump -a "/$2" "$1" | grep -oE '\(0\): "[^"]*"' | head -1 | cut -d'"' -f2; }
+lattice=$("$V" "${A[@]}" --solver matrix-free --set coarse_space=lattice --out "$WORK/lattice.verify.h5" --quiet 2>&1)
+check "(b) coarse space recorded" -- test "$(sattr "$WORK/free.verify.h5" coarse_space_full)" = material
+check "(b) lattice coarse space recorded" -- test "$(sattr "$WORK/lattice.verify.h5" coarse_space_full)" = lattice
+for c in bend stretch; do
+  check "(b) $c: material and lattice coarse spaces agree" -- \
+    close "$(percent $c "$free" displacement)" "$(percent $c "$lattice" displacement)" 0.01
+done
 if [ "$removed" = 0 ]; then
   for c in bend stretch; do
     check "(b) $c: void removed and ersatz void agree (displacement)" -- \
@@ -161,6 +170,7 @@ expect_exit 2 "void_ratio = 0: must be in \(0, 1\]" -- "$V" "${A[@]}" --set void
 expect_exit 2 "homogenized_elements = 0: must be 1..64" -- "$V" "${A[@]}" --set homogenized_elements=0 --out "$B"
 expect_exit 2 "tile_structure = 99: is 99, the set .* holds" -- "$V" "${A[@]}" --set fill=tile --set tile_structure=99 --out "$B"
 expect_exit 2 "void = 0.1: must be one of" -- "$V" "${A[@]}" --set void=0.1 --out "$B"
+expect_exit 2 "coarse_space = trilinear: must be one of" -- "$V" "${A[@]}" --set coarse_space=trilinear --out "$B"
 expect_exit 2 "unknown key 'voids'" -- "$V" "${A[@]}" --set voids=remove --out "$B"
 # Hinged on one line of nodes, the bar can turn about it: no piece is held.
 sed 's/supports: .*/supports: [{box: {min: [0, 0, 0], max: [0, 0, 2]}}]/' "$WORK/bar.yaml" > "$WORK/hinge.yaml"

@@ -1,0 +1,286 @@
+#include "solve/component_multigrid.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+
+#include "solve/hex_lattice.hpp"
+#include "solve/sparse_ops.hpp"
+
+namespace msfab {
+namespace {
+
+using namespace hex_lattice;
+
+// Kernels of the coarse levels are applied more times than the level-1 one.
+constexpr int kCoarseDegreeFactor = 2;
+constexpr int kCoarseCorrections = 2;
+// Level 1 of a large grid is the biggest matrix held (about 27 blocks per
+// copy). After set-up only its single-precision copy in the smoother is
+// used, so above this many blocks its double values are released (set-up
+// refills them).
+constexpr int kKeepLevel1Blocks = 1 << 20;
+
+// Rows [begin, end) of a block matrix built range by range: per row its
+// sorted columns and 9 values per block.
+struct RowRange {
+  std::vector<int> count, column;
+  std::vector<double> values;
+};
+
+// Joins row ranges (in order) into M and sets its diagonal slots. Every row
+// must hold its diagonal block.
+void join_ranges(int rows, std::vector<RowRange>& ranges, BlockMatrix& M) {
+  M.rows = rows;
+  M.row_start.assign(std::size_t(rows) + 1, 0);
+  std::size_t blocks = 0;
+  for (const RowRange& r : ranges) blocks += r.column.size();
+  M.column.clear();
+  M.column.reserve(blocks);
+  M.values.clear();
+  M.values.reserve(9 * blocks);
+  int row = 0;
+  for (RowRange& r : ranges) {
+    for (int c : r.count) {
+      M.row_start[std::size_t(row) + 1] = M.row_start[std::size_t(row)] + c;
+      ++row;
+    }
+    M.column.insert(M.column.end(), r.column.begin(), r.column.end());
+    M.values.insert(M.values.end(), r.values.begin(), r.values.end());
+    r = RowRange{};
+  }
+  M.diagonal.assign(std::size_t(rows), -1);
+  for (int i = 0; i < rows; ++i) {
+    const auto begin = M.column.begin() + M.row_start[std::size_t(i)];
+    const auto end = M.column.begin() + M.row_start[std::size_t(i) + 1];
+    const auto it = std::lower_bound(begin, end, i);
+    if (it == end || *it != i) throw std::logic_error("component multigrid: a row without its diagonal block");
+    M.diagonal[std::size_t(i)] = static_cast<int>(it - M.column.begin());
+  }
+}
+
+// Splits [0, n) into contiguous ranges, one per thread of the team, runs
+// body(range index, begin, end) on each; the ranges are joined in order.
+template <class Body>
+std::vector<RowRange> by_ranges(int n, int threads, Body&& body) {
+  const int team = std::max(1, std::min(resolve_thread_count(threads), n / 256 + 1));
+  std::vector<RowRange> ranges(static_cast<std::size_t>(team));
+#pragma omp parallel for schedule(static, 1) num_threads(team)
+  for (int t = 0; t < team; ++t) {
+    const int begin = static_cast<int>(std::int64_t(n) * t / team), end = static_cast<int>(std::int64_t(n) * (t + 1) / team);
+    body(ranges[std::size_t(t)], begin, end);
+  }
+  return ranges;
+}
+
+// Sorts a row's columns and carries their 9-value blocks along.
+void sort_row(std::vector<int>& column, std::vector<double>& values, std::vector<int>& order, RowRange& out) {
+  order.resize(column.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return column[std::size_t(a)] < column[std::size_t(b)]; });
+  out.count.push_back(static_cast<int>(column.size()));
+  for (int o : order) {
+    out.column.push_back(column[std::size_t(o)]);
+    out.values.insert(out.values.end(), values.begin() + 9 * o, values.begin() + 9 * o + 9);
+  }
+}
+
+}  // namespace
+
+BlockMatrix level1_element_pattern(const MaterialComponents& components, int threads) {
+  const ComponentLevel& level1 = components.levels().at(1);
+  const int nx = components.nx(), ny = components.ny(), nz = components.nz();
+  const int NX = nx / 2, NY = ny / 2, NZ = nz / 2;
+  const int rows = level1.copies();
+  std::vector<RowRange> ranges = by_ranges(rows, threads, [&](RowRange& out, int begin, int end) {
+    std::vector<int> columns, order;
+    std::vector<double> zeros;
+    // Rows of one lattice point are contiguous: walk points, not copies.
+    std::int64_t point = std::upper_bound(level1.first.begin(), level1.first.end(), begin) - level1.first.begin() - 1;
+    for (int row = begin; row < end; ++row) {
+      while (level1.first[std::size_t(point) + 1] <= row) ++point;
+      const int I = static_cast<int>(point % level1.points[0]),
+                J = static_cast<int>((point / level1.points[0]) % level1.points[1]),
+                K = static_cast<int>(point / (std::int64_t(level1.points[0]) * level1.points[1]));
+      columns.clear();
+      // The level-1 elements around the point, and the point's corner in each.
+      for (int a = 0; a < 8; ++a) {
+        const int EI = I - corner_x(a), EJ = J - corner_y(a), EK = K - corner_z(a);
+        if (EI < 0 || EJ < 0 || EK < 0 || EI >= NX || EJ >= NY || EK >= NZ) continue;
+        for (int pos = 0; pos < 8; ++pos) {
+          const int i = 2 * EI + (pos & 1), j = 2 * EJ + (pos >> 1 & 1), k = 2 * EK + (pos >> 2 & 1);
+          if (components.element_copy(i, j, k, a) != row) continue;
+          for (int b = 0; b < 8; ++b) columns.push_back(components.element_copy(i, j, k, b));
+        }
+      }
+      columns.push_back(row);  // a copy no free unknown reaches still has its diagonal
+      std::sort(columns.begin(), columns.end());
+      columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+      zeros.assign(9 * columns.size(), 0.0);
+      sort_row(columns, zeros, order, out);
+    }
+  });
+  BlockMatrix M;
+  join_ranges(rows, ranges, M);
+  return M;
+}
+
+void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
+                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads) {
+  const int rows = transfer.coarse_copies();
+  if (transfer.fine_rows() != fine.rows)
+    throw std::invalid_argument("component_galerkin_product: transfer and matrix sizes differ");
+  std::vector<RowRange> ranges = by_ranges(rows, threads, [&](RowRange& out, int begin, int end) {
+    std::vector<int> marker(std::size_t(rows), -1), columns, order;
+    std::vector<double> values;
+    for (int C = begin; C < end; ++C) {
+      columns.clear();
+      values.clear();
+      for (int t = transfer.child_start[std::size_t(C)]; t < transfer.child_start[std::size_t(C) + 1]; ++t) {
+        const int i = transfer.child[std::size_t(t)];
+        const double wi = transfer.child_weight[std::size_t(t)];
+        const char* di = fine_decoupled.data() + 3 * std::size_t(i);
+        for (int slot = fine.row_start[std::size_t(i)]; slot < fine.row_start[std::size_t(i) + 1]; ++slot) {
+          const int j = fine.column[std::size_t(slot)];
+          const char* dj = fine_decoupled.data() + 3 * std::size_t(j);
+          double block[9];
+          const double* m = fine.values.data() + 9 * std::size_t(slot);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) block[3 * r + q] = (di[r] || dj[q]) ? 0.0 : m[3 * r + q];
+          for (int u = transfer.parent_start[std::size_t(j)]; u < transfer.parent_start[std::size_t(j) + 1]; ++u) {
+            const int D = transfer.parent[std::size_t(u)];
+            const double w = wi * transfer.parent_weight[std::size_t(u)];
+            int& index = marker[std::size_t(D)];
+            if (index < 0) {
+              index = static_cast<int>(columns.size());
+              columns.push_back(D);
+              values.resize(values.size() + 9, 0.0);
+            }
+            double* target = values.data() + 9 * std::size_t(index);
+            for (int e = 0; e < 9; ++e) target[e] += w * block[e];
+          }
+        }
+      }
+      if (marker[std::size_t(C)] < 0) {  // keep the diagonal block
+        marker[std::size_t(C)] = static_cast<int>(columns.size());
+        columns.push_back(C);
+        values.resize(values.size() + 9, 0.0);
+      }
+      for (int D : columns) marker[std::size_t(D)] = -1;
+      sort_row(columns, values, order, out);
+    }
+  });
+  join_ranges(rows, ranges, coarse);
+  fill_empty_diagonal(coarse);
+}
+
+void fill_empty_diagonal(BlockMatrix& M) {
+  double sum = 0.0;
+  std::int64_t count = 0;
+  for (int i = 0; i < M.rows; ++i)
+    for (int d = 0; d < 3; ++d)
+      if (const double v = M.values[9 * std::size_t(M.diagonal[std::size_t(i)]) + 4 * d]; v > 0) sum += v, ++count;
+  const double scale = count > 0 ? sum / double(count) : 1.0;
+  for (int i = 0; i < M.rows; ++i)
+    for (int d = 0; d < 3; ++d) {
+      double& v = M.values[9 * std::size_t(M.diagonal[std::size_t(i)]) + 4 * d];
+      if (v == 0.0) v = scale;
+    }
+}
+
+struct ComponentMultigrid::Level {
+  BlockMatrix matrix;
+  std::vector<char> decoupled;
+  ChebyshevSmoother smoother;
+  VecX rhs, solution, residual;
+};
+
+ComponentMultigrid::ComponentMultigrid(std::shared_ptr<const MaterialComponents> components, int smoother_degree,
+                                       int threads)
+    : components_(std::move(components)), smoother_degree_(smoother_degree), threads_(threads) {
+  const int count = static_cast<int>(components_->levels().size()) - 1;
+  if (count < 1) throw std::invalid_argument("ComponentMultigrid: the components have no level 1");
+  for (int l = 0; l < count; ++l) levels_.push_back(std::make_unique<Level>());
+  levels_.front()->matrix = level1_element_pattern(*components_, threads_);
+}
+
+ComponentMultigrid::~ComponentMultigrid() = default;
+
+BlockMatrix& ComponentMultigrid::level1() {
+  BlockMatrix& M = levels_.front()->matrix;
+  if (M.values.empty()) M.values.assign(9 * std::size_t(M.num_blocks()), 0.0);
+  return M;
+}
+
+const BlockMatrix& ComponentMultigrid::level_matrix(int level) const { return levels_.at(std::size_t(level))->matrix; }
+
+bool ComponentMultigrid::factorize() {
+  fill_empty_diagonal(levels_.front()->matrix);
+  for (std::size_t l = 0; l < levels_.size(); ++l) {
+    Level& level = *levels_[l];
+    level.decoupled = decoupled_unknowns(level.matrix, threads_);
+    if (l + 1 == levels_.size()) break;
+    component_galerkin_product(level.matrix, level.decoupled, components_->transfers()[l + 1],
+                               levels_[l + 1]->matrix, threads_);
+    const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * smoother_degree_;
+    if (!level.smoother.setup(level.matrix, degree, threads_)) return false;
+    if (l == 0 && level.matrix.num_blocks() > kKeepLevel1Blocks) std::vector<double>().swap(level.matrix.values);
+  }
+  const BlockMatrix& last = levels_.back()->matrix;
+  if (!coarse_analyzed_ || coarsest_.rows() != last.unknowns() ||
+      coarsest_.nonZeros() != 9 * Eigen::Index(last.num_blocks())) {
+    coarsest_ = sparse_pattern(last);
+    copy_to_sparse(last, coarsest_);
+    coarse_solver_.analyzePattern(coarsest_);
+    coarse_analyzed_ = true;
+  } else {
+    copy_to_sparse(last, coarsest_);
+  }
+  coarse_solver_.factorize(coarsest_);
+  return coarse_solver_.info() == Eigen::Success;
+}
+
+void ComponentMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
+  if (index + 1 == levels_.size()) {
+    solution = coarse_solver_.solve(rhs);
+    return;
+  }
+  Level& level = *levels_[index];
+  Level& coarse = *levels_[index + 1];
+  const ComponentTransfer& transfer = components_->transfers()[index + 1];
+  level.smoother.smooth(rhs, solution, /*zero_start=*/true);
+  const int corrections = index == 0 ? 1 : kCoarseCorrections;
+  const int team = resolve_thread_count(threads_);
+  for (int c = 0; c < corrections; ++c) {
+    level.smoother.residual(rhs, solution, level.residual);
+    coarse.rhs.resize(coarse.matrix.unknowns());
+    parallel_row_ranges(coarse.matrix.rows, team, [&](int begin, int end) {
+      for (int C = begin; C < end; ++C) {
+        double sum[3] = {0, 0, 0};
+        for (int t = transfer.child_start[std::size_t(C)]; t < transfer.child_start[std::size_t(C) + 1]; ++t) {
+          const std::size_t i = std::size_t(transfer.child[std::size_t(t)]);
+          const double w = transfer.child_weight[std::size_t(t)];
+          for (int d = 0; d < 3; ++d)
+            if (!level.decoupled[3 * i + d]) sum[d] += w * level.residual[Eigen::Index(3 * i + d)];
+        }
+        for (int d = 0; d < 3; ++d) coarse.rhs[3 * Eigen::Index(C) + d] = sum[d];
+      }
+    });
+    cycle(index + 1, coarse.rhs, coarse.solution);
+    parallel_row_ranges(level.matrix.rows, team, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) {
+        double sum[3] = {0, 0, 0};
+        for (int u = transfer.parent_start[std::size_t(i)]; u < transfer.parent_start[std::size_t(i) + 1]; ++u) {
+          const Eigen::Index C = transfer.parent[std::size_t(u)];
+          const double w = transfer.parent_weight[std::size_t(u)];
+          for (int d = 0; d < 3; ++d) sum[d] += w * coarse.solution[3 * C + d];
+        }
+        for (int d = 0; d < 3; ++d)
+          if (!level.decoupled[3 * std::size_t(i) + d]) solution[3 * Eigen::Index(i) + d] += sum[d];
+      }
+    });
+  }
+  level.smoother.smooth(rhs, solution, /*zero_start=*/false);
+}
+
+}  // namespace msfab

@@ -1,0 +1,76 @@
+#pragma once
+// The assembled part of a multigrid hierarchy whose coarse spaces follow
+// the material (solve/material_components.hpp): level 1 of a voxel grid,
+// given as a block matrix over its node copies, and the Galerkin products
+// P^T A P below it down to a level small enough to factor.
+//
+// The cycle matches MultigridSolver's: Chebyshev / block-Jacobi smoothing
+// before and after each coarse correction, one correction on level 1 and
+// two on each level below (a V-cycle over W-cycles), a sparse Cholesky
+// factorization on the coarsest level; a fixed symmetric positive definite
+// operator, bitwise deterministic for any thread count.
+#include <Eigen/SparseCholesky>
+
+#include <memory>
+#include <vector>
+
+#include "solve/block_matrix.hpp"
+#include "solve/chebyshev_smoother.hpp"
+#include "solve/material_components.hpp"
+
+namespace msfab {
+
+// The block pattern of level 1's Galerkin operator for the grid's
+// hexahedra: copies are coupled when one solid voxel interpolates both.
+BlockMatrix level1_element_pattern(const MaterialComponents& components, int threads);
+
+// coarse = P^T fine P over a transfer (coarse's pattern and values are
+// rebuilt); rows and columns of the fine unknowns flagged in
+// fine_decoupled are left out (their rows of P are zero). Unknowns that P
+// reaches with no stiffness get the mean diagonal of the others.
+void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
+                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads);
+
+// Gives every unknown of M with a zero diagonal entry the mean diagonal of
+// the others (coarse copies that no free fine unknown reaches).
+void fill_empty_diagonal(BlockMatrix& M);
+
+class ComponentMultigrid {
+ public:
+  // Level 1 is levels()[1] of `components`; its operator is set with
+  // level1() and factorize(). smoother_degree: Chebyshev degree on level 1
+  // (twice that below).
+  ComponentMultigrid(std::shared_ptr<const MaterialComponents> components, int smoother_degree, int threads);
+  ~ComponentMultigrid();
+  ComponentMultigrid(const ComponentMultigrid&) = delete;
+  ComponentMultigrid& operator=(const ComponentMultigrid&) = delete;
+
+  // Level 1's operator: the pattern of level1_element_pattern(); the caller
+  // writes the values, then calls factorize().
+  BlockMatrix& level1();
+  // Galerkin operators, smoothers and the coarsest factorization. Returns
+  // false if a level is not positive definite.
+  bool factorize();
+  // One cycle on level 1: z = M^-1 r.
+  void cycle(const VecX& r, VecX& z) { cycle(0, r, z); }
+
+  int num_levels() const { return static_cast<int>(levels_.size()); }
+  Eigen::Index level_unknowns(int level) const { return level_matrix(level).unknowns(); }
+  // Level 1 of a large grid holds no double values after factorize() (its
+  // smoother's single-precision copy is what the cycle uses).
+  const BlockMatrix& level_matrix(int level) const;
+
+ private:
+  struct Level;
+  void cycle(std::size_t index, const VecX& rhs, VecX& solution);
+
+  std::shared_ptr<const MaterialComponents> components_;
+  int smoother_degree_;
+  int threads_;
+  std::vector<std::unique_ptr<Level>> levels_;
+  SpMat coarsest_;
+  Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> coarse_solver_;
+  bool coarse_analyzed_ = false;
+};
+
+}  // namespace msfab

@@ -1,0 +1,189 @@
+// Coarse spaces that follow the material (solve/material_components.hpp,
+// solve/component_multigrid.hpp): copies per piece across a gap, a
+// partition of unity on every piece at every level, nested pieces, the
+// lattice hierarchy on a solid box, level 1 as the Galerkin product, and
+// the matrix-free CG on a structure with gaps against a direct solve, in
+// fewer iterations than the lattice coarse space, for any thread count.
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+
+#include "core/errors.hpp"
+
+#include "fem/voxel_stiffness_field.hpp"
+#include "homog/periodic_homogenization.hpp"
+#include "material/linear_isotropic.hpp"
+#include "solve/component_multigrid.hpp"
+#include "solve/dirichlet_grid_multigrid.hpp"
+#include "solve/material_components.hpp"
+
+namespace msfab {
+namespace {
+
+std::int64_t voxel_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx) * (j + std::int64_t(ny) * k); }
+std::int64_t node_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k); }
+
+// A comb: a solid back plate at x < 2 and teeth along x, one voxel thick
+// in y with one-voxel gaps between them, so that every coarse hat function
+// at a gap spans two teeth that move apart freely.
+std::vector<char> comb(int nx, int ny, int nz) {
+  std::vector<char> solid(std::size_t(nx) * ny * nz, 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) solid[std::size_t(voxel_of(nx, ny, i, j, k))] = (i < 2 || j % 2 == 0);
+  return solid;
+}
+
+VoxelStiffnessField field_of(int nx, int ny, int nz, const std::vector<char>& solid) {
+  VoxelStiffnessField f;
+  f.nx = nx, f.ny = ny, f.nz = nz, f.h = 1.0 / nx;
+  f.basis = {voxel_stiffness(std::make_shared<LinearIsotropic>(1.0, 0.3), f.h)};
+  f.weights.resize(std::size_t(f.voxels()));
+  for (std::int64_t v = 0; v < f.voxels(); ++v) f.weights[std::size_t(v)] = solid[std::size_t(v)] ? 1.0 : 0.0;
+  return f;
+}
+
+// Nodes at x = 0 clamped, nodes that touch no solid voxel fixed (void
+// carries no unknowns, as in msfab-verify-map).
+std::vector<char> clamped_without_void(int nx, int ny, int nz, const std::vector<char>& solid) {
+  std::vector<char> fixed(3 * std::size_t(nx + 1) * (ny + 1) * (nz + 1), 0);
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) {
+        bool material = false;
+        for (int dz = -1; dz <= 0; ++dz)
+          for (int dy = -1; dy <= 0; ++dy)
+            for (int dx = -1; dx <= 0; ++dx) {
+              const int vi = i + dx, vj = j + dy, vk = k + dz;
+              if (vi >= 0 && vj >= 0 && vk >= 0 && vi < nx && vj < ny && vk < nz)
+                material = material || solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))];
+            }
+        if (i == 0 || !material)
+          for (int d = 0; d < 3; ++d) fixed[3 * std::size_t(node_of(nx, ny, i, j, k)) + d] = 1;
+      }
+  return fixed;
+}
+
+// Per row of a transfer with parents: the weights sum to 1.
+void expect_partition_of_unity(const ComponentTransfer& t, const ComponentLevel& fine) {
+  int rows_with_parents = 0;
+  for (int f = 0; f < t.fine_rows(); ++f) {
+    if (fine.representative[std::size_t(f)] < 0) {
+      EXPECT_EQ(t.parent_start[std::size_t(f) + 1], t.parent_start[std::size_t(f)]);
+      continue;
+    }
+    double sum = 0.0;
+    for (int s = t.parent_start[std::size_t(f)]; s < t.parent_start[std::size_t(f) + 1]; ++s)
+      sum += t.parent_weight[std::size_t(s)];
+    EXPECT_NEAR(sum, 1.0, 1e-15) << "row " << f;
+    ++rows_with_parents;
+  }
+  EXPECT_GT(rows_with_parents, 0);
+}
+
+TEST(MaterialComponents, CopiesPerPieceAndPartitionOfUnityAtEveryLevel) {
+  const int nx = 16, ny = 8, nz = 4;
+  const std::vector<char> solid = comb(nx, ny, nz);
+  const MaterialComponents components(nx, ny, nz, solid, 10, 1);
+  const auto& levels = components.levels();
+  ASSERT_GE(levels.size(), 3u);
+  // Level 1 at the gap between teeth j = 2 and j = 4 (lattice point y = 2,
+  // y = 3 the gap), away from the back plate: two pieces, two copies.
+  const ComponentLevel& level1 = levels[1];
+  const std::int64_t gap = level1.point(6, 1, 1);
+  EXPECT_EQ(level1.first[std::size_t(gap) + 1] - level1.first[std::size_t(gap)], 2);
+  // Over the back plate the teeth join: one copy.
+  const std::int64_t plate = level1.point(0, 1, 1);
+  EXPECT_EQ(level1.first[std::size_t(plate) + 1] - level1.first[std::size_t(plate)], 1);
+  for (std::size_t l = 0; l + 1 < levels.size(); ++l) expect_partition_of_unity(components.transfers()[l], levels[l]);
+  // Each copy's piece lies in exactly one piece of a coarser point: one
+  // parent per coarse lattice point.
+  for (std::size_t l = 1; l + 1 < levels.size(); ++l) {
+    const ComponentTransfer& t = components.transfers()[l];
+    const ComponentLevel& coarse = levels[l + 1];
+    for (int f = 0; f < t.fine_rows(); ++f) {
+      std::vector<std::int64_t> points;
+      for (int s = t.parent_start[std::size_t(f)]; s < t.parent_start[std::size_t(f) + 1]; ++s) {
+        const int C = t.parent[std::size_t(s)];
+        points.push_back(std::upper_bound(coarse.first.begin(), coarse.first.end(), C) - coarse.first.begin() - 1);
+      }
+      std::sort(points.begin(), points.end());
+      EXPECT_EQ(std::adjacent_find(points.begin(), points.end()), points.end()) << "level " << l << " copy " << f;
+    }
+  }
+}
+
+TEST(MaterialComponents, SolidBoxHasOneCopyPerLatticePoint) {
+  const int nx = 8, ny = 6, nz = 4;
+  const MaterialComponents components(nx, ny, nz, std::vector<char>(std::size_t(nx) * ny * nz, 1), 1, 1);
+  for (const ComponentLevel& level : components.levels()) EXPECT_EQ(level.copies(), level.num_points());
+  EXPECT_EQ(components.levels()[1].points[0], 5);
+  EXPECT_EQ(components.levels()[1].points[1], 4);
+  EXPECT_EQ(components.levels()[2].points[1], 3);  // level-1 points 0..3: 0, 2 and 4 (covers 3)
+  EXPECT_THROW(MaterialComponents(5, 4, 4, std::vector<char>(80, 1), 1, 1), InputError);
+}
+
+TEST(MaterialComponents, LevelOneIsTheGalerkinProductOfThePieces) {
+  const int nx = 12, ny = 8, nz = 4;
+  const std::vector<char> solid = comb(nx, ny, nz);
+  DirichletMultigridOptions options;
+  options.material_coarse_space = true;
+  options.coarse_unknowns = 30;
+  DirichletGridMultigrid mg(nx, ny, nz, clamped_without_void(nx, ny, nz, solid), options);
+  mg.set_field(field_of(nx, ny, nz, solid));
+  const SpMat A = mg.fine_operator(), P = mg.prolongation(), Ac = mg.coarse_operator();
+  const MatX reference = MatX(SpMat(P.transpose()) * A * P);
+  MatX difference = MatX(Ac) - reference;
+  // Unknowns P does not reach (clamped) hold a diagonal on the level.
+  for (Eigen::Index u = 0; u < Ac.rows(); ++u)
+    if (reference.row(u).norm() == 0.0) difference(u, u) = 0.0;
+  EXPECT_LT(difference.norm(), 1e-12 * reference.norm());
+  EXPECT_GE(mg.num_levels(), 3);
+}
+
+TEST(MaterialComponents, CombSolvesLikeADirectSolverInFewerIterations) {
+  const int nx = 24, ny = 16, nz = 4;
+  const std::vector<char> solid = comb(nx, ny, nz);
+  const std::vector<char> fixed = clamped_without_void(nx, ny, nz, solid);
+  VecX b = VecX::Zero(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1));
+  for (int k = 0; k <= nz; ++k)  // the teeth's tips pushed sideways
+    for (int j = 0; j <= ny; ++j) {
+      const std::int64_t d = 3 * node_of(nx, ny, nx, j, k) + 1;
+      if (!fixed[std::size_t(d)]) b[d] = 1e-3;
+    }
+  int iterations[2];
+  VecX solution[2];
+  for (int material = 0; material < 2; ++material) {
+    DirichletMultigridOptions options;
+    options.tolerance = 1e-10;
+    options.coarse_unknowns = 60;
+    options.material_coarse_space = material == 1;
+    DirichletGridMultigrid mg(nx, ny, nz, fixed, options);
+    mg.set_field(field_of(nx, ny, nz, solid));
+    solution[material] = mg.solve(b);
+    iterations[material] = mg.stats().iterations;
+    const SpMat A = mg.fine_operator();
+    Eigen::SimplicialLDLT<SpMat> direct(A);
+    ASSERT_EQ(direct.info(), Eigen::Success);
+    const VecX reference = direct.solve(b);
+    EXPECT_LT((solution[material] - reference).norm(), 1e-7 * reference.norm());
+  }
+  EXPECT_LT(iterations[1], iterations[0]);
+  // Thread count does not change a bit of the result.
+  DirichletMultigridOptions options;
+  options.tolerance = 1e-10;
+  options.coarse_unknowns = 60;
+  options.material_coarse_space = true;
+  options.threads = 1;
+  DirichletGridMultigrid one(nx, ny, nz, fixed, options);
+  one.set_field(field_of(nx, ny, nz, solid));
+  options.threads = 3;
+  DirichletGridMultigrid three(nx, ny, nz, fixed, options);
+  three.set_field(field_of(nx, ny, nz, solid));
+  const VecX x1 = one.solve(b), x3 = three.solve(b);
+  EXPECT_EQ((x1 - x3).cwiseAbs().maxCoeff(), 0.0);
+}
+
+}  // namespace
+}  // namespace msfab
