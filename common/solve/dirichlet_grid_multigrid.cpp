@@ -205,13 +205,42 @@ void DirichletGridMultigrid::build_fine_smoother() {
                 max_eigenvalue_);
 }
 
-void DirichletGridMultigrid::assemble_coarse() {
+void DirichletGridMultigrid::galerkin_tables(std::vector<Mat24>& P, std::vector<Mat24>& galerkin) const {
   const int B = field_.basis_size();
-  std::vector<Mat24> P(8), galerkin(8 * std::size_t(B));
+  P.resize(8);
+  galerkin.resize(8 * std::size_t(B));
   for (int pos = 0; pos < 8; ++pos) {
     P[pos] = interpolation(pos);
     for (int b = 0; b < B; ++b) galerkin[std::size_t(pos) * B + b] = P[pos].transpose() * field_.basis[b] * P[pos];
   }
+}
+
+void DirichletGridMultigrid::add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P,
+                                                const std::vector<Mat24>& galerkin, Mat24& KE) const {
+  const int B = field_.basis_size();
+  const std::int64_t e = i + std::int64_t(fine_.n[0]) * (j + std::int64_t(fine_.n[1]) * k);
+  std::uint8_t masked = 0;
+  for (int a = 0; a < 8; ++a) masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+  if (!masked) {
+    for (int b = 0; b < B; ++b)
+      if (const double w = field_.weight(e, b); w != 0.0) KE.noalias() += w * galerkin[std::size_t(pos) * B + b];
+    return;
+  }
+  Mat24 Ke = field_.element(e);
+  for (int a = 0; a < 8; ++a) {
+    const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+    for (int d = 0; d < 3; ++d)
+      if (m >> d & 1) {
+        Ke.row(3 * a + d).setZero();
+        Ke.col(3 * a + d).setZero();
+      }
+  }
+  KE.noalias() += P[pos].transpose() * Ke * P[pos];
+}
+
+void DirichletGridMultigrid::assemble_coarse() {
+  std::vector<Mat24> P, galerkin;
+  galerkin_tables(P, galerkin);
   BlockMatrix& M = coarse_blocks_;
   std::fill(M.values.begin(), M.values.end(), 0.0);
   const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
@@ -228,25 +257,7 @@ void DirichletGridMultigrid::assemble_coarse() {
       Mat24 KE = Mat24::Zero();
       for (int pos = 0; pos < 8; ++pos) {
         const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
-        const std::int64_t e = i + std::int64_t(fine_.n[0]) * (j + std::int64_t(fine_.n[1]) * k);
-        std::uint8_t masked = 0;
-        for (int a = 0; a < 8; ++a)
-          masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
-        if (!masked) {
-          for (int b = 0; b < B; ++b)
-            if (const double w = field_.weight(e, b); w != 0.0) KE.noalias() += w * galerkin[std::size_t(pos) * B + b];
-          continue;
-        }
-        Mat24 Ke = field_.element(e);
-        for (int a = 0; a < 8; ++a) {
-          const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
-          for (int d = 0; d < 3; ++d)
-            if (m >> d & 1) {
-              Ke.row(3 * a + d).setZero();
-              Ke.col(3 * a + d).setZero();
-            }
-        }
-        KE.noalias() += P[pos].transpose() * Ke * P[pos];
+        add_voxel_galerkin(i, j, k, pos, P, galerkin, KE);
       }
       for (int a = 0; a < 8; ++a) {
         const std::int64_t row = coarse_.node(I + corner_x(a), J + corner_y(a), K + corner_z(a));
@@ -313,11 +324,8 @@ void DirichletGridMultigrid::assemble_material_coarse() {
       copies += (copies.empty() ? "" : ", ") + std::to_string(level.copies());
     spdlog::debug("matrix-free multigrid: node copies per level {} ({:.2f} s)", copies, seconds_since(start));
   }
-  std::vector<Mat24> P(8), galerkin(8 * std::size_t(B));
-  for (int pos = 0; pos < 8; ++pos) {
-    P[pos] = interpolation(pos);
-    for (int b = 0; b < B; ++b) galerkin[std::size_t(pos) * B + b] = P[pos].transpose() * field_.basis[b] * P[pos];
-  }
+  std::vector<Mat24> P, galerkin;
+  galerkin_tables(P, galerkin);
   BlockMatrix& M = component_solver_->level1();
   std::fill(M.values.begin(), M.values.end(), 0.0);
   const auto slot = [&M](int row, int column) {
@@ -354,24 +362,7 @@ void DirichletGridMultigrid::assemble_material_coarse() {
           KE[g].setZero();
           ++groups;
         }
-        std::uint8_t masked = 0;
-        for (int a = 0; a < 8; ++a)
-          masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
-        if (!masked) {
-          for (int b = 0; b < B; ++b)
-            if (const double w = field_.weight(e, b); w != 0.0) KE[g].noalias() += w * galerkin[std::size_t(pos) * B + b];
-          continue;
-        }
-        Mat24 Ke = field_.element(e);
-        for (int a = 0; a < 8; ++a) {
-          const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
-          for (int d = 0; d < 3; ++d)
-            if (m >> d & 1) {
-              Ke.row(3 * a + d).setZero();
-              Ke.col(3 * a + d).setZero();
-            }
-        }
-        KE[g].noalias() += P[pos].transpose() * Ke * P[pos];
+        add_voxel_galerkin(i, j, k, pos, P, galerkin, KE[g]);
       }
       for (int g = 0; g < groups; ++g)
         for (int a = 0; a < 8; ++a)

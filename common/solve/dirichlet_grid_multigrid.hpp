@@ -101,6 +101,12 @@ class DirichletGridMultigrid {
   void build_coarse_pattern();
   void assemble_coarse();
   void assemble_material_coarse();
+  // P_pos and the Galerkin products P_pos^T K_b P_pos of the field's basis.
+  void galerkin_tables(std::vector<Mat24>& P, std::vector<Mat24>& galerkin) const;
+  // Adds fine voxel (i, j, k)'s share of its coarse element's matrix,
+  // P_pos^T D K_e D P_pos (D: its corners' free unknowns).
+  void add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P,
+                          const std::vector<Mat24>& galerkin, Mat24& KE) const;
   void cycle(const VecX& r, VecX& z);
   void restrict_residual(const VecX& fine, VecX& coarse) const;
   void add_prolongation(const VecX& coarse, VecX& fine) const;
