@@ -9,6 +9,8 @@
 #   make -f Makefile.pipeline topopt-checks          all three
 #   make -f Makefile.pipeline topopt-bridge-large    the bridge at 128x64x32 cells (Fig. 3-29's grid), optimized
 #                                                    with cell MMA: out/topopt/bridge_cubic_large.design.h5 (about 30 min)
+#   make -f Makefile.pipeline topopt-thesis-2d       the thesis's 2D scenes: the S-beam (Fig. 3-18), the four
+#                                                    grippers (Fig. 3-20) and the orthotropic lattice (Fig. 3-25)
 #   make -f Makefile.pipeline topopt-cubes           Table 3.1's cubes and the tiling study (Fig. 3-23) in
 #                                                    configs/gamut/cubic3d_bar_dense.yaml: out/topopt/cubes.md
 #                                                    (tools/bench_cubes.sh, about 15 minutes)
@@ -16,11 +18,11 @@
 # Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.design.h5,
 # S.structures.h5 (the gamut's structures; with FILL_TARGETS=1 plus those
 # generated at the design's uncovered targets), S.mapped.h5 (the mapping with its STL surfaces and PNG slice stack for the bar and the
-# gripper, the voxel model for all), and S.verify.h5, the thesis's comparison
-# (one hexahedron per cell). The bar adds bar.h4.verify.h5 (the homogenized
-# model with 4^3 hexahedra per cell: the homogenization's own error, without
-# most of the coarse mesh's stiffness), bar.solid.verify.h5 (every cell
-# solid: the coarse mesh's error alone) and bar.t2.verify.h5 (each cell 2^3
+# gripper, the voxel model for all), S.verify.h5, the thesis's comparison
+# (one hexahedron per cell), S.h4.verify.h5 (the homogenized model with 4^3
+# hexahedra per cell: the homogenization's own error, without most of the
+# coarse mesh's stiffness) and S.solid.verify.h5 (every cell solid: the
+# coarse mesh's error alone). The bar adds bar.t2.verify.h5 (each cell 2^3
 # copies of its structure, 4^3 hexahedra per cell: thinner boundary layers). Each check prints one summary line
 # (docs/verify_map.md). SEED (pipelines/gamut.mk) seeds the gamut and the mapping.
 BAR_GAMUT := $(OUT)/gamut/cubic3d_bar
@@ -71,13 +73,15 @@ $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.verify.h5): $(OUT)/topopt/%.verify.h5: $(OU
 	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
 	  --structures $(OUT)/topopt/$*.structures.h5 --threads $(THREADS) --out $@
 
-$(OUT)/topopt/bar.h4.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.h4.verify.h5): $(OUT)/topopt/%.h4.verify.h5: $(OUT)/topopt/%.mapped.h5 \
+    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
+	  --structures $(OUT)/topopt/$*.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
-$(OUT)/topopt/bar.solid.verify.h5: $(OUT)/topopt/bar.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/bar.structures.h5 --set fill=solid --threads $(THREADS) --out $@
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.solid.verify.h5): $(OUT)/topopt/%.solid.verify.h5: $(OUT)/topopt/%.mapped.h5 \
+    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
+	  --structures $(OUT)/topopt/$*.structures.h5 --set fill=solid --threads $(THREADS) --out $@
 
 $(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(OUT)/topopt/bar.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
@@ -103,11 +107,31 @@ $(OUT)/topopt/bridge_cubic_large.design.h5: configs/topopt/bridge_cubic_large.ya
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@
 
+# The thesis's 2D scenes, each in its gamut.
+THESIS_2D_SCENES := s_beam orthotropic_lattice gripper gripper_pull gripper_push gripper_stretch
+GAMUT_s_beam := cubic2d
+GAMUT_orthotropic_lattice := orthotropic2d
+GAMUT_gripper := cubic2d_void
+GAMUT_gripper_pull := cubic2d_void
+GAMUT_gripper_push := cubic2d_void
+GAMUT_gripper_stretch := cubic2d_void
+define THESIS_2D_DESIGN
+$(OUT)/topopt/$(1).design.h5: configs/topopt/$(1).yaml $(OUT)/gamut/$(2).gamut.h5 $(BIN)/msfab-topopt
+	@mkdir -p $$(@D)
+	$(BIN)/msfab-topopt --config $$< --set gamut=$(OUT)/gamut/$(2).gamut.h5 --threads $(THREADS) --out $$@
+endef
+$(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)))))
+
+.PHONY: topopt-thesis-2d
+topopt-thesis-2d: build $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
+
 .PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-checks topopt-cubes topopt-bridge-large
 topopt-bar-check: build $(OUT)/topopt/bar.verify.h5 $(OUT)/topopt/bar.h4.verify.h5 $(OUT)/topopt/bar.solid.verify.h5 \
     $(OUT)/topopt/bar.t2.verify.h5
 topopt-cubes: build $(OUT)/topopt/cubes.md
-topopt-gripper-check: build $(OUT)/topopt/gripper3d.verify.h5
-topopt-bridge-check: build $(OUT)/topopt/bridge_cubic.verify.h5
+topopt-gripper-check: build $(OUT)/topopt/gripper3d.verify.h5 $(OUT)/topopt/gripper3d.h4.verify.h5 \
+    $(OUT)/topopt/gripper3d.solid.verify.h5
+topopt-bridge-check: build $(OUT)/topopt/bridge_cubic.verify.h5 $(OUT)/topopt/bridge_cubic.h4.verify.h5 \
+    $(OUT)/topopt/bridge_cubic.solid.verify.h5
 topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check
 topopt-bridge-large: build $(OUT)/topopt/bridge_cubic_large.design.h5

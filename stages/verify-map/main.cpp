@@ -283,7 +283,8 @@ int main(int argc, char** argv) {
     }
     if (settings.remove_void) remove_void_from_cells(hgrid, hsolid, hfixed, report, design_path);
     const auto homogenized_model =
-        make_model(hgrid, hfixed, settings.homogenized_solver, "homogenized_solver", solver_options);
+        make_model(hgrid, hfixed, settings.homogenized_solver, "homogenized_solver", solver_options,
+                   settings.material_coarse_space);
     GridElasticity& homogenized = *homogenized_model;
     {
       const MatX cell_pairs = homogenized_pairs(coarse, mapped, set, materials, settings.fill);

@@ -56,6 +56,12 @@ check "coarse-to-fine continuation" -- "$T" --config "$WORK/cubic.yaml" --set 'g
   --set "initial.design=$WORK/cubic.design.h5" --set 'loads=[{objective: compliance, forces: [{node: [24, 0], force: [0, -1]}]}]' \
   --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' --set optimizer.max_iterations=20 --out "$WORK/fine.design.h5" --quiet
 
+# The thesis's 2D scenes (configs/topopt/) read and run in a cubic2d gamut.
+for scene in s_beam gripper gripper_pull gripper_push gripper_stretch; do
+  check "configs/topopt/$scene.yaml runs" -- "$T" --config "$SRC/configs/topopt/$scene.yaml" \
+    --set gamut="$WORK/set.gamut.h5" --set optimizer.max_iterations=3 --out "$WORK/$scene.design.h5" --quiet
+done
+
 # Plane strain: the same as the plane-stress plate of E / (1 - nu^2), nu / (1 - nu).
 simp=(--set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]'
   --set 'loads=[{objective: compliance, forces: [{box: {min: [12, 0], max: [24, 0]}, force: [0, -1], distribute: total}]}]'
