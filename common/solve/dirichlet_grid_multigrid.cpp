@@ -44,6 +44,23 @@ Mat24 interpolation(int pos) {
   return P;
 }
 
+// Calls body(I, J, K) for every element of a grid of n[0] x n[1] x n[2]
+// elements, one parity colour after the other (elements of one colour
+// share no node, so bodies that add into their corners do not conflict),
+// in parallel within a colour.
+template <class Body>
+void for_each_element_by_colour(const int n[3], int team, Body&& body) {
+  for (int colour = 0; colour < 8; ++colour) {
+    const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
+    const int hx = (n[0] - ci + 1) / 2, hy = (n[1] - cj + 1) / 2, hz = (n[2] - ck + 1) / 2;
+    const std::int64_t count = std::int64_t(hx) * hy * hz;
+#pragma omp parallel for schedule(static) num_threads(team)
+    for (std::int64_t t = 0; t < count; ++t)
+      body(ci + 2 * static_cast<int>(t % hx), cj + 2 * static_cast<int>((t / hx) % hy),
+           ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy)));
+  }
+}
+
 }  // namespace
 
 bool DirichletGridMultigrid::supports(int nx, int ny, int nz) {
@@ -243,17 +260,7 @@ void DirichletGridMultigrid::assemble_coarse() {
   galerkin_tables(P, galerkin);
   BlockMatrix& M = coarse_blocks_;
   std::fill(M.values.begin(), M.values.end(), 0.0);
-  const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
-  const int team = resolve_thread_count(options_.threads);
-  // Coarse elements of one parity colour share no coarse node.
-  for (int colour = 0; colour < 8; ++colour) {
-    const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
-    const int hx = (NX - ci + 1) / 2, hy = (NY - cj + 1) / 2, hz = (NZ - ck + 1) / 2;
-    const std::int64_t count = std::int64_t(hx) * hy * hz;
-#pragma omp parallel for schedule(static) num_threads(team)
-    for (std::int64_t t = 0; t < count; ++t) {
-      const int I = ci + 2 * static_cast<int>(t % hx), J = cj + 2 * static_cast<int>((t / hx) % hy),
-                K = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+  for_each_element_by_colour(coarse_.n, resolve_thread_count(options_.threads), [&](int I, int J, int K) {
       Mat24 KE = Mat24::Zero();
       for (int pos = 0; pos < 8; ++pos) {
         const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
@@ -267,8 +274,7 @@ void DirichletGridMultigrid::assemble_coarse() {
             for (int q = 0; q < 3; ++q) block[3 * r + q] += KE(3 * a + r, 3 * b + q);
         }
       }
-    }
-  }
+  });
   // Coarse unknowns no free fine unknown interpolates have empty rows and
   // columns: a diagonal of the level's scale keeps the operator definite.
   double diagonal_sum = 0.0;
@@ -289,6 +295,7 @@ void DirichletGridMultigrid::assemble_coarse() {
     options.threads = options_.threads;
     options.mg_coarse_unknowns = options_.coarse_unknowns;
     options.mg_smoother_degree = options_.smoother_degree;
+    const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
     auto positions =
         std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(coarse_.nodes(), 3);
     for (int k = 0; k <= NZ; ++k)
@@ -307,7 +314,7 @@ void DirichletGridMultigrid::assemble_coarse() {
 }
 
 void DirichletGridMultigrid::assemble_material_coarse() {
-  const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
+  const int nx = fine_.n[0], ny = fine_.n[1];
   const int B = field_.basis_size();
   std::vector<char> solid(std::size_t(field_.voxels()), 0);
   for (std::int64_t e = 0; e < field_.voxels(); ++e)
@@ -315,7 +322,7 @@ void DirichletGridMultigrid::assemble_material_coarse() {
   if (!components_ || solid != components_solid_) {
     const auto start = std::chrono::steady_clock::now();
     component_solver_.reset();
-    components_ = std::make_shared<MaterialComponents>(nx, ny, nz, solid, std::max(1, options_.coarse_unknowns / 3),
+    components_ = std::make_shared<MaterialComponents>(nx, ny, fine_.n[2], solid, std::max(1, options_.coarse_unknowns / 3),
                                                        options_.threads);
     components_solid_ = std::move(solid);
     component_solver_ = std::make_unique<ComponentMultigrid>(components_, options_.smoother_degree, options_.threads);
@@ -333,17 +340,8 @@ void DirichletGridMultigrid::assemble_material_coarse() {
     const auto end = M.column.begin() + M.row_start[std::size_t(row) + 1];
     return static_cast<std::size_t>(std::lower_bound(begin, end, column) - M.column.begin());
   };
-  const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
-  const int team = resolve_thread_count(options_.threads);
-  // Level-1 elements of one parity colour share no lattice point, hence no copy.
-  for (int colour = 0; colour < 8; ++colour) {
-    const int ci = corner_x(colour), cj = corner_y(colour), ck = corner_z(colour);
-    const int hx = (NX - ci + 1) / 2, hy = (NY - cj + 1) / 2, hz = (NZ - ck + 1) / 2;
-    const std::int64_t count = std::int64_t(hx) * hy * hz;
-#pragma omp parallel for schedule(static) num_threads(team)
-    for (std::int64_t t = 0; t < count; ++t) {
-      const int I = ci + 2 * static_cast<int>(t % hx), J = cj + 2 * static_cast<int>((t / hx) % hy),
-                K = ck + 2 * static_cast<int>(t / (std::int64_t(hx) * hy));
+  // Level-1 elements of one colour share no lattice point, hence no copy.
+  for_each_element_by_colour(coarse_.n, resolve_thread_count(options_.threads), [&](int I, int J, int K) {
       // Voxels whose pieces meet the element's corners in the same copies
       // share one coarse element matrix.
       std::array<int, 8> copies[8];
@@ -371,9 +369,7 @@ void DirichletGridMultigrid::assemble_material_coarse() {
             for (int r = 0; r < 3; ++r)
               for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
           }
-    }
-  }
-  (void)nz;
+  });
   if (!component_solver_->factorize())
     throw NumericalError("matrix-free multigrid: a coarse operator that follows the material (" +
                          dims_text(coarse_.n) + " elements and below) is not positive definite: part of the body "
