@@ -250,35 +250,12 @@ void ComponentMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solutio
   const ComponentTransfer& transfer = components_->transfers()[index + 1];
   level.smoother.smooth(rhs, solution, /*zero_start=*/true);
   const int corrections = index == 0 ? 1 : kCoarseCorrections;
-  const int team = resolve_thread_count(threads_);
+  const auto is_free = [&level](int row, int d) { return !level.decoupled[3 * std::size_t(row) + std::size_t(d)]; };
   for (int c = 0; c < corrections; ++c) {
     level.smoother.residual(rhs, solution, level.residual);
-    coarse.rhs.resize(coarse.matrix.unknowns());
-    parallel_row_ranges(coarse.matrix.rows, team, [&](int begin, int end) {
-      for (int C = begin; C < end; ++C) {
-        double sum[3] = {0, 0, 0};
-        for (int t = transfer.child_start[std::size_t(C)]; t < transfer.child_start[std::size_t(C) + 1]; ++t) {
-          const std::size_t i = std::size_t(transfer.child[std::size_t(t)]);
-          const double w = transfer.child_weight[std::size_t(t)];
-          for (int d = 0; d < 3; ++d)
-            if (!level.decoupled[3 * i + d]) sum[d] += w * level.residual[Eigen::Index(3 * i + d)];
-        }
-        for (int d = 0; d < 3; ++d) coarse.rhs[3 * Eigen::Index(C) + d] = sum[d];
-      }
-    });
+    component_restrict(transfer, level.residual, is_free, coarse.rhs, threads_);
     cycle(index + 1, coarse.rhs, coarse.solution);
-    parallel_row_ranges(level.matrix.rows, team, [&](int begin, int end) {
-      for (int i = begin; i < end; ++i) {
-        double sum[3] = {0, 0, 0};
-        for (int u = transfer.parent_start[std::size_t(i)]; u < transfer.parent_start[std::size_t(i) + 1]; ++u) {
-          const Eigen::Index C = transfer.parent[std::size_t(u)];
-          const double w = transfer.parent_weight[std::size_t(u)];
-          for (int d = 0; d < 3; ++d) sum[d] += w * coarse.solution[3 * C + d];
-        }
-        for (int d = 0; d < 3; ++d)
-          if (!level.decoupled[3 * std::size_t(i) + d]) solution[3 * Eigen::Index(i) + d] += sum[d];
-      }
-    });
+    component_add_prolongation(transfer, coarse.solution, is_free, solution, threads_);
   }
   level.smoother.smooth(rhs, solution, /*zero_start=*/false);
 }

@@ -17,6 +17,7 @@
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_smoother.hpp"
 #include "solve/material_components.hpp"
+#include "solve/sparse_ops.hpp"
 
 namespace msfab {
 
@@ -30,6 +31,44 @@ BlockMatrix level1_element_pattern(const MaterialComponents& components, int thr
 // reaches with no stiffness get the mean diagonal of the others.
 void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
                                 const ComponentTransfer& transfer, BlockMatrix& coarse, int threads);
+
+// coarse = P^T fine and fine += P coarse over a transfer, leaving out the
+// fine unknowns for which is_free(row, component) is false (their rows of
+// P are zero). Rows are independent: the same bits for any thread count.
+template <class IsFree>
+void component_restrict(const ComponentTransfer& t, const VecX& fine, IsFree&& is_free, VecX& coarse, int threads) {
+  const int copies = t.coarse_copies();
+  coarse.resize(3 * Eigen::Index(copies));
+  parallel_row_ranges(copies, resolve_thread_count(threads), [&](int begin, int end) {
+    for (int C = begin; C < end; ++C) {
+      double sum[3] = {0, 0, 0};
+      for (int s = t.child_start[std::size_t(C)]; s < t.child_start[std::size_t(C) + 1]; ++s) {
+        const int f = t.child[std::size_t(s)];
+        const double w = t.child_weight[std::size_t(s)];
+        for (int d = 0; d < 3; ++d)
+          if (is_free(f, d)) sum[d] += w * fine[3 * Eigen::Index(f) + d];
+      }
+      for (int d = 0; d < 3; ++d) coarse[3 * Eigen::Index(C) + d] = sum[d];
+    }
+  });
+}
+template <class IsFree>
+void component_add_prolongation(const ComponentTransfer& t, const VecX& coarse, IsFree&& is_free, VecX& fine,
+                                int threads) {
+  parallel_row_ranges(t.fine_rows(), resolve_thread_count(threads), [&](int begin, int end) {
+    for (int f = begin; f < end; ++f) {
+      if (t.parent_start[std::size_t(f)] == t.parent_start[std::size_t(f) + 1]) continue;
+      double sum[3] = {0, 0, 0};
+      for (int s = t.parent_start[std::size_t(f)]; s < t.parent_start[std::size_t(f) + 1]; ++s) {
+        const Eigen::Index C = t.parent[std::size_t(s)];
+        const double w = t.parent_weight[std::size_t(s)];
+        for (int d = 0; d < 3; ++d) sum[d] += w * coarse[3 * C + d];
+      }
+      for (int d = 0; d < 3; ++d)
+        if (is_free(f, d)) fine[3 * Eigen::Index(f) + d] += sum[d];
+    }
+  });
+}
 
 // Gives every unknown of M with a zero diagonal entry the mean diagonal of
 // the others (coarse copies that no free fine unknown reaches).

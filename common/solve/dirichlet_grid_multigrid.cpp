@@ -97,6 +97,7 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
       fixed_list_.push_back(d);
     }
 
+  if (options_.material_coarse_space) return;  // set_field() builds the copies
   // A coarse unknown is reached when some free fine unknown of the same
   // component lies within one fine spacing of its point.
   const std::int64_t coarse_nodes = coarse_.nodes();
@@ -115,7 +116,7 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
                 if (!(m >> d & 1)) coarse_reached_[std::size_t(3 * C + d)] = 1;
             }
       }
-  if (!options_.material_coarse_space) build_coarse_pattern();
+  build_coarse_pattern();
 }
 
 void DirichletGridMultigrid::build_coarse_pattern() {
@@ -432,22 +433,8 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
 
 void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) const {
   if (components_) {
-    const ComponentTransfer& t = components_->transfers()[0];
-    const int copies = t.coarse_copies();
-    coarse.resize(3 * Eigen::Index(copies));
-    parallel_row_ranges(copies, resolve_thread_count(options_.threads), [&](int begin, int end) {
-      for (int C = begin; C < end; ++C) {
-        double sum[3] = {0, 0, 0};
-        for (int s = t.child_start[std::size_t(C)]; s < t.child_start[std::size_t(C) + 1]; ++s) {
-          const std::int64_t f = t.child[std::size_t(s)];
-          const double w = t.child_weight[std::size_t(s)];
-          const std::uint8_t m = node_mask_[std::size_t(f)];
-          for (int d = 0; d < 3; ++d)
-            if (!(m >> d & 1)) sum[d] += w * fine[3 * f + d];
-        }
-        for (int d = 0; d < 3; ++d) coarse[3 * Eigen::Index(C) + d] = sum[d];
-      }
-    });
+    const auto is_free = [this](int node, int d) { return !is_fixed(3 * std::int64_t(node) + d); };
+    component_restrict(components_->transfers()[0], fine, is_free, coarse, options_.threads);
     return;
   }
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
@@ -476,21 +463,8 @@ void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) c
 
 void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) const {
   if (components_) {
-    const ComponentTransfer& t = components_->transfers()[0];
-    parallel_row_ranges(t.fine_rows(), resolve_thread_count(options_.threads), [&](int begin, int end) {
-      for (int p = begin; p < end; ++p) {
-        const std::uint8_t m = node_mask_[std::size_t(p)];
-        if (m == 7) continue;
-        double sum[3] = {0, 0, 0};
-        for (int s = t.parent_start[std::size_t(p)]; s < t.parent_start[std::size_t(p) + 1]; ++s) {
-          const Eigen::Index C = t.parent[std::size_t(s)];
-          const double w = t.parent_weight[std::size_t(s)];
-          for (int d = 0; d < 3; ++d) sum[d] += w * coarse[3 * C + d];
-        }
-        for (int d = 0; d < 3; ++d)
-          if (!(m >> d & 1)) fine[3 * std::int64_t(p) + d] += sum[d];
-      }
-    });
+    const auto is_free = [this](int node, int d) { return !is_fixed(3 * std::int64_t(node) + d); };
+    component_add_prolongation(components_->transfers()[0], coarse, is_free, fine, options_.threads);
     return;
   }
   const int nx = fine_.n[0], ny = fine_.n[1];
