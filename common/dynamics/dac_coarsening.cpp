@@ -29,7 +29,7 @@ DacResult dac_geometric_coarsening(const DacLevelBuilder& build, const DacOption
   const int k = options.num_modes;
 
   DacResult result;
-  std::vector<BoundarySurface> surfaces;
+  std::vector<ModeShapeSurface> surfaces;
   std::vector<ModalResult> modes;
   for (int level = options.first_level; level <= options.max_level; ++level) {
     DacLevel built = build(level);
@@ -39,7 +39,7 @@ DacResult dac_geometric_coarsening(const DacLevelBuilder& build, const DacOption
     report.dofs = built.mesh.num_dofs();
     report.element_size = built.element_size;
     modes.push_back(modal_analysis(built.mesh, built.density, built.fixed, modal));
-    surfaces.push_back(boundary_surface(built.mesh));
+    surfaces.push_back(mode_shape_surface(built.mesh));
     report.frequencies = modes.back().frequencies;
     if (!result.levels.empty()) {
       const VecX& previous = result.levels.back().frequencies;

@@ -164,7 +164,7 @@ class TriangleGrid {
   std::vector<Vec3> boxes_lo_, boxes_hi_;  // per triangle
 };
 
-std::vector<Triangle> deformed_triangles(const BoundarySurface& s, const VecX& u) {
+std::vector<Triangle> deformed_triangles(const ModeShapeSurface& s, const VecX& u) {
   if (u.size() != 3 * s.rest.rows())
     throw InputError("mode shape distance: displacement has " + std::to_string(u.size()) + " entries for " +
                      std::to_string(s.rest.rows()) + " nodes");
@@ -240,8 +240,8 @@ double max_nodal_displacement(const VecX& u) {
 
 }  // namespace
 
-BoundarySurface boundary_surface(const HexMesh& mesh) {
-  BoundarySurface s;
+ModeShapeSurface mode_shape_surface(const HexMesh& mesh) {
+  ModeShapeSurface s;
   s.rest = mesh.nodes;
   if (mesh.num_elements() == 0) throw InputError("boundary surface: the mesh has no elements");
   s.diagonal = (mesh.bbox_max() - mesh.bbox_min()).norm();
@@ -250,7 +250,7 @@ BoundarySurface boundary_surface(const HexMesh& mesh) {
   return s;
 }
 
-double hausdorff_distance(const BoundarySurface& a, const VecX& ua, const BoundarySurface& b, const VecX& ub,
+double hausdorff_distance(const ModeShapeSurface& a, const VecX& ua, const ModeShapeSurface& b, const VecX& ub,
                           int samples, double upper_bound) {
   if (samples < 1) throw InputError("hausdorff distance: samples must be at least 1");
   if (a.faces.empty() || b.faces.empty()) throw InputError("hausdorff distance: a surface has no faces");
@@ -264,7 +264,7 @@ double hausdorff_distance(const BoundarySurface& a, const VecX& ua, const Bounda
 namespace {
 
 // mode_shape_distance, exact when <= upper (relative) and +inf otherwise.
-double bounded_mode_distance(const BoundarySurface& ref, const VecX& ref_mode, const BoundarySurface& other,
+double bounded_mode_distance(const ModeShapeSurface& ref, const VecX& ref_mode, const ModeShapeSurface& other,
                              const VecX& other_mode, const ModeDistanceOptions& options, double upper) {
   if (!(options.amplitude_fraction > 0) || !std::isfinite(options.amplitude_fraction))
     throw InputError("mode shape distance: amplitude_fraction must be positive");
@@ -281,12 +281,12 @@ double bounded_mode_distance(const BoundarySurface& ref, const VecX& ref_mode, c
 
 }  // namespace
 
-double mode_shape_distance(const BoundarySurface& ref, const VecX& ref_mode, const BoundarySurface& other,
+double mode_shape_distance(const ModeShapeSurface& ref, const VecX& ref_mode, const ModeShapeSurface& other,
                            const VecX& other_mode, const ModeDistanceOptions& options) {
   return bounded_mode_distance(ref, ref_mode, other, other_mode, options, std::numeric_limits<double>::infinity());
 }
 
-std::vector<ModeMatch> match_modes(const BoundarySurface& ref, const MatX& ref_modes, const BoundarySurface& other,
+std::vector<ModeMatch> match_modes(const ModeShapeSurface& ref, const MatX& ref_modes, const ModeShapeSurface& other,
                                    const MatX& other_modes, int window, const ModeDistanceOptions& options) {
   if (window < 0) throw InputError("mode matching: window must be >= 0");
   std::vector<ModeMatch> matches(static_cast<size_t>(other_modes.cols()));

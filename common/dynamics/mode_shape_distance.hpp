@@ -14,15 +14,16 @@
 
 namespace msfab {
 
-// The boundary of a hex mesh: the element faces not shared by two elements.
+// The boundary of a hex mesh as the mode-shape distance samples it: the
+// element faces not shared by two elements.
 // Each quad is split into four triangles around its centre, so the surface
 // displaced by a nodal field is piecewise linear and exactly reproducible.
-struct BoundarySurface {
+struct ModeShapeSurface {
   NodeArray rest;                            // rest positions of every mesh node
   std::vector<std::array<int, 4>> faces;     // boundary quads, corners in cyclic order
   double diagonal = 0.0;                     // bounding-box diagonal of the rest mesh
 };
-BoundarySurface boundary_surface(const HexMesh& mesh);
+ModeShapeSurface mode_shape_surface(const HexMesh& mesh);
 
 // Symmetric Hausdorff distance (metres) between surface a displaced by ua
 // and surface b displaced by ub (DOF vectors, node-major 3 n + c). Each
@@ -34,7 +35,7 @@ BoundarySurface boundary_surface(const HexMesh& mesh);
 // With a finite upper_bound the result is exact when it is <= upper_bound
 // and +inf otherwise, which lets comparisons against a best-so-far stop
 // early.
-double hausdorff_distance(const BoundarySurface& a, const VecX& ua, const BoundarySurface& b,
+double hausdorff_distance(const ModeShapeSurface& a, const VecX& ua, const ModeShapeSurface& b,
                           const VecX& ub, int samples = 2,
                           double upper_bound = std::numeric_limits<double>::infinity());
 
@@ -49,7 +50,7 @@ struct ModeDistanceOptions {
 // `other_mode` on `other`, divided by ref.diagonal. A mode's sign is
 // arbitrary, so both signs of other_mode are tried and the smaller distance
 // is returned. InputError if a mode has the wrong length or is zero.
-double mode_shape_distance(const BoundarySurface& ref, const VecX& ref_mode, const BoundarySurface& other,
+double mode_shape_distance(const ModeShapeSurface& ref, const VecX& ref_mode, const ModeShapeSurface& other,
                            const VecX& other_mode, const ModeDistanceOptions& options = {});
 
 // Modes can change order between resolutions (close frequencies swap), so
@@ -61,8 +62,8 @@ struct ModeMatch {
   int reference_mode = -1;
   double distance = 0.0;  // relative Hausdorff distance to it
 };
-std::vector<ModeMatch> match_modes(const BoundarySurface& ref, const MatX& ref_modes,
-                                   const BoundarySurface& other, const MatX& other_modes, int window,
+std::vector<ModeMatch> match_modes(const ModeShapeSurface& ref, const MatX& ref_modes,
+                                   const ModeShapeSurface& other, const MatX& other_modes, int window,
                                    const ModeDistanceOptions& options = {});
 
 }  // namespace msfab

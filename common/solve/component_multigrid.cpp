@@ -6,15 +6,14 @@
 
 #include "solve/hex_lattice.hpp"
 #include "solve/sparse_ops.hpp"
+#include "solve/multigrid_cycle.hpp"
 
 namespace msfab {
 namespace {
 
 using namespace hex_lattice;
 
-// Kernels of the coarse levels are applied more times than the level-1 one.
-constexpr int kCoarseDegreeFactor = 2;
-constexpr int kCoarseCorrections = 2;
+using namespace multigrid_cycle;
 // Level 1 of a large grid is the biggest matrix held (about 27 blocks per
 // copy). After set-up only its single-precision copy in the smoother is
 // used, so above this many blocks its double values are released (set-up

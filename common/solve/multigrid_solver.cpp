@@ -13,6 +13,7 @@
 #include "solve/node_lattice.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
+#include "solve/multigrid_cycle.hpp"
 
 namespace msfab {
 
@@ -20,10 +21,7 @@ namespace {
 
 // Deeper hierarchies than this never occur for meshes that fit in memory.
 constexpr int kMaxLevels = 24;
-// Smoother degree on the coarse levels, relative to mg_smoother_degree.
-constexpr int kCoarseDegreeFactor = 2;
-// Coarse corrections per visit of a level below the finest (2: W-cycle).
-constexpr int kCoarseCorrections = 2;
+using namespace multigrid_cycle;
 
 }  // namespace
 

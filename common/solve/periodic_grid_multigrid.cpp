@@ -14,6 +14,7 @@
 #include "solve/chebyshev_smoother.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/sparse_ops.hpp"
+#include "solve/multigrid_cycle.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -23,8 +24,7 @@ namespace {
 // Coarse levels are small: smoothing them harder and visiting them twice (a
 // W-cycle below the finest level) costs little and keeps the high-contrast
 // coarse operators from slowing CG down.
-constexpr int kCoarseDegreeFactor = 2;
-constexpr int kCoarseCorrections = 2;
+using namespace multigrid_cycle;
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 

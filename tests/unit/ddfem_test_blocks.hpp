@@ -9,6 +9,7 @@
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
 #include "ddfem/periodic_samples.hpp"
+#include "fem/hex8.hpp"
 #include "material/neo_hookean.hpp"
 #include "scene/scene.hpp"
 
@@ -100,5 +101,16 @@ struct NearlyIncompressibleBlock {
   ForceSampleSet samples = sample_periodic(block, options.sampling);
   std::vector<Vec3> directions = std::vector<Vec3>(8, Vec3::UnitX());
 };
+
+
+// A uniform draw in [0, 1) with 53 random bits.
+inline double u01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
+
+// Corner positions X moved by the corner displacements u.
+inline hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
+  hex8::NodeMatrix x = X;
+  for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
+  return x;
+}
 
 }  // namespace msfab::ddfem_test

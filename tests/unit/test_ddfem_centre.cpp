@@ -20,20 +20,14 @@
 namespace msfab {
 namespace {
 
+using ddfem_test::deformed;
 using ddfem_test::kVoxel;
-
-double u01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
+using ddfem_test::u01;
 
 Vec24 random_corners(std::mt19937_64& rng, double amplitude) {
   Vec24 u;
   for (int i = 0; i < 24; ++i) u[i] = amplitude * (2 * u01(rng) - 1);
   return u;
-}
-
-hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
-  hex8::NodeMatrix x = X;
-  for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
-  return x;
 }
 
 TEST(DdfemCentre, BasisIsTheVolumetricEnergyAtTheCentre) {

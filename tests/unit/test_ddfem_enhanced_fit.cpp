@@ -21,15 +21,9 @@
 namespace msfab {
 namespace {
 
+using ddfem_test::deformed;
 using ddfem_test::kVoxel;
-
-double u01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
-
-hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
-  hex8::NodeMatrix x = X;
-  for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
-  return x;
-}
+using ddfem_test::u01;
 
 // Energies of a known coarse material on the enhanced element: its own
 // condensed energies. The alternation starts from the fine materials, far

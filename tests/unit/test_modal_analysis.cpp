@@ -22,7 +22,7 @@ using namespace msfab;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kE = 1e6, kNu = 0.3, kRho = 1000.0;
+constexpr double kBeamE = 1e6, kBeamNu = 0.3, kRho = 1000.0;
 
 struct Body {
   HexMesh mesh;
@@ -32,10 +32,10 @@ struct Body {
 
 // nx x ny x nz voxels of edge h from the origin, optionally clamped (all
 // three DOFs) on the face x = 0.
-Body voxel_box(int nx, int ny, int nz, double h, bool clamp, double E = kE) {
+Body voxel_box(int nx, int ny, int nz, double h, bool clamp, double E = kBeamE) {
   VoxelGrid grid(nx, ny, nz, h, 1);
   Body b;
-  b.mesh = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(E, kNu)}).mesh;
+  b.mesh = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(E, kBeamNu)}).mesh;
   b.density.assign(static_cast<size_t>(b.mesh.num_elements()), kRho);
   if (clamp) {
     b.fixed.assign(static_cast<size_t>(b.mesh.num_dofs()), 0);
@@ -49,11 +49,11 @@ Body voxel_box(int nx, int ny, int nz, double h, bool clamp, double E = kE) {
 // Cantilever of section w x w and length 10 w with n voxels through the
 // thickness.
 constexpr double kWidth = 0.01, kLength = 10 * kWidth;
-Body cantilever(int n, double E = kE) { return voxel_box(10 * n, n, n, kWidth / n, true, E); }
+Body cantilever(int n, double E = kBeamE) { return voxel_box(10 * n, n, n, kWidth / n, true, E); }
 
 double euler_bernoulli_f1() {
   const double I = std::pow(kWidth, 4) / 12.0, A = kWidth * kWidth;
-  return 1.875104068711961 * 1.875104068711961 / (2 * kPi) * std::sqrt(kE * I / (kRho * A * std::pow(kLength, 4)));
+  return 1.875104068711961 * 1.875104068711961 / (2 * kPi) * std::sqrt(kBeamE * I / (kRho * A * std::pow(kLength, 4)));
 }
 
 struct Dense {
@@ -161,7 +161,7 @@ TEST(ModalAnalysis, TwoIdenticalBodiesSkipTwelveRigidModesAndSeparate) {
   VoxelGrid grid(7, 2, 2, 0.01, 1);
   for (int k = 0; k < 2; ++k)
     for (int j = 0; j < 2; ++j) grid.at(3, j, k) = 0;
-  const HexMesh mesh = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(kE, kNu)}).mesh;
+  const HexMesh mesh = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(kBeamE, kBeamNu)}).mesh;
   const std::vector<double> density(static_cast<size_t>(mesh.num_elements()), kRho);
   ModalOptions opt;
   opt.num_modes = 4;
@@ -230,7 +230,7 @@ TEST(ModalAnalysis, InvalidInputIsRejected) {
 
 TEST(ModalAnalysis, CantileverConvergesToEulerBernoulliFromAbove) {
   const double f_eb = euler_bernoulli_f1();
-  std::printf("  cantilever L/w = 10, E = %g, nu = %g, rho = %g: Euler-Bernoulli f1 = %.4f Hz\n", kE, kNu, kRho,
+  std::printf("  cantilever L/w = 10, E = %g, nu = %g, rho = %g: Euler-Bernoulli f1 = %.4f Hz\n", kBeamE, kBeamNu, kRho,
               f_eb);
   std::printf("  %-10s %8s %12s %10s %8s\n", "voxels", "dofs", "f1 (Hz)", "f1/f_EB-1", "cycles");
   std::vector<double> f1;
@@ -261,10 +261,10 @@ TEST(ModalAnalysis, DacModulusScalingMatchesFineFrequency) {
   const ModalResult rf = modal_analysis(fine.mesh, fine.density, fine.fixed);
   const ModalResult rc = modal_analysis(coarse.mesh, coarse.density, coarse.fixed);
   // Calibrate against the fine mesh's undamped fundamental (Eq. 4.18).
-  const double En = calibrate_dac(rf.frequencies(0), 0.0, rc.eigenvalues(0), kE).youngs_modulus;
+  const double En = calibrate_dac(rf.frequencies(0), 0.0, rc.eigenvalues(0), kBeamE).youngs_modulus;
   const Body scaled = cantilever(1, En);
   const ModalResult rs = modal_analysis(scaled.mesh, scaled.density, scaled.fixed);
-  std::printf("  E_n / E = %.4f\n  %-5s %10s %10s %10s %9s %9s\n", En / kE, "mode", "fine", "coarse", "scaled",
+  std::printf("  E_n / E = %.4f\n  %-5s %10s %10s %10s %9s %9s\n", En / kBeamE, "mode", "fine", "coarse", "scaled",
               "err", "err DAC");
   for (int i = 0; i < 4; ++i)
     std::printf("  %-5d %10.3f %10.3f %10.3f %+9.4f %+9.4f\n", i + 1, rf.frequencies(i), rc.frequencies(i),
@@ -281,7 +281,7 @@ TEST(ModalAnalysis, DacModulusScalingMatchesFineFrequency) {
 
 TEST(ModeShapeDistance, HausdorffOfScaledBoxIsHalfDiagonalTimesStrain) {
   const Body b = voxel_box(4, 3, 2, 0.5, false);
-  const BoundarySurface s = boundary_surface(b.mesh);
+  const ModeShapeSurface s = mode_shape_surface(b.mesh);
   EXPECT_EQ(s.faces.size(), size_t(2 * (4 * 3 + 3 * 2 + 4 * 2)));
   // Uniform expansion by eps about the centre: the farthest sample, a
   // corner, is eps * half-diagonal from the original box.
@@ -301,7 +301,7 @@ TEST(ModeShapeDistance, IdenticalZeroAndCoarseBeamModesClose) {
   const Body fine = cantilever(4), coarse = cantilever(1);
   const ModalResult rf = modal_analysis(fine.mesh, fine.density, fine.fixed);
   const ModalResult rc = modal_analysis(coarse.mesh, coarse.density, coarse.fixed);
-  const BoundarySurface sf = boundary_surface(fine.mesh), sc = boundary_surface(coarse.mesh);
+  const ModeShapeSurface sf = mode_shape_surface(fine.mesh), sc = mode_shape_surface(coarse.mesh);
   EXPECT_LT(mode_shape_distance(sf, rf.modes.col(0), sf, rf.modes.col(0)), 1e-12);
   // The sign of a mode does not matter.
   EXPECT_LT(mode_shape_distance(sf, rf.modes.col(0), sf, -rf.modes.col(0)), 1e-12);
