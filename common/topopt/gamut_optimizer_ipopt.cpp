@@ -215,10 +215,11 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   app->Options()->SetNumericValue("acceptable_tol", 10 * settings.tolerance);
   app->Options()->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
   app->Options()->SetStringValue("mu_strategy", "adaptive");
-  // The gamut level set is piecewise multilinear, so its gradient jumps
-  // across grid faces and the dual infeasibility never settles below tight
-  // tolerances; the objective does. Stop when the objective has changed by
-  // less than 1e-4 (relative) for 5 iterations with the constraints met to
+  // The cells are held to the level set's quadratic B-spline, which is C1
+  // but whose curvature jumps across grid faces, so the dual infeasibility
+  // can stall above tight tolerances while the objective settles. Then stop
+  // when the objective has changed by less than 1e-4 (relative to the
+  // start) for 5 iterations with the constraints met to
   // constraint_tolerance (docs/topopt.md).
   app->Options()->SetIntegerValue("acceptable_iter", 5);
   app->Options()->SetNumericValue("acceptable_obj_change_tol", 1e-4);
