@@ -102,7 +102,6 @@ struct NearlyIncompressibleBlock {
   std::vector<Vec3> directions = std::vector<Vec3>(8, Vec3::UnitX());
 };
 
-
 // A uniform draw in [0, 1) with 53 random bits.
 inline double u01(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
 
