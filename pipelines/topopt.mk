@@ -68,20 +68,18 @@ $(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.mapped.h5): $(OUT)/topopt/%.mapped.h5: $(OU
 	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
 	  --set export.voxels=true $(MAP_EXPORTS_$*) --threads $(THREADS) --out $@ --quiet
 
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.verify.h5): $(OUT)/topopt/%.verify.h5: $(OUT)/topopt/%.mapped.h5 \
+# The three checks of Table 3.1 per scene: S.verify.h5 (one hexahedron per
+# cell), S.h4.verify.h5 and S.solid.verify.h5, differing only in settings.
+VERIFY_SETTINGS_ :=
+VERIFY_SETTINGS_.h4 := --set homogenized_elements=4
+VERIFY_SETTINGS_.solid := --set fill=solid
+define TWO_SCALE_CHECK
+$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%$(1).verify.h5): $(OUT)/topopt/%$(1).verify.h5: $(OUT)/topopt/%.mapped.h5 \
     $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/$*.structures.h5 --threads $(THREADS) --out $@
-
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.h4.verify.h5): $(OUT)/topopt/%.h4.verify.h5: $(OUT)/topopt/%.mapped.h5 \
-    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/$*.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
-
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.solid.verify.h5): $(OUT)/topopt/%.solid.verify.h5: $(OUT)/topopt/%.mapped.h5 \
-    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$*.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/$*.structures.h5 --set fill=solid --threads $(THREADS) --out $@
+	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$$*.design.h5 --mapped $$< \
+	  --structures $(OUT)/topopt/$$*.structures.h5 $(VERIFY_SETTINGS_$(1)) --threads $(THREADS) --out $$@
+endef
+$(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
 $(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(OUT)/topopt/bar.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \

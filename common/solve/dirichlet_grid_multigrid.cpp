@@ -236,7 +236,7 @@ void DirichletGridMultigrid::galerkin_tables(std::vector<Mat24>& P, std::vector<
 void DirichletGridMultigrid::add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P,
                                                 const std::vector<Mat24>& galerkin, Mat24& KE) const {
   const int B = field_.basis_size();
-  const std::int64_t e = i + std::int64_t(fine_.n[0]) * (j + std::int64_t(fine_.n[1]) * k);
+  const std::int64_t e = fine_.element(i, j, k);
   std::uint8_t masked = 0;
   for (int a = 0; a < 8; ++a) masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
   if (!masked) {
@@ -262,19 +262,19 @@ void DirichletGridMultigrid::assemble_coarse() {
   BlockMatrix& M = coarse_blocks_;
   std::fill(M.values.begin(), M.values.end(), 0.0);
   for_each_element_by_colour(coarse_.n, resolve_thread_count(options_.threads), [&](int I, int J, int K) {
-      Mat24 KE = Mat24::Zero();
-      for (int pos = 0; pos < 8; ++pos) {
-        const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
-        add_voxel_galerkin(i, j, k, pos, P, galerkin, KE);
+    Mat24 KE = Mat24::Zero();
+    for (int pos = 0; pos < 8; ++pos) {
+      const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
+      add_voxel_galerkin(i, j, k, pos, P, galerkin, KE);
+    }
+    for (int a = 0; a < 8; ++a) {
+      const std::int64_t row = coarse_.node(I + corner_x(a), J + corner_y(a), K + corner_z(a));
+      for (int b = 0; b < 8; ++b) {
+        double* block = M.values.data() + 9 * std::size_t(coarse_slot_[27 * std::size_t(row) + corner_code(a, b)]);
+        for (int r = 0; r < 3; ++r)
+          for (int q = 0; q < 3; ++q) block[3 * r + q] += KE(3 * a + r, 3 * b + q);
       }
-      for (int a = 0; a < 8; ++a) {
-        const std::int64_t row = coarse_.node(I + corner_x(a), J + corner_y(a), K + corner_z(a));
-        for (int b = 0; b < 8; ++b) {
-          double* block = M.values.data() + 9 * std::size_t(coarse_slot_[27 * std::size_t(row) + corner_code(a, b)]);
-          for (int r = 0; r < 3; ++r)
-            for (int q = 0; q < 3; ++q) block[3 * r + q] += KE(3 * a + r, 3 * b + q);
-        }
-      }
+    }
   });
   // Coarse unknowns no free fine unknown interpolates have empty rows and
   // columns: a diagonal of the level's scale keeps the operator definite.
@@ -315,7 +315,6 @@ void DirichletGridMultigrid::assemble_coarse() {
 }
 
 void DirichletGridMultigrid::assemble_material_coarse() {
-  const int nx = fine_.n[0], ny = fine_.n[1];
   const int B = field_.basis_size();
   std::vector<char> solid(std::size_t(field_.voxels()), 0);
   for (std::int64_t e = 0; e < field_.voxels(); ++e)
@@ -323,8 +322,8 @@ void DirichletGridMultigrid::assemble_material_coarse() {
   if (!components_ || solid != components_solid_) {
     const auto start = std::chrono::steady_clock::now();
     component_solver_.reset();
-    components_ = std::make_shared<MaterialComponents>(nx, ny, fine_.n[2], solid, std::max(1, options_.coarse_unknowns / 3),
-                                                       options_.threads);
+    components_ = std::make_shared<MaterialComponents>(fine_.n[0], fine_.n[1], fine_.n[2], solid,
+                                                       std::max(1, options_.coarse_unknowns / 3), options_.threads);
     components_solid_ = std::move(solid);
     component_solver_ = std::make_unique<ComponentMultigrid>(components_, options_.smoother_degree, options_.threads);
     std::string copies;
@@ -343,33 +342,33 @@ void DirichletGridMultigrid::assemble_material_coarse() {
   };
   // Level-1 elements of one colour share no lattice point, hence no copy.
   for_each_element_by_colour(coarse_.n, resolve_thread_count(options_.threads), [&](int I, int J, int K) {
-      // Voxels whose pieces meet the element's corners in the same copies
-      // share one coarse element matrix.
-      std::array<int, 8> copies[8];
-      Mat24 KE[8];
-      int groups = 0;
-      for (int pos = 0; pos < 8; ++pos) {
-        const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
-        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
-        if (!components_solid_[std::size_t(e)]) continue;
-        std::array<int, 8> c;
-        for (int a = 0; a < 8; ++a) c[std::size_t(a)] = components_->element_copy(i, j, k, a);
-        int g = 0;
-        while (g < groups && copies[g] != c) ++g;
-        if (g == groups) {
-          copies[g] = c;
-          KE[g].setZero();
-          ++groups;
-        }
-        add_voxel_galerkin(i, j, k, pos, P, galerkin, KE[g]);
+    // Voxels whose pieces meet the element's corners in the same copies
+    // share one coarse element matrix.
+    std::array<int, 8> copies[8];
+    Mat24 KE[8];
+    int groups = 0;
+    for (int pos = 0; pos < 8; ++pos) {
+      const int i = 2 * I + (pos & 1), j = 2 * J + (pos >> 1 & 1), k = 2 * K + (pos >> 2 & 1);
+      const std::int64_t e = fine_.element(i, j, k);
+      if (!components_solid_[std::size_t(e)]) continue;
+      std::array<int, 8> c;
+      for (int a = 0; a < 8; ++a) c[std::size_t(a)] = components_->element_copy(i, j, k, a);
+      int g = 0;
+      while (g < groups && copies[g] != c) ++g;
+      if (g == groups) {
+        copies[g] = c;
+        KE[g].setZero();
+        ++groups;
       }
-      for (int g = 0; g < groups; ++g)
-        for (int a = 0; a < 8; ++a)
-          for (int b = 0; b < 8; ++b) {
-            double* block = M.values.data() + 9 * slot(copies[g][std::size_t(a)], copies[g][std::size_t(b)]);
-            for (int r = 0; r < 3; ++r)
-              for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
-          }
+      add_voxel_galerkin(i, j, k, pos, P, galerkin, KE[g]);
+    }
+    for (int g = 0; g < groups; ++g)
+      for (int a = 0; a < 8; ++a)
+        for (int b = 0; b < 8; ++b) {
+          double* block = M.values.data() + 9 * slot(copies[g][std::size_t(a)], copies[g][std::size_t(b)]);
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
+        }
   });
   if (!component_solver_->factorize())
     throw NumericalError("matrix-free multigrid: a coarse operator that follows the material (" +

@@ -96,6 +96,7 @@ class DirichletGridMultigrid {
     int n[3]{0, 0, 0};  // elements per axis; nodes n + 1
     std::int64_t nodes() const { return std::int64_t(n[0] + 1) * (n[1] + 1) * (n[2] + 1); }
     std::int64_t node(int i, int j, int k) const { return i + std::int64_t(n[0] + 1) * (j + std::int64_t(n[1] + 1) * k); }
+    std::int64_t element(int i, int j, int k) const { return i + std::int64_t(n[0]) * (j + std::int64_t(n[1]) * k); }
   };
   void build_fine_smoother();
   void build_coarse_pattern();
