@@ -9,15 +9,19 @@
 # DATABASE2: a level-2 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
 # nu = 0.45); DATABASE1 (environment, optional) a level-1 one for the uniform
 # level-1 rows. Naive coarsening at both levels is measured too. TARGETS (environment) lists the target errors (default
-# "0.02 0.01 0.005 0.002"); PYTHON, a python3 with matplotlib (Debian
-# python3-matplotlib). Writes the section bench:ddfem-adaptive of
-# BENCHMARKS.md, OUTDIR/adaptive.csv and docs/images/ddfem-adaptive.png.
+# "0.02 0.01 0.005 0.002"); COARSE_ARGS, extra msfab-simulate arguments of
+# the database runs (e.g. "--coarse-fallback galerkin"); PYTHON, a python3
+# with matplotlib (Debian python3-matplotlib). Writes the section
+# bench:$BENCH_SECTION (default ddfem-adaptive) of BENCHMARKS.md,
+# OUTDIR/adaptive.csv and docs/images/$BENCH_SECTION.png.
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3 DB2=$4
 shift 4
 SCENES=("$@")
 [ ${#SCENES[@]} -gt 0 ] || SCENES=(bending twisting pushing layers1 checker random3 sole bridge_arch skeleton holes3)
 read -r -a TARGET_LIST <<< "${TARGETS:-0.02 0.01 0.005 0.002}"
+read -r -a COARSE_ARG_LIST <<< "${COARSE_ARGS:-}"
+SECTION=${BENCH_SECTION:-ddfem-adaptive}
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
 
@@ -58,15 +62,16 @@ for scene in "${SCENES[@]}"; do
   tf=$(attr "$fine" /timings newton_total)
   nf=$(attr "$fine" / elements)
   uniform naive2 "naive level 2" --coarsen 2 --coarse-material naive
-  uniform level2 "level 2" --coarsen 2 --database "$DB2"
+  uniform level2 "level 2" --coarsen 2 --database "$DB2" "${COARSE_ARG_LIST[@]}"
   if [ -n "${DATABASE1:-}" ]; then
     uniform naive1 "naive level 1" --coarsen 1 --coarse-material naive
-    uniform level1 "level 1" --coarsen 1 --database "$DATABASE1"
+    uniform level1 "level 1" --coarsen 1 --database "$DATABASE1" "${COARSE_ARG_LIST[@]}"
   fi
   for target in "${TARGET_LIST[@]}"; do
     echo "bench: $scene adaptive $target ..." >&2
     f="$OUTDIR/$scene-A$target.h5"
-    run "$f" --config "$cfg" --target-error "$target" --database "$DB2" --reference "$fine" || continue
+    run "$f" --config "$cfg" --target-error "$target" --database "$DB2" "${COARSE_ARG_LIST[@]}" --reference "$fine" ||
+      continue
     e=$(attr "$f" /coarsening error_vs_fine) p=$(attr "$f" /coarsening predicted_error) t=$(coarse_seconds "$f")
     rows+=$(awk -v s="$scene" -v g="$target" -v p="$p" -v e="$e" -v t="$t" -v tf="$tf" -v l="$(levels "$f")" \
       -v nf="$nf" 'BEGIN { printf "| %s | adaptive | %g | %.2e | %.2e | %s | %s of %d | %.3f | %.3f | %.1f |", s, g, p, e,
@@ -75,11 +80,11 @@ for scene in "${SCENES[@]}"; do
   done
 done
 printf "%s" "$csv" > "$OUTDIR/adaptive.csv"
-"${PYTHON:-python3}" "$SRC/tools/plot_adaptive.py" "$OUTDIR/adaptive.csv" "$SRC/docs/images/ddfem-adaptive.png" ||
+"${PYTHON:-python3}" "$SRC/tools/plot_adaptive.py" "$OUTDIR/adaptive.csv" "$SRC/docs/images/$SECTION.png" ||
   echo "bench: no plot (python3 with matplotlib needed)" >&2
 
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB2")${DATABASE1:+ (level 2) and $(basename "$DATABASE1") (level 1)}.
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB2")${DATABASE1:+ (level 2) and $(basename "$DATABASE1") (level 1)}${COARSE_ARGS:+, database runs with $COARSE_ARGS}.
 
 | scene | model | target | predicted | error | met | elements fine/L1/L2 | s | fine s | speedup |
 |---|---|---|---|---|---|---|---|---|---|
@@ -87,6 +92,6 @@ ${rows}
 Seconds after the fine mesh is built: coarsening, for adaptive runs the uniform level-2 and level-1 solves the
 estimate comes from, and Newton on the model; \"fine s\" is the fine model's Newton time in the same run.
 
-![adaptive speed against error](images/ddfem-adaptive.png)"
-python3 "$SRC/tools/replace_bench_section.py" "$DOC" ddfem-adaptive "$table"
+![adaptive speed against error](images/$SECTION.png)"
+python3 "$SRC/tools/replace_bench_section.py" "$DOC" "$SECTION" "$table"
 echo "bench: table written to $DOC" >&2

@@ -39,7 +39,7 @@ struct ElementBox {
 MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
                                       const CoarseGrid& level1, const CoarseGrid& level2,
                                       const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
-                                      const CoarseMaterialLookup& level2_materials) {
+                                      const CoarseMaterialLookup& level2_materials, bool enhanced_modes) {
   if (level1.level != 1 || level2.level != 2 || level1.fine_nx != fine.nx || level1.fine_ny != fine.ny ||
       level1.fine_nz != fine.nz || level2.fine_nx != fine.nx || level2.fine_ny != fine.ny || level2.fine_nz != fine.nz)
     throw InputError("mixed-level mesh: the level-1 and level-2 grids were not built from this voxel grid");
@@ -58,20 +58,28 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
   std::vector<ElementBox> boxes;
   m.voxel_element.assign(fine.size(), -1);
 
-  // Geometries per (level, centre point); materials per palette id or combination.
+  // Geometries per (level, rule), told apart by an element's number of
+  // materials as in build_coarse_mesh: the Gauss rule (or one material for
+  // all points), the Gauss rule and the centre, or 8 points per fine voxel
+  // (the Galerkin element). Coarse elements carry the bubble modes when
+  // asked; fine voxels are always trilinear (they are the reference model).
+  enum Rule { kGauss, kGaussCentre, kComposite };
   const double h = fine.voxel_size;
-  std::map<std::pair<int, bool>, int> geometry_slot;
-  auto geometry = [&](int level, bool centre) {
-    auto it = geometry_slot.find({level, centre});
+  std::map<std::pair<int, Rule>, int> geometry_slot;
+  auto geometry = [&](int level, Rule rule) {
+    auto it = geometry_slot.find({level, rule});
     if (it != geometry_slot.end()) return it->second;
     const int size = 1 << level;
     hex8::NodeMatrix cube;
     for (int c = 0; c < 8; ++c) cube.row(c) = size * h * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
-    hex8::ElementGeometry geo = hex8::element_geometry(cube, hex8::gauss_rule(level == 2 ? 4 : 2));
-    if (centre) geo = hex8::with_centre_point(geo, cube);
+    const hex8::QuadratureRule quadrature =
+        rule == kComposite ? hex8::composite_gauss_rule(size, 2) : hex8::gauss_rule(level == 2 ? 4 : 2);
+    hex8::ElementGeometry geo = enhanced_modes && level > 0 ? hex8::enhanced_element_geometry(cube, quadrature)
+                                                            : hex8::element_geometry(cube, quadrature);
+    if (rule == kGaussCentre) geo = hex8::with_centre_point(geo, cube);
     mesh.geometries.push_back(std::move(geo));
     const int slot = static_cast<int>(mesh.geometries.size()) - 1;
-    geometry_slot.emplace(std::make_pair(level, centre), slot);
+    geometry_slot.emplace(std::make_pair(level, rule), slot);
     return slot;
   };
   std::map<std::pair<int, int>, int> material_slot;  // (level, id or combination) -> materials index
@@ -87,11 +95,18 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
     const int size = 1 << level;
     const QuadratureMaterials& mat = mesh.materials[material_index];
     const int points = level == 2 ? 64 : 8;
+    const int composite = 8 * size * size * size;
     const int n = static_cast<int>(mat.at_point.size());
-    if (n != 1 && n != points && n != points + 1)
+    Rule rule = kGauss;
+    if (n == points + 1) {
+      rule = kGaussCentre;
+    } else if (level > 0 && n == composite) {
+      rule = kComposite;
+    } else if (n != 1 && n != points) {
       throw InputError("mixed-level mesh: a level-" + std::to_string(level) + " material lookup returned " +
-                       std::to_string(n) + " materials (expected 1, " + std::to_string(points) + " or " +
-                       std::to_string(points + 1) + ")");
+                       std::to_string(n) + " materials (expected 1, " + std::to_string(points) + ", " +
+                       std::to_string(points + 1) + " or " + std::to_string(composite) + ")");
+    }
     std::array<int, 8> el;
     for (int c = 0; c < 8; ++c) {
       const int p =
@@ -105,7 +120,7 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
     const int e = mesh.num_elements();
     mesh.elements.push_back(el);
     mesh.element_material.push_back(material_index);
-    mesh.element_geometry.push_back(geometry(level, n == points + 1));
+    mesh.element_geometry.push_back(geometry(level, rule));
     mesh.element_tag.push_back(tag);
     m.element_level.push_back(level);
     ++m.elements_per_level[level];

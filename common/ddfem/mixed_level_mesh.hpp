@@ -43,12 +43,18 @@ struct MixedLevelMesh {
 
 // `cell_level` has one entry (0, 1 or 2) per cell of `level2`, which must be
 // coarsen_grid(level1) with level1 = coarsen_grid(fine). The lookups give
-// the materials of level-1 and level-2 cells as for build_coarse_mesh.
+// the materials of level-1 and level-2 cells as for build_coarse_mesh (one per
+// Gauss point, with the centre, or the Galerkin element's 8 per fine voxel).
+// enhanced_modes: level-1 and level-2 elements carry the condensed bubble
+// modes of hex8::enhanced_element_geometry. The bubbles are element-internal
+// (incompatible) modes, so the hanging-node constraints act on the trilinear
+// part, as the coarse-to-fine interpolation of a uniform enhanced model does.
 // Throws InputError on mismatched grids or levels.
 MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
                                       const CoarseGrid& level1, const CoarseGrid& level2,
                                       const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
-                                      const CoarseMaterialLookup& level2_materials);
+                                      const CoarseMaterialLookup& level2_materials,
+                                      bool enhanced_modes = false);
 
 // Displacements (or positions) of the unknowns interpolated to the fine
 // mesh's nodes: a (fine nodes) x (unknown nodes) matrix with rows summing to

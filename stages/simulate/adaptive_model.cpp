@@ -11,12 +11,15 @@ namespace msfab {
 
 namespace {
 
-CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseDatabase& db) {
-  return database_coarsening(*db.level1, naive_coarsening(scene.material_by_id));
+// The materials of the uniform models: the database's fits, blocks without
+// one coarsened as the level-2 model's request said (naive or Galerkin).
+CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2) {
+  return database_coarsening(*level2.database->level1, baseline_coarsening(level2.fallback, scene.material_by_id, nullptr));
 }
 
-CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseDatabase& db, const CoarseGrid& level1) {
-  return database_coarsening_level2(db, level1, naive_coarsening(scene.material_by_id, level1));
+CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseModel& level2) {
+  return database_coarsening_level2(*level2.database, level2.level1,
+                                    baseline_coarsening(level2.fallback, scene.material_by_id, &level2.level1));
 }
 
 // Displacements of a coarse solution (positions x) interpolated to the fine nodes.
@@ -72,7 +75,9 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
   m.database = level2.database;
   m.level1 = level2.level1;
   m.grid = level2.level1;
-  m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, *level2.database), 0, &m.stats);
+  m.element = level2.element;
+  m.fallback = level2.fallback;
+  m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, level2), 0, &m.stats, m.element == "enhanced");
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   m.seconds = seconds_since(t0);
   return m;
@@ -84,7 +89,6 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   const auto t0 = std::chrono::steady_clock::now();
   if (!level2.database || level2.database->level != 2)
     throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
-  const CoarseDatabase& db = *level2.database;
   AdaptiveModel m;
 
   // The estimate: the two uniform solutions' difference, energies of the finer one.
@@ -97,12 +101,12 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   // The mixed mesh, with the same materials as the uniform models. A node
   // the scene fixes must not hang on free corners: the cells around it are
   // meshed fine (face conditions fix whole faces, so this is rare).
-  const CoarseMaterialLookup lookup1 = level1_lookup(scene, db);
-  const CoarseMaterialLookup lookup2 = level2_lookup(scene, db, level2.level1);
+  const CoarseMaterialLookup lookup1 = level1_lookup(scene, level2);
+  const CoarseMaterialLookup lookup2 = level2_lookup(scene, level2);
   std::vector<int>& levels = m.choice.cell_level;
   for (;;) {
     m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels, lookup1,
-                                     lookup2);
+                                     lookup2, level2.element == "enhanced");
     std::vector<int> unresolved;
     m.conditions =
         mixed_static_conditions(scene, fine, fine_conditions, level2.level1, level2.grid, m.mixed, &unresolved);

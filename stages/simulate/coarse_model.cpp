@@ -8,6 +8,15 @@
 
 namespace msfab {
 
+CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
+                                         const CoarseGrid* level1) {
+  if (name == "naive") return level1 ? naive_coarsening(palette, *level1) : naive_coarsening(palette);
+  if (name == "averaged") return level1 ? averaged_coarsening(palette, *level1) : averaged_coarsening(palette);
+  if (name == "galerkin") return level1 ? galerkin_coarsening(palette, *level1) : galerkin_coarsening(palette);
+  if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
+  throw InputError("coarse materials: expected naive, averaged, galerkin or homogenized, got '" + name + "'");
+}
+
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request) {
   if (request.fallback != "naive" && request.fallback != "galerkin")
     throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
@@ -41,23 +50,15 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
   const auto t0 = std::chrono::steady_clock::now();
   m.level1 = coarsen_grid(scene.grid);
   m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
-  // A baseline of ddfem/baseline_coarsening.hpp by name, at the requested level.
-  auto baseline = [&](const std::string& name) -> CoarseMaterialLookup {
-    const auto& palette = scene.material_by_id;
-    const bool two = request.level == 2;
-    if (name == "naive") return two ? naive_coarsening(palette, m.level1) : naive_coarsening(palette);
-    if (name == "averaged") return two ? averaged_coarsening(palette, m.level1) : averaged_coarsening(palette);
-    if (name == "galerkin") return two ? galerkin_coarsening(palette, m.level1) : galerkin_coarsening(palette);
-    return two ? homogenized_coarsening(palette, m.level1) : homogenized_coarsening(palette);
-  };
+  const CoarseGrid* level1 = request.level == 2 ? &m.level1 : nullptr;
   CoarseMaterialLookup lookup;
   if (request.material != "ddfem") {
-    lookup = baseline(request.material);
+    lookup = baseline_coarsening(request.material, scene.material_by_id, level1);
   } else {
     // Blocks the database holds no fit for (void children in a database
     // built without them, blocks that could not be fitted) are coarsened
     // naively or by the Galerkin element.
-    const CoarseMaterialLookup fallback = baseline(request.fallback);
+    const CoarseMaterialLookup fallback = baseline_coarsening(request.fallback, scene.material_by_id, level1);
     int* fallbacks = &m.fallback_blocks;
     const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
       ++*fallbacks;
@@ -65,6 +66,7 @@ CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const 
     };
     lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
                                 : database_coarsening(*m.database, counted);
+    m.fallback = request.fallback;
   }
   m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

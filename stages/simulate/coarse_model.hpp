@@ -32,7 +32,14 @@ struct CoarseModel {
   int fallback_blocks = 0;           // ddfem: distinct combinations without a fit (coarsened by request.fallback)
   std::shared_ptr<CoarseDatabase> database;
   std::string element = "trilinear"; // the coarse element used (request resolved)
+  std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
 };
+
+// A baseline of ddfem/baseline_coarsening.hpp by name (naive, averaged,
+// galerkin, homogenized): of level-1 blocks when level1 is null, of level-2
+// cells of that level-1 grid otherwise.
+CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
+                                         const CoarseGrid* level1);
 
 // InputError for a bad request: unknown material, ddfem without a database
 // or with a database of another level, a database whose palette disagrees

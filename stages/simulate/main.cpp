@@ -101,11 +101,6 @@ int main(int argc, char** argv) {
         throw InputError("--target-error: must be a finite number > 0 (the mean-vertex error), got " +
                          fmt::format("{}", target_error));
       if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
-      if (coarsening.element == "enhanced")
-        throw InputError("--coarse-element enhanced: not available with --target-error (mixed meshes are trilinear)");
-      if (coarsening.fallback != "naive")
-        throw InputError("--coarse-fallback " + coarsening.fallback +
-                         ": not available with --target-error (mixed meshes coarsen blocks without a fit naively)");
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
       if (scene.newton.linear_solver == "pcg-mg")
@@ -118,9 +113,6 @@ int main(int argc, char** argv) {
       throw InputError("--coarse-element: needs --coarsen 1 or 2 (the fine mesh is trilinear)");
     CoarseModel coarse;
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
-    if (adaptive && coarse.element == "enhanced")
-      throw InputError(coarsening.database + ": fitted for the enhanced coarse element, which --target-error does not "
-                       "support (mixed meshes are trilinear)");
     const bool coarsened = coarsening.level > 0;
     AdaptiveModel adapted;
     double uniform_seconds = 0;  // adaptive: the two uniform solves the estimate comes from

@@ -132,17 +132,31 @@ check "compressed enhanced database" -- "$BIN/msfab-ddfem-compress" --database "
   --set representatives=64 --out "$WORK/k64_enhanced.h5"
 check "the compressed enhanced database keeps its element" -- \
   bash -c "h5dump -a /fit/element '$WORK/k64_enhanced.h5' | grep -q enhanced"
+# Adaptive coarsening on the enhanced element: a level-2 database over the
+# enhanced level-1 one; the mixed mesh carries the bubbles in its level-1 and
+# level-2 elements, blocks without a fit by the Galerkin element.
+check "tiny level-2 database for the enhanced element" -- "$BIN/msfab-ddfem-build" \
+  --config "$SRC/configs/ddfem/tiny_level2.yaml" --set base_database="$WORK/db_enhanced.h5" \
+  --set sampling.mode=periodic --set sampling.magnitudes=1 --set fit.element=enhanced --set fit.bend_weight=0 \
+  --set fit.twist_weight=0 --set fit.pinch_weight=0 --out "$WORK/db2_enhanced.h5" --quiet
+"$SIM" --config "$BAR" --target-error 0.02 --database "$WORK/db2_enhanced.h5" --coarse-fallback galerkin \
+  --reference "$WORK/fine.h5" --out "$WORK/adaptive_enhanced.h5" --quiet >/dev/null
+adaptive_enhanced=$(attr_of adaptive_enhanced error_vs_fine)
+elements_enhanced=$(h5dump -a /elements "$WORK/adaptive_enhanced.h5" | sed -n 's/.*(0): *//p')
+echo "adaptive on the enhanced element, target 0.02: error $adaptive_enhanced, $elements_enhanced elements (fine: 256)"
+check "adaptive target met on the enhanced element with fewer elements than fine" -- \
+  awk -v e="$adaptive_enhanced" -v n="$elements_enhanced" 'BEGIN { exit !(e > 0 && e <= 0.02 && n < 256) }'
+check "the adaptive result records the enhanced element" -- \
+  bash -c "h5dump -a /coarsening/element '$WORK/adaptive_enhanced.h5' | grep -q enhanced"
 
 # Bad requests.
 expect_exit 2 "coarse-element" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-element quadratic --out "$WORK/o.h5"
 expect_exit 2 "needs --coarsen 1 or 2" -- "$SIM" --config "$BAR" --coarse-element enhanced --out "$WORK/o.h5"
-expect_exit 2 "not available with --target-error" -- "$SIM" --config "$BAR" --target-error 0.01 --coarse-element enhanced \
-  --database "$WORK/db2.h5" --out "$WORK/o.h5"
+expect_exit 2 "fitted for the trilinear coarse element" -- "$SIM" --config "$BAR" --target-error 0.01 \
+  --coarse-element enhanced --database "$WORK/db2.h5" --out "$WORK/o.h5"
 expect_exit 2 "coarse-material" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material homogenised --out "$WORK/o.h5"
 expect_exit 2 "coarse-fallback galerkin: applies to --coarse-material ddfem only" -- "$SIM" --config "$BAR" --coarsen 1 \
   --coarse-material naive --coarse-fallback galerkin --out "$WORK/o.h5"
-expect_exit 2 "coarse-fallback galerkin: not available with --target-error" -- "$SIM" --config "$BAR" --target-error 0.01 \
-  --coarse-fallback galerkin --database "$WORK/db2.h5" --out "$WORK/o.h5"
 expect_exit 2 "needs --database" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-material ddfem --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db.h5" --out "$WORK/o.h5"

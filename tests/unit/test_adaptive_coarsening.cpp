@@ -65,6 +65,28 @@ MixedLevelMesh naive_mixed_mesh(const Scene& s, const Grids& g, const std::vecto
                                 naive_coarsening(s.material_by_id), naive_coarsening(s.material_by_id, g.level1));
 }
 
+// The coarse models a mixed mesh can hold besides the trilinear naive one:
+// the enhanced element (condensed bubbles) with naive materials, and with the
+// Galerkin element's 8 points per fine voxel.
+struct CoarseVariant {
+  const char* name;
+  bool enhanced;
+  bool galerkin;
+};
+constexpr CoarseVariant kCoarseVariants[] = {
+    {"trilinear naive", false, false}, {"enhanced naive", true, false}, {"enhanced Galerkin", true, true}};
+
+CoarseMaterialLookup variant_lookup(const Scene& s, const CoarseVariant& v, const CoarseGrid* level1) {
+  if (v.galerkin) return level1 ? galerkin_coarsening(s.material_by_id, *level1) : galerkin_coarsening(s.material_by_id);
+  return level1 ? naive_coarsening(s.material_by_id, *level1) : naive_coarsening(s.material_by_id);
+}
+
+MixedLevelMesh variant_mixed_mesh(const Scene& s, const Grids& g, const std::vector<int>& levels,
+                                  const CoarseVariant& v) {
+  return build_mixed_level_mesh(s.grid, s.material_by_id, g.level1, g.level2, levels, variant_lookup(s, v, nullptr),
+                                variant_lookup(s, v, &g.level1), v.enhanced);
+}
+
 TEST(AdaptiveMixedMesh, HangingNodesInterpolateRestPositionsAndRowsSumToOne) {
   const Scene s = two_material_block();
   const Grids g = grids_of(s);
@@ -120,34 +142,77 @@ TEST(AdaptiveMixedMesh, AffineDisplacementIsReproducedAcrossLevelInterfaces) {
   s.grid.at(5, 6, 2) = 1;  // no holes: the body is a box
   s.grid.at(1, 9, 6) = 1;
   const Grids g = grids_of(s);
-  const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
-  const ElasticAssembler a(m.mesh, m.constraints);
-  Mat3 strain;
-  strain << 0.02, 0.005, 0, 0.005, -0.01, 0.004, 0, 0.004, 0.015;
-  const NodeArray& X = m.constraints->unknown_rest;
-  const Vec3 lo = m.mesh.bbox_min(), hi = m.mesh.bbox_max();
-  DirichletConditions bc = DirichletConditions::none(a.num_dofs());
-  for (int n = 0; n < X.rows(); ++n) {
-    const Vec3 p = X.row(n).transpose();
-    const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-12) || ((hi - p).cwiseAbs().minCoeff() < 1e-12);
-    if (!boundary) continue;
-    for (int c = 0; c < 3; ++c) {
-      bc.fixed[3 * n + c] = 1;
-      bc.displacement[3 * n + c] = (strain * p)[c];
+  for (const CoarseVariant& v : kCoarseVariants) {
+    SCOPED_TRACE(v.name);
+    const MixedLevelMesh m = variant_mixed_mesh(s, g, patchwork_levels(g.level2), v);
+    const ElasticAssembler a(m.mesh, m.constraints);
+    Mat3 strain;
+    strain << 0.02, 0.005, 0, 0.005, -0.01, 0.004, 0, 0.004, 0.015;
+    const NodeArray& X = m.constraints->unknown_rest;
+    const Vec3 lo = m.mesh.bbox_min(), hi = m.mesh.bbox_max();
+    DirichletConditions bc = DirichletConditions::none(a.num_dofs());
+    for (int n = 0; n < X.rows(); ++n) {
+      const Vec3 p = X.row(n).transpose();
+      const bool boundary = ((p - lo).cwiseAbs().minCoeff() < 1e-12) || ((hi - p).cwiseAbs().minCoeff() < 1e-12);
+      if (!boundary) continue;
+      for (int c = 0; c < 3; ++c) {
+        bc.fixed[3 * n + c] = 1;
+        bc.displacement[3 * n + c] = (strain * p)[c];
+      }
     }
+    NewtonOptions opt;
+    opt.linear_solver = "cholmod";
+    opt.relative_tolerance = 1e-10;
+    const NewtonResult r = solve_static(a, bc, VecX::Zero(a.num_dofs()), opt);
+    ASSERT_TRUE(r.converged) << r.failure;
+    const VecX x = a.mesh_positions(r.x);
+    double worst = 0;
+    for (int n = 0; n < m.mesh.num_nodes(); ++n) {
+      const Vec3 p = m.mesh.nodes.row(n).transpose();
+      worst = std::max(worst, (x.segment<3>(3 * n) - p - strain * p).norm());
+    }
+    EXPECT_LT(worst, 1e-9 * s.grid.voxel_size);
   }
+}
+
+// With every cell at level 1 (or 2) the mixed mesh is the uniform coarse
+// model of build_coarse_mesh, element and materials included: the same
+// solution under the scene's conditions.
+TEST(AdaptiveMixedMesh, UniformLevelsSolveTheUniformCoarseModel) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const VoxelMesh fine = build_voxel_mesh(s.grid, s.material_by_id);
+  const StaticConditions fc = build_static_conditions(s, fine);
   NewtonOptions opt;
   opt.linear_solver = "cholmod";
   opt.relative_tolerance = 1e-10;
-  const NewtonResult r = solve_static(a, bc, VecX::Zero(a.num_dofs()), opt);
-  ASSERT_TRUE(r.converged) << r.failure;
-  const VecX x = a.mesh_positions(r.x);
-  double worst = 0;
-  for (int n = 0; n < m.mesh.num_nodes(); ++n) {
-    const Vec3 p = m.mesh.nodes.row(n).transpose();
-    worst = std::max(worst, (x.segment<3>(3 * n) - p - strain * p).norm());
-  }
-  EXPECT_LT(worst, 1e-9 * s.grid.voxel_size);
+  for (const CoarseVariant& v : kCoarseVariants)
+    for (int level : {1, 2}) {
+      SCOPED_TRACE(std::string(v.name) + ", level " + std::to_string(level));
+      const MixedLevelMesh m = variant_mixed_mesh(s, g, std::vector<int>(g.level2.num_cells(), level), v);
+      EXPECT_EQ(m.hanging_nodes, 0);
+      const CoarseGrid& grid = level == 1 ? g.level1 : g.level2;
+      const VoxelMesh cm =
+          build_coarse_mesh(grid, variant_lookup(s, v, level == 1 ? nullptr : &g.level1), 0, nullptr, v.enhanced);
+      ASSERT_EQ(m.mesh.num_elements(), cm.mesh.num_elements());
+      ASSERT_EQ(m.num_unknown_nodes(), cm.mesh.num_nodes());
+      const StaticConditions cc = coarse_static_conditions(s, fine, grid, cm);
+      const StaticConditions mc = mixed_static_conditions(s, fine, fc, g.level1, g.level2, m);
+      EXPECT_EQ(mc.dirichlet.count_fixed(), cc.dirichlet.count_fixed());
+      const ElasticAssembler ac(cm.mesh);
+      const NewtonResult rc = solve_static(ac, cc.dirichlet, cc.force, opt);
+      const ElasticAssembler am(m.mesh, m.constraints);
+      const NewtonResult rm = solve_static(am, mc.dirichlet, mc.force, opt);
+      ASSERT_TRUE(rc.converged && rm.converged);
+      const VecX uc = interpolate_to_fine(s.grid, fine, grid, cm, rc.x - ac.rest_positions());
+      const SpMat W = mixed_to_fine_interpolation(s.grid, fine, m);
+      const VecX um = rm.x - am.rest_positions();
+      VecX interpolated(fine.mesh.num_dofs());
+      Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
+          W * Eigen::Map<const Rows3>(um.data(), m.num_unknown_nodes(), 3);
+      EXPECT_LT(mean_vertex_error(fine, uc, interpolated), 1e-8 * uc.cwiseAbs().maxCoeff());
+      EXPECT_GT(uc.cwiseAbs().maxCoeff(), 0);
+    }
 }
 
 // With every cell at level 0 (a zero budget) the mixed model is the fine
