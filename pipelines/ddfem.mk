@@ -8,6 +8,7 @@
 #   make -f Makefile.pipeline ddfem-table-centre    periodic sampling and a fitted centre point, its own section
 #   make -f Makefile.pipeline ddfem-table-void      periodic sampling with void in the palette, its own section
 #   make -f Makefile.pipeline ddfem-table-adaptive  adaptive coarsening (--target-error): speed against error, PNG
+#   make -f Makefile.pipeline ddfem-table-adaptive-enhanced  the same on the enhanced element, Galerkin fallback
 #   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
 #   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
@@ -39,7 +40,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -98,3 +99,14 @@ ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/d
 	DATABASE1=$(OUT)/ddfem/palette3_periodic.coarse_db.h5 \
 	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+
+# The same on the enhanced element (docs/ddfem.md, "Adaptive coarsening"):
+# the affine databases of ddfem-table-mixed, blocks without a fit by the
+# Galerkin element (FALLBACK=naive for the naive fallback).
+FALLBACK ?= galerkin
+ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
+                               $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
+	DATABASE1=$(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 BENCH_SECTION=ddfem-adaptive-enhanced \
+	  COARSE_ARGS="--coarse-fallback $(FALLBACK)" \
+	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-enhanced-$(FALLBACK) docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5

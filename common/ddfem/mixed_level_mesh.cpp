@@ -1,6 +1,7 @@
 #include "ddfem/mixed_level_mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 
@@ -273,6 +274,54 @@ SpMat mixed_to_fine_interpolation(const VoxelGrid& fine_grid, const VoxelMesh& f
   to_mesh.setFromTriplets(trip.begin(), trip.end());
   SpMat out = to_mesh * mixed.constraints->node_map;
   out.makeCompressed();
+  return out;
+}
+
+VecX uniform_displacement_at(const CoarseGrid& grid, const VoxelMesh& coarse_mesh, const VecX& x_coarse,
+                             const NodeArray& points) {
+  const HexMesh& cm = coarse_mesh.mesh;
+  if (x_coarse.size() != cm.num_dofs() || coarse_mesh.voxel_element.size() != size_t(grid.num_cells()))
+    throw InputError("uniform start: the solution does not belong to the coarse mesh of this grid");
+  const int f = grid.fine_per_cell();
+  const double h = grid.fine_voxel_size;
+  const std::array<int, 3> cells{grid.nx, grid.ny, grid.nz};
+  auto element_at = [&](const std::array<int, 3>& c) {
+    for (int ax = 0; ax < 3; ++ax)
+      if (c[ax] < 0 || c[ax] >= cells[ax]) return -1;
+    return coarse_mesh.voxel_element[grid.index(c[0], c[1], c[2])];
+  };
+  VecX out = VecX::Zero(3 * points.rows());
+  for (int p = 0; p < points.rows(); ++p) {
+    std::array<int, 3> a;  // fine lattice point
+    for (int ax = 0; ax < 3; ++ax) a[ax] = int(std::lround((points(p, ax) - grid.origin[ax]) / h));
+    // A cell touching the point (up to 8 share a node); else the nearest
+    // cell with an element within a few cells, extrapolated.
+    std::array<int, 3> cell{};
+    int e = -1;
+    for (int q = 0; q < 8 && e < 0; ++q) {
+      std::array<int, 3> c;
+      for (int ax = 0; ax < 3; ++ax) {
+        const int shifted = a[ax] - ((q >> (2 - ax)) & 1);
+        c[ax] = shifted < 0 ? -1 : shifted / f;
+      }
+      if ((e = element_at(c)) >= 0) cell = c;
+    }
+    for (int radius = 1; radius <= 3 && e < 0; ++radius)
+      for (int dk = -radius; dk <= radius && e < 0; ++dk)
+        for (int dj = -radius; dj <= radius && e < 0; ++dj)
+          for (int di = -radius; di <= radius && e < 0; ++di) {
+            const std::array<int, 3> c{a[0] / f + di, a[1] / f + dj, a[2] / f + dk};
+            if ((e = element_at(c)) >= 0) cell = c;
+          }
+    if (e < 0) continue;  // no coarse element near: start at rest
+    const double t[3] = {double(a[0] - f * cell[0]) / f, double(a[1] - f * cell[1]) / f,
+                         double(a[2] - f * cell[2]) / f};
+    for (int c = 0; c < 8; ++c) {
+      const int node = cm.elements[e][c];
+      const Vec3 u = x_coarse.segment<3>(3 * node) - cm.nodes.row(node).transpose();
+      out.segment<3>(3 * p) += corner_weight(c, t) * u;
+    }
+  }
   return out;
 }
 

@@ -62,6 +62,16 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
 // voxels.
 SpMat mixed_to_fine_interpolation(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh, const MixedLevelMesh& mixed);
 
+// A start for Newton on a model whose nodes lie on the fine node lattice (a
+// mixed-level mesh, or a uniform model of a finer level): the displacements
+// of a uniform coarse solution (`x_coarse`, positions of `coarse_mesh`'s
+// nodes) at `points` (rest positions), 3 per point. Each point is
+// interpolated trilinearly in a coarse element whose cell touches it, or
+// extrapolated from the nearest cell with an element where every cell
+// around it is void. A starting guess, not a model: the caller solves from it.
+VecX uniform_displacement_at(const CoarseGrid& grid, const VoxelMesh& coarse_mesh, const VecX& x_coarse,
+                             const NodeArray& points);
+
 // The scene's conditions on the unknowns. Forces: the fine nodal forces
 // restricted by the transpose of mixed_to_fine_interpolation (total force
 // and moment kept). Dirichlet conditions: a node is fixed where the fine,

@@ -83,6 +83,13 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
   return m;
 }
 
+VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& rest) {
+  using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  VecX x = uniform_displacement_at(from.grid, from.mesh, x_from, rest);
+  Eigen::Map<Rows3>(x.data(), rest.rows(), 3) += rest;
+  return x;
+}
+
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
                                    const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
                                    const VecX& x1, double target_error) {

@@ -25,6 +25,11 @@ struct AdaptiveModel {
 // level-2 model's database (the database's compressed level-1 entries).
 CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2);
 
+// Positions to start Newton from on a finer model with rest nodes `rest`
+// (flattened, 3 per node): the coarser uniform model `from`'s solution
+// x_from interpolated to them (uniform_displacement_at).
+VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& rest);
+
 // `level2` / `level1` are the uniform models and x2 / x1 their solutions
 // (positions).
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,

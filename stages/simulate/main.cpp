@@ -36,11 +36,11 @@ using namespace msfab;
 namespace {
 
 NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticConditions& conditions,
-                            const NewtonOptions& options, const char* label) {
+                            const NewtonOptions& options, const char* label, const VecX& x0 = VecX()) {
   NewtonOptions newton = options;
   Progress progress(label, 100);
   newton.on_load_step = [&](double load) { progress.set(static_cast<std::uint64_t>(100 * load + 0.5)); };
-  NewtonResult result = solve_static(assembler, conditions.dirichlet, conditions.force, newton);
+  NewtonResult result = solve_static(assembler, conditions.dirichlet, conditions.force, newton, x0);
   progress.done();
   if (!result.converged)
     throw NumericalError(std::string(label) + ": " + result.failure + "\nresidual history:\n" +
@@ -116,14 +116,20 @@ int main(int argc, char** argv) {
     const bool coarsened = coarsening.level > 0;
     AdaptiveModel adapted;
     double uniform_seconds = 0;  // adaptive: the two uniform solves the estimate comes from
+    // Each finer adaptive solve starts from the coarser solution, at full
+    // load: a few Newton steps instead of the scene's load stepping from rest.
+    NewtonOptions warm_newton = scene.newton;
+    warm_newton.load_steps = 1;
+    VecX adaptive_start;
     if (adaptive) {
       const NewtonResult solve2 =
           solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
       const CoarseModel level1 = level1_model_of(scene, fine, coarse);
-      const NewtonResult solve1 =
-          solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, scene.newton, "level-1 load");
+      const NewtonResult solve1 = solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, warm_newton,
+                                                 "level-1 load", start_from(coarse, solve2.x, level1.mesh.mesh.nodes));
       uniform_seconds = solve2.timings.total + solve1.timings.total;
       adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, target_error);
+      adaptive_start = start_from(level1, solve1.x, adapted.mixed.constraints->unknown_rest);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
     const HexMesh& solved_mesh = adaptive ? adapted.mixed.mesh : vm.mesh;
@@ -153,10 +159,11 @@ int main(int argc, char** argv) {
     // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
     // step apart, which elements of mixed sizes are not: adaptive models are
     // factored directly (they are the smaller ones; docs/ddfem.md).
-    NewtonOptions newton = scene.newton;
+    NewtonOptions newton = adaptive ? warm_newton : scene.newton;
     if (adaptive && newton.linear_solver == "auto") newton.linear_solver = "cholmod";
     const NewtonResult result = solve_or_throw(assembler, conditions, newton,
-                                               adaptive ? "adaptive load" : coarsened ? "coarse load" : "load");
+                                               adaptive ? "adaptive load" : coarsened ? "coarse load" : "load",
+                                               adaptive_start);
     // The coarse model's Newton time; adaptive runs include the uniform solves.
     const double coarse_seconds = result.timings.total + (adaptive ? uniform_seconds + adapted.seconds : 0.0);
 
