@@ -101,12 +101,14 @@ ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/d
 	  $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
 
 # The same on the enhanced element (docs/ddfem.md, "Adaptive coarsening"):
-# the affine databases of ddfem-table-mixed, blocks without a fit by the
-# Galerkin element (FALLBACK=naive for the naive fallback).
+# the affine databases of ddfem-table-mixed (ENHANCED_DB), blocks without a
+# fit by the Galerkin element (FALLBACK=naive for the naive fallback);
+# ENHANCED_DB=palette3_periodic_enhanced_affine_void fits the blocks with
+# void too.
 FALLBACK ?= galerkin
-ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
-                               $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
-	DATABASE1=$(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 BENCH_SECTION=ddfem-adaptive-enhanced \
+ENHANCED_DB ?= palette3_periodic_enhanced_affine
+ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+	DATABASE1=$(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 BENCH_SECTION=ddfem-adaptive-enhanced \
 	  COARSE_ARGS="--coarse-fallback $(FALLBACK)" \
-	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-enhanced-$(FALLBACK) docs/BENCHMARKS.md \
-	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
+	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-$(ENHANCED_DB)-$(FALLBACK) docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
