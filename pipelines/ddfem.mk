@@ -104,7 +104,7 @@ ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/d
 # the affine databases of ddfem-table-mixed (ENHANCED_DB), blocks without a
 # fit by the Galerkin element (FALLBACK=naive for the naive fallback);
 # ENHANCED_DB=palette3_periodic_enhanced_affine_void fits the blocks with
-# void too.
+# void too (its level 2 takes hours; docs/BENCHMARKS.md).
 FALLBACK ?= galerkin
 ENHANCED_DB ?= palette3_periodic_enhanced_affine
 ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5

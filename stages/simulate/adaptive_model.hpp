@@ -25,8 +25,8 @@ struct AdaptiveModel {
 // level-2 model's database (the database's compressed level-1 entries).
 CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2);
 
-// Positions to start Newton from on a finer model with rest nodes `rest`
-// (flattened, 3 per node): the coarser uniform model `from`'s solution
+// Positions (3 per node) to start Newton from on a finer model whose rest
+// nodes are the rows of `rest`: the coarser uniform model `from`'s solution
 // x_from interpolated to them (uniform_displacement_at).
 VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& rest);
 
