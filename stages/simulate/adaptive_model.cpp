@@ -11,6 +11,8 @@ namespace msfab {
 
 namespace {
 
+using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
 // The materials of the uniform models: the database's fits, blocks without
 // one coarsened as the level-2 model's request said (naive or Galerkin).
 CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2) {
@@ -46,7 +48,6 @@ VecX as_vecx(const std::vector<double>& v) { return Eigen::Map<const VecX>(v.dat
 
 VecX adaptive_displacement_on_fine(const Scene& scene, const VoxelMesh& fine, const AdaptiveModel& model,
                                    const ElasticAssembler& assembler, const VecX& x) {
-  using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
   const VecX u = x - assembler.rest_positions();
   const SpMat W = mixed_to_fine_interpolation(scene.grid, fine, model.mixed);
   VecX out(fine.mesh.num_dofs());
@@ -84,7 +85,6 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
 }
 
 VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& rest) {
-  using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
   VecX x = uniform_displacement_at(from.grid, from.mesh, x_from, rest);
   Eigen::Map<Rows3>(x.data(), rest.rows(), 3) += rest;
   return x;
