@@ -180,7 +180,8 @@ SamplerState GamutSampler::initialize(StepReport* report) const {
   set.soft_is_void = o_.soft_is_void;
 
   std::vector<VoxelGrid> cells = {solid_cell()};
-  for (VoxelGrid& c : random_cuts(0, o_.population)) cells.push_back(std::move(c));
+  if (!o_.set_only)
+    for (VoxelGrid& c : random_cuts(0, o_.population)) cells.push_back(std::move(c));
   for (VoxelGrid& c : initial_set_cells()) cells.push_back(std::move(c));
   *report = add_structures(state, cells, std::vector<std::int64_t>(cells.size(), -1), 0, SampleStep::initial, palette_);
   if (state.set.items.empty())

@@ -29,7 +29,7 @@ void_stiffness: 1.0e-6
 use_symmetry: true        # cell problems on the symmetric part (exact); false: six cases on the whole cell
 min_feature: 1            # the printer's smallest beam or gap, voxels (1: no limit)
 plot_every_cycle: true
-mode: sampler             # sampler | random (the benchmark's baseline)
+mode: sampler             # sampler | random (the benchmark's baseline) | set (initial_set's structures alone)
 void_variants: false      # also write the structures with the soft material removed (thesis 3.6.1)
 )";
 
@@ -205,7 +205,11 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.plot_every_cycle = config.get_or<bool>("plot_every_cycle", o.plot_every_cycle);
   o.void_variants = config.get_or<bool>("void_variants", o.void_variants);
   if (o.void_variants && o.soft_is_void) config.fail("void_variants", "needs a soft material to remove (materials.soft)");
-  if (config.has("mode")) o.random_baseline = config.one_of("mode", {"sampler", "random"}) == "random";
+  if (config.has("mode")) {
+    const std::string mode = config.one_of("mode", {"sampler", "random", "set"});
+    o.random_baseline = mode == "random";
+    o.set_only = mode == "set";
+  }
   if (config.has("initial_set")) {
     const Config seeds = config.child("initial_set");
     o.initial_set = seeds.get_path("path");
@@ -215,6 +219,9 @@ SamplerOptions read_sampler_options(const Config& config) {
     if (o.initial_refine < 1 || o.initial_refine > 8) seeds.fail("refine", "must be in 1..8");
     seeds.check_no_unknown_keys();
   }
+  if (o.set_only && o.initial_set.empty()) config.fail("mode", "set needs initial_set.path (the structures to keep)");
+  if (o.set_only && o.cycles != 0)
+    config.fail("cycles", "must be 0 with mode: set (the gamut of the given structures, nothing sampled)");
   return o;
 }
 

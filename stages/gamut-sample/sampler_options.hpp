@@ -78,6 +78,11 @@ struct SamplerOptions {
   // the solid cell (the initial distribution): at least the sampler's
   // number of homogenizations, no evolution, scoring or continuous step.
   bool random_baseline = false;
+  // `mode: set`: the gamut of the solid cell and initial_set's structures
+  // alone, no random population and no cycles: e.g. a hand-made family
+  // whose members connect to each other through their faces
+  // (configs/gamut/graded_lattice.yaml, docs/mapping.md).
+  bool set_only = false;
 };
 
 // The largest coverage of cycles 0..through of `history` (cycle 0 first).

@@ -84,6 +84,23 @@ expect_exit 2 "initial_set.refine.*must be in 1..8" -- "$SAMPLE" --config "$TINY
 expect_exit 2 "initial_set.*missing.h5" -- "$SAMPLE" --config "$TINY" --set initial_set="{path: $WORK/missing.h5}" \
   --out "$WORK/bad.gamut.h5"
 
+# `mode: set`: the gamut of a given set (and the solid cell) alone, nothing
+# sampled: the set's structures come back unchanged, in order, after the solid cell.
+out=$("$SAMPLE" --config "$TINY" --seed 7 --set mode=set --set cycles=0 \
+  --set initial_set="{path: $WORK/one.microstructures.h5}" --out "$WORK/setonly.gamut.h5" 2>&1)
+echo "mode set: $(initial_of "$out") structures from a set of $n_one"
+check "mode set keeps the set and the solid cell, nothing else" -- \
+  test "$(count_of "$WORK/setonly.microstructures.h5")" -le "$((n_one + 1))"
+check "mode set: no cycle ran" -- bash -c "h5dump -d /history/cycle '$WORK/setonly.gamut.h5' | grep -q '(0): 0\$'"
+check "mode set: the set's last structure is the artifact's last" -- bash -c \
+  "h5dump -d /properties '$WORK/one.microstructures.h5' | grep -o '([0-9]*,0):.*' | tail -1 | cut -d: -f2 > '$WORK/a' && \
+   h5dump -d /properties '$WORK/setonly.microstructures.h5' | grep -o '([0-9]*,0):.*' | tail -1 | cut -d: -f2 > '$WORK/b' && \
+   cmp -s '$WORK/a' '$WORK/b'"
+expect_exit 2 "mode.*set needs initial_set.path" -- "$SAMPLE" --config "$TINY" --set mode=set --set cycles=0 \
+  --out "$WORK/bad.gamut.h5"
+expect_exit 2 "cycles.*must be 0 with mode: set" -- "$SAMPLE" --config "$TINY" --set mode=set \
+  --set initial_set="{path: $WORK/one.microstructures.h5}" --out "$WORK/bad.gamut.h5"
+
 # Runs to convergence: `stop` ends the run once the coverage grew by less
 # than coverage_growth over `window` cycles; `cycles` is then the most. On
 # this seed the coverage per cycle is 0.0059, 0.0080, 0.0141, 0.0140 (best
