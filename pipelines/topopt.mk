@@ -1,12 +1,13 @@
 # Two-scale topology optimization and its full-resolution check (thesis
 # §3.4–3.6, Table 3.1): gamut -> design -> mapping -> homogenized against
-# voxel simulation, for three scenes in one 3D cubic gamut of one material
+# voxel simulation, for four scenes in one 3D cubic gamut of one material
 # and void at 16^3 voxels per cell (configs/gamut/cubic3d_bar.yaml, minutes):
 #
 #   make -f Makefile.pipeline topopt-bar-check       the 8x2x2 bar of Table 3.1 (128x32x32 voxels)
 #   make -f Makefile.pipeline topopt-gripper-check   the gripper as a 32x16x2 plate (512x256x32 voxels)
 #   make -f Makefile.pipeline topopt-bridge-check    a 24x6x4 bridge (384x96x64 voxels)
-#   make -f Makefile.pipeline topopt-checks          all three
+#   make -f Makefile.pipeline topopt-cantilever-check a 16x4x8 cantilever (256x64x128 voxels)
+#   make -f Makefile.pipeline topopt-checks          all four
 #   make -f Makefile.pipeline topopt-bridge-large    the bridge at 128x64x32 cells (Fig. 3-29's grid), optimized
 #                                                    with cell MMA: out/topopt/bridge_cubic_large.design.h5 (about 30 min)
 #   make -f Makefile.pipeline topopt-thesis-2d       the thesis's 2D scenes: the S-beam (Fig. 3-18), the four
@@ -25,17 +26,40 @@
 # coarse mesh's error alone). The bar adds bar.t2.verify.h5 (each cell 2^3
 # copies of its structure, 4^3 hexahedra per cell: thinner boundary layers). Each check prints one summary line
 # (docs/verify_map.md). SEED (pipelines/gamut.mk) seeds the gamut and the mapping.
-BAR_GAMUT := $(OUT)/gamut/cubic3d_bar
+# TWO_SCALE_GAMUT names the gamut (configs/gamut/NAME.yaml) the four
+# scenes are optimized and mapped in; its results go to out/topopt/NAME/
+# (the default's to out/topopt/). graded_lattice is one hand-made family
+# whose members connect through every face (configs/families/
+# graded_lattice.yaml, docs/mapping.md): it is mapped to the nearest member
+# without half-shifted exemplars, which would break the connection.
+#   make -f Makefile.pipeline topopt-checks TWO_SCALE_GAMUT=graded_lattice
+# TOPOPT_ARGS go to msfab-topopt (e.g. "--set gamut_padding=subtract", the
+# feasible set ending at the outermost structures); give such a variant its
+# own TOPOPT_DIR.
+TWO_SCALE_GAMUT ?= cubic3d_bar
+TOPOPT_ARGS ?=
+BAR_GAMUT := $(OUT)/gamut/$(TWO_SCALE_GAMUT)
+ifeq ($(TWO_SCALE_GAMUT),cubic3d_bar)
+TOPOPT_DIR ?= $(OUT)/topopt
+else
+TOPOPT_DIR ?= $(OUT)/topopt/$(TWO_SCALE_GAMUT)
+endif
+MAP_ARGS_graded_lattice := --set half_shift=false --set candidates=1
 CUBES_GAMUT := $(OUT)/gamut/cubic3d_bar_dense
-TWO_SCALE_SCENES := bar gripper3d bridge_cubic
+TWO_SCALE_SCENES := bar gripper3d bridge_cubic cantilever_cubic
+
+$(OUT)/gamut/graded_lattice.gamut.h5: $(OUT)/families/graded_lattice.microstructures.h5
+$(OUT)/families/graded_lattice.microstructures.h5: configs/families/graded_lattice.yaml $(BIN)/msfab-family-generate
+	@mkdir -p $(@D)
+	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ --quiet
 
 $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 	@test -s $@
 
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.design.h5): $(OUT)/topopt/%.design.h5: configs/topopt/%.yaml \
+$(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.design.h5): $(TOPOPT_DIR)/%.design.h5: configs/topopt/%.yaml \
     $(BAR_GAMUT).gamut.h5 $(BIN)/msfab-topopt
 	@mkdir -p $(@D)
-	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 $(TOPOPT_ARGS) --threads $(THREADS) --out $@ --quiet
 
 # The gamut's structures, with FILL_TARGETS=1 plus structures generated at
 # the design's targets that the gamut does not cover (msfab-fill-targets). The targets fan out over MPI ranks with
@@ -50,7 +74,7 @@ FILL_TARGETS ?= 0
 FILL_MPIRUN ?=
 MATCH ?= all
 FILL_ARGS ?=
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.structures.h5): $(OUT)/topopt/%.structures.h5: $(OUT)/topopt/%.design.h5 \
+$(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.structures.h5): $(TOPOPT_DIR)/%.structures.h5: $(TOPOPT_DIR)/%.design.h5 \
     $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-fill-targets
 ifeq ($(FILL_TARGETS),0)
 	cp $(BAR_GAMUT).microstructures.h5 $@.tmp && mv $@.tmp $@
@@ -63,10 +87,10 @@ endif
 # layer for the smaller models.
 MAP_EXPORTS_bar := --set export.stl=true --set export.png=true
 MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%.mapped.h5): $(OUT)/topopt/%.mapped.h5: $(OUT)/topopt/%.design.h5 \
-    $(OUT)/topopt/%.structures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
-	  --set export.voxels=true $(MAP_EXPORTS_$*) --threads $(THREADS) --out $@ --quiet
+$(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.mapped.h5): $(TOPOPT_DIR)/%.mapped.h5: $(TOPOPT_DIR)/%.design.h5 \
+    $(TOPOPT_DIR)/%.structures.h5 $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
+	  --set export.voxels=true $(MAP_EXPORTS_$*) $(MAP_ARGS_$(TWO_SCALE_GAMUT)) --threads $(THREADS) --out $@ --quiet
 
 # The three checks of Table 3.1 per scene: S.verify.h5 (one hexahedron per
 # cell), S.h4.verify.h5 and S.solid.verify.h5, differing only in settings.
@@ -74,20 +98,20 @@ VERIFY_SETTINGS_ :=
 VERIFY_SETTINGS_.h4 := --set homogenized_elements=4
 VERIFY_SETTINGS_.solid := --set fill=solid
 define TWO_SCALE_CHECK
-$(TWO_SCALE_SCENES:%=$(OUT)/topopt/%$(1).verify.h5): $(OUT)/topopt/%$(1).verify.h5: $(OUT)/topopt/%.mapped.h5 \
-    $(OUT)/topopt/%.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/$$*.design.h5 --mapped $$< \
-	  --structures $(OUT)/topopt/$$*.structures.h5 $(VERIFY_SETTINGS_$(1)) --threads $(THREADS) --out $$@
+$(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%$(1).verify.h5): $(TOPOPT_DIR)/%$(1).verify.h5: $(TOPOPT_DIR)/%.mapped.h5 \
+    $(TOPOPT_DIR)/%.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/$$*.design.h5 --mapped $$< \
+	  --structures $(TOPOPT_DIR)/$$*.structures.h5 $(VERIFY_SETTINGS_$(1)) --threads $(THREADS) --out $$@
 endef
 $(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
-$(OUT)/topopt/bar.t2.mapped.h5: $(OUT)/topopt/bar.design.h5 $(OUT)/topopt/bar.structures.h5 $(BIN)/msfab-map
-	$(BIN)/msfab-map --design $< --structures $(OUT)/topopt/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
-	  --threads $(THREADS) --out $@ --quiet
+$(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
+	  $(MAP_ARGS_$(TWO_SCALE_GAMUT)) --threads $(THREADS) --out $@ --quiet
 
-$(OUT)/topopt/bar.t2.verify.h5: $(OUT)/topopt/bar.t2.mapped.h5 $(OUT)/topopt/bar.design.h5 $(BIN)/msfab-verify-map
-	$(BIN)/msfab-verify-map --design $(OUT)/topopt/bar.design.h5 --mapped $< \
-	  --structures $(OUT)/topopt/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
+$(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(BIN)/msfab-verify-map
+	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \
+	  --structures $(TOPOPT_DIR)/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
 $(CUBES_GAMUT).microstructures.h5: $(CUBES_GAMUT).gamut.h5
 	@test -s $@
@@ -123,13 +147,16 @@ $(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)
 .PHONY: topopt-thesis-2d
 topopt-thesis-2d: build $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
 
-.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-checks topopt-cubes topopt-bridge-large
-topopt-bar-check: build $(OUT)/topopt/bar.verify.h5 $(OUT)/topopt/bar.h4.verify.h5 $(OUT)/topopt/bar.solid.verify.h5 \
-    $(OUT)/topopt/bar.t2.verify.h5
+.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check topopt-checks topopt-cubes \
+    topopt-bridge-large
+topopt-bar-check: build $(TOPOPT_DIR)/bar.verify.h5 $(TOPOPT_DIR)/bar.h4.verify.h5 $(TOPOPT_DIR)/bar.solid.verify.h5 \
+    $(TOPOPT_DIR)/bar.t2.verify.h5
 topopt-cubes: build $(OUT)/topopt/cubes.md
-topopt-gripper-check: build $(OUT)/topopt/gripper3d.verify.h5 $(OUT)/topopt/gripper3d.h4.verify.h5 \
-    $(OUT)/topopt/gripper3d.solid.verify.h5
-topopt-bridge-check: build $(OUT)/topopt/bridge_cubic.verify.h5 $(OUT)/topopt/bridge_cubic.h4.verify.h5 \
-    $(OUT)/topopt/bridge_cubic.solid.verify.h5
-topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check
+topopt-gripper-check: build $(TOPOPT_DIR)/gripper3d.verify.h5 $(TOPOPT_DIR)/gripper3d.h4.verify.h5 \
+    $(TOPOPT_DIR)/gripper3d.solid.verify.h5
+topopt-bridge-check: build $(TOPOPT_DIR)/bridge_cubic.verify.h5 $(TOPOPT_DIR)/bridge_cubic.h4.verify.h5 \
+    $(TOPOPT_DIR)/bridge_cubic.solid.verify.h5
+topopt-cantilever-check: build $(TOPOPT_DIR)/cantilever_cubic.verify.h5 $(TOPOPT_DIR)/cantilever_cubic.h4.verify.h5 \
+    $(TOPOPT_DIR)/cantilever_cubic.solid.verify.h5
+topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check
 topopt-bridge-large: build $(OUT)/topopt/bridge_cubic_large.design.h5
