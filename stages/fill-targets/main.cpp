@@ -35,6 +35,7 @@
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "mapping/mapper.hpp"
+#include "mapping/set_lineage.hpp"
 #include "mapping/target_fill.hpp"
 #include "parallel/fan_out.hpp"
 
@@ -155,6 +156,7 @@ int main(int argc, char** argv) {
     MicrostructureSet set = read_microstructures_artifact(structures_path);
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
+    check_set_belongs_to_design(design_path, structures_path);
     const auto start = std::chrono::steady_clock::now();
     const std::size_t given = set.items.size();
     if (rank == 0)

@@ -24,6 +24,7 @@
 #include "core/timing.hpp"
 #include "core/errors.hpp"
 #include "mapping/mapper.hpp"
+#include "mapping/set_lineage.hpp"
 #include "mapping/voxel_model.hpp"
 
 using namespace msfab;
@@ -106,6 +107,7 @@ int main(int argc, char** argv) {
     const MicrostructureSet set = read_microstructures_artifact(structures_path);
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
+    check_set_belongs_to_design(design_path, structures_path);
     const std::int64_t tiles =
         std::int64_t(settings.tiling) * settings.tiling * (design.dimension == 3 ? settings.tiling : 1);
     const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz * tiles;

@@ -48,6 +48,17 @@ check "cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-
 check "the gamut stores its base materials for the Voigt bound" -- h5ls "$WORK/set.gamut.h5/bound/stiff"
 check "the design maps to microstructures" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
   --structures "$WORK/set.microstructures.h5" --out "$WORK/cubic.mapped.h5" --quiet
+# Another gamut of the same material and space: its structures are not the
+# design's (refused, naming both files); a set derived from the design's
+# structures (re-homogenized) is accepted.
+check "another gamut" -- "$BIN/msfab-gamut-sample" --config "$WORK/set.yaml" --seed 4 --out "$WORK/other.gamut.h5" --quiet
+expect_exit 2 "other.microstructures.h5: not the structures of the gamut .*set.gamut.h5 that .*cubic.design.h5 was optimized in" -- \
+  "$BIN/msfab-map" --design "$WORK/cubic.design.h5" --structures "$WORK/other.microstructures.h5" --out "$WORK/other.mapped.h5"
+check "nothing written for the refused set" -- test ! -e "$WORK/other.mapped.h5"
+check "a set derived from the gamut's structures" -- "$BIN/msfab-homogenize" --structures "$WORK/set.microstructures.h5" \
+  --out "$WORK/derived.microstructures.h5" --quiet
+check "maps the design too" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
+  --structures "$WORK/derived.microstructures.h5" --out "$WORK/derived.mapped.h5" --quiet
 out=$("$T" --config "$WORK/cubic.yaml" --set optimizer.name=cell-mma --set filter.radius=1.5 \
   --out "$WORK/cellmma.design.h5" --quiet 2>&1)
 check "cell-mma: cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-0[4-9]|0\.000)" <<<"$out"
