@@ -1,7 +1,8 @@
 #!/bin/bash
 # msfab-map: bad input exits with code 2 and a message naming the file and
-# the problem, and writes nothing. (No stage writes designs yet; the mapping
-# itself is covered by tests/unit/test_mapping.cpp.)
+# the problem, and writes nothing. (A design mapped end to end, and a set
+# that is not the design's, are in test_topopt.sh; the mapping itself is
+# covered by tests/unit/test_mapping.cpp.)
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 M="$BIN/msfab-map"
