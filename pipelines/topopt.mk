@@ -45,6 +45,7 @@ else
 TOPOPT_DIR ?= $(OUT)/topopt/$(TWO_SCALE_GAMUT)
 endif
 MAP_ARGS_graded_lattice := --set half_shift=false --set candidates=1
+MAP_ARGS_cubic3d_bar_backbone := --set half_shift=false
 CUBES_GAMUT := $(OUT)/gamut/cubic3d_bar_dense
 TWO_SCALE_SCENES := bar gripper3d bridge_cubic cantilever_cubic
 

@@ -150,6 +150,55 @@ std::vector<std::uint8_t> face_connector(const VoxelGrid& c, int half_width, int
   return mask;
 }
 
+int add_axis_backbone(VoxelGrid& c, int half_width) {
+  const bool flat = is_2d(c);
+  if (c.nx != c.ny || (!flat && c.nz != c.nx))
+    throw InputError("axis backbone: the cell must be cubic (or square in 2D)");
+  const int n = c.nx;
+  if (half_width < 1 || 2 * half_width > n)
+    throw InputError("axis backbone: half_width must be 1.." + std::to_string(n / 2) + " voxels");
+  auto central = [&](int i) { return std::abs(2 * i + 1 - n) < 2 * half_width; };
+  int changed = 0;
+  std::vector<std::uint8_t> beam(c.size(), 0);
+  for (int k = 0; k < c.nz; ++k)
+    for (int j = 0; j < c.ny; ++j)
+      for (int i = 0; i < c.nx; ++i) {
+        const bool on = flat ? central(i) || central(j)
+                             : (central(j) && central(k)) || (central(i) && central(k)) || (central(i) && central(j));
+        if (!on) continue;
+        const std::size_t v = c.index(i, j, k);
+        beam[v] = 1;
+        if (c.ids[v] != 1) c.ids[v] = 1, ++changed;
+      }
+  // Reached from the beams through faces inside the cell, not across its
+  // periodic boundary: in a mapped object the neighbour across a face is
+  // another structure, so material joined to the backbone only through the
+  // cell's own periodic image would float there.
+  const int n3[3] = {c.nx, c.ny, c.nz};
+  std::vector<std::uint8_t> reached(beam);
+  std::vector<std::size_t> stack;
+  for (std::size_t v = 0; v < c.size(); ++v)
+    if (beam[v]) stack.push_back(v);
+  while (!stack.empty()) {
+    const std::size_t v = stack.back();
+    stack.pop_back();
+    const int idx[3] = {int(v % c.nx), int((v / c.nx) % c.ny), int(v / (std::size_t(c.nx) * c.ny))};
+    for (int a = 0; a < (flat ? 2 : 3); ++a)
+      for (int step : {-1, 1}) {
+        int q[3] = {idx[0], idx[1], idx[2]};
+        q[a] += step;
+        if (q[a] < 0 || q[a] >= n3[a]) continue;
+        const std::size_t w = c.index(q[0], q[1], q[2]);
+        if (reached[w] || c.ids[w] == 0) continue;
+        reached[w] = 1;
+        stack.push_back(w);
+      }
+  }
+  for (std::size_t v = 0; v < c.size(); ++v)
+    if (c.ids[v] != 0 && !reached[v]) c.ids[v] = 0, ++changed;
+  return changed;
+}
+
 CleanupReport clean_structure(VoxelGrid& c) {
   CleanupReport report;
   const int dims = is_2d(c) ? 2 : 3;

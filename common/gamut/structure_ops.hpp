@@ -47,6 +47,16 @@ int paint_beam(VoxelGrid& cell, const Vec3& a, const Vec3& b, double radius, int
 // wider than the face.
 std::vector<std::uint8_t> face_connector(const VoxelGrid& cell, int half_width, int depth);
 
+// The axis backbone: the beams along x, y (and z) through the cell centre,
+// 2 * half_width voxels wide (their central indices, as face_connector's
+// patches), painted solid (id 1), and every solid voxel that is not
+// face-connected to them inside the cell (not through the periodic
+// boundary: across a face a mapped cell meets another structure) removed. Two cells that carry it
+// meet at every shared face centre, whatever else they hold, and each cell
+// is one piece. Invariant under the cubic and orthotropic symmetries.
+// Returns the voxels changed; InputError as face_connector.
+int add_axis_backbone(VoxelGrid& cell, int half_width);
+
 struct CleanupReport {
   int removed_voxels = 0;  // solid voxels in pieces that do not wrap around the cell
   int filled_voxels = 0;   // void voxels in enclosed cavities

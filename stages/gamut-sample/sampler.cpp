@@ -81,9 +81,15 @@ bool GamutSampler::fill_properties(Microstructure& m, const Mat6& C, double rho)
   return MaterialSpace::clamp_to_box(m.unit);
 }
 
-StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& cells,
+StepReport GamutSampler::add_structures(SamplerState& state, const std::vector<VoxelGrid>& given,
                                         const std::vector<std::int64_t>& parents, int cycle, SampleStep step,
                                         const std::vector<MaterialPtr>& palette) const {
+  std::vector<VoxelGrid> with_backbone;
+  if (o_.backbone > 0) {
+    with_backbone = given;
+    for (VoxelGrid& c : with_backbone) add_axis_backbone(c, o_.backbone);
+  }
+  const std::vector<VoxelGrid>& cells = o_.backbone > 0 ? with_backbone : given;
   StepReport report;
   report.tried = static_cast<int>(cells.size());
   std::vector<std::uint8_t> thin(cells.size(), 0);

@@ -28,6 +28,7 @@ decades: 4
 void_stiffness: 1.0e-6
 use_symmetry: true        # cell problems on the symmetric part (exact); false: six cases on the whole cell
 min_feature: 1            # the printer's smallest beam or gap, voxels (1: no limit)
+backbone: 0               # half-width (voxels) of axis beams through the centre that every structure keeps (0: none)
 plot_every_cycle: true
 mode: sampler             # sampler | random (the benchmark's baseline) | set (initial_set's structures alone)
 void_variants: false      # also write the structures with the soft material removed (thesis 3.6.1)
@@ -151,6 +152,11 @@ SamplerOptions read_sampler_options(const Config& config) {
   if (o.min_feature < 1 || o.min_feature > o.resolution / 2)
     config.fail("min_feature", "must be in 1..resolution/2 (" + std::to_string(o.resolution / 2) + ")");
   o.continuous.min_feature = o.min_feature;
+  o.backbone = config.get_or<int>("backbone", o.backbone);
+  if (o.backbone < 0 || o.backbone > o.resolution / 2)
+    config.fail("backbone", "must be in 0..resolution/2 (" + std::to_string(o.resolution / 2) + "; 0: none)");
+  if (o.backbone > 0 && !o.soft_is_void)
+    config.fail("backbone", "needs a void phase (leave out materials.soft): with two materials every cell is solid");
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
   o.continuous.use_symmetry = o.use_symmetry;

@@ -29,6 +29,12 @@ struct SamplerOptions {
   // The printer's minimum feature size in voxels: structures with a thinner
   // beam or gap (thin_feature_voxels) are not added. 1: no limit.
   int min_feature = 1;
+  // The axis backbone (structure_ops.hpp: add_axis_backbone) of this
+  // half-width in voxels added to every structure before it is
+  // homogenized, and what it does not reach removed, so that any two
+  // structures of the gamut connect at their shared face centres
+  // (docs/mapping.md). 0: none. Needs a void phase.
+  int backbone = 0;
 
   // Structures of an earlier set added to the initial population
   // (initial_set.path, a microstructures artifact of the same base

@@ -10,7 +10,10 @@
 
 #include <random>
 
+#include "core/errors.hpp"
+
 #include "families/beam_template.hpp"
+#include "gamut/structure_ops.hpp"
 #include "mapping/mismatch.hpp"
 #include "verify/solid_pieces.hpp"
 
@@ -80,6 +83,40 @@ TEST(ConnectedFamily, HalfShiftedMembersDoNotConnect) {
   std::vector<int> pick(8, 0);
   pick[1] = 1;  // cell (1, 0, 0)
   EXPECT_GT(pieces_of(members, pick, 2).count(), 1);
+}
+
+TEST(ConnectedFamily, AxisBackboneJoinsAnyStructures) {
+  // Random voxel clouds given the backbone (what `backbone: 1` does to every
+  // sampled structure): each cell becomes one piece that holds the three
+  // axis beams, and any arrangement of such cells is one piece.
+  std::mt19937 rng(11);
+  std::bernoulli_distribution solid(0.3);
+  std::vector<std::vector<int>> members;
+  for (int m = 0; m < 6; ++m) {
+    VoxelGrid cell(kCell, kCell, kCell, 1.0 / kCell);
+    for (int& id : cell.ids) id = solid(rng) ? 1 : 0;
+    add_axis_backbone(cell, 1);
+    for (int i = 0; i < kCell; ++i) {  // the x beam: the 2 x 2 central voxels of every x
+      EXPECT_EQ(cell.at(i, kCell / 2 - 1, kCell / 2), 1);
+      EXPECT_EQ(cell.at(i, kCell / 2, kCell / 2 - 1), 1);
+    }
+    EXPECT_EQ(pieces_of({cell.ids}, {0}, 1).count(), 1) << "member " << m;
+    members.push_back(cell.ids);
+  }
+  std::uniform_int_distribution<int> any(0, int(members.size()) - 1);
+  std::vector<int> pick(27);
+  for (int& p : pick) p = any(rng);
+  EXPECT_EQ(pieces_of(members, pick, 3).count(), 1);
+}
+
+TEST(ConnectedFamily, AxisBackboneKeepsTheCubicSymmetry) {
+  VoxelGrid cell(kCell, kCell, kCell, 1.0 / kCell);
+  cell.ids = lattice_member(0.10, 0.05);
+  ASSERT_TRUE(has_cubic_symmetry(cell));
+  add_axis_backbone(cell, 3);
+  EXPECT_TRUE(has_cubic_symmetry(cell));
+  EXPECT_THROW(add_axis_backbone(cell, 0), InputError);
+  EXPECT_THROW(add_axis_backbone(cell, kCell), InputError);
 }
 
 }  // namespace
