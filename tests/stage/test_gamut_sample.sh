@@ -98,6 +98,14 @@ check "mode set: the set's last structure is the artifact's last" -- bash -c \
    cmp -s '$WORK/a' '$WORK/b'"
 expect_exit 2 "mode.*set needs initial_set.path" -- "$SAMPLE" --config "$TINY" --set mode=set --set cycles=0 \
   --out "$WORK/bad.gamut.h5"
+# The axis backbone: refused with two materials (every cell is solid) and
+# wider than the cell; with void the run completes (the unit test
+# ConnectedFamily checks the cells themselves).
+expect_exit 2 "backbone.*needs a void phase" -- "$SAMPLE" --config "$TINY" --set backbone=1 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "backbone = 5: must be in 0..resolution/2 .4" -- "$SAMPLE" --config "$TINY" --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' \
+  --set backbone=5 --out "$WORK/bad.gamut.h5"
+expect_exit 0 "after 3 cycles" -- "$SAMPLE" --config "$TINY" --seed 7 --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' \
+  --set backbone=1 --out "$WORK/backbone.gamut.h5"
 expect_exit 2 "cycles.*must be 0 with mode: set" -- "$SAMPLE" --config "$TINY" --set mode=set \
   --set initial_set="{path: $WORK/one.microstructures.h5}" --out "$WORK/bad.gamut.h5"
 
