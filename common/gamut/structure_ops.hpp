@@ -51,9 +51,10 @@ std::vector<std::uint8_t> face_connector(const VoxelGrid& cell, int half_width, 
 // 2 * half_width voxels wide (their central indices, as face_connector's
 // patches), painted solid (id 1), and every solid voxel that is not
 // face-connected to them inside the cell (not through the periodic
-// boundary: across a face a mapped cell meets another structure) removed. Two cells that carry it
-// meet at every shared face centre, whatever else they hold, and each cell
-// is one piece. Invariant under the cubic and orthotropic symmetries.
+// boundary: across a face a mapped cell meets another structure) removed.
+// Two cells that carry it meet at every shared face centre, whatever else
+// they hold, and each cell is one piece. A cubic (orthotropic) cell stays
+// cubic (orthotropic).
 // Returns the voxels changed; InputError as face_connector.
 int add_axis_backbone(VoxelGrid& cell, int half_width);
 

@@ -10,12 +10,13 @@
 namespace msfab {
 
 // Nothing to check for a design whose inputs list the set itself
-// (msfab-assign). Otherwise InputError naming both files when the design's gamut (the design's first
-// input of schema msfab.gamut, if that file is still there unchanged) was
-// built from other structures than `structures_path` and the set is not
-// derived from them either (a set whose own inputs list them: msfab-
-// fill-targets, msfab-homogenize). Where the gamut cannot be found or has
-// changed since the design was written, a warning and no check.
+// (msfab-assign). Otherwise InputError naming both files when the design's
+// gamut (its first input of schema msfab.gamut, if that file is still there
+// unchanged) was built from other structures than `structures_path` and
+// the set is not derived from them either (a set whose own inputs list
+// them: msfab-fill-targets, msfab-homogenize). Where the gamut cannot be
+// found or has changed since the design was written, a warning and no
+// check.
 void check_set_belongs_to_design(const std::string& design_path, const std::string& structures_path);
 
 }  // namespace msfab
