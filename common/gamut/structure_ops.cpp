@@ -24,14 +24,16 @@ int wrap(int i, int n) { return ((i % n) + n) % n; }
 // Face-connected pieces of voxels for which `member` holds; for each, the
 // set of axes along which it wraps around the periodic cell. A piece wraps
 // along an axis when a voxel is reached twice with unwrapped positions
-// that differ along that axis.
+// that differ along that axis. With periodic false, voxels connect only
+// inside the cell (what a cell next to another structure keeps); no piece
+// then wraps.
 struct Pieces {
   std::vector<int> piece;                 // per voxel, -1 if not a member
   std::vector<std::array<bool, 3>> wraps;  // per piece
   std::vector<int> size;
 };
 template <class Member>
-Pieces face_pieces(const VoxelGrid& c, Member member) {
+Pieces face_pieces(const VoxelGrid& c, Member member, bool periodic = true) {
   const int dims = is_2d(c) ? 2 : 3;
   const int n[3] = {c.nx, c.ny, c.nz};
   Pieces p;
@@ -56,7 +58,10 @@ Pieces face_pieces(const VoxelGrid& c, Member member) {
           int q[3] = {idx[0], idx[1], idx[2]};
           std::array<int, 3> off = offset[v];
           q[a] += step;
-          if (q[a] < 0 || q[a] >= n[a]) off[a] += q[a] < 0 ? -1 : 1;
+          if (q[a] < 0 || q[a] >= n[a]) {
+            if (!periodic) continue;
+            off[a] += q[a] < 0 ? -1 : 1;
+          }
           q[a] = wrap(q[a], n[a]);
           const int w = static_cast<int>(c.index(q[0], q[1], q[2]));
           if (!member(c.ids[w])) continue;
@@ -159,7 +164,7 @@ int add_axis_backbone(VoxelGrid& c, int half_width) {
     throw InputError("axis backbone: half_width must be 1.." + std::to_string(n / 2) + " voxels");
   auto central = [&](int i) { return std::abs(2 * i + 1 - n) < 2 * half_width; };
   int changed = 0;
-  std::vector<std::uint8_t> beam(c.size(), 0);
+  std::size_t a_beam_voxel = 0;
   for (int k = 0; k < c.nz; ++k)
     for (int j = 0; j < c.ny; ++j)
       for (int i = 0; i < c.nx; ++i) {
@@ -167,35 +172,18 @@ int add_axis_backbone(VoxelGrid& c, int half_width) {
                              : (central(j) && central(k)) || (central(i) && central(k)) || (central(i) && central(j));
         if (!on) continue;
         const std::size_t v = c.index(i, j, k);
-        beam[v] = 1;
+        a_beam_voxel = v;
         if (c.ids[v] != 1) c.ids[v] = 1, ++changed;
       }
-  // Reached from the beams through faces inside the cell, not across its
+  // Joined to the beams through faces inside the cell, not across its
   // periodic boundary: in a mapped object the neighbour across a face is
   // another structure, so material joined to the backbone only through the
-  // cell's own periodic image would float there.
-  const int n3[3] = {c.nx, c.ny, c.nz};
-  std::vector<std::uint8_t> reached(beam);
-  std::vector<std::size_t> stack;
+  // cell's own periodic image would float there. The three beams cross at
+  // the centre, so they are one piece.
+  const Pieces solid = face_pieces(c, [](int id) { return id != 0; }, false);
+  const int backbone = solid.piece[a_beam_voxel];
   for (std::size_t v = 0; v < c.size(); ++v)
-    if (beam[v]) stack.push_back(v);
-  while (!stack.empty()) {
-    const std::size_t v = stack.back();
-    stack.pop_back();
-    const int idx[3] = {int(v % c.nx), int((v / c.nx) % c.ny), int(v / (std::size_t(c.nx) * c.ny))};
-    for (int a = 0; a < (flat ? 2 : 3); ++a)
-      for (int step : {-1, 1}) {
-        int q[3] = {idx[0], idx[1], idx[2]};
-        q[a] += step;
-        if (q[a] < 0 || q[a] >= n3[a]) continue;
-        const std::size_t w = c.index(q[0], q[1], q[2]);
-        if (reached[w] || c.ids[w] == 0) continue;
-        reached[w] = 1;
-        stack.push_back(w);
-      }
-  }
-  for (std::size_t v = 0; v < c.size(); ++v)
-    if (c.ids[v] != 0 && !reached[v]) c.ids[v] = 0, ++changed;
+    if (solid.piece[v] >= 0 && solid.piece[v] != backbone) c.ids[v] = 0, ++changed;
   return changed;
 }
 

@@ -282,23 +282,32 @@ TEST(AdaptiveMixedMesh, UniformStartReproducesAffineDisplacements) {
   Mat3 A;
   A << 0.01, -0.02, 0.005, 0.003, 0.02, -0.01, 0.0, 0.004, -0.015;
   const Vec3 shift(1e-4, -2e-4, 3e-4);
+  // Positions of the mesh's nodes moved by the affine field.
+  auto affine_positions = [&](const HexMesh& mesh) {
+    VecX x(mesh.num_dofs());
+    for (int n = 0; n < mesh.num_nodes(); ++n) {
+      const Vec3 p = mesh.nodes.row(n).transpose();
+      x.segment<3>(3 * n) = p + A * p + shift;
+    }
+    return x;
+  };
+  // The largest distance of u from the affine displacement at the points.
+  auto worst_affine_error = [&](const VecX& u, const NodeArray& points) {
+    double worst = 0;
+    for (int n = 0; n < points.rows(); ++n) {
+      const Vec3 p = points.row(n).transpose();
+      worst = std::max(worst, (u.segment<3>(3 * n) - A * p - shift).norm());
+    }
+    return worst;
+  };
   const VoxelMesh level2 = build_coarse_mesh(g.level2, naive_coarsening(s.material_by_id, g.level1));
   const VoxelMesh level1 = build_coarse_mesh(g.level1, naive_coarsening(s.material_by_id));
-  VecX x2(level2.mesh.num_dofs());
-  for (int n = 0; n < level2.mesh.num_nodes(); ++n) {
-    const Vec3 p = level2.mesh.nodes.row(n).transpose();
-    x2.segment<3>(3 * n) = p + A * p + shift;
-  }
+  const VecX x2 = affine_positions(level2.mesh);
   const MixedLevelMesh m = naive_mixed_mesh(s, g, patchwork_levels(g.level2));
   for (const NodeArray* points : {&level1.mesh.nodes, &m.constraints->unknown_rest}) {
     const VecX u = uniform_displacement_at(g.level2, level2, x2, *points);
     ASSERT_EQ(u.size(), 3 * points->rows());
-    double worst = 0;
-    for (int n = 0; n < points->rows(); ++n) {
-      const Vec3 p = points->row(n).transpose();
-      worst = std::max(worst, (u.segment<3>(3 * n) - A * p - shift).norm());
-    }
-    EXPECT_LT(worst, 1e-15);
+    EXPECT_LT(worst_affine_error(u, *points), 1e-15);
   }
   EXPECT_THROW(uniform_displacement_at(g.level1, level2, x2, level1.mesh.nodes), InputError);
 
@@ -312,21 +321,11 @@ TEST(AdaptiveMixedMesh, UniformStartReproducesAffineDisplacements) {
   const Grids hg = grids_of(holed);
   const VoxelMesh holed1 = build_coarse_mesh(hg.level1, naive_coarsening(holed.material_by_id));
   ASSERT_LT(holed1.voxel_element[hg.level1.index(0, 0, 0)], 0);
-  VecX x1(holed1.mesh.num_dofs());
-  for (int n = 0; n < holed1.mesh.num_nodes(); ++n) {
-    const Vec3 p = holed1.mesh.nodes.row(n).transpose();
-    x1.segment<3>(3 * n) = p + A * p + shift;
-  }
+  const VecX x1 = affine_positions(holed1.mesh);
   const MixedLevelMesh all2 = naive_mixed_mesh(holed, hg, std::vector<int>(hg.level2.num_cells(), 2));
   const NodeArray& points = all2.constraints->unknown_rest;
   ASSERT_LT(points.row(0).norm(), 1e-15);  // the corner at the origin is a node
-  const VecX u = uniform_displacement_at(hg.level1, holed1, x1, points);
-  double worst = 0;
-  for (int n = 0; n < points.rows(); ++n) {
-    const Vec3 p = points.row(n).transpose();
-    worst = std::max(worst, (u.segment<3>(3 * n) - A * p - shift).norm());
-  }
-  EXPECT_LT(worst, 1e-15);
+  EXPECT_LT(worst_affine_error(uniform_displacement_at(hg.level1, holed1, x1, points), points), 1e-15);
 }
 
 TEST(AdaptiveLevels, ChoiceMeetsTheTargetAndRefinesHighEnergyCellsFirst) {
