@@ -33,24 +33,44 @@
 # graded_lattice.yaml, docs/mapping.md): it is mapped to the nearest member
 # without half-shifted exemplars, which would break the connection.
 #   make -f Makefile.pipeline topopt-checks TWO_SCALE_GAMUT=graded_lattice
+# TWO_SCALE_FAMILY=NAME designs in a family's own parameters instead of a
+# gamut (topopt space family3d, docs/topopt.md): the structure grid of
+# configs/families/NAME.yaml is the optimizer's material model and the
+# mapping's set; results go to out/topopt/NAME/.
+#   make -f Makefile.pipeline topopt-checks TWO_SCALE_FAMILY=graded_lattice_grid
 # TOPOPT_ARGS go to msfab-topopt (e.g. "--set gamut_padding=subtract", the
 # feasible set ending at the outermost structures); give such a variant its
 # own TOPOPT_DIR.
 TWO_SCALE_GAMUT ?= cubic3d_bar
+TWO_SCALE_FAMILY ?=
 TOPOPT_ARGS ?=
 BAR_GAMUT := $(OUT)/gamut/$(TWO_SCALE_GAMUT)
+MAP_ARGS_graded_lattice := --set half_shift=false --set candidates=1
+MAP_ARGS_cubic3d_bar_backbone := --set half_shift=false
+ifneq ($(TWO_SCALE_FAMILY),)
+TOPOPT_DIR ?= $(OUT)/topopt/$(TWO_SCALE_FAMILY)
+TWO_SCALE_SET := $(OUT)/families/$(TWO_SCALE_FAMILY).microstructures.h5
+TWO_SCALE_SPACE := $(TWO_SCALE_SET)
+TWO_SCALE_SPACE_ARGS := --set gamut=null --set space=family3d --set family=$(TWO_SCALE_SET)
+TWO_SCALE_MAP_ARGS := --set half_shift=false --set candidates=1
+else
 ifeq ($(TWO_SCALE_GAMUT),cubic3d_bar)
 TOPOPT_DIR ?= $(OUT)/topopt
 else
 TOPOPT_DIR ?= $(OUT)/topopt/$(TWO_SCALE_GAMUT)
 endif
-MAP_ARGS_graded_lattice := --set half_shift=false --set candidates=1
-MAP_ARGS_cubic3d_bar_backbone := --set half_shift=false
+TWO_SCALE_SET := $(BAR_GAMUT).microstructures.h5
+TWO_SCALE_SPACE := $(BAR_GAMUT).gamut.h5
+TWO_SCALE_SPACE_ARGS := --set gamut=$(BAR_GAMUT).gamut.h5
+TWO_SCALE_MAP_ARGS := $(MAP_ARGS_$(TWO_SCALE_GAMUT))
+endif
 CUBES_GAMUT := $(OUT)/gamut/cubic3d_bar_dense
 TWO_SCALE_SCENES := bar gripper3d bridge_cubic cantilever_cubic
 
 $(OUT)/gamut/graded_lattice.gamut.h5: $(OUT)/families/graded_lattice.microstructures.h5
-$(OUT)/families/graded_lattice.microstructures.h5: configs/families/graded_lattice.yaml $(BIN)/msfab-family-generate
+HAND_MADE_FAMILIES := graded_lattice graded_lattice_grid
+$(HAND_MADE_FAMILIES:%=$(OUT)/families/%.microstructures.h5): $(OUT)/families/%.microstructures.h5: \
+    configs/families/%.yaml $(BIN)/msfab-family-generate
 	@mkdir -p $(@D)
 	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ --quiet
 
@@ -58,9 +78,9 @@ $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 	@test -s $@
 
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.design.h5): $(TOPOPT_DIR)/%.design.h5: configs/topopt/%.yaml \
-    $(BAR_GAMUT).gamut.h5 $(BIN)/msfab-topopt
+    $(TWO_SCALE_SPACE) $(BIN)/msfab-topopt
 	@mkdir -p $(@D)
-	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 $(TOPOPT_ARGS) --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-topopt --config $< $(TWO_SCALE_SPACE_ARGS) $(TOPOPT_ARGS) --threads $(THREADS) --out $@ --quiet
 
 # The gamut's structures, with FILL_TARGETS=1 plus structures generated at
 # the design's targets that the gamut does not cover (msfab-fill-targets). The targets fan out over MPI ranks with
@@ -76,11 +96,11 @@ FILL_MPIRUN ?=
 MATCH ?= all
 FILL_ARGS ?=
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.structures.h5): $(TOPOPT_DIR)/%.structures.h5: $(TOPOPT_DIR)/%.design.h5 \
-    $(BAR_GAMUT).microstructures.h5 $(BIN)/msfab-fill-targets
+    $(TWO_SCALE_SET) $(BIN)/msfab-fill-targets
 ifeq ($(FILL_TARGETS),0)
-	cp $(BAR_GAMUT).microstructures.h5 $@.tmp && mv $@.tmp $@
+	cp $(TWO_SCALE_SET) $@.tmp && mv $@.tmp $@
 else
-	OMP_NUM_THREADS=$(THREADS) $(FILL_MPIRUN) $(BIN)/msfab-fill-targets --design $< --structures $(BAR_GAMUT).microstructures.h5 \
+	OMP_NUM_THREADS=$(THREADS) $(FILL_MPIRUN) $(BIN)/msfab-fill-targets --design $< --structures $(TWO_SCALE_SET) \
 	  --set match=$(MATCH) $(FILL_ARGS) --threads $(THREADS) --out $@
 endif
 
@@ -91,7 +111,7 @@ MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.mapped.h5): $(TOPOPT_DIR)/%.mapped.h5: $(TOPOPT_DIR)/%.design.h5 \
     $(TOPOPT_DIR)/%.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
-	  --set export.voxels=true $(MAP_EXPORTS_$*) $(MAP_ARGS_$(TWO_SCALE_GAMUT)) --threads $(THREADS) --out $@ --quiet
+	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ --quiet
 
 # The three checks of Table 3.1 per scene: S.verify.h5 (one hexahedron per
 # cell), S.h4.verify.h5 and S.solid.verify.h5, differing only in settings.
@@ -108,7 +128,7 @@ $(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
 $(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
-	  $(MAP_ARGS_$(TWO_SCALE_GAMUT)) --threads $(THREADS) --out $@ --quiet
+	  $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ --quiet
 
 $(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \

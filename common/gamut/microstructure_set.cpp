@@ -3,6 +3,7 @@
 #include "material/linear_isotropic.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -19,7 +20,57 @@ std::string at(const std::string& group, const std::string& name) {
   throw InputError(f.path() + ": " + field + ": " + problem);
 }
 
+void write_grid(H5File& f, const std::string& g, const StructureGrid& grid, std::size_t items) {
+  if (grid.names.size() != grid.axes.size() || grid.points() != items)
+    throw std::logic_error("write_microstructure_set: the parameter grid does not match the structures");
+  const std::string gg = at(g, "grid");
+  f.create_group(gg);
+  std::string names;
+  for (const auto& name : grid.names) names += (names.empty() ? "" : ",") + name;
+  f.write_attribute(gg, "names", names);
+  f.write_attribute(gg, "order", "structure i is the grid point whose indices, first axis slowest, spell i");
+  for (std::size_t a = 0; a < grid.axes.size(); ++a) f.write_vector(at(gg, "axis" + std::to_string(a)), grid.axes[a]);
+}
+
+StructureGrid read_grid(const H5File& f, const std::string& g, std::size_t items) {
+  StructureGrid grid;
+  const std::string gg = at(g, "grid");
+  std::stringstream names(f.read_string_attribute(gg, "names"));
+  for (std::string name; std::getline(names, name, ',');) grid.names.push_back(name);
+  if (grid.names.empty() || grid.names.size() > 3) bad(f, gg + " names", "expected 1 to 3 axis names");
+  for (std::size_t a = 0; a < grid.names.size(); ++a) {
+    const std::string field = at(gg, "axis" + std::to_string(a));
+    std::vector<double> axis = f.read_vector<double>(field);
+    if (axis.empty()) bad(f, field, "is empty");
+    for (std::size_t i = 0; i < axis.size(); ++i)
+      if (!std::isfinite(axis[i]) || (i > 0 && !(axis[i] > axis[i - 1])))
+        bad(f, field, "values must be finite and strictly increasing");
+    grid.axes.push_back(std::move(axis));
+  }
+  if (grid.points() != items)
+    bad(f, gg, "the grid has " + std::to_string(grid.points()) + " points but the set " + std::to_string(items) +
+                   " structures");
+  return grid;
+}
+
 }  // namespace
+
+std::size_t StructureGrid::points() const {
+  if (axes.empty()) return 0;
+  std::size_t n = 1;
+  for (const auto& a : axes) n *= a.size();
+  return n;
+}
+
+std::size_t StructureGrid::item(const std::vector<int>& index) const {
+  if (index.size() != axes.size()) throw std::logic_error("StructureGrid::item: one index per axis");
+  std::size_t i = 0;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    if (index[a] < 0 || std::size_t(index[a]) >= axes[a].size()) throw std::logic_error("StructureGrid::item: index");
+    i = i * axes[a].size() + std::size_t(index[a]);
+  }
+  return i;
+}
 
 const char* step_name(SampleStep step) {
   switch (step) {
@@ -126,6 +177,7 @@ void write_microstructure_set(H5File& f, const std::string& g, const Microstruct
   f.write_vector(at(g, "step"), step);
   f.write_attribute(at(g, "step"), "meaning", "0 initial, 1 discrete, 2 continuous, 3 void variant, 4 directed, 5 targeted");
   f.write_vector(at(g, "parent"), parent);
+  if (!set.grid.empty()) write_grid(f, g, set.grid, n);
 }
 
 MicrostructureSet read_microstructure_set(const H5File& f, const std::string& g) {
@@ -178,6 +230,7 @@ MicrostructureSet read_microstructure_set(const H5File& f, const std::string& g)
     m.step = static_cast<SampleStep>(step[i]);
     m.parent = parent[i];
   }
+  if (f.exists(at(g, "grid"))) set.grid = read_grid(f, g, n);
   return set;
 }
 

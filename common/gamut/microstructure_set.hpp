@@ -40,6 +40,20 @@ struct BaseMaterial {
   double E = 0, nu = 0;
 };
 
+// Structures laid out on a tensor grid of a family's parameters
+// (msfab-family-generate `grid:`): item i is the grid point whose indices,
+// first axis slowest, spell i. A two-scale design can then move along the
+// family's own parameters (topopt space family3d) instead of a level set
+// around its members. Empty for a set that is not such a grid.
+struct StructureGrid {
+  std::vector<std::string> names;          // one per axis
+  std::vector<std::vector<double>> axes;   // per axis: the parameter values, strictly increasing
+  bool empty() const { return axes.empty(); }
+  std::size_t points() const;
+  // The item of the grid point with these indices (one per axis).
+  std::size_t item(const std::vector<int>& index) const;
+};
+
 struct MicrostructureSet {
   std::string space;                 // MaterialSpace kind name: cubic3d | cubic2d | orthotropic2d
   std::vector<std::string> property_names;
@@ -48,6 +62,8 @@ struct MicrostructureSet {
   BaseMaterial stiff, soft;          // ids 1 and 2
   bool soft_is_void = true;          // no id 2; cuts leave void
   std::vector<Microstructure> items;
+  StructureGrid grid;                // empty unless the items are a parameter grid (a stage that adds
+                                     // or removes items must clear it)
 };
 
 // The set's base materials as a palette: [0] void, [1] stiff, [2] soft

@@ -292,8 +292,10 @@ double CellMaterialModel::constraint(const VecX& p, VecX* gradient) const {
 
 std::vector<std::string> cell_material_spaces() {
   return {"cubic3d", "cubic2d", "orthotropic2d", "isotropic2d", "isotropic3d",
-          "analytic2d", "analytic3d", "simp2d", "simp3d"};
+          "analytic2d", "analytic3d", "simp2d", "simp3d", "family3d"};
 }
+
+bool needs_family_grid(const std::string& space) { return space == "family3d"; }
 
 std::string required_gamut_space(const std::string& space) {
   if (space == "cubic3d" || space == "cubic2d" || space == "orthotropic2d") return space;
@@ -320,6 +322,7 @@ std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSe
       throw InputError("material space " + sp + ": the gamut level set has " +
                        std::to_string(s.level_set->dimension()) + " dimensions, expected " + std::to_string(want));
   }
+  if (needs_family_grid(sp)) throw InputError("material space " + sp + " is made from a family's structure grid (family:)");
   if (sp == "cubic3d") return std::make_unique<CubicModel>(3, scale, s.level_set);
   if (sp == "cubic2d") return std::make_unique<CubicModel>(2, scale, s.level_set);
   if (sp == "orthotropic2d") return std::make_unique<OrthotropicModel>(scale, s.level_set);

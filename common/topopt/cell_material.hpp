@@ -16,6 +16,7 @@
 //   isotropic2d/3d E, nu, rho          G = E / (2 (1 + nu))         the cubic gamut at that G
 //   analytic2d/3d  E, rho              isotropic, nu fixed          E / E0 - rho^3 <= 0 (§3.6.2)
 //   simp2d/3d      rho                 E = Emin + rho^p (E0 - Emin) none (a volume constraint instead)
+//   family3d       the family's own, rho  interpolated between members rho >= the members' (family_material.hpp)
 //
 // Every C is the inverse of a compliance S that is linear in a few raw
 // properties, so dC/dp_k = -C (dS/dp_k) C exactly.
@@ -37,7 +38,9 @@ class CellMaterialModel {
   int parameters() const { return static_cast<int>(names().size()); }
   virtual int dimension() const = 0;
   // Voigt stiffness at unit parameters p; with dC, also dC/dp_k for every k.
-  void tensor(const VecX& p, MatX& C, std::vector<MatX>* dC = nullptr) const;
+  // By default the inverse of compliance(); a model that interpolates C
+  // directly (the family spaces) overrides this instead.
+  virtual void tensor(const VecX& p, MatX& C, std::vector<MatX>* dC = nullptr) const;
   // Raw parameters (moduli in Pa) of unit parameters.
   virtual VecX raw(const VecX& p) const = 0;
   // Index of rho (the mass fraction) among the parameters.
@@ -48,6 +51,17 @@ class CellMaterialModel {
   virtual double constraint(const VecX& p, VecX* gradient) const;
   // A point to start from: inside the constraint where there is one.
   virtual VecX initial_point(double rho) const = 0;
+
+  // What the design artifact records for a cell: space, property names and
+  // the unit and raw rows. By default the parameters themselves; a family
+  // space records the cubic3d material its cell interpolates, so the mapper
+  // and the checks compare it with structures like any gamut design.
+  virtual std::string design_space() const { return space(); }
+  virtual std::vector<std::string> design_names() const { return names(); }
+  virtual void design_row(const VecX& p, VecX& unit, VecX& raw_row) const { unit = p, raw_row = raw(p); }
+  // A family space's own parameters (the first parameters of every cell;
+  // raw() gives their values); empty elsewhere.
+  virtual std::vector<std::string> family_names() const { return {}; }
 
   // The Voigt bound C(p) <= rho C_stiff + (1 - rho) C_soft (voigt_bound.hpp)
   // as bound_conditions() more per-cell conditions g(p) <= 0; none unless
@@ -80,11 +94,16 @@ struct CellMaterialSettings {
 };
 
 // InputError for an unknown space, a missing level set where one is
-// needed, or a level set of the wrong dimension.
+// needed, or a level set of the wrong dimension. The family spaces are made
+// from their structure grid by make_family_material_model
+// (topopt/family_material.hpp).
 std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSettings& settings);
 
 // The spaces make_cell_material_model accepts.
 std::vector<std::string> cell_material_spaces();
+
+// Whether a design space reads a family's structure grid (`family:`).
+bool needs_family_grid(const std::string& space);
 
 // The gamut space whose artifact a design space needs ("" for none):
 // isotropic2d -> cubic2d, isotropic3d -> cubic3d, a gamut space -> itself.

@@ -24,6 +24,11 @@ void check_sizes(const Design& d, const std::string& where) {
   if (d.displacement.size() != 0 && (d.displacement.rows() != d.nodes() || d.displacement.cols() != d.dimension))
     fail("/nodes/displacement must be nodes x dimension");
   if (!d.unit.allFinite() || !d.raw.allFinite()) fail("non-finite cell parameters");
+  const Eigen::Index k = Eigen::Index(d.family_names.size());
+  if (k > 0 && (d.family_unit.rows() != n || d.family_unit.cols() != k || d.family_raw.rows() != n ||
+                d.family_raw.cols() != k))
+    fail("/family/unit and /family/raw must be cells x family parameters");
+  if (k > 0 && (!d.family_unit.allFinite() || !d.family_raw.allFinite())) fail("non-finite family parameters");
 }
 // Hexahedra for ParaView: a 2D design becomes a slab one cell thick.
 void write_mesh(H5File& f, const Design& d) {
@@ -102,6 +107,13 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
     f.write_vector("/history/max_violation", violation);
     f.write_vector("/history/seconds", seconds);
   }
+  if (!d.family_names.empty()) {
+    f.write_matrix("/family/unit", d.family_unit);
+    f.write_attribute("/family/unit", "meaning", "the family grid's parameters, each normalized to [0, 1] along its axis");
+    f.write_matrix("/family/raw", d.family_raw);
+    f.write_attribute("/family/raw", "meaning", "the family's parameters (beam half-sizes in cell units)");
+    f.write_attribute("/family", "names", format_name_list(d.family_names));
+  }
   write_mesh(f, d);
   out.commit();
   // The ParaView sidecar.
@@ -150,6 +162,11 @@ Design read_design_artifact(const std::string& path) {
     if (obj.size() != it.size() || el.size() != it.size() || vi.size() != it.size() || se.size() != it.size())
       throw InputError(path + ": /history datasets differ in length");
     for (std::size_t i = 0; i < it.size(); ++i) d.history.push_back({it[i], obj[i], el[i], vi[i], se[i]});
+  }
+  if (f.exists("/family")) {
+    d.family_names = parse_name_list(f.read_string_attribute("/family", "names"));
+    d.family_unit = f.read_matrix<double>("/family/unit");
+    d.family_raw = f.read_matrix<double>("/family/raw");
   }
   check_sizes(d, path);
   return d;

@@ -43,6 +43,12 @@ struct Design {
   VecX phi;                // per cell, the gamut constraint value at the end (<= 0 inside)
   MatX displacement;       // nodes x dimension, the first load case's solution
   std::vector<DesignHistoryEntry> history;
+  // A design in a family's own parameters (topopt space family3d; the cells
+  // above then hold the cubic3d material they interpolate): the parameter
+  // names, their values normalized to [0, 1] along the family's grid, and
+  // raw (beam half-sizes). Empty otherwise.
+  std::vector<std::string> family_names;
+  MatX family_unit, family_raw;  // cells x family parameters
 
   std::int64_t cells() const { return std::int64_t(nx) * ny * nz; }
   std::int64_t nodes() const {

@@ -104,7 +104,7 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
     scene.E0 /= 1 - scene.nu * scene.nu;
     scene.nu /= 1 - scene.nu;
   }
-  if (!required_gamut_space(scene.space).empty() && gamut_E_stiff > 0) {
+  if ((!required_gamut_space(scene.space).empty() || needs_family_grid(scene.space)) && gamut_E_stiff > 0) {
     scene.E0 = gamut_E_stiff;
     scene.decades = gamut_decades;
   }

@@ -16,6 +16,7 @@
 // families, e.g. to check that family discovery finds them again.
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -101,6 +102,71 @@ std::vector<TemplateRequest> read_templates(const Config& config) {
   return out;
 }
 
+// The config's `grid:`: one template whose beams take their half-sizes
+// from the axes of a tensor grid. The set records the grid
+// (MicrostructureSet::grid), so a two-scale design can move along the
+// family's parameters (topopt space family3d).
+struct GridRequest {
+  BeamTemplate tpl;
+  std::vector<int> beam_axis;  // per beam: the axis its half-size comes from
+  StructureGrid grid;
+  bool empty() const { return grid.empty(); }
+};
+
+GridRequest read_grid(const Config& config) {
+  GridRequest req;
+  if (!config.has("grid")) return req;
+  const Config g = config.child("grid");
+  req.tpl.caps = g.get_or<bool>("caps", true);
+  const std::vector<Config> parameters = g.children("parameters");
+  if (parameters.empty() || parameters.size() > 3) g.fail("parameters", "needs 1 to 3 parameters");
+  for (const Config& p : parameters) {
+    const std::string name = p.get<std::string>("name");
+    if (name.empty() || name.find(',') != std::string::npos) p.fail("name", "must be non-empty, without commas");
+    for (const std::string& other : req.grid.names)
+      if (other == name) p.fail("name", "'" + name + "' is given twice");
+    const std::vector<double> values = p.get<std::vector<double>>("values");
+    if (values.empty() || values.size() > 64) p.fail("values", "needs 1 to 64 values");
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!(std::isfinite(values[i]) && values[i] >= 0 && values[i] <= 1) || (i > 0 && !(values[i] > values[i - 1])))
+        p.fail("values", "half-sizes must lie in [0, 1] and increase strictly");
+    req.grid.names.push_back(name);
+    req.grid.axes.push_back(values);
+  }
+  const std::vector<Config> beams = g.children("beams");
+  if (beams.empty()) g.fail("beams", "needs at least one beam");
+  for (const Config& b : beams) {
+    Beam beam;
+    for (const char* key : {"a", "b"}) {
+      const std::vector<double> v = b.get<std::vector<double>>(key);
+      if (v.size() != 3) b.fail(key, "must be [x, y, z] in unit-cell coordinates");
+      (std::string(key) == "a" ? beam.a : beam.b) = Vec3(v[0], v[1], v[2]);
+    }
+    beam.theta = b.get_or<double>("theta", 0.0);
+    const std::string name = b.get<std::string>("parameter");
+    const auto it = std::find(req.grid.names.begin(), req.grid.names.end(), name);
+    if (it == req.grid.names.end()) b.fail("parameter", "'" + name + "' is not one of grid.parameters");
+    req.beam_axis.push_back(int(it - req.grid.names.begin()));
+    req.tpl.beams.push_back(beam);
+  }
+  return req;
+}
+
+// The grid point's template: each beam at its axis's half-size, beams of
+// half-size 0 left out.
+BeamTemplate grid_template(const GridRequest& req, const std::vector<int>& index) {
+  BeamTemplate tpl;
+  tpl.caps = req.tpl.caps;
+  for (std::size_t b = 0; b < req.tpl.beams.size(); ++b) {
+    const double r = req.grid.axes[std::size_t(req.beam_axis[b])][std::size_t(index[std::size_t(req.beam_axis[b])])];
+    if (r == 0) continue;
+    Beam beam = req.tpl.beams[b];
+    beam.r0 = beam.r1 = r;
+    tpl.beams.push_back(beam);
+  }
+  return tpl;
+}
+
 // "0.5,-0.2" -> {0.5, -0.2}; InputError naming the option on anything else.
 std::vector<double> parse_reduced(const std::string& text) {
   std::vector<double> r;
@@ -182,6 +248,9 @@ int main(int argc, char** argv) {
     double decades = ctx.config.get_or<double>("decades", 4.0);
     if (!(decades > 0)) ctx.config.fail("decades", "must be > 0");
     const std::vector<TemplateRequest> templates = read_templates(ctx.config);
+    const GridRequest grid = read_grid(ctx.config);
+    if (!grid.empty() && !templates.empty()) ctx.config.fail("grid", "give either templates or a grid, not both");
+    if (!grid.empty() && !families_path.empty()) ctx.config.fail("grid", "is for generating without --families");
     ctx.config.check_no_unknown_keys();
     const std::string out = ctx.require_out();
     ctx.check_out_folder();
@@ -190,10 +259,31 @@ int main(int argc, char** argv) {
     std::vector<std::string> labels;
     std::vector<std::string> inputs;
     double E_stiff = material.E;
-    if (families_path.empty()) {
+    if (!grid.empty()) {
+      // One template over a grid of half-sizes, first axis slowest.
+      if (family != 0 || sweep != 0 || !reduced_options.empty())
+        throw InputError("--family, --reduced and --sweep need --families");
+      if (resolution == 0) resolution = 16;
+      for (std::size_t i = 0; i < grid.grid.points(); ++i) {
+        std::vector<int> index(grid.grid.axes.size());
+        std::size_t rest = i;
+        for (std::size_t a = grid.grid.axes.size(); a-- > 0;) {
+          index[a] = int(rest % grid.grid.axes[a].size());
+          rest /= grid.grid.axes[a].size();
+        }
+        const BeamTemplate tpl = grid_template(grid, index);
+        std::string label;
+        for (std::size_t a = 0; a < index.size(); ++a)
+          label += (a ? ", " : "") + grid.grid.names[a] + " " +
+                   std::to_string(grid.grid.axes[a][std::size_t(index[a])]).substr(0, 5);
+        if (tpl.beams.empty()) ctx.config.fail("grid.parameters", "the point (" + label + ") leaves every beam out");
+        cells.push_back(rasterize_template(tpl, resolution));
+        labels.push_back(label);
+      }
+    } else if (families_path.empty()) {
       // Hand-written templates.
       if (templates.empty())
-        throw InputError("nothing to generate: give --families FILE --family K, or templates in the config");
+        throw InputError("nothing to generate: give --families FILE --family K, or templates or a grid in the config");
       if (family != 0 || sweep != 0 || !reduced_options.empty())
         throw InputError("--family, --reduced and --sweep need --families");
       if (resolution == 0) resolution = 16;
@@ -256,8 +346,9 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
 
-    const MicrostructureSet set =
+    MicrostructureSet set =
         make_set(std::move(cells), resolution, E_stiff, decades, material, homogenize, ctx.options.threads);
+    set.grid = grid.grid;
     write_microstructures_artifact(out, set, "msfab-family-generate", ctx.config.resolved_text(), inputs,
                                    ctx.options.seed);
     std::printf("msfab-family-generate: %zu structures of %d^3 voxels\n", set.items.size(), resolution);

@@ -159,6 +159,7 @@ int main(int argc, char** argv) {
     check_set_belongs_to_design(design_path, structures_path);
     const auto start = std::chrono::steady_clock::now();
     const std::size_t given = set.items.size();
+    set.grid = {};  // generated structures lie off any parameter grid the set had
     if (rank == 0)
       spdlog::info("{}: {} x {} x {} cells; {}: {} structures of {} x {} x {} voxels; {} rank(s) x {} thread(s)",
                    design_path, design.nx, design.ny, design.nz, structures_path, given, set.nx, set.ny, set.nz, size,

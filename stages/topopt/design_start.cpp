@@ -19,9 +19,11 @@ DesignStart read_design_start(const Config& config, const CellMaterialModel& mod
     if (config.has("initial.rho")) config.fail("initial.rho", "give either initial.rho or initial.design");
     start.path = config.get_path("initial.design");
     const Design coarse = read_design_artifact(start.path);
-    if (coarse.space != model.space())
-      config.fail("initial.design", start.path + " is a design in space " + coarse.space + ", this run uses " +
-                                        model.space());
+    const std::vector<std::string> family = model.family_names();
+    if (coarse.space != model.design_space() || coarse.family_names != family)
+      config.fail("initial.design", start.path + " is a design in space " + coarse.space +
+                                        (coarse.family_names.empty() ? "" : " (a family's parameters)") +
+                                        ", this run uses " + model.space());
     if (coarse.dimension != grid.dimension())
       config.fail("initial.design", start.path + " is " + std::to_string(coarse.dimension) + "D");
     for (std::int64_t c = 0; c < grid.cells(); ++c) {
@@ -30,7 +32,13 @@ DesignStart read_design_start(const Config& config, const CellMaterialModel& mod
       const int cj = std::min(coarse.ny - 1, int((j + 0.5) * coarse.ny / grid.ny()));
       const int ck = std::min(coarse.nz - 1, int((k + 0.5) * coarse.nz / grid.nz()));
       const std::int64_t cc = ci + std::int64_t(coarse.nx) * (cj + std::int64_t(coarse.ny) * ck);
-      start.per_cell.row(c) = coarse.unit.row(cc);
+      if (family.empty()) {
+        start.per_cell.row(c) = coarse.unit.row(cc);
+      } else {  // the family's parameters, then rho
+        const Eigen::Index k = Eigen::Index(family.size());
+        start.per_cell.row(c).head(k) = coarse.family_unit.row(cc);
+        start.per_cell(c, k) = coarse.unit(cc, coarse.unit.cols() - 1);
+      }
       // A coarse cell outside its design domain has no parameters to give.
       if (coarse.roles[cc] != CellRole::design)
         start.per_cell.row(c) = model.initial_point(coarse.roles[cc] == CellRole::solid ? 0.9 : 0.1).transpose();

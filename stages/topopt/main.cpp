@@ -3,8 +3,9 @@
 //
 //   1. read the scene: grid, design domain, supports, load cases, mass terms
 //   2. the material space: a gamut level set (cubic3d, cubic2d,
-//      orthotropic2d; isotropic inside a cubic gamut), the analytic gamut
-//      E <= rho^3 E0, or SIMP E = rho^p E0
+//      orthotropic2d; isotropic inside a cubic gamut), a family's own
+//      parameters (family3d), the analytic gamut E <= rho^3 E0, or SIMP
+//      E = rho^p E0
 //   3. the start: uniform rho inside the space, or a coarser design
 //      (coarse-to-fine continuation, §3.6.3)
 //   4. minimize S(p, u) s.t. K(p) u = f (adjoint), Phi(p_i) <= 0 and the
@@ -14,6 +15,7 @@
 //   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "cli/stage_app.hpp"
@@ -21,7 +23,9 @@
 #include "design_start.hpp"
 #include "design_report.hpp"
 #include "gamut/gamut_artifact.hpp"
+#include "gamut/microstructure_set.hpp"
 #include "topopt/cell_mma.hpp"
+#include "topopt/family_material.hpp"
 #include "topopt/simp_mma.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
@@ -75,6 +79,22 @@ int main(int argc, char** argv) {
       }
     } else if (config.has("gamut")) {
       config.fail("gamut", "space " + space + " takes no gamut");
+    }
+    // A family space reads the family's structure grid instead; its base
+    // material sets E0 and the normalization as a gamut's does.
+    MicrostructureSet family;
+    std::string family_path;
+    if (needs_family_grid(space)) {
+      if (!config.has("family"))
+        config.fail("family", "is missing: space " + space + " needs a family's structures (msfab-family-generate, grid:)");
+      family_path = config.get_path("family");
+      family = read_microstructures_artifact(family_path);
+      inputs.push_back(family_path);
+      gamut.E_stiff = family.E_stiff;
+      gamut.decades = family.decades;
+      if (config.has("gamut_padding")) config.fail("gamut_padding", "space " + space + " takes no gamut");
+    } else if (config.has("family")) {
+      config.fail("family", "is read by the family3d space only");
     } else if (config.has("gamut_padding")) {
       config.fail("gamut_padding", "space " + space + " takes no gamut");
     }
@@ -92,9 +112,12 @@ int main(int argc, char** argv) {
 
     // 1. The scene.
     const TopoptScene scene = read_topopt_scene(config, gamut.E_stiff, gamut.decades);
+    if (!family_path.empty() && std::abs(scene.nu - family.stiff.nu) > 1e-12)
+      config.fail("material.nu", "is " + std::to_string(scene.nu) + " but the family's base material has " +
+                                     std::to_string(family.stiff.nu));
     CellMaterialSettings ms{scene.space, scene.E0, scene.decades, scene.nu, scene.penalty, scene.E_min_ratio,
                             needs.empty() ? nullptr : &gamut.level_set};
-    const auto model = make_cell_material_model(ms);
+    const auto model = family_path.empty() ? make_cell_material_model(ms) : make_family_material_model(family, family_path);
     if (use_bound && gamut.bound_stiff.size() > 0) model->set_voigt_bound(gamut.bound_stiff, gamut.bound_soft);
 
     OptimizerSettings os;

@@ -23,7 +23,7 @@ namespace msfab {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
+fs::path mapping_scratch(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("msfab_mapping_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
@@ -386,7 +386,7 @@ TEST(Mapping, MappedDesignMatchesTheVoxelsAndTheTargets) {
     }
 
   // The artifact reads back as written.
-  const std::string path = scratch("m.mapped.h5").string();
+  const std::string path = mapping_scratch("m.mapped.h5").string();
   write_mapped_artifact(path, m, "test", "", {}, 9);
   const MappedDesign back = read_mapped_artifact(path);
   EXPECT_EQ(back.structure, m.structure);
@@ -530,7 +530,7 @@ TEST(Mapping, TiledCellsRepeatTheirStructure) {
         }
     }
     // The voxel file holds every layer of the tiled model.
-    const std::string path = scratch("tiled.voxels.h5").string();
+    const std::string path = mapping_scratch("tiled.voxels.h5").string();
     write_voxels_artifact(path, model, "test", "", {}, 0);
     const VoxelsReader in(path);
     ASSERT_EQ(in.nz(), model.nz());
@@ -541,7 +541,7 @@ TEST(Mapping, TiledCellsRepeatTheirStructure) {
   }
   SmallModel bad;
   bad.m.tiling = 0;
-  EXPECT_THROW(write_mapped_artifact(scratch("bad_tiling.mapped.h5").string(), bad.m, "test", "", {}, 0),
+  EXPECT_THROW(write_mapped_artifact(mapping_scratch("bad_tiling.mapped.h5").string(), bad.m, "test", "", {}, 0),
                std::invalid_argument);
 }
 
@@ -551,7 +551,7 @@ TEST(Mapping, VoxelFileReadsBackAsTheAssembledModel) {
   ASSERT_EQ(model.nx(), 12);
   ASSERT_EQ(model.ny(), 6);
   ASSERT_EQ(model.nz(), 4);
-  const std::string path = scratch("small.voxels.h5").string();
+  const std::string path = mapping_scratch("small.voxels.h5").string();
   write_voxels_artifact(path, model, "test", "", {}, 0);
   const VoxelsReader in(path);
   EXPECT_EQ(in.bits_per_voxel(), 2);
@@ -575,7 +575,7 @@ TEST(Mapping, VoxelFileReadsBackAsTheAssembledModel) {
 TEST(Mapping, StlHasTwoTrianglesPerDifferingVoxelFace) {
   const SmallModel small;
   const VoxelModel model(small.m, small.set);
-  const std::string stem = scratch("small").string();
+  const std::string stem = mapping_scratch("small").string();
   const StlExport stl = write_material_stls(stem, model);
   ASSERT_EQ(stl.paths.size(), 2u);
   const Vec3 h = model.voxel_size();
@@ -619,14 +619,14 @@ TEST(Mapping, StlHasTwoTrianglesPerDifferingVoxelFace) {
     EXPECT_LT(flux.norm(), 1e-10);
   }
   // No tmp files are left behind.
-  for (const auto& entry : fs::directory_iterator(scratch("").parent_path()))
+  for (const auto& entry : fs::directory_iterator(mapping_scratch("").parent_path()))
     EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
 }
 
 TEST(Mapping, PngSlicesOnePerLayer) {
   const SmallModel small;
   const VoxelModel model(small.m, small.set);
-  const std::string folder = scratch("small.slices").string();
+  const std::string folder = mapping_scratch("small.slices").string();
   EXPECT_EQ(write_png_slices(folder, model), 4);
   for (const char* name : {"z00000.png", "z00003.png"}) {
     std::ifstream file(fs::path(folder) / name, std::ios::binary);
@@ -677,8 +677,8 @@ TEST(Mapping, BadInputsAreInputErrorsNamingTheFile) {
   expect_input_error([&] { check_mapping_inputs(d2, "d.h5", renamed, "s.h5"); }, "property names");
 
   // Files: a missing one, and a microstructures artifact given as the design.
-  expect_input_error([&] { read_design_artifact(scratch("missing.h5").string()); }, "missing.h5: no such file");
-  const std::string structures = scratch("set.microstructures.h5").string();
+  expect_input_error([&] { read_design_artifact(mapping_scratch("missing.h5").string()); }, "missing.h5: no such file");
+  const std::string structures = mapping_scratch("set.microstructures.h5").string();
   write_microstructures_artifact(structures, set2d, "test", "", {}, 0);
   expect_input_error([&] { read_design_artifact(structures); }, "expected schema 'msfab.design'");
   expect_input_error([&] { read_mapped_artifact(structures); }, "expected schema 'msfab.mapped'");
@@ -689,7 +689,7 @@ TEST(Mapping, BadInputsAreInputErrorsNamingTheFile) {
 }
 
 TEST(Mapping, ChunkedDatasetSlabsRoundTrip) {
-  const std::string path = scratch("slabs.h5").string();
+  const std::string path = mapping_scratch("slabs.h5").string();
   {
     H5File f = H5File::create(path);
     f.create_chunked_dataset<std::int32_t>("/a", {5, 7}, {2, 7}, 4);
