@@ -14,7 +14,20 @@ void upper_triangle(const MatX& C, int m, double* out) {
 TopologyObjective::TopologyObjective(TopologySetup setup, const CellMaterialModel& model)
     : setup_(std::move(setup)), model_(model) {
   const CellGrid& g = setup_.grid;
-  const std::int64_t n = g.unknowns();
+  const int m = setup_.elements_per_cell;
+  if (m < 1) throw std::invalid_argument("TopologyObjective: elements_per_cell must be >= 1");
+  if (m > 1) {
+    const CellGrid& f = setup_.fem_grid;
+    if (f.dimension() != g.dimension() || f.nx() != m * g.nx() || f.ny() != m * g.ny() ||
+        f.nz() != (g.dimension() == 3 ? m * g.nz() : 1))
+      throw std::invalid_argument("TopologyObjective: fem_grid must have elements_per_cell times the grid's cells");
+    fem_parent_.resize(std::size_t(f.cells()));
+    for (std::int64_t c = 0; c < f.cells(); ++c) {
+      const auto [i, j, k] = f.cell_coords(c);
+      fem_parent_[std::size_t(c)] = g.cell_index(i / m, j / m, k / m);
+    }
+  }
+  const std::int64_t n = fem_grid().unknowns();
   if (model.dimension() != g.dimension())
     throw InputError("material space " + model.space() + " is " + std::to_string(model.dimension()) +
                      "D but the grid is " + std::to_string(g.dimension()) + "D");
@@ -37,7 +50,7 @@ TopologyObjective::TopologyObjective(TopologySetup setup, const CellMaterialMode
     if (setup_.roles[c] == CellRole::design) design_cells_.push_back(c);
   if (design_cells_.empty()) throw InputError("the design domain has no design cell");
   filter_ = CellFilter(g, design_cells_, setup_.filter_radius);
-  fem_ = std::make_unique<GridElasticity>(g, setup_.fixed, setup_.solver, setup_.solver_options);
+  fem_ = std::make_unique<GridElasticity>(fem_grid(), setup_.fixed, setup_.solver, setup_.solver_options);
 }
 
 double TopologyObjective::mass(const MatX& q) const {
@@ -86,7 +99,13 @@ void TopologyObjective::compute_state(const MatX& q) {
     pairs.row(design_cells_[r]) = row;
   }
   if (!finite) throw NumericalError("a cell's stiffness is not finite (parameters at a singular point of the space)");
-  fem_->set_stiffness(pairs);
+  if (fem_parent_.empty()) {
+    fem_->set_stiffness(pairs);
+  } else {
+    MatX fine(fem_grid().cells(), npairs);
+    for (std::size_t f = 0; f < fem_parent_.size(); ++f) fine.row(Eigen::Index(f)) = pairs.row(fem_parent_[f]);
+    fem_->set_stiffness(fine);
+  }
 
 
 
@@ -130,8 +149,8 @@ MatX TopologyObjective::gradient_from_state() {
   const int m = g.voigt(), npairs = g.voigt_pairs(), d = model_.parameters();
   const Eigen::Index rows = Eigen::Index(design_cells_.size());
   const MatX& p = p_;
-  // dS/dC per cell and pair by the adjoint method.
-  MatX dS_dC = MatX::Zero(g.cells(), npairs);
+  // dS/dC per FEM cell and pair by the adjoint method.
+  MatX dS_dC = MatX::Zero(fem_grid().cells(), npairs);
   for (std::size_t i = 0; i < setup_.loads.size(); ++i) {
     const LoadCase& l = setup_.loads[i];
     const VecX& u = u_[i];
@@ -142,6 +161,11 @@ MatX TopologyObjective::gradient_from_state() {
       const VecX lambda = fem_->solve_adjoint(2 * l.target_weight.cwiseProduct(u - l.target));
       dS_dC -= l.weight * fem_->pair_products(lambda, u);
     }
+  }
+  if (!fem_parent_.empty()) {  // a design cell's stiffness acts in all its FEM cells
+    MatX per_cell = MatX::Zero(g.cells(), npairs);
+    for (std::size_t f = 0; f < fem_parent_.size(); ++f) per_cell.row(fem_parent_[f]) += dS_dC.row(Eigen::Index(f));
+    dS_dC = std::move(per_cell);
   }
   const int rho = model_.density_index();
   const double V = g.cell_volume();
@@ -167,6 +191,22 @@ MatX TopologyObjective::gradient_from_state() {
     }
   }
   return filter_.apply_transpose(grad_p);
+}
+
+VecX TopologyObjective::grid_displacement(std::size_t l) const {
+  const VecX& u = u_.at(l);
+  const int m = setup_.elements_per_cell;
+  if (m == 1) return u;
+  const CellGrid& g = setup_.grid;
+  const CellGrid& f = fem_grid();
+  const int dim = g.dimension();
+  VecX out(g.unknowns());
+  for (std::int64_t node = 0; node < g.nodes(); ++node) {
+    const auto [i, j, k] = g.node_coords(node);
+    const std::int64_t fine = f.node_index(m * i, m * j, dim == 3 ? m * k : 0);
+    for (int c = 0; c < dim; ++c) out[node * dim + c] = u[fine * dim + c];
+  }
+  return out;
 }
 
 }  // namespace msfab

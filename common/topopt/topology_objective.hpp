@@ -46,7 +46,16 @@ struct MassTerms {
 struct TopologySetup {
   CellGrid grid;
   std::vector<CellRole> roles;         // per grid cell
-  std::vector<char> fixed;             // per unknown
+  // The mesh the elasticity is solved on: the design grid itself
+  // (elements_per_cell 1), or m^3 hexahedra per design cell, each taking its
+  // cell's stiffness (fem_grid, m = elements_per_cell): one trilinear
+  // hexahedron per cell locks in bending, and the design then promises a
+  // stiffness its homogenized model on a finer mesh does not have
+  // (docs/topopt.md, "Elements per cell"). `fixed` and the loads' vectors
+  // are per unknown of this mesh.
+  int elements_per_cell = 1;
+  CellGrid fem_grid;                   // read when elements_per_cell > 1
+  std::vector<char> fixed;             // per unknown (of the FEM mesh)
   std::vector<LoadCase> loads;
   MassTerms mass;
   double filter_radius = 0;            // in cells; <= 1: none
@@ -86,8 +95,13 @@ class TopologyObjective {
   double mass(const MatX& q) const;
   // The value of the last evaluate().
   const ObjectiveValue& last_value() const { return value_; }
-  // Displacements of the last evaluate(), one per load case.
+  // Displacements of the last evaluate(), one per load case, per unknown
+  // of the FEM mesh.
   const std::vector<VecX>& displacements() const { return u_; }
+  // The mesh they live on (the design grid unless elements_per_cell > 1).
+  const CellGrid& fem_grid() const { return setup_.elements_per_cell > 1 ? setup_.fem_grid : setup_.grid; }
+  // Load case l's displacement at the design grid's nodes.
+  VecX grid_displacement(std::size_t l) const;
   GridElasticity& elasticity() { return *fem_; }
 
  private:
@@ -96,6 +110,7 @@ class TopologyObjective {
   std::vector<std::int64_t> design_cells_;
   CellFilter filter_;
   std::unique_ptr<GridElasticity> fem_;
+  std::vector<std::int64_t> fem_parent_;  // per FEM cell, its design grid cell (elements_per_cell > 1)
   // The state of the last evaluation.
   void compute_state(const MatX& q);
   MatX gradient_from_state();

@@ -108,6 +108,9 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
     scene.E0 = gamut_E_stiff;
     scene.decades = gamut_decades;
   }
+  scene.elements_per_cell = config.get_or<int>("elements_per_cell", 1);
+  if (scene.elements_per_cell < 1 || scene.elements_per_cell > 8) config.fail("elements_per_cell", "must be 1..8");
+  if (scene.elements_per_cell > 1 && dim != 3) config.fail("elements_per_cell", "above 1 needs a 3D grid");
   const double void_ratio = mat.get_or<double>("void_stiffness", 1e-9);
   if (!(void_ratio > 0 && void_ratio < 1e-2)) mat.fail("void_stiffness", "must be in (0, 0.01)");
   s.solid_C = isotropic_voigt(dim, scene.E0, scene.nu);

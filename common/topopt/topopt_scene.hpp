@@ -20,6 +20,10 @@ struct TopoptScene {
   std::string space;
   double E0 = 1.0, nu = 0.3, penalty = 3.0, E_min_ratio = 1e-9, decades = 4.0;
   double volume_fraction = 0;  // > 0: a hard mass budget volume_fraction * domain volume
+  // `elements_per_cell`: hexahedra per design cell edge for the elasticity
+  // (3D). The setup above is on the design grid; the stage refines it
+  // (TopologySetup::fem_grid).
+  int elements_per_cell = 1;
 };
 
 // Reads grid, domain, supports, loads, mass, filter, solver and the

@@ -47,7 +47,7 @@ Design make_design(TopologyObjective& objective, const OptimizationResult& r, do
     }
   }
   objective.evaluate(r.q, nullptr);
-  const VecX& u = objective.displacements().front();
+  const VecX u = objective.grid_displacement(0);
   d.displacement = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
       u.data(), g.nodes(), g.dimension());
   d.history = r.history;

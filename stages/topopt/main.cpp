@@ -29,6 +29,7 @@
 #include "topopt/simp_mma.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
+#include "verify/design_refinement.hpp"
 
 using namespace msfab;
 
@@ -158,6 +159,7 @@ int main(int argc, char** argv) {
 
     TopologySetup setup = scene.setup;
     setup.solver_options.threads = ctx.options.threads;
+    refine_fem_mesh(setup, scene.elements_per_cell);
     // cell-mma regularizes as the thesis does, by smoothing the gradient
     // (topopt/cell_mma.hpp): its cells' parameters are the physical ones.
     const double smoothing_radius = use_cell_mma ? setup.filter_radius : 0.0;
@@ -165,10 +167,11 @@ int main(int argc, char** argv) {
     TopologyObjective objective(setup, *model);
     const CellFilter smoothing(grid, objective.design_cells(), smoothing_radius);
     const MatX q0 = start.rows(objective.design_cells());
-    spdlog::info("{}D grid {} x {} x {} ({} design cells, {} unknowns), space {} ({} parameters), {} load case(s), "
-                 "solver {}, optimizer {}",
+    spdlog::info("{}D grid {} x {} x {} ({} design cells; {}^{} elements per cell, {} unknowns), space {} ({} parameters), "
+                 "{} load case(s), solver {}, optimizer {}",
                  grid.dimension(), grid.nx(), grid.ny(), grid.nz(), objective.design_cells().size(),
-                 grid.unknowns(), space, model->parameters(), setup.loads.size(),
+                 scene.elements_per_cell, grid.dimension(), objective.fem_grid().unknowns(), space, model->parameters(),
+                 setup.loads.size(),
                  objective.elasticity().solver_name(), chosen);
 
     // 4. Optimize.

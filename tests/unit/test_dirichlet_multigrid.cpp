@@ -21,17 +21,17 @@
 namespace msfab {
 namespace {
 
-Mat24 rest_stiffness(double E, double nu, double h) {
+Mat24 dirichlet_rest_stiffness(double E, double nu, double h) {
   return voxel_stiffness(std::make_shared<LinearIsotropic>(E, nu), h);
 }
 
 // Two materials mixed per element with random weights; `void_fraction` of
 // the elements get weight 1e-9 on the stiff one and none on the soft one
 // (SIMP-like contrast).
-VoxelStiffnessField random_field(int nx, int ny, int nz, unsigned seed, double void_fraction = 0.0) {
+VoxelStiffnessField dirichlet_random_field(int nx, int ny, int nz, unsigned seed, double void_fraction = 0.0) {
   VoxelStiffnessField f;
   f.nx = nx, f.ny = ny, f.nz = nz, f.h = 1.0 / nx;
-  f.basis = {rest_stiffness(1.0, 0.3, f.h), rest_stiffness(0.05, 0.45, f.h)};
+  f.basis = {dirichlet_rest_stiffness(1.0, 0.3, f.h), dirichlet_rest_stiffness(0.05, 0.45, f.h)};
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   f.weights.resize(2 * f.voxels());
@@ -58,7 +58,7 @@ std::vector<char> cantilever_mask(int nx, int ny, int nz, bool partial = true, i
   return fixed;
 }
 
-VecX random_vector(Eigen::Index n, unsigned seed) {
+VecX dirichlet_random_vector(Eigen::Index n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g;
   VecX x(n);
@@ -69,10 +69,10 @@ VecX random_vector(Eigen::Index n, unsigned seed) {
 TEST(DirichletMultigrid, ProductMatchesAssembledMatrix) {
   const int nx = 6, ny = 4, nz = 4;
   DirichletGridMultigrid mg(nx, ny, nz, cantilever_mask(nx, ny, nz));
-  mg.set_field(random_field(nx, ny, nz, 3, 0.2));
+  mg.set_field(dirichlet_random_field(nx, ny, nz, 3, 0.2));
   const SpMat A = mg.fine_operator();
   EXPECT_LT((SpMat(A.transpose()) - A).norm(), 1e-12 * A.norm());
-  const VecX x = random_vector(A.rows(), 5);
+  const VecX x = dirichlet_random_vector(A.rows(), 5);
   VecX y;
   mg.multiply(x, y);
   EXPECT_LT((y - A * x).norm(), 1e-12 * (A * x).norm());
@@ -82,7 +82,7 @@ TEST(DirichletMultigrid, LevelOneIsTheGalerkinProduct) {
   const int nx = 6, ny = 4, nz = 4;
   const std::vector<char> fixed = cantilever_mask(nx, ny, nz, true, 2);
   DirichletGridMultigrid mg(nx, ny, nz, fixed);
-  mg.set_field(random_field(nx, ny, nz, 7, 0.2));
+  mg.set_field(dirichlet_random_field(nx, ny, nz, 7, 0.2));
   const SpMat A = mg.fine_operator(), P = mg.prolongation(), Ac = mg.coarse_operator();
   const SpMat reference = SpMat(P.transpose()) * A * P;
   ASSERT_EQ(Ac.rows(), reference.rows());
@@ -110,9 +110,9 @@ TEST(DirichletMultigrid, SolvesHighContrastCantileverLikeADirectSolver) {
   options.tolerance = 1e-10;
   options.coarse_unknowns = 200;
   DirichletGridMultigrid mg(nx, ny, nz, fixed, options);
-  mg.set_field(random_field(nx, ny, nz, 11, 0.3));
+  mg.set_field(dirichlet_random_field(nx, ny, nz, 11, 0.3));
   EXPECT_GE(mg.num_levels(), 3);
-  VecX b = random_vector(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1), 13);
+  VecX b = dirichlet_random_vector(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1), 13);
   const VecX x = mg.solve(b);
   const SpMat A = mg.fine_operator();
   Eigen::SimplicialLDLT<SpMat> direct(A);
@@ -136,7 +136,7 @@ TEST(DirichletMultigrid, IterationsStayBoundedUnderRefinement) {
     DirichletGridMultigrid mg(nx, ny, nz, cantilever_mask(nx, ny, nz, false));
     VoxelStiffnessField f;
     f.nx = nx, f.ny = ny, f.nz = nz, f.h = 1.0 / n;
-    f.basis = {rest_stiffness(1.0, 0.3, f.h)};
+    f.basis = {dirichlet_rest_stiffness(1.0, 0.3, f.h)};
     f.weights.assign(f.voxels(), 1.0);
     mg.set_field(f);
     // The tip load: -z on the nodes of the edge x = L, z = 0.
@@ -159,8 +159,8 @@ TEST(DirichletMultigrid, ResultDoesNotDependOnThreadCount) {
     options.threads = t + 1;
     options.coarse_unknowns = 200;
     DirichletGridMultigrid mg(nx, ny, nz, cantilever_mask(nx, ny, nz), options);
-    mg.set_field(random_field(nx, ny, nz, 17, 0.3));
-    x[t] = mg.solve(random_vector(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1), 19));
+    mg.set_field(dirichlet_random_field(nx, ny, nz, 17, 0.3));
+    x[t] = mg.solve(dirichlet_random_vector(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1), 19));
   }
   EXPECT_EQ((x[0] - x[1]).cwiseAbs().maxCoeff(), 0.0);
 }
@@ -168,11 +168,11 @@ TEST(DirichletMultigrid, ResultDoesNotDependOnThreadCount) {
 TEST(DirichletMultigrid, RejectsBadGridsAndFields) {
   EXPECT_THROW(DirichletGridMultigrid(5, 4, 4, std::vector<char>(3 * 6 * 5 * 5, 0)), InputError);
   DirichletGridMultigrid mg(4, 4, 4, std::vector<char>(3 * 125, 0));
-  EXPECT_THROW(mg.set_field(random_field(4, 4, 2, 1)), InputError);
+  EXPECT_THROW(mg.set_field(dirichlet_random_field(4, 4, 2, 1)), InputError);
   // Nothing held: the coarse operator is singular (rigid motions).
-  EXPECT_THROW(mg.set_field(random_field(4, 4, 4, 1)), NumericalError);
+  EXPECT_THROW(mg.set_field(dirichlet_random_field(4, 4, 4, 1)), NumericalError);
   DirichletGridMultigrid all(2, 2, 2, std::vector<char>(3 * 27, 1));
-  EXPECT_THROW(all.set_field(random_field(2, 2, 2, 1)), InputError);
+  EXPECT_THROW(all.set_field(dirichlet_random_field(2, 2, 2, 1)), InputError);
 }
 
 // Per-cell stiffness of a topology-optimization grid: SIMP (C proportional

@@ -18,7 +18,7 @@
 namespace msfab {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kEmbeddingPi = 3.14159265358979323846;
 
 double uniform(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
 
@@ -26,7 +26,7 @@ double uniform(std::mt19937_64& rng) { return double(rng() >> 11) * 0x1.0p-53; }
 // standard library's normal_distribution.
 double gaussian(std::mt19937_64& rng) {
   const double u = 1.0 - uniform(rng), v = uniform(rng);
-  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kPi * v);
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * kEmbeddingPi * v);
 }
 
 std::vector<int> random_ids(int n, double solid_fraction, std::uint64_t seed) {
@@ -36,7 +36,7 @@ std::vector<int> random_ids(int n, double solid_fraction, std::uint64_t seed) {
   return ids;
 }
 
-VoxelField random_field(int n, std::uint64_t seed) {
+VoxelField embedding_random_field(int n, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   VoxelField f(n);
   for (Eigen::Index v = 0; v < f.values.size(); ++v) f.values[v] = uniform(rng);
@@ -105,7 +105,7 @@ TEST(StructureDistance, IsSymmetricWithOppositeShifts) {
 TEST(StructureDistance, FftMinimumEqualsBruteForceOverAllTranslations) {
   // 8: the radix-4 real transform; 6 and 7: the generic even and odd paths.
   for (int n : {8, 6, 7}) {
-    const VoxelField a = random_field(n, 10 + n), b = random_field(n, 20 + n);
+    const VoxelField a = embedding_random_field(n, 10 + n), b = embedding_random_field(n, 20 + n);
     std::array<int, 3> argmin{};
     const double brute = brute_force_distance(a, b, &argmin);
     const AlignedDistance d = structure_distance(a, b);
@@ -118,7 +118,7 @@ TEST(StructureDistance, FftMinimumEqualsBruteForceOverAllTranslations) {
 }
 
 TEST(StructureDistance, BlurKeepsMassAndCommutesWithTranslation) {
-  const VoxelField f = random_field(12, 5);
+  const VoxelField f = embedding_random_field(12, 5);
   for (double sigma : {0.7, 1.0, 4.0}) {  // 4.0: the kernel wraps around the cell more than once
     const VoxelField g = periodic_gaussian_blur(f, sigma);
     EXPECT_NEAR(g.values.sum(), f.values.sum(), 1e-10 * f.values.sum()) << sigma;
@@ -158,7 +158,7 @@ TEST(StructureDistance, BlurMakesOneVoxelDifferencesSmall) {
 }
 
 TEST(StructureDistance, PoolingAveragesBlocks) {
-  const VoxelField f = random_field(8, 7);
+  const VoxelField f = embedding_random_field(8, 7);
   const VoxelField p = average_pool(f, 2);
   ASSERT_EQ(p.n, 4);
   EXPECT_NEAR(p.values.sum() * 8, f.values.sum(), 1e-12);
@@ -225,7 +225,7 @@ TEST(Isomap, UnrollsASpiralThatPlainMdsCannot) {
   const int n = 100;
   MatX X(n, 3);
   for (int i = 0; i < n; ++i) {
-    const double t = kPi + 3.0 * kPi * i / (n - 1);  // 1.5 turns, radius pi..4 pi
+    const double t = kEmbeddingPi + 3.0 * kEmbeddingPi * i / (n - 1);  // 1.5 turns, radius pi..4 pi
     X.row(i) << t * std::cos(t), t * std::sin(t), 0.05 * t;
   }
   const MatX D = euclidean_distances(X);

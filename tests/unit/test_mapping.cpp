@@ -29,7 +29,7 @@ fs::path mapping_scratch(const std::string& name) {
   return dir / name;
 }
 
-std::vector<int> random_ids(std::mt19937& rng, std::size_t n, int max_id) {
+std::vector<int> mapping_random_ids(std::mt19937& rng, std::size_t n, int max_id) {
   std::vector<int> ids(n);
   for (int& v : ids) v = int(rng() % unsigned(max_id + 1));
   return ids;
@@ -49,7 +49,7 @@ MicrostructureSet random_set(int structures, int vx, int vy, int vz, unsigned se
   set.soft_is_void = !soft;
   for (int s = 0; s < structures; ++s) {
     Microstructure m;
-    m.ids = random_ids(rng, std::size_t(vx) * vy * vz, soft ? 2 : 1);
+    m.ids = mapping_random_ids(rng, std::size_t(vx) * vy * vz, soft ? 2 : 1);
     m.unit = VecX(3);
     for (int j = 0; j < 3; ++j) m.unit[j] = u(rng);
     m.properties = m.unit * 1e5;
@@ -60,7 +60,7 @@ MicrostructureSet random_set(int structures, int vx, int vy, int vz, unsigned se
 
 // A design over the set's space with random targets; every 7th cell forced
 // empty and every 11th forced solid.
-Design random_design(const MicrostructureSet& set, int nx, int ny, int nz, unsigned seed) {
+Design mapping_random_design(const MicrostructureSet& set, int nx, int ny, int nz, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   Design d;
@@ -215,7 +215,7 @@ TEST(Mapping, FaceMismatchCountsEveryDifferingPair) {
 TEST(Mapping, HalfShiftIsThePeriodicTranslateByHalfACell) {
   std::mt19937 rng(5);
   const int nx = 5, ny = 4, nz = 3;  // odd sizes round down: shift (2, 2, 1)
-  const std::vector<int> ids = random_ids(rng, std::size_t(nx) * ny * nz, 2);
+  const std::vector<int> ids = mapping_random_ids(rng, std::size_t(nx) * ny * nz, 2);
   const std::vector<int> shifted = half_shifted(ids, nx, ny, nz);
   for (int z = 0; z < nz; ++z)
     for (int y = 0; y < ny; ++y)
@@ -224,7 +224,7 @@ TEST(Mapping, HalfShiftIsThePeriodicTranslateByHalfACell) {
   // Translating by a whole period changes nothing; half of an even cell
   // twice is a whole period.
   EXPECT_EQ(periodic_shift(ids, nx, ny, nz, nx, -ny, 2 * nz), ids);
-  const std::vector<int> even = random_ids(rng, 4 * 4 * 2, 1);
+  const std::vector<int> even = mapping_random_ids(rng, 4 * 4 * 2, 1);
   EXPECT_EQ(half_shifted(half_shifted(even, 4, 4, 2), 4, 4, 2), even);
   EXPECT_NE(half_shifted(even, 4, 4, 2), even);
   // Its lower x face is the original's column x = nx / 2.
@@ -234,7 +234,7 @@ TEST(Mapping, HalfShiftIsThePeriodicTranslateByHalfACell) {
     for (int y = 0; y < ny; ++y)
       EXPECT_EQ(table.face(e, 0)[y + ny * z], ids[2 + nx * ((y + 2) % ny + ny * ((z + 1) % nz))]);
   // A 2D cell (nz = 1) is not shifted along z.
-  const std::vector<int> flat = random_ids(rng, 4 * 6, 1);
+  const std::vector<int> flat = mapping_random_ids(rng, 4 * 6, 1);
   EXPECT_EQ(half_shifted(flat, 4, 6, 1), periodic_shift(flat, 4, 6, 1, 2, 3, 0));
 }
 
@@ -292,7 +292,7 @@ void expect_descent_to_local_minimum(const FaceGrid& grid, int vx, int vy, int v
   std::mt19937 rng(seed);
   FaceTable table(vx, vy, vz, grid.dimension);
   const int empty = table.add_uniform(0);
-  for (int s = 0; s < 20; ++s) table.add(random_ids(rng, std::size_t(vx) * vy * vz, 2));
+  for (int s = 0; s < 20; ++s) table.add(mapping_random_ids(rng, std::size_t(vx) * vy * vz, 2));
   std::vector<std::int64_t> offsets{0};
   std::vector<std::int32_t> options;
   for (std::int64_t c = 0; c < grid.cells(); ++c) {
@@ -334,7 +334,7 @@ TEST(Mapping, GreedyNeverIncreasesAndEndsInALocalMinimum) {
 
 TEST(Mapping, SameSeedSameMappingOnAnyThreadCount) {
   const MicrostructureSet set = random_set(60, 4, 4, 1, 3);
-  const Design d = random_design(set, 9, 7, 1, 4);
+  const Design d = mapping_random_design(set, 9, 7, 1, 4);
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
   const MapperRun one = run_mapper(d, set, default_options(6), 42);
@@ -353,7 +353,7 @@ TEST(Mapping, SameSeedSameMappingOnAnyThreadCount) {
 
 TEST(Mapping, MappedDesignMatchesTheVoxelsAndTheTargets) {
   const MicrostructureSet set = random_set(40, 3, 3, 2, 7);
-  const Design d = random_design(set, 4, 3, 3, 8);
+  const Design d = mapping_random_design(set, 4, 3, 3, 8);
   const MapperRun r = run_mapper(d, set, default_options(5), 9);
   const MappedDesign& m = r.mapped;
   // The final mismatch is what the assembled voxels show.
@@ -426,7 +426,7 @@ TEST(Mapping, PropertyGapIsZeroAtTheTargetAndRelativeInTheNormOfC) {
     m.properties = physical();
     m.unit = space.normalize(m.properties);
   }
-  Design d = random_design(set, 3, 3, 2, 33);
+  Design d = mapping_random_design(set, 3, 3, 2, 33);
   d.unit = MatX(d.cells(), 4);
   d.raw = MatX(d.cells(), 4);
   for (std::int64_t c = 0; c < d.cells(); ++c) {
@@ -639,7 +639,7 @@ TEST(Mapping, PngSlicesOnePerLayer) {
 
 // --- bad input ---------------------------------------------------------------------
 
-void expect_input_error(const std::function<void()>& f, const std::string& fragment) {
+void mapping_expect_input_error(const std::function<void()>& f, const std::string& fragment) {
   try {
     f();
     ADD_FAILURE() << "no InputError; expected one mentioning '" << fragment << "'";
@@ -651,41 +651,41 @@ void expect_input_error(const std::function<void()>& f, const std::string& fragm
 TEST(Mapping, BadInputsAreInputErrorsNamingTheFile) {
   const MicrostructureSet set2d = random_set(5, 4, 4, 1, 1);
   const MicrostructureSet set3d = random_set(5, 4, 4, 4, 2);
-  const Design d2 = random_design(set2d, 3, 3, 1, 3);
+  const Design d2 = mapping_random_design(set2d, 3, 3, 1, 3);
   EXPECT_NO_THROW(check_mapping_inputs(d2, "d.h5", set2d, "s.h5"));
   Design simp = d2;
   simp.space = "simp2d";
-  expect_input_error([&] { check_mapping_inputs(simp, "d.h5", set2d, "s.h5"); },
+  mapping_expect_input_error([&] { check_mapping_inputs(simp, "d.h5", set2d, "s.h5"); },
                      "d.h5: design space 'simp2d' is not a gamut space");
   Design ortho = d2;
   ortho.space = "orthotropic2d";
-  expect_input_error([&] { check_mapping_inputs(ortho, "d.h5", set2d, "s.h5"); },
+  mapping_expect_input_error([&] { check_mapping_inputs(ortho, "d.h5", set2d, "s.h5"); },
                      "s.h5: microstructure space 'cubic2d' differs from the design's 'orthotropic2d'");
   MicrostructureSet empty = set2d;
   empty.items.clear();
-  expect_input_error([&] { check_mapping_inputs(d2, "d.h5", empty, "s.h5"); }, "s.h5: the microstructure set holds no structures");
+  mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", empty, "s.h5"); }, "s.h5: the microstructure set holds no structures");
   MicrostructureSet flat_as_3d = set3d;
   flat_as_3d.space = "cubic2d";
-  expect_input_error([&] { check_mapping_inputs(d2, "d.h5", flat_as_3d, "s.h5"); },
+  mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", flat_as_3d, "s.h5"); },
                      "s.h5: 3D structures (4 x 4 x 4 voxels) for the 2D design d.h5");
-  Design d3 = random_design(set3d, 2, 2, 2, 4);
+  Design d3 = mapping_random_design(set3d, 2, 2, 2, 4);
   MicrostructureSet flat = set2d;
   flat.space = "cubic3d";
-  expect_input_error([&] { check_mapping_inputs(d3, "d.h5", flat, "s.h5"); }, "2D structures");
+  mapping_expect_input_error([&] { check_mapping_inputs(d3, "d.h5", flat, "s.h5"); }, "2D structures");
   MicrostructureSet renamed = set2d;
   renamed.property_names = {"E", "nu", "Gxy"};
-  expect_input_error([&] { check_mapping_inputs(d2, "d.h5", renamed, "s.h5"); }, "property names");
+  mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", renamed, "s.h5"); }, "property names");
 
   // Files: a missing one, and a microstructures artifact given as the design.
-  expect_input_error([&] { read_design_artifact(mapping_scratch("missing.h5").string()); }, "missing.h5: no such file");
+  mapping_expect_input_error([&] { read_design_artifact(mapping_scratch("missing.h5").string()); }, "missing.h5: no such file");
   const std::string structures = mapping_scratch("set.microstructures.h5").string();
   write_microstructures_artifact(structures, set2d, "test", "", {}, 0);
-  expect_input_error([&] { read_design_artifact(structures); }, "expected schema 'msfab.design'");
-  expect_input_error([&] { read_mapped_artifact(structures); }, "expected schema 'msfab.mapped'");
-  expect_input_error([&] { VoxelsReader reader(structures); }, "expected schema 'msfab.voxels'");
+  mapping_expect_input_error([&] { read_design_artifact(structures); }, "expected schema 'msfab.design'");
+  mapping_expect_input_error([&] { read_mapped_artifact(structures); }, "expected schema 'msfab.mapped'");
+  mapping_expect_input_error([&] { VoxelsReader reader(structures); }, "expected schema 'msfab.voxels'");
   // A mapping that does not fit the set's cells.
   const SmallModel small;
-  expect_input_error([&] { VoxelModel model(small.m, set3d); }, "voxels, the structures 4 x 4 x 4");
+  mapping_expect_input_error([&] { VoxelModel model(small.m, set3d); }, "voxels, the structures 4 x 4 x 4");
 }
 
 TEST(Mapping, ChunkedDatasetSlabsRoundTrip) {

@@ -22,7 +22,7 @@ namespace msfab {
 namespace {
 
 std::int64_t voxel_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx) * (j + std::int64_t(ny) * k); }
-std::int64_t node_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k); }
+std::int64_t components_node_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k); }
 
 // A comb: a solid back plate at x < 2 and teeth along x, one voxel thick
 // in y with one-voxel gaps between them, so that every coarse hat function
@@ -60,7 +60,7 @@ std::vector<char> clamped_without_void(int nx, int ny, int nz, const std::vector
                 material = material || solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))];
             }
         if (i == 0 || !material)
-          for (int d = 0; d < 3; ++d) fixed[3 * std::size_t(node_of(nx, ny, i, j, k)) + d] = 1;
+          for (int d = 0; d < 3; ++d) fixed[3 * std::size_t(components_node_of(nx, ny, i, j, k)) + d] = 1;
       }
   return fixed;
 }
@@ -149,7 +149,7 @@ TEST(MaterialComponents, CombSolvesLikeADirectSolverInFewerIterations) {
   VecX b = VecX::Zero(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1));
   for (int k = 0; k <= nz; ++k)  // the teeth's tips pushed sideways
     for (int j = 0; j <= ny; ++j) {
-      const std::int64_t d = 3 * node_of(nx, ny, nx, j, k) + 1;
+      const std::int64_t d = 3 * components_node_of(nx, ny, nx, j, k) + 1;
       if (!fixed[std::size_t(d)]) b[d] = 1e-3;
     }
   int iterations[2];

@@ -481,7 +481,7 @@ TEST(MaterialSum, AddsEnergiesStressesAndModuli) {
 
 // ------------------------------------------------------------ bad parameters
 
-void expect_input_error(const std::function<void()>& make, const std::string& must_mention) {
+void materials_expect_input_error(const std::function<void()>& make, const std::string& must_mention) {
   try {
     make();
     ADD_FAILURE() << "no InputError; expected one mentioning '" << must_mention << "'";
@@ -493,32 +493,32 @@ void expect_input_error(const std::function<void()>& make, const std::string& mu
 TEST(MaterialParameters, BadValuesThrowInputErrorNamingTheParameter) {
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
   for (double E : {-1.0, 0.0, nan, inf}) {
-    expect_input_error([&] { LinearIsotropic m(E, 0.3); }, "Young's modulus E");
-    expect_input_error([&] { NeoHookean m(E, 0.3); }, "Young's modulus E");
+    materials_expect_input_error([&] { LinearIsotropic m(E, 0.3); }, "Young's modulus E");
+    materials_expect_input_error([&] { NeoHookean m(E, 0.3); }, "Young's modulus E");
   }
   for (double nu : {0.5, 0.7, -1.0, -2.0, nan}) {
-    expect_input_error([&] { LinearIsotropic m(kE, nu); }, "Poisson's ratio nu");
-    expect_input_error([&] { NeoHookean m(kE, nu); }, "Poisson's ratio nu");
+    materials_expect_input_error([&] { LinearIsotropic m(kE, nu); }, "Poisson's ratio nu");
+    materials_expect_input_error([&] { NeoHookean m(kE, nu); }, "Poisson's ratio nu");
   }
-  expect_input_error([&] { NeoHookean m(kE, 0.5); }, "0.5");
-  expect_input_error([&] { AnisotropicSpring m(-1.0, Vec3::UnitX()); }, "stiffness C");
-  expect_input_error([&] { AnisotropicSpring m(nan, Vec3::UnitX()); }, "stiffness C");
-  expect_input_error([&] { AnisotropicSpring m(1.0, Vec3::Zero()); }, "direction v");
-  expect_input_error([&] { AnisotropicSpring m(1.0, Vec3(nan, 0, 0)); }, "direction v");
-  expect_input_error([&] { cubic_C(kE, 0.3, 0.0); }, "shear modulus G");
+  materials_expect_input_error([&] { NeoHookean m(kE, 0.5); }, "0.5");
+  materials_expect_input_error([&] { AnisotropicSpring m(-1.0, Vec3::UnitX()); }, "stiffness C");
+  materials_expect_input_error([&] { AnisotropicSpring m(nan, Vec3::UnitX()); }, "stiffness C");
+  materials_expect_input_error([&] { AnisotropicSpring m(1.0, Vec3::Zero()); }, "direction v");
+  materials_expect_input_error([&] { AnisotropicSpring m(1.0, Vec3(nan, 0, 0)); }, "direction v");
+  materials_expect_input_error([&] { cubic_C(kE, 0.3, 0.0); }, "shear modulus G");
 
   Mat6 nonsymmetric = isotropic_C(kE, 0.3);
   nonsymmetric(0, 3) = 0.1 * kE;
-  expect_input_error([&] { LinearAnisotropic m(nonsymmetric); }, "not symmetric");
+  materials_expect_input_error([&] { LinearAnisotropic m(nonsymmetric); }, "not symmetric");
   Mat6 indefinite = isotropic_C(kE, 0.3);
   indefinite(4, 4) = -1.0;
-  expect_input_error([&] { LinearAnisotropic m(indefinite); }, "not positive definite");
-  expect_input_error([&] { LinearAnisotropic m(Mat6::Zero()); }, "not positive definite");
+  materials_expect_input_error([&] { LinearAnisotropic m(indefinite); }, "not positive definite");
+  materials_expect_input_error([&] { LinearAnisotropic m(Mat6::Zero()); }, "not positive definite");
   Mat6 with_nan = isotropic_C(kE, 0.3);
   with_nan(2, 2) = nan;
-  expect_input_error([&] { LinearAnisotropic m(with_nan); }, "non-finite");
+  materials_expect_input_error([&] { LinearAnisotropic m(with_nan); }, "non-finite");
   OrthotropicConstants k{kE, kE, kE, 0.9, 0.9, 0.9, kE, kE, kE};
-  expect_input_error([&] { orthotropic_C(k); }, "not positive definite");
+  materials_expect_input_error([&] { orthotropic_C(k); }, "not positive definite");
 
   // Valid edge cases are accepted.
   EXPECT_NO_THROW(AnisotropicSpring(0.0, Vec3(0, 0, 5)));

@@ -21,7 +21,7 @@ using namespace msfab;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+constexpr double kModalPi = 3.14159265358979323846;
 constexpr double kBeamE = 1e6, kBeamNu = 0.3, kRho = 1000.0;
 
 struct Body {
@@ -53,7 +53,7 @@ Body cantilever(int n, double E = kBeamE) { return voxel_box(10 * n, n, n, kWidt
 
 double euler_bernoulli_f1() {
   const double I = std::pow(kWidth, 4) / 12.0, A = kWidth * kWidth;
-  return 1.875104068711961 * 1.875104068711961 / (2 * kPi) * std::sqrt(kBeamE * I / (kRho * A * std::pow(kLength, 4)));
+  return 1.875104068711961 * 1.875104068711961 / (2 * kModalPi) * std::sqrt(kBeamE * I / (kRho * A * std::pow(kLength, 4)));
 }
 
 struct Dense {
@@ -117,7 +117,7 @@ TEST(ModalAnalysis, ClampedBlockMatchesDenseGeneralizedEigensolver) {
   ASSERT_EQ(r.eigenvalues.size(), 8);
   for (int i = 0; i < 8; ++i) {
     EXPECT_NEAR(r.eigenvalues(i), ref.eigenvalues()(i), 1e-8 * ref.eigenvalues()(i)) << "mode " << i;
-    EXPECT_NEAR(r.frequencies(i), std::sqrt(ref.eigenvalues()(i)) / (2 * kPi), 1e-8 * r.frequencies(i));
+    EXPECT_NEAR(r.frequencies(i), std::sqrt(ref.eigenvalues()(i)) / (2 * kModalPi), 1e-8 * r.frequencies(i));
   }
   check_modes(b, d, r, 0);
   EXPECT_EQ(r.rigid_modes_skipped, 0);

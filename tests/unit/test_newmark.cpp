@@ -76,13 +76,13 @@ DynamicsModel clamped_linear_bar(double a, double b) {
   return m;
 }
 
-struct Mode {
+struct NewmarkMode {
   double lambda;
   VecX shape;  // M-normalized, full DOF length
 };
 
 // Lowest mode of K x = lambda M x on the free DOFs (dense reference).
-Mode lowest_mode(const NewmarkIntegrator& sim) {
+NewmarkMode lowest_mode(const NewmarkIntegrator& sim) {
   const DynamicsModel& m = sim.model();
   std::vector<int> free;
   for (int i = 0; i < m.mesh.num_dofs(); ++i)
@@ -95,7 +95,7 @@ Mode lowest_mode(const NewmarkIntegrator& sim) {
   for (size_t i = 0; i < free.size(); ++i)
     for (size_t j = 0; j < free.size(); ++j) Kf(i, j) = Kd(free[i], free[j]), Mf(i, j) = Md(free[i], free[j]);
   Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(Kf, Mf);
-  Mode mode;
+  NewmarkMode mode;
   mode.lambda = eig.eigenvalues()(0);
   mode.shape = VecX::Zero(m.mesh.num_dofs());
   for (size_t i = 0; i < free.size(); ++i) mode.shape(free[i]) = eig.eigenvectors()(i, 0);
@@ -108,7 +108,7 @@ TEST(Newmark, UndampedTrapezoidConservesEnergyAndLengthensThePeriod) {
   const DynamicsModel model = clamped_linear_bar(0, 0);
   NewmarkOptions opt;
   const NewmarkIntegrator probe(model, opt);
-  const Mode mode = lowest_mode(probe);
+  const NewmarkMode mode = lowest_mode(probe);
   const double omega = std::sqrt(mode.lambda);
   // A coarse step (omega h = 0.8) makes the period error large and visible.
   opt.time_step = 0.8 / omega;
@@ -138,7 +138,7 @@ TEST(Newmark, RayleighDampedModeDecaysAndOscillatesAtTheModalRates) {
   const double a = 3.0;
   DynamicsModel probe_model = clamped_linear_bar(a, 0);
   const NewmarkIntegrator probe(probe_model, NewmarkOptions{});
-  const Mode mode = lowest_mode(probe);
+  const NewmarkMode mode = lowest_mode(probe);
   const double b = 0.2 / std::sqrt(mode.lambda);  // modal damping ratio ~0.1 from b alone
   const DynamicsModel model = clamped_linear_bar(a, b);
   const double d = 0.5 * (a + b * mode.lambda);

@@ -33,7 +33,7 @@ VoxelStiffnessField random_field(int nx, int ny, int nz, unsigned seed) {
   return f;
 }
 
-VoxelGrid sphere_inclusion(int n, double radius_fraction, int inside, int outside) {
+VoxelGrid periodic_sphere_inclusion(int n, double radius_fraction, int inside, int outside) {
   VoxelGrid g(n, n, n, 1.0 / n, outside);
   for (int k = 0; k < n; ++k)
     for (int j = 0; j < n; ++j)
@@ -111,10 +111,10 @@ TEST(PeriodicMultigrid, BitwiseIdenticalForOneAndTwoThreads) {
 TEST(PeriodicMultigrid, HomogenizationMatchesTheDirectSolverWithVoid) {
   // Stiff sphere in soft matrix, and a soft sphere in void-free stiff
   // matrix with a void channel: contrast 100 and 1e6 (void).
-  VoxelGrid with_void = sphere_inclusion(16, 0.3, 1, 2);
+  VoxelGrid with_void = periodic_sphere_inclusion(16, 0.3, 1, 2);
   for (int a = 0; a < 16; ++a)
     for (int b = 0; b < 3; ++b) with_void.at(a, b, 0) = 0;  // a void slab along x
-  for (const VoxelGrid& cell : {sphere_inclusion(16, 0.3, 1, 2), with_void}) {
+  for (const VoxelGrid& cell : {periodic_sphere_inclusion(16, 0.3, 1, 2), with_void}) {
     HomogenizationOptions direct, multigrid;
     direct.solver = "direct";
     multigrid.solver = "multigrid";
@@ -136,7 +136,7 @@ TEST(PeriodicMultigrid, IterationsAreNearlyIndependentOfTheGrid) {
   int iterations[2];
   for (int t = 0; t < 2; ++t) {
     const int n = t == 0 ? 16 : 32;
-    iterations[t] = homogenize(sphere_inclusion(n, 0.3, 1, 2), palette(), o).iterations;
+    iterations[t] = homogenize(periodic_sphere_inclusion(n, 0.3, 1, 2), palette(), o).iterations;
     std::printf("[periodic-mg] sphere %d^3: %d CG iterations over 6 cases\n", n, iterations[t]);
   }
   EXPECT_LE(iterations[1], iterations[0] + 12);  // 6 cases: at most 2 more per case
@@ -148,7 +148,7 @@ TEST(PeriodicMultigrid, SphereInclusionConvergesUpTo64Cubed) {
   std::vector<CubicModuli> m;
   for (int n : {16, 32, 64}) {
     const auto t0 = std::chrono::steady_clock::now();
-    const HomogenizationResult r = homogenize(sphere_inclusion(n, 0.3, 1, 2), palette());
+    const HomogenizationResult r = homogenize(periodic_sphere_inclusion(n, 0.3, 1, 2), palette());
     m.push_back(cubic_moduli(r.C));
     EXPECT_LT(cubic_deviation(r.C), 1e-6);
     std::printf("[periodic-mg] sphere n=%d (%s): E %.6g nu %.6f G %.6g, %d iterations, %.2f s\n", n, r.solver.c_str(),

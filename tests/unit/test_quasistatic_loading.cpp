@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kH = 0.01;  // voxel edge, 1 cm
 
-struct Body {
+struct QuasistaticBody {
   VoxelGrid grid;
   VoxelMesh vm;
   std::unique_ptr<ElasticAssembler> assembler;
@@ -32,8 +32,8 @@ struct Body {
 
 // A solid nx x ny x nz block of 1 cm voxels with its lower corner at
 // `origin`, Neo-Hookean rubber, loaded by its weight (rho = 1000 kg/m^3).
-std::unique_ptr<Body> make_block(int nx, int ny, int nz, const Vec3& origin, double E = 1e6, double nu = 0.3) {
-  auto s = std::make_unique<Body>();
+std::unique_ptr<QuasistaticBody> make_block(int nx, int ny, int nz, const Vec3& origin, double E = 1e6, double nu = 0.3) {
+  auto s = std::make_unique<QuasistaticBody>();
   s->grid = VoxelGrid(nx, ny, nz, kH, 1);
   s->grid.origin = origin;
   s->vm = build_voxel_mesh(s->grid, {nullptr, std::make_shared<NeoHookean>(E, nu)});
@@ -47,7 +47,7 @@ std::unique_ptr<Body> make_block(int nx, int ny, int nz, const Vec3& origin, dou
 }
 
 // Adds a total force spread over the nodes of a region by their weights.
-void add_region_load(Body& s, const Region& region, const Vec3& total) {
+void add_region_load(QuasistaticBody& s, const Region& region, const Vec3& total) {
   const RegionNodes sel = select_region(region, s.grid, s.vm);
   double sum = 0;
   for (double w : sel.weight) sum += w;
@@ -63,7 +63,7 @@ Obstacle ground(double z = 0.0) {
 }
 
 // Static solve with the given nodes clamped where `x` has them.
-VecX clamped_solve(const Body& s, const std::vector<int>& nodes, const VecX& x) {
+VecX clamped_solve(const QuasistaticBody& s, const std::vector<int>& nodes, const VecX& x) {
   auto dc = DirichletConditions::none(s.vm.mesh.num_dofs());
   for (int i : nodes)
     for (int a = 0; a < 3; ++a) {
@@ -83,7 +83,7 @@ double max_abs(const VecX& v) { return v.cwiseAbs().maxCoeff(); }
 
 // Net force and moment (about the origin) of the loads plus the reactions,
 // relative to the load's magnitude and the moment arm of the mesh size.
-void expect_balanced(const Body& s, const QuasistaticResult& r, double rel) {
+void expect_balanced(const QuasistaticBody& s, const QuasistaticResult& r, double rel) {
   Vec3 force = Vec3::Zero(), moment = Vec3::Zero(), load = Vec3::Zero();
   double load_abs = 0;
   for (int i = 0; i < s.vm.mesh.num_nodes(); ++i) {
@@ -105,7 +105,7 @@ void expect_balanced(const Body& s, const QuasistaticResult& r, double rel) {
 
 // Sign conditions of B.24: no active vertex is pulled, none is away from
 // its face, no free vertex is inside an obstacle.
-void expect_admissible(const Body& s, const std::vector<Obstacle>& obstacles, const QuasistaticResult& r) {
+void expect_admissible(const QuasistaticBody& s, const std::vector<Obstacle>& obstacles, const QuasistaticResult& r) {
   std::vector<char> active(s.vm.mesh.num_nodes(), 0);
   double scale = 0;
   for (const ContactVertex& c : r.contacts) scale = std::max(scale, c.reaction.norm());
@@ -222,7 +222,7 @@ namespace {
 // also tips the bar about the ledge's edge and lifts its far end. The
 // ground lies at ground_z.
 struct LedgeCase {
-  std::unique_ptr<Body> s;
+  std::unique_ptr<QuasistaticBody> s;
   std::vector<Obstacle> obstacles;
   QuasistaticResult r;
   double tip_drop = 0;  // of the bottom edge at the tip
@@ -253,7 +253,7 @@ LedgeCase run_ledge(double ground_z) {
 
 TEST(QuasistaticLoading, BarOverhangingALedgeRestsOnTheBoxTop) {
   const LedgeCase c = run_ledge(0.0);
-  const Body& s = *c.s;
+  const QuasistaticBody& s = *c.s;
   ASSERT_FALSE(c.r.contacts.empty());
   double last_lifted = -1, first_held = 1;  // x of the lifted / held bottom nodes
   std::vector<char> active(s.vm.mesh.num_nodes(), 0);
@@ -294,7 +294,7 @@ TEST(QuasistaticLoading, OverhangTouchingDownIsProjectedAndHeld) {
   // without it) lands: vertices that were free must be stopped at the
   // ground, become active and carry compressive reactions.
   const LedgeCase c = run_ledge(2 * kH - 0.002);
-  const Body& s = *c.s;
+  const QuasistaticBody& s = *c.s;
   int on_ground = 0, activated = 0;
   for (const ContactVertex& v : c.r.contacts)
     if (v.obstacle == 0) {

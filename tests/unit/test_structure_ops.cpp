@@ -11,7 +11,7 @@
 namespace msfab {
 namespace {
 
-VoxelGrid random_cell(int n, int nz, int materials, std::uint64_t seed) {
+VoxelGrid ops_random_cell(int n, int nz, int materials, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   VoxelGrid c(n, n, nz, 1.0 / n, 0);
   for (int& id : c.ids) id = 1 + int(rng() % materials);
@@ -19,7 +19,7 @@ VoxelGrid random_cell(int n, int nz, int materials, std::uint64_t seed) {
 }
 
 TEST(StructureOps, MirroringGivesCubicSymmetryAndACubicTensor) {
-  VoxelGrid c = random_cell(6, 6, 2, 1);
+  VoxelGrid c = ops_random_cell(6, 6, 2, 1);
   EXPECT_FALSE(has_cubic_symmetry(c));
   mirror_fundamental_domain(c);
   EXPECT_TRUE(has_cubic_symmetry(c));
@@ -36,7 +36,7 @@ TEST(StructureOps, MirroringGivesCubicSymmetryAndACubicTensor) {
   EXPECT_LT(cubic_deviation(homogenize(c, pal).C), 1e-9);
   // 2D: the square's symmetry; the plane tensor has C11 = C22 and no
   // shear coupling.
-  VoxelGrid s = random_cell(8, 1, 2, 2);
+  VoxelGrid s = ops_random_cell(8, 1, 2, 2);
   mirror_fundamental_domain(s);
   EXPECT_TRUE(has_cubic_symmetry(s));
   const Mat3 C2 = homogenize_plane_strain(s, pal).C;

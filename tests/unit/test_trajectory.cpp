@@ -54,7 +54,7 @@ std::string read_text(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-std::size_t count_of(const std::string& text, const std::string& what) {
+std::size_t trajectory_count_of(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
   return n;
@@ -179,7 +179,7 @@ void expect_identical(const Trajectory& a, const Trajectory& b) {
 }
 
 template <class F>
-std::string input_error_message(F&& action) {
+std::string trajectory_input_error_message(F&& action) {
   try {
     action();
   } catch (const InputError& e) {
@@ -242,7 +242,7 @@ TEST_F(TrajectoryArtifact, EmptyTrajectoryRoundTrips) {
   expect_identical(t, read_trajectory_artifact(path));
   // Without frames the sidecar shows the rest mesh.
   const std::string text = read_text(xmf);
-  EXPECT_EQ(count_of(text, "<Grid "), 1u);
+  EXPECT_EQ(trajectory_count_of(text, "<Grid "), 1u);
   EXPECT_NE(text.find("empty.h5:/mesh/nodes"), std::string::npos);
   // One event with empty texts must not read back as none.
   t.events = {{0.5, "", ""}};
@@ -256,13 +256,13 @@ TEST_F(TrajectoryArtifact, SidecarNamesEveryFrame) {
   const std::string xmf = write_trajectory_artifact(file("run.h5"), t, {});
   ASSERT_TRUE(fs::exists(xmf));
   const std::string text = read_text(xmf);
-  EXPECT_EQ(count_of(text, "<Time Value="), 3u);
+  EXPECT_EQ(trajectory_count_of(text, "<Time Value="), 3u);
   EXPECT_NE(text.find("CollectionType=\"Temporal\""), std::string::npos);
   for (const char* frame : {"000000", "000001", "000002"}) {
     EXPECT_NE(text.find(std::string("run.h5:/frames/") + frame + "/displacement"), std::string::npos) << frame;
     EXPECT_NE(text.find(std::string("run.h5:/frames/") + frame + "/velocity"), std::string::npos) << frame;
   }
-  EXPECT_EQ(count_of(text, "run.h5:/mesh/elements_vtk"), 3u);
+  EXPECT_EQ(trajectory_count_of(text, "run.h5:/mesh/elements_vtk"), 3u);
   // Frame times are written so that they read back exactly.
   std::vector<double> times;
   const std::string tag = "<Time Value=\"";
@@ -302,7 +302,7 @@ TEST_F(TrajectoryArtifact, MissingFolderIsInputErrorAndLeavesNothing) {
   const fs::path folder = dir_ / "missing";
   const std::string path = (folder / "run.h5").string();
   const std::string message =
-      input_error_message([&] { write_trajectory_artifact(path, synthetic_trajectory(), {}); });
+      trajectory_input_error_message([&] { write_trajectory_artifact(path, synthetic_trajectory(), {}); });
   EXPECT_NE(message.find(folder.string()), std::string::npos) << message;
   EXPECT_FALSE(fs::exists(folder));
   EXPECT_TRUE(fs::is_empty(dir_));
@@ -315,7 +315,7 @@ TEST_F(TrajectoryArtifact, WrongSchemaIsInputError) {
     out.file().write_attribute("/", "scene", "drop-test");
     out.commit();
   }
-  const std::string message = input_error_message([&] { read_trajectory_artifact(path); });
+  const std::string message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("msfab.trajectory"), std::string::npos) << message;
   EXPECT_NE(message.find("msfab.result"), std::string::npos) << message;
@@ -328,7 +328,7 @@ TEST_F(TrajectoryArtifact, DamagedFileNamesFileAndDataset) {
     H5File f = H5File::open(path, H5File::Mode::kReadWrite);
     ASSERT_GE(H5Ldelete(f.id(), "/frames/000001/velocity", H5P_DEFAULT), 0);
   }
-  std::string message = input_error_message([&] { read_trajectory_artifact(path); });
+  std::string message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("/frames/000001/velocity"), std::string::npos) << message;
 
@@ -338,7 +338,7 @@ TEST_F(TrajectoryArtifact, DamagedFileNamesFileAndDataset) {
     ASSERT_GE(H5Ldelete(f.id(), "/samples/kinetic", H5P_DEFAULT), 0);
     f.write_vector("/samples/kinetic", std::vector<double>{1, 2, 3, 4});
   }
-  message = input_error_message([&] { read_trajectory_artifact(path); });
+  message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("/samples/kinetic"), std::string::npos) << message;
   EXPECT_NE(message.find("expected 5"), std::string::npos) << message;
@@ -348,7 +348,7 @@ TEST_F(TrajectoryArtifact, DamagedFileNamesFileAndDataset) {
     H5File f = H5File::open(path, H5File::Mode::kReadWrite);
     f.write_attribute("/events", "kind", "contact");  // two events, one line
   }
-  message = input_error_message([&] { read_trajectory_artifact(path); });
+  message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
   EXPECT_NE(message.find("'kind'"), std::string::npos) << message;
   EXPECT_NE(message.find("/events"), std::string::npos) << message;
 }
