@@ -45,6 +45,11 @@ check "coarse-to-fine continuation in the family" -- "$BIN/msfab-topopt" --confi
   --set loads[0].forces[0].box.min=[12,0,0] --set loads[0].forces[0].box.max=[12,4,4] \
   --set supports[0].box.max=[0,4,4] --out "$WORK/bar_fine.design.h5" --quiet
 
+out=$("$BIN/msfab-topopt" --config "$WORK/bar.yaml" --set elements_per_cell=2 --set optimizer.max_iterations=20 \
+  --out "$WORK/bar_m2.design.h5" 2>&1)
+check "the elasticity on 2^3 hexahedra per cell" -- grep -q "2^3 elements per cell, 975 unknowns" <<<"$out"
+check "its design keeps the design grid's nodes" -- test "$(h5dump -H -d /nodes/displacement "$WORK/bar_m2.design.h5" | grep -c '( 63, 3 )')" = 1
+
 # Bad input.
 expect_exit 2 "family = \\(nothing\\): is missing: space family3d needs" -- "$BIN/msfab-topopt" --config "$WORK/bar.yaml" \
   --set family=null --out "$WORK/x.design.h5"
@@ -67,5 +72,9 @@ expect_exit 2 "grid.parameters\[1\].values = .*: half-sizes must lie in \[0, 1\]
   "$BIN/msfab-family-generate" --config "$WORK/grid.yaml" --set 'grid.parameters[1].values=[0.1, 0.05]' --out "$WORK/x.h5"
 expect_exit 2 "grid.beams\[0\].parameter = width: 'width' is not one of grid.parameters" -- \
   "$BIN/msfab-family-generate" --config "$WORK/grid.yaml" --set 'grid.beams[0].parameter=width' --out "$WORK/x.h5"
+expect_exit 2 "elements_per_cell = 9: must be 1..8" -- "$BIN/msfab-topopt" --config "$WORK/bar.yaml" \
+  --set elements_per_cell=9 --out "$WORK/x.design.h5"
+expect_exit 2 "elements_per_cell = 2: above 1 needs a 3D grid" -- "$BIN/msfab-topopt" --set elements_per_cell=2 \
+  --out "$WORK/x.design.h5"
 check "nothing written for refused runs" -- test ! -e "$WORK/x.design.h5" -a ! -e "$WORK/x.h5"
 finish
