@@ -248,6 +248,12 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
           double next = slope < 0 ? at - excess / slope : std::numeric_limits<double>::quiet_NaN();
           if (!(next > lo && next < hi))
             next = !std::isfinite(hi) ? 10 * std::max(at, 1e-6) : lo > 0 ? std::sqrt(lo * hi) : 0.1 * hi;
+          // Until the budget is bracketed, at most a decade per search: where
+          // the mass hardly responds to mu (a parameter the objective does not
+          // see, such as a family cell's rho above its member's), Newton's
+          // step from the slope jumps straight to the slack price, and every
+          // cell sheds all the mass its move limits allow.
+          if (!std::isfinite(hi)) next = std::min(next, 10 * std::max(at, 1e-6));
           if (!std::isfinite(hi) && next >= kSlackPrice) {
             // The move limits cannot shed enough mass in one step (a start
             // above the budget): the budget gets the cells' slack price,

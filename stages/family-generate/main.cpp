@@ -54,6 +54,17 @@ struct TemplateRequest {
   int moves = 1;                 // end positions per scale (from a, b to a_to, b_to)
 };
 
+// A beam's ends `a` and `b` (unit-cell coordinates) from its config item.
+Beam read_beam_ends(const Config& b) {
+  Beam beam;
+  for (const char* key : {"a", "b"}) {
+    const std::vector<double> v = b.get<std::vector<double>>(key);
+    if (v.size() != 3) b.fail(key, "must be [x, y, z] in unit-cell coordinates");
+    (std::string(key) == "a" ? beam.a : beam.b) = Vec3(v[0], v[1], v[2]);
+  }
+  return beam;
+}
+
 // The config's `templates:` list.
 std::vector<TemplateRequest> read_templates(const Config& config) {
   std::vector<TemplateRequest> out;
@@ -66,12 +77,7 @@ std::vector<TemplateRequest> read_templates(const Config& config) {
     const std::vector<Config> beams = item.children("beams");
     if (beams.empty()) item.fail("beams", "needs at least one beam");
     for (const Config& b : beams) {
-      Beam beam;
-      for (const char* key : {"a", "b"}) {
-        const std::vector<double> v = b.get<std::vector<double>>(key);
-        if (v.size() != 3) b.fail(key, "must be [x, y, z] in unit-cell coordinates");
-        (std::string(key) == "a" ? beam.a : beam.b) = Vec3(v[0], v[1], v[2]);
-      }
+      Beam beam = read_beam_ends(b);
       beam.r0 = b.require_positive("r0", "cross-section half-size");
       beam.r1 = b.require_positive("r1", "cross-section half-size");
       beam.theta = b.get_or<double>("theta", 0.0);
@@ -136,12 +142,7 @@ GridRequest read_grid(const Config& config) {
   const std::vector<Config> beams = g.children("beams");
   if (beams.empty()) g.fail("beams", "needs at least one beam");
   for (const Config& b : beams) {
-    Beam beam;
-    for (const char* key : {"a", "b"}) {
-      const std::vector<double> v = b.get<std::vector<double>>(key);
-      if (v.size() != 3) b.fail(key, "must be [x, y, z] in unit-cell coordinates");
-      (std::string(key) == "a" ? beam.a : beam.b) = Vec3(v[0], v[1], v[2]);
-    }
+    Beam beam = read_beam_ends(b);
     beam.theta = b.get_or<double>("theta", 0.0);
     const std::string name = b.get<std::string>("parameter");
     const auto it = std::find(req.grid.names.begin(), req.grid.names.end(), name);
