@@ -36,7 +36,10 @@
 # TWO_SCALE_FAMILY=NAME designs in a family's own parameters instead of a
 # gamut (topopt space family3d, docs/topopt.md): the structure grid of
 # configs/families/NAME.yaml is the optimizer's material model and the
-# mapping's set; results go to out/topopt/NAME/.
+# mapping's set; results go to out/topopt/NAME/. These designs are made
+# with cell MMA on 4^3 hexahedra per cell (the model the .h4 check uses;
+# TOPOPT_ARGS="--set optimizer.name=ipopt --set elements_per_cell=1" for
+# the thesis's set-up).
 #   make -f Makefile.pipeline topopt-checks TWO_SCALE_FAMILY=graded_lattice_grid
 # TOPOPT_ARGS go to msfab-topopt (e.g. "--set gamut_padding=subtract", the
 # feasible set ending at the outermost structures); give such a variant its
@@ -51,7 +54,8 @@ ifneq ($(TWO_SCALE_FAMILY),)
 TOPOPT_DIR ?= $(OUT)/topopt/$(TWO_SCALE_FAMILY)
 TWO_SCALE_SET := $(OUT)/families/$(TWO_SCALE_FAMILY).microstructures.h5
 TWO_SCALE_SPACE := $(TWO_SCALE_SET)
-TWO_SCALE_SPACE_ARGS := --set gamut=null --set space=family3d --set family=$(TWO_SCALE_SET)
+TWO_SCALE_SPACE_ARGS := --set gamut=null --set space=family3d --set family=$(TWO_SCALE_SET) \
+  --set optimizer.name=cell-mma --set elements_per_cell=4
 TWO_SCALE_MAP_ARGS := --set half_shift=false --set candidates=1
 else
 ifeq ($(TWO_SCALE_GAMUT),cubic3d_bar)
