@@ -50,6 +50,7 @@ TopologyObjective::TopologyObjective(TopologySetup setup, const CellMaterialMode
     if (setup_.roles[c] == CellRole::design) design_cells_.push_back(c);
   if (design_cells_.empty()) throw InputError("the design domain has no design cell");
   filter_ = CellFilter(g, design_cells_, setup_.filter_radius);
+  hold_void_nodes();
   fem_ = std::make_unique<GridElasticity>(fem_grid(), setup_.fixed, setup_.solver, setup_.solver_options);
 }
 
@@ -191,6 +192,21 @@ MatX TopologyObjective::gradient_from_state() {
     }
   }
   return filter_.apply_transpose(grad_p);
+}
+
+void TopologyObjective::hold_void_nodes() {
+  const CellGrid& f = fem_grid();
+  const int dim = f.dimension();
+  std::vector<char> touched(std::size_t(f.nodes()), 0);
+  for (std::int64_t c = 0; c < f.cells(); ++c) {
+    const std::int64_t parent = fem_parent_.empty() ? c : fem_parent_[std::size_t(c)];
+    if (setup_.roles[std::size_t(parent)] == CellRole::empty) continue;
+    const auto nodes = f.cell_nodes(c);
+    for (int k = 0; k < f.corners(); ++k) touched[std::size_t(nodes[std::size_t(k)])] = 1;
+  }
+  for (std::int64_t node = 0; node < f.nodes(); ++node)
+    if (!touched[std::size_t(node)])
+      for (int c = 0; c < dim; ++c) setup_.fixed[std::size_t(node * dim + c)] = 1;
 }
 
 VecX TopologyObjective::grid_displacement(std::size_t l) const {
