@@ -28,7 +28,6 @@ Mat6 isotropic_tensor(double E, double nu) {
   return C;
 }
 
-namespace {
 Mat6 cubic_tensor(double C11, double C12, double C44) {
   Mat6 C = Mat6::Zero();
   for (int i = 0; i < 3; ++i) {
@@ -38,7 +37,6 @@ Mat6 cubic_tensor(double C11, double C12, double C44) {
   }
   return C;
 }
-}  // namespace
 
 CubicModuli cubic_moduli(const Mat6& C) {
   CubicModuli m;

@@ -35,6 +35,8 @@ struct CubicModuli {
   double E = 0, nu = 0, G = 0, shear_ratio = 0;
 };
 CubicModuli cubic_moduli(const Mat6& C);
+// The cubic tensor (axes along x, y, z) with these three moduli.
+Mat6 cubic_tensor(double C11, double C12, double C44);
 
 // Largest deviation of C from the cubic tensor of cubic_moduli(C), relative
 // to C11: 0 for an exactly cubic tensor.

@@ -5,19 +5,19 @@
 
 #include "core/errors.hpp"
 #include "gamut/material_space.hpp"
+#include "homog/elastic_tensor.hpp"
 #include "topopt/grid_interpolant.hpp"
 
 namespace msfab {
 namespace {
 
 // The eigenvalues of a cubic Voigt tensor: hydrostatic C11 + 2 C12 (once),
-// deviatoric C11 - C12 (twice), shear C44 (three times); averaged over the
-// axes so that round-off asymmetry of a homogenized tensor does not matter.
+// deviatoric C11 - C12 (twice), shear C44 (three times), from the moduli
+// averaged over their copies (round-off asymmetry of a homogenized tensor
+// does not matter).
 Eigen::Vector3d cubic_eigenvalues(const Mat6& C) {
-  const double c11 = (C(0, 0) + C(1, 1) + C(2, 2)) / 3;
-  const double c12 = (C(0, 1) + C(0, 2) + C(1, 2)) / 3;
-  const double c44 = (C(3, 3) + C(4, 4) + C(5, 5)) / 3;
-  return {c11 + 2 * c12, c11 - c12, c44};
+  const CubicModuli m = cubic_moduli(C);
+  return {m.C11 + 2 * m.C12, m.C11 - m.C12, m.C44};
 }
 
 class FamilyGridModel : public CellMaterialModel {
@@ -118,14 +118,7 @@ class FamilyGridModel : public CellMaterialModel {
   int axes() const { return table_.axes(); }
   // Linear in the eigenvalues, so it also maps their derivatives.
   static MatX cubic_from_eigenvalues(const Eigen::Vector3d& l) {
-    MatX C = MatX::Zero(6, 6);
-    const double c11 = (l[0] + 2 * l[1]) / 3, c12 = (l[0] - l[1]) / 3;
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) C(i, j) = c12;
-      C(i, i) = c11;
-      C(3 + i, 3 + i) = l[2];
-    }
-    return C;
+    return cubic_tensor((l[0] + 2 * l[1]) / 3, (l[0] - l[1]) / 3, l[2]);
   }
 
   StructureGrid grid_;
