@@ -1,5 +1,6 @@
-// msfab-gamut-sample: the material-property gamut of two-material
-// microstructures (thesis §3.2), MPI-parallel.
+// msfab-gamut-sample: the material-property gamut of microstructures of two
+// phases (two materials, or one and void) or three (two and void; thesis
+// §3.2, Fig. 3-15), MPI-parallel.
 //
 //   1. read the material space, base materials and sampler settings
 //   2. cycle 0: the solid cell and random beam cuts of it, homogenized;
@@ -21,6 +22,7 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -239,6 +241,18 @@ int main(int argc, char** argv) {
           options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], by_step[4],
           state.cycles_done);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
+      if (options.three_phase) {
+        // How many structures hold void, the soft material, and both: the
+        // three-phase gamut is only that where structures mix all three.
+        int with_void = 0, with_soft = 0, with_both = 0;
+        for (const Microstructure& m : state.set.items) {
+          const bool v = std::find(m.ids.begin(), m.ids.end(), 0) != m.ids.end();
+          const bool s = std::find(m.ids.begin(), m.ids.end(), 2) != m.ids.end();
+          with_void += v, with_soft += s, with_both += v && s;
+        }
+        std::printf("  phases: %d structures with void, %d with the soft material, %d with both\n", with_void,
+                    with_soft, with_both);
+      }
       if (options.stop_coverage_growth > 0) {
         const std::size_t w = std::min<std::size_t>(options.stop_window, state.history.size() - 1);
         const double growth = best_coverage_growth(state.history, options.stop_window);

@@ -13,6 +13,7 @@ resolution: 16            # voxels per cell side (2D cells are n x n x 1)
 materials:
   stiff: {E: 1.0e6, nu: 0.3}
   soft:  {E: 1.0e4, nu: 0.45}   # leave out for stiff material and void
+  void: false               # true with soft: two materials and void (discrete sampling only)
 population: 24
 cycles: 6                 # the most; stop earlier once the coverage stops growing:
 stop: {coverage_growth: 0, window: 3}   # relative growth of the best coverage over `window` cycles below which the run ends (0: off)
@@ -90,6 +91,11 @@ SamplerOptions read_sampler_options(const Config& config) {
     o.soft = read_base(mats.child("soft"));
     if (!(o.soft.E < o.stiff.E)) mats.fail("soft", "E must be below the stiff material's");
   }
+  if (mats.has("void")) {
+    const bool with_void = mats.get_or<bool>("void", false);
+    if (o.soft_is_void && !with_void) mats.fail("void", "false needs materials.soft (without it the second phase is void)");
+    o.three_phase = with_void && !o.soft_is_void;
+  }
   mats.check_no_unknown_keys();
   o.decades = config.get_or<double>("decades", o.decades);
   if (!(o.decades > 0 && o.decades <= 12)) config.fail("decades", "must be in (0, 12]");
@@ -122,8 +128,8 @@ SamplerOptions read_sampler_options(const Config& config) {
       b.fail("max_radius", "need 0 < min_radius <= max_radius");
     b.check_no_unknown_keys();
   }
-  o.move.materials = 1;
-  o.move.cut_id = o.soft_is_void ? 0 : 2;
+  o.move.materials = o.three_phase ? 2 : 1;
+  o.move.cut_id = o.soft_is_void || o.three_phase ? 0 : 2;
   o.move.symmetry = o.kind == MaterialSpaceKind::orthotropic2d ? CellSymmetry::orthotropic : CellSymmetry::cubic;
 
   if (config.has("continuous")) {
@@ -155,8 +161,9 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.backbone = config.get_or<int>("backbone", o.backbone);
   if (o.backbone < 0 || o.backbone > o.resolution / 2)
     config.fail("backbone", "must be in 0..resolution/2 (" + std::to_string(o.resolution / 2) + "; 0: none)");
-  if (o.backbone > 0 && !o.soft_is_void)
-    config.fail("backbone", "needs a void phase (leave out materials.soft): with two materials every cell is solid");
+  if (o.backbone > 0 && !o.soft_is_void && !o.three_phase)
+    config.fail("backbone", "needs a void phase (leave out materials.soft, or set materials.void: true): with two "
+                            "materials every cell is solid");
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
   o.continuous.use_symmetry = o.use_symmetry;
@@ -193,6 +200,18 @@ SamplerOptions read_sampler_options(const Config& config) {
     if (!(k.penalty >= 1 && k.penalty <= 16)) d.fail("penalty", "must be in [1, 16]");
     d.check_no_unknown_keys();
   }
+
+  // The continuous and directed steps interpolate between two phases
+  // (SIMP stiff/soft or stiff/void); a third has no place in them.
+  const auto refuse_step = [&](const std::string& step, int per_cycle, const std::string& what) {
+    const std::string why = "must be 0 with two materials and void (materials.void: true): " + what;
+    if (config.has(step)) config.child(step).fail("per_cycle", why);
+    config.fail(step, "per_cycle is " + std::to_string(per_cycle) + " by default and " + why);
+  };
+  if (o.three_phase && o.continuous_per_cycle > 0)
+    refuse_step("continuous", o.continuous_per_cycle, "the continuous step interpolates between two phases");
+  if (o.three_phase && o.directed_per_cycle > 0)
+    refuse_step("directed", o.directed_per_cycle, "directed pushes interpolate between two phases");
 
   if (config.has("level_set")) {
     const Config l = config.child("level_set");

@@ -20,6 +20,11 @@ struct SamplerOptions {
   int resolution = 16;           // voxels per side; a 2D space uses n x n x 1
   BaseMaterial stiff{1e6, 0.3}, soft{1e4, 0.45};
   bool soft_is_void = false;
+  // Two materials and void (thesis Fig. 3-15, `materials.void: true` with a
+  // soft material): the move adds stiff or soft beams and cuts to void.
+  // Discrete sampling only: the continuous and directed steps interpolate
+  // between two phases.
+  bool three_phase = false;
   double decades = 4;            // log range of the moduli below the stiff E
   double void_stiffness = 1e-6;
   // Cell problems solved on the cell's symmetric part: two strain cases for

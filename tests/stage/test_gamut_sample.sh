@@ -61,6 +61,24 @@ check "void variants: 1 and 3 ranks agree" -- bash -c "h5diff -q '$WORK/v.void.m
 expect_exit 2 "void_variants.*needs a soft material" -- "$SAMPLE" --config "$TINY" --set void_variants=true \
   --set materials='{stiff: {E: 1.0e6, nu: 0.3}}' --out "$WORK/bad.gamut.h5"
 
+# Two materials and void (thesis Fig. 3-15): beams add the stiff or the soft
+# material or cut to void, so structures mix all three; 1 and 3 ranks agree.
+THREE_MATERIALS='{stiff: {E: 1.0e6, nu: 0.3}, soft: {E: 1.0e3, nu: 0.45}, void: true}'
+expect_exit 0 "phases: [1-9][0-9]* structures with void, [1-9][0-9]* with the soft material, [1-9][0-9]* with both" -- \
+  "$SAMPLE" --config "$TINY" --seed 7 --set materials="$THREE_MATERIALS" --set continuous.per_cycle=0 \
+  --set directed.per_cycle=0 --out "$WORK/tri.gamut.h5"
+check "two materials and void: 1 and 3 ranks agree" -- bash -c "mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 \
+  '$SAMPLE' --config '$TINY' --seed 7 --set materials='$THREE_MATERIALS' --set continuous.per_cycle=0 \
+  --set directed.per_cycle=0 --out '$WORK/tri3.gamut.h5' --quiet && \
+  h5diff -q '$WORK/tri.microstructures.h5' '$WORK/tri3.microstructures.h5' /voxels /voxels && \
+  h5diff -q '$WORK/tri.gamut.h5' '$WORK/tri3.gamut.h5' /level_set/phi /level_set/phi"
+expect_exit 2 "continuous.per_cycle = 2: must be 0 with two materials and void" -- "$SAMPLE" --config "$TINY" \
+  --set materials="$THREE_MATERIALS" --out "$WORK/bad.gamut.h5"
+expect_exit 2 "directed.per_cycle = 1: must be 0 with two materials and void" -- "$SAMPLE" --config "$TINY" \
+  --set materials="$THREE_MATERIALS" --set continuous.per_cycle=0 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "materials.void.*false needs materials.soft" -- "$SAMPLE" --config "$TINY" \
+  --set materials='{stiff: {E: 1.0e6, nu: 0.3}, void: false}' --out "$WORK/bad.gamut.h5"
+
 # An earlier set as part of the initial population: every structure of
 # `one` (8 x 8) is added again, as is, or with each voxel split into 2 x 2
 # for a 16 x 16 gamut.
