@@ -8,6 +8,7 @@
 #   make -f Makefile.pipeline gamut-auxetic-2d-printable  the same at 48^2, no feature below 2 voxels, ~5 min
 #   make -f Makefile.pipeline gamut-auxetic-3d  3D cubic void gamut at 16^3 with min_nu pushes, ~2 min
 #   make -f Makefile.pipeline gamut-auxetic-3d-32  the same at 32^3 (lengths in voxels doubled), ~10 min
+#   make -f Makefile.pipeline gamut-auxetic-3d-64  at 64^3, started from the 16^3 gamut's structures, ~20 min
 #   make -f Makefile.pipeline gamut-3d       3D cubic gamut, one material + void, 16^3 cells; hours on 2 cores, use RANKS
 #   make -f Makefile.pipeline gamut-converge-2d  2D cubic, orthotropic (stiff + soft and one material + void) and 2D
 #                                             cubic of two materials + void run
@@ -42,7 +43,7 @@ gamut-converge-2d: build $(addprefix $(OUT)/gamut/converged/,cubic2d.gamut.h5 or
     orthotropic2d_void.gamut.h5 cubic2d_three.gamut.h5)
 gamut-converge-3d: build $(OUT)/gamut/converged/cubic3d_void.gamut.h5
 
-.PHONY: gamut-2d gamut-ortho gamut-2d-void gamut-2d-three gamut-auxetic-2d gamut-auxetic-2d-printable gamut-auxetic-3d gamut-auxetic-3d-32 gamut-3d gamut-bench
+.PHONY: gamut-2d gamut-ortho gamut-2d-void gamut-2d-three gamut-auxetic-2d gamut-auxetic-2d-printable gamut-auxetic-3d gamut-auxetic-3d-32 gamut-auxetic-3d-64 gamut-3d gamut-bench
 gamut-2d: build $(OUT)/gamut/cubic2d.gamut.h5
 gamut-ortho: build $(OUT)/gamut/orthotropic2d.gamut.h5
 gamut-2d-void: build $(OUT)/gamut/cubic2d_void.gamut.h5 $(OUT)/gamut/orthotropic2d_void.gamut.h5
@@ -51,6 +52,8 @@ gamut-auxetic-2d: build $(OUT)/gamut/cubic2d_auxetic.gamut.h5
 gamut-auxetic-2d-printable: build $(OUT)/gamut/cubic2d_auxetic_printable.gamut.h5
 gamut-auxetic-3d: build $(OUT)/gamut/cubic3d_auxetic.gamut.h5
 gamut-auxetic-3d-32: build $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5
+gamut-auxetic-3d-64: build $(OUT)/gamut/cubic3d_auxetic_64.gamut.h5
+$(OUT)/gamut/cubic3d_auxetic_64.gamut.h5: $(OUT)/gamut/cubic3d_auxetic.gamut.h5
 gamut-3d: build $(OUT)/gamut/cubic3d_void.gamut.h5
 
 gamut-bench: build

@@ -10,6 +10,8 @@
 #   make -f Makefile.pipeline topopt-checks          all four
 #   make -f Makefile.pipeline topopt-bridge-large    the bridge at 128x64x32 cells (Fig. 3-29's grid), optimized
 #                                                    with cell MMA: out/topopt/bridge_cubic_large.design.h5 (about 30 min)
+#   make -f Makefile.pipeline topopt-bridge-huge     the bridge at 320x160x80 cells (Table 3.2's largest grid) in the
+#                                                    lattice family at 64^3, coarse to fine, mapped (1.07e12 voxels; about an hour)
 #   make -f Makefile.pipeline topopt-thesis-2d       the thesis's 2D scenes: the S-beam (Fig. 3-18), the four
 #                                                    grippers (Fig. 3-20) and the orthotropic lattice (Fig. 3-25)
 #   make -f Makefile.pipeline topopt-cubes           Table 3.1's cubes and the tiling study (Fig. 3-23) in
@@ -154,6 +156,34 @@ $(OUT)/topopt/bridge_cubic_large.design.h5: configs/topopt/bridge_cubic_large.ya
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@
 
+# The bridge at Table 3.2's largest grid, end to end: 320x160x80 cells
+# designed in the connected lattice family generated at 64^3 voxels per
+# cell (1.07e12 voxels), coarse to fine (80x40x20, 160x80x40, then
+# HUGE_ITERATIONS cell MMA steps at 320x160x80), and mapped cell by cell
+# onto the family's members (the mapped artifact names each cell's member;
+# the voxels are not written). 16 GB of memory at the finest grid, about an
+# hour on 2 cores (docs/BENCHMARKS.md, "The bridge at 320x160x80").
+HUGE_DIR := $(OUT)/topopt/huge
+HUGE_FAMILY := $(OUT)/families/graded_lattice_grid64.microstructures.h5
+HUGE_ITERATIONS ?= 4
+HUGE_CONFIG := configs/topopt/bridge_family_huge.yaml
+HUGE_TOPOPT = $(BIN)/msfab-topopt --config $(HUGE_CONFIG) --set family=$(HUGE_FAMILY) --threads $(THREADS)
+$(HUGE_FAMILY): configs/families/graded_lattice_grid.yaml $(BIN)/msfab-family-generate
+	@mkdir -p $(@D)
+	$(BIN)/msfab-family-generate --config $< --set resolution=64 --threads $(THREADS) --out $@ --quiet
+$(HUGE_DIR)/bridge80.design.h5: $(HUGE_CONFIG) $(HUGE_FAMILY) $(BIN)/msfab-topopt
+	@mkdir -p $(@D)
+	$(HUGE_TOPOPT) --set grid="{size: [80, 40, 20], cell_size: 4.0}" --set optimizer.max_iterations=30 \
+	  --set domain="[{box: {min: [0, 0, 76], max: [320, 160, 80]}, role: solid}]" --out $@
+$(HUGE_DIR)/bridge160.design.h5: $(HUGE_DIR)/bridge80.design.h5
+	$(HUGE_TOPOPT) --set grid="{size: [160, 80, 40], cell_size: 2.0}" --set optimizer.max_iterations=40 \
+	  --set domain="[{box: {min: [0, 0, 78], max: [320, 160, 80]}, role: solid}]" --set initial="{design: $<}" --out $@
+$(HUGE_DIR)/bridge320.design.h5: $(HUGE_DIR)/bridge160.design.h5
+	$(HUGE_TOPOPT) --set optimizer.max_iterations=$(HUGE_ITERATIONS) --set initial="{design: $<}" --out $@
+$(HUGE_DIR)/bridge320.mapped.h5: $(HUGE_DIR)/bridge320.design.h5 $(HUGE_FAMILY) $(BIN)/msfab-map
+	$(BIN)/msfab-map --design $< --structures $(HUGE_FAMILY) --set half_shift=false --set candidates=1 \
+	  --seed $(SEED) --threads $(THREADS) --out $@
+
 # The thesis's 2D scenes, each in its gamut.
 THESIS_2D_SCENES := s_beam orthotropic_lattice gripper gripper_pull gripper_push gripper_stretch
 GAMUT_s_beam := cubic2d
@@ -173,7 +203,7 @@ $(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)
 topopt-thesis-2d: build $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
 
 .PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check topopt-checks topopt-cubes \
-    topopt-bridge-large
+    topopt-bridge-large topopt-bridge-huge
 topopt-bar-check: build $(TOPOPT_DIR)/bar.verify.h5 $(TOPOPT_DIR)/bar.h4.verify.h5 $(TOPOPT_DIR)/bar.solid.verify.h5 \
     $(TOPOPT_DIR)/bar.t2.verify.h5
 topopt-cubes: build $(OUT)/topopt/cubes.md
@@ -185,3 +215,4 @@ topopt-cantilever-check: build $(TOPOPT_DIR)/cantilever_cubic.verify.h5 $(TOPOPT
     $(TOPOPT_DIR)/cantilever_cubic.solid.verify.h5
 topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check
 topopt-bridge-large: build $(OUT)/topopt/bridge_cubic_large.design.h5
+topopt-bridge-huge: build $(HUGE_DIR)/bridge320.mapped.h5
