@@ -8,7 +8,7 @@
 #   make -f Makefile.pipeline gamut-auxetic-2d-printable  the same at 48^2, no feature below 2 voxels, ~5 min
 #   make -f Makefile.pipeline gamut-auxetic-3d  3D cubic void gamut at 16^3 with min_nu pushes, ~2 min
 #   make -f Makefile.pipeline gamut-auxetic-3d-32  the same at 32^3 (lengths in voxels doubled), ~10 min
-#   make -f Makefile.pipeline gamut-auxetic-3d-64  at 64^3, started from the 16^3 gamut's structures, ~20 min
+#   make -f Makefile.pipeline gamut-auxetic-3d-64  at 64^3, started from the 16^3 gamut's structures, ~45 min
 #   make -f Makefile.pipeline gamut-3d       3D cubic gamut, one material + void, 16^3 cells; hours on 2 cores, use RANKS
 #   make -f Makefile.pipeline gamut-converge-2d  2D cubic, orthotropic (stiff + soft and one material + void) and 2D
 #                                             cubic of two materials + void run

@@ -3,6 +3,7 @@
 #include <nlopt.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -117,33 +118,29 @@ void ContinuousCellProblem::setup_cell(MaterialPtr stiff, MaterialPtr soft) {
     }
   }
 
-  // Periodic cone filter, weights R - distance, rows normalized.
+  // Periodic cone filter, weights R - distance, normalized. The neighbours
+  // of a voxel are offsets wrapped into the cell, so one stencil serves every
+  // voxel; a small cell reaches one neighbour from two sides: merged.
   const double R = options.filter_radius;
   const int reach = R > 1 ? static_cast<int>(std::ceil(R)) : 0;
-  filter_.resize(probe.size());
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        auto& row = filter_[probe.index(i, j, k)];
-        double sum = 0;
-        for (int dk = nz == 1 ? 0 : -reach; dk <= (nz == 1 ? 0 : reach); ++dk)
-          for (int dj = -reach; dj <= reach; ++dj)
-            for (int di = -reach; di <= reach; ++di) {
-              const int a = ((i + di) % nx + nx) % nx, b = ((j + dj) % ny + ny) % ny, c = ((k + dk) % nz + nz) % nz;
-              const double d = std::sqrt(double(periodic_gap(i, a, nx) * periodic_gap(i, a, nx) +
-                                                periodic_gap(j, b, ny) * periodic_gap(j, b, ny) +
-                                                periodic_gap(k, c, nz) * periodic_gap(k, c, nz)));
-              const double w = reach == 0 ? (d == 0 ? 1.0 : 0.0) : std::max(0.0, R - d);
-              if (w <= 0) continue;
-              const int v = static_cast<int>(probe.index(a, b, c));
-              // A small cell can reach one neighbour from two sides: merge.
-              auto it = std::find_if(row.begin(), row.end(), [&](const auto& e) { return e.first == v; });
-              if (it == row.end()) row.emplace_back(v, w);
-              else it->second = std::max(it->second, w);
-            }
-        for (const auto& e : row) sum += e.second;
-        for (auto& e : row) e.second /= sum;
+  const auto wrap = [](int d, int n) { return (d % n + n) % n; };
+  std::map<std::array<int, 3>, std::size_t> tap_of_offset;
+  double sum = 0;
+  for (int dk = nz == 1 ? 0 : -reach; dk <= (nz == 1 ? 0 : reach); ++dk)
+    for (int dj = -reach; dj <= reach; ++dj)
+      for (int di = -reach; di <= reach; ++di) {
+        const int a = wrap(di, nx), b = wrap(dj, ny), c = wrap(dk, nz);
+        const double d = std::sqrt(double(periodic_gap(0, a, nx) * periodic_gap(0, a, nx) +
+                                          periodic_gap(0, b, ny) * periodic_gap(0, b, ny) +
+                                          periodic_gap(0, c, nz) * periodic_gap(0, c, nz)));
+        const double w = reach == 0 ? (d == 0 ? 1.0 : 0.0) : std::max(0.0, R - d);
+        if (w <= 0) continue;
+        auto [it, added] = tap_of_offset.emplace(std::array<int, 3>{a, b, c}, filter_.size());
+        if (added) filter_.push_back({a, b, c, w});
+        else filter_[it->second].weight = std::max(filter_[it->second].weight, w);
       }
+  for (const FilterTap& t : filter_) sum += t.weight;
+  for (FilterTap& t : filter_) t.weight /= sum;
 }
 
 std::vector<double> ContinuousCellProblem::start(const VoxelGrid& structure, int stiff_id) const {
@@ -177,10 +174,24 @@ void ContinuousCellProblem::set_projection(double beta) {
   last_.reset();
 }
 
+template <typename F>
+void ContinuousCellProblem::for_each_filter_tap(F&& f) const {
+  for (int k = 0; k < nz_; ++k)
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i) {
+        const std::size_t v = std::size_t(i) + std::size_t(nx_) * (std::size_t(j) + std::size_t(ny_) * k);
+        for (const FilterTap& t : filter_) {
+          const int a = i + t.dx < nx_ ? i + t.dx : i + t.dx - nx_;
+          const int b = j + t.dy < ny_ ? j + t.dy : j + t.dy - ny_;
+          const int c = k + t.dz < nz_ ? k + t.dz : k + t.dz - nz_;
+          f(v, std::size_t(a) + std::size_t(nx_) * (std::size_t(b) + std::size_t(ny_) * c), t.weight);
+        }
+      }
+}
+
 std::vector<double> ContinuousCellProblem::filtered(const std::vector<double>& x) const {
-  std::vector<double> xt(filter_.size(), 0.0);
-  for (std::size_t v = 0; v < filter_.size(); ++v)
-    for (const auto& [w, weight] : filter_[v]) xt[v] += weight * x[orbit_of_voxel_[w]];
+  std::vector<double> xt(orbit_of_voxel_.size(), 0.0);
+  for_each_filter_tap([&](std::size_t v, std::size_t w, double weight) { xt[v] += weight * x[orbit_of_voxel_[w]]; });
   return xt;
 }
 
@@ -280,8 +291,8 @@ void ContinuousCellProblem::chain(const Evaluation& e, const MatX& dfdC_small, d
     df_dxt[v] = (p * std::pow(e.xp[v], p - 1) * (dfdC.cwiseProduct(e.dC[v])).sum() + drho) * e.dxp[v];
   // Through the filter (x~_v = sum_w H_vw x_orbit(w)) and the orbit sums.
   gradient->assign(orbit_voxels_.size(), 0.0);
-  for (std::size_t v = 0; v < filter_.size(); ++v)
-    for (const auto& [w, weight] : filter_[v]) (*gradient)[orbit_of_voxel_[w]] += weight * df_dxt[v];
+  for_each_filter_tap(
+      [&](std::size_t v, std::size_t w, double weight) { (*gradient)[orbit_of_voxel_[w]] += weight * df_dxt[v]; });
 }
 
 VecX ContinuousCellProblem::properties_and_gradients(const Evaluation& e, std::vector<MatX>* dudC) const {

@@ -80,6 +80,43 @@ TEST(ContinuousRefinement, FilteredDensitiesKeepTheSymmetryAndAverage) {
   for (double v : problem.filtered(std::vector<double>(problem.variables(), 0.7))) EXPECT_NEAR(v, 0.7, 1e-12);
 }
 
+// The filter as one stencil against the definition: x~_v = sum_w
+// max(0, R - |v - w|) x_w / sum_w max(0, R - |v - w|), |v - w| the periodic
+// distance, on a box so small along y that the cone wraps onto itself.
+TEST(ContinuousRefinement, FilterStencilEqualsThePeriodicConeOnASmallBox) {
+  const int nx = 6, ny = 4, nz = 5;
+  const double R = 2.6;
+  RefinementTarget target;
+  target.G = Mat6::Identity() * 1e-4;
+  ContinuousOptions o;
+  o.symmetry = CellSymmetry::orthotropic;
+  o.filter_radius = R;
+  const ContinuousCellProblem problem(nx, ny, nz, 1.0 / nx, kStiff, nullptr, target, o);
+  VoxelGrid s(nx, ny, nz, 1.0 / nx);
+  const auto mirror = [](int i, int n) { return std::min(i, n - 1 - i); };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) s.at(i, j, k) = (mirror(i, nx) + 2 * mirror(j, ny) + 3 * mirror(k, nz)) % 3 == 0;
+  const std::vector<double> xt = problem.filtered(problem.start(s, 1));
+  const double high = 0.5 + o.start_offset, low = 0.5 - o.start_offset;
+  const auto gap = [](int a, int b, int n) { return std::min(std::abs(a - b), n - std::abs(a - b)); };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        double sum = 0, weighted = 0;
+        for (int c = 0; c < nz; ++c)
+          for (int b = 0; b < ny; ++b)
+            for (int a = 0; a < nx; ++a) {
+              const double d = std::sqrt(double(gap(i, a, nx) * gap(i, a, nx) + gap(j, b, ny) * gap(j, b, ny) +
+                                                gap(k, c, nz) * gap(k, c, nz)));
+              const double w = std::max(0.0, R - d);
+              sum += w;
+              weighted += w * (s.at(a, b, c) == 1 ? high : low);
+            }
+        EXPECT_NEAR(xt[s.index(i, j, k)], weighted / sum, 1e-14) << i << " " << j << " " << k;
+      }
+}
+
 TEST(ContinuousRefinement, MmaMovesTheStructureTowardsAStifferShear) {
   // Start: a cross frame (weak in shear); target: its own properties with
   // the shear modulus doubled. The refined, thresholded structure must
