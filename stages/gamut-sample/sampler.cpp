@@ -165,6 +165,14 @@ std::vector<VoxelGrid> GamutSampler::initial_set_cells() const {
     throw InputError(where + "its base materials (stiff E " + std::to_string(seeds.stiff.E) + ", nu " +
                      std::to_string(seeds.stiff.nu) + (seeds.soft_is_void ? ", void" : ", a soft material") +
                      ") are not the sampler's");
+  // Two materials without void never hold void; a set of two materials and
+  // void is not a start for such a run.
+  if (!o_.soft_is_void && !o_.three_phase)
+    for (std::size_t i = 0; i < seeds.items.size(); ++i)
+      if (std::find(seeds.items[i].ids.begin(), seeds.items[i].ids.end(), 0) != seeds.items[i].ids.end())
+        throw InputError(where + "structure " + std::to_string(i) +
+                         " holds void, which this run of two materials does not (materials.void: true samples "
+                         "two materials and void)");
   std::vector<VoxelGrid> cells;
   cells.reserve(seeds.items.size());
   for (const Microstructure& m : seeds.items)

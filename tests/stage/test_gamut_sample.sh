@@ -76,6 +76,9 @@ expect_exit 2 "continuous.per_cycle = 2: must be 0 with two materials and void" 
   --set materials="$THREE_MATERIALS" --out "$WORK/bad.gamut.h5"
 expect_exit 2 "directed.per_cycle = 1: must be 0 with two materials and void" -- "$SAMPLE" --config "$TINY" \
   --set materials="$THREE_MATERIALS" --set continuous.per_cycle=0 --out "$WORK/bad.gamut.h5"
+expect_exit 2 "initial_set.path .*tri.microstructures.h5: structure [0-9]+ holds void" -- "$SAMPLE" --config "$TINY" \
+  --set initial_set="{path: $WORK/tri.microstructures.h5}" --set materials='{stiff: {E: 1.0e6, nu: 0.3}, soft: {E: 1.0e3, nu: 0.45}}' \
+  --out "$WORK/bad.gamut.h5"
 expect_exit 2 "materials.void.*false needs materials.soft" -- "$SAMPLE" --config "$TINY" \
   --set materials='{stiff: {E: 1.0e6, nu: 0.3}, void: false}' --out "$WORK/bad.gamut.h5"
 
