@@ -89,15 +89,12 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
   if (std::int64_t(fixed_.size()) != 3 * nodes)
     throw std::invalid_argument("DirichletGridMultigrid: one fixed flag per unknown");
   coarse_.n[0] = nx / 2, coarse_.n[1] = ny / 2, coarse_.n[2] = nz / 2;
+  fixed_count_ = std::count_if(fixed_.begin(), fixed_.end(), [](char f) { return f != 0; });
 
-  node_mask_.assign(std::size_t(nodes), 0);
-  for (std::int64_t d = 0; d < 3 * nodes; ++d)
-    if (fixed_[std::size_t(d)]) {
-      node_mask_[std::size_t(d / 3)] |= std::uint8_t(1u << (d % 3));
-      fixed_list_.push_back(d);
-    }
-
-  if (options_.material_coarse_space) return;  // set_field() builds the copies
+  if (options_.material_coarse_space) return;  // set_field() numbers the nodes that touch material
+  own_first_.resize(std::size_t(nodes) + 1);
+  for (std::int64_t p = 0; p <= nodes; ++p) own_first_[std::size_t(p)] = static_cast<int>(p);
+  number_rows(own_first_);
   // A coarse unknown is reached when some free fine unknown of the same
   // component lies within one fine spacing of its point.
   const std::int64_t coarse_nodes = coarse_.nodes();
@@ -111,7 +108,7 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
             for (int dx = -1; dx <= 1; ++dx) {
               const int i = 2 * I + dx, j = 2 * J + dy, k = 2 * K + dz;
               if (i < 0 || j < 0 || k < 0 || i > nx || j > ny || k > nz) continue;
-              const std::uint8_t m = node_mask_[std::size_t(fine_.node(i, j, k))];
+              const std::uint8_t m = node_mask(fine_.node(i, j, k));
               for (int d = 0; d < 3; ++d)
                 if (!(m >> d & 1)) coarse_reached_[std::size_t(3 * C + d)] = 1;
             }
@@ -155,10 +152,11 @@ void DirichletGridMultigrid::set_field(VoxelStiffnessField field) {
     throw InputError("matrix-free multigrid: a field of " + std::to_string(field.nx) + " x " +
                      std::to_string(field.ny) + " x " + std::to_string(field.nz) + " elements for a " +
                      dims_text(fine_.n) + " grid");
-  if (std::int64_t(fixed_list_.size()) == 3 * fine_.nodes())
+  if (fixed_count_ == 3 * fine_.nodes())
     throw InputError("every unknown of the grid is fixed: nothing to solve");
   field_ = std::move(field);
   has_field_ = false;
+  if (options_.material_coarse_space) build_material_components();
   build_fine_smoother();
   if (options_.material_coarse_space)
     assemble_material_coarse();
@@ -170,16 +168,67 @@ void DirichletGridMultigrid::set_field(VoxelStiffnessField field) {
   stats_.positive_definite = true;
 }
 
+void DirichletGridMultigrid::number_rows(const std::vector<int>& first) {
+  first_ = &first;
+  const std::int64_t nodes = fine_.nodes();
+  row_mask_.assign(std::size_t(rows()), 0);
+  fixed_list_.clear();
+  std::int64_t loose = 0;  // nodes without a row that have a free unknown
+  for (std::int64_t p = 0; p < nodes; ++p) {
+    const int r = row_of(p);
+    bool free = false;
+    for (int d = 0; d < 3; ++d) {
+      if (!fixed_[std::size_t(3 * p + d)]) {
+        free = true;
+        continue;
+      }
+      if (r < 0) continue;
+      row_mask_[std::size_t(r)] |= std::uint8_t(1u << d);
+      fixed_list_.push_back(3 * std::int64_t(r) + d);
+    }
+    if (r < 0 && free) ++loose;
+  }
+  if (loose > 0)
+    throw NumericalError("matrix-free multigrid: " + std::to_string(loose) +
+                         " nodes have a diagonal stiffness block that is not positive definite (nodes that only "
+                         "cells without stiffness touch)");
+}
+
+VecX DirichletGridMultigrid::gather_rows(const VecX& grid) const {
+  VecX out(3 * Eigen::Index(rows()));
+  chunked_for(fine_.nodes(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index p = begin; p < end; ++p)
+      if (const int r = row_of(p); r >= 0) out.segment<3>(3 * Eigen::Index(r)) = grid.segment<3>(3 * p);
+  });
+  return out;
+}
+
+VecX DirichletGridMultigrid::scatter_rows(const VecX& rows_vector, const VecX& grid, double scale) const {
+  VecX out(3 * Eigen::Index(fine_.nodes()));
+  chunked_for(fine_.nodes(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index p = begin; p < end; ++p) {
+      if (const int r = row_of(p); r >= 0)
+        out.segment<3>(3 * p) = rows_vector.segment<3>(3 * Eigen::Index(r));
+      else
+        out.segment<3>(3 * p) = scale * grid.segment<3>(3 * p);
+    }
+  });
+  return out;
+}
+
 void DirichletGridMultigrid::build_fine_smoother() {
   const int B = field_.basis_size();
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
   const std::int64_t nodes = fine_.nodes();
-  // The blocks themselves are needed only here: 72 bytes per node.
-  std::vector<double> diagonal(9 * std::size_t(nodes), 0.0);
+  const int rows = static_cast<int>(this->rows());
+  // The blocks themselves are needed only here: 72 bytes per row.
+  std::vector<double> diagonal(9 * std::size_t(rows), 0.0);
   // Unmasked diagonal blocks, and (sum, count) of the free unknowns' diagonal entries.
   const Eigen::Vector2d sum = chunked_reduce(nodes, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
     Eigen::Vector2d s = Eigen::Vector2d::Zero();
     for (Eigen::Index p = begin; p < end; ++p) {
+      const int r = row_of(p);
+      if (r < 0) continue;
       const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
                 k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
       Mat3 D = Mat3::Zero();
@@ -190,9 +239,9 @@ void DirichletGridMultigrid::build_fine_smoother() {
         for (int b = 0; b < B; ++b)
           if (const double w = field_.weight(e, b); w != 0.0) D += w * field_.basis[b].block<3, 3>(3 * a, 3 * a);
       }
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal.data() + 9 * p) = D;
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal.data() + 9 * std::size_t(r)) = D;
       for (int d = 0; d < 3; ++d)
-        if (!(node_mask_[std::size_t(p)] >> d & 1)) s += Eigen::Vector2d(D(d, d), 1.0);
+        if (!(row_mask_[std::size_t(r)] >> d & 1)) s += Eigen::Vector2d(D(d, d), 1.0);
     }
     return s;
   });
@@ -205,18 +254,18 @@ void DirichletGridMultigrid::build_fine_smoother() {
     for (int t = 0; t < 3; ++t) m[3 * c + t] = m[3 * t + c] = 0.0;
     m[4 * c] = fixed_scale_;
   }
-  const int bad = chebyshev::invert_diagonal_blocks(static_cast<int>(nodes), diagonal.data(), inverse_, options_.threads);
+  const int bad = chebyshev::invert_diagonal_blocks(rows, diagonal.data(), inverse_, options_.threads);
   if (bad != 0)
     throw NumericalError("matrix-free multigrid: " + std::to_string(bad) +
                          " nodes have a diagonal stiffness block that is not positive definite (nodes that only "
                          "cells without stiffness touch)");
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      static_cast<int>(nodes), diagonal.data(), inverse_.data(),
+      rows, diagonal.data(), inverse_.data(),
       [this](int i, const double*, double out[3]) {
         const double* y = product_.data() + 3 * std::size_t(i);
         out[0] = y[0], out[1] = y[1], out[2] = y[2];
       },
-      [this](const VecX& x) { multiply(x, product_); }, options_.threads);
+      [this](const VecX& x) { multiply_rows(x, product_); }, options_.threads);
   if (!(max_eigenvalue_ > 0) || !std::isfinite(max_eigenvalue_))
     throw NumericalError("matrix-free multigrid: no usable eigenvalue bound for the smoother");
   spdlog::debug("matrix-free multigrid: largest eigenvalue of the block-Jacobi-scaled operator about {:.4g}",
@@ -238,7 +287,7 @@ void DirichletGridMultigrid::add_voxel_galerkin(int i, int j, int k, int pos, co
   const int B = field_.basis_size();
   const std::int64_t e = fine_.element(i, j, k);
   std::uint8_t masked = 0;
-  for (int a = 0; a < 8; ++a) masked |= node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+  for (int a = 0; a < 8; ++a) masked |= node_mask(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)));
   if (!masked) {
     for (int b = 0; b < B; ++b)
       if (const double w = field_.weight(e, b); w != 0.0) KE.noalias() += w * galerkin[std::size_t(pos) * B + b];
@@ -246,7 +295,7 @@ void DirichletGridMultigrid::add_voxel_galerkin(int i, int j, int k, int pos, co
   }
   Mat24 Ke = field_.element(e);
   for (int a = 0; a < 8; ++a) {
-    const std::uint8_t m = node_mask_[std::size_t(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)))];
+    const std::uint8_t m = node_mask(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)));
     for (int d = 0; d < 3; ++d)
       if (m >> d & 1) {
         Ke.row(3 * a + d).setZero();
@@ -314,7 +363,7 @@ void DirichletGridMultigrid::assemble_coarse() {
                          " elements) is not positive definite: part of the body is not held by a support");
 }
 
-void DirichletGridMultigrid::assemble_material_coarse() {
+void DirichletGridMultigrid::build_material_components() {
   const int B = field_.basis_size();
   std::vector<char> solid(std::size_t(field_.voxels()), 0);
   for (std::int64_t e = 0; e < field_.voxels(); ++e)
@@ -322,6 +371,8 @@ void DirichletGridMultigrid::assemble_material_coarse() {
   if (!components_ || solid != components_solid_) {
     const auto start = std::chrono::steady_clock::now();
     component_solver_.reset();
+    components_.reset();
+    first_ = nullptr;
     components_ = std::make_shared<MaterialComponents>(fine_.n[0], fine_.n[1], fine_.n[2], solid,
                                                        std::max(1, options_.coarse_unknowns / 3), options_.threads);
     components_solid_ = std::move(solid);
@@ -331,6 +382,10 @@ void DirichletGridMultigrid::assemble_material_coarse() {
       copies += (copies.empty() ? "" : ", ") + std::to_string(level.copies());
     spdlog::debug("matrix-free multigrid: node copies per level {} ({:.2f} s)", copies, seconds_since(start));
   }
+  number_rows(components_->levels()[0].first);
+}
+
+void DirichletGridMultigrid::assemble_material_coarse() {
   std::vector<Mat24> P, galerkin;
   galerkin_tables(P, galerkin);
   BlockMatrix& M = component_solver_->level1();
@@ -377,8 +432,15 @@ void DirichletGridMultigrid::assemble_material_coarse() {
 }
 
 void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
+  if (!has_field_) throw std::logic_error("DirichletGridMultigrid::multiply: no field set");
+  VecX product;
+  multiply_rows(gather_rows(x), product);
+  y = scatter_rows(product, x, fixed_scale_);
+}
+
+void DirichletGridMultigrid::multiply_rows(const VecX& x, VecX& y) const {
   const int nx = fine_.n[0], ny = fine_.n[1], nz = fine_.n[2];
-  const Eigen::Index n = 3 * Eigen::Index(fine_.nodes());
+  const Eigen::Index n = 3 * Eigen::Index(rows());
   const int B = field_.basis_size();
   y.resize(n);
   const int team = resolve_thread_count(options_.threads);
@@ -401,12 +463,13 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
         bool has_stiffness = false;
         for (int b = 0; b < B && !has_stiffness; ++b) has_stiffness = field_.weight(e, b) != 0.0;
         if (!has_stiffness) continue;
+        // Every corner of a voxel with stiffness has a row.
         std::int64_t corner[8];
         Vec24 xe, ye = Vec24::Zero();
         for (int a = 0; a < 8; ++a) {
-          corner[a] = fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a));
+          corner[a] = row_of(fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)));
           xe.segment<3>(3 * a) = x.segment<3>(3 * corner[a]);
-          if (const std::uint8_t m = node_mask_[std::size_t(corner[a])]; m != 0)
+          if (const std::uint8_t m = row_mask_[std::size_t(corner[a])]; m != 0)
             for (int d = 0; d < 3; ++d)
               if (m >> d & 1) xe[3 * a + d] = 0.0;
         }
@@ -432,7 +495,7 @@ void DirichletGridMultigrid::multiply(const VecX& x, VecX& y) const {
 
 void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) const {
   if (components_) {
-    const auto is_free = [this](int node, int d) { return !is_fixed(3 * std::int64_t(node) + d); };
+    const auto is_free = [this](int row, int d) { return !(row_mask_[std::size_t(row)] >> d & 1); };
     component_restrict(components_->transfers()[0], fine, is_free, coarse, options_.threads);
     return;
   }
@@ -451,7 +514,7 @@ void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) c
             if (i < 0 || j < 0 || k < 0 || i > nx || j > ny || k > nz) continue;
             const double w = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
             const std::int64_t f = fine_.node(i, j, k);
-            const std::uint8_t m = node_mask_[std::size_t(f)];
+            const std::uint8_t m = row_mask_[std::size_t(f)];  // rows are the nodes here
             for (int d = 0; d < 3; ++d)
               if (!(m >> d & 1)) sum[d] += w * fine[3 * f + d];
           }
@@ -462,7 +525,7 @@ void DirichletGridMultigrid::restrict_residual(const VecX& fine, VecX& coarse) c
 
 void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) const {
   if (components_) {
-    const auto is_free = [this](int node, int d) { return !is_fixed(3 * std::int64_t(node) + d); };
+    const auto is_free = [this](int row, int d) { return !(row_mask_[std::size_t(row)] >> d & 1); };
     component_add_prolongation(components_->transfers()[0], coarse, is_free, fine, options_.threads);
     return;
   }
@@ -470,7 +533,7 @@ void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) co
   const std::int64_t nodes = fine_.nodes();
   parallel_row_ranges(static_cast<int>(nodes), resolve_thread_count(options_.threads), [&](int begin, int end) {
     for (int p = begin; p < end; ++p) {
-      const std::uint8_t m = node_mask_[std::size_t(p)];
+      const std::uint8_t m = row_mask_[std::size_t(p)];  // rows are the nodes here
       if (m == 7) continue;
       const int i = p % (nx + 1), j = (p / (nx + 1)) % (ny + 1), k = p / ((nx + 1) * (ny + 1));
       const int ox = i % 2, oy = j % 2, oz = k % 2;
@@ -489,13 +552,13 @@ void DirichletGridMultigrid::add_prolongation(const VecX& coarse, VecX& fine) co
 }
 
 void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
-  const int rows = static_cast<int>(fine_.nodes());
+  const int rows = static_cast<int>(this->rows());
   const int threads = options_.threads;
   const auto row_product = [this](int i, const double*, double out[3]) {
     const double* y = product_.data() + 3 * std::size_t(i);
     out[0] = y[0], out[1] = y[1], out[2] = y[2];
   };
-  const auto apply = [this](const VecX& x) { multiply(x, product_); };
+  const auto apply = [this](const VecX& x) { multiply_rows(x, product_); };
   chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
                     true, step_, next_, threads);
   apply(z);
@@ -513,8 +576,8 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
 VecX DirichletGridMultigrid::apply_preconditioner(const VecX& r) {
   if (!has_field_) throw std::logic_error("DirichletGridMultigrid: no field set");
   VecX z;
-  cycle(r, z);
-  return z;
+  cycle(gather_rows(r), z);
+  return scatter_rows(z, r, 1.0 / fixed_scale_);
 }
 
 VecX DirichletGridMultigrid::solve(const VecX& b) {
@@ -525,9 +588,9 @@ VecX DirichletGridMultigrid::solve(const VecX& b) {
                                 " entries, the grid has " + std::to_string(n) + " unknowns");
   const int threads = options_.threads;
   CgOperator op;
-  op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
+  op.multiply = [this](const VecX& x, VecX& y) { multiply_rows(x, y); };
   op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
-    multiply(x, y);
+    multiply_rows(x, y);
     return parallel_dot(x, y, threads);
   };
   CgPreconditioner preconditioner;
@@ -546,7 +609,8 @@ VecX DirichletGridMultigrid::solve(const VecX& b) {
   settings.progress = [](int iteration, double residual) {
     spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
   };
-  return conjugate_gradient(op, preconditioner, b, settings, stats_);
+  // Nodes without a row have every unknown fixed: their rows of A are s I.
+  return scatter_rows(conjugate_gradient(op, preconditioner, gather_rows(b), settings, stats_), b, 1.0 / fixed_scale_);
 }
 
 int DirichletGridMultigrid::num_levels() const {
@@ -567,7 +631,8 @@ SpMat DirichletGridMultigrid::fine_operator() const {
       for (int c = 0; c < 24; ++c)
         if (!is_fixed(dof[r]) && !is_fixed(dof[c])) triplets.emplace_back(int(dof[r]), int(dof[c]), K(r, c));
   }
-  for (std::int64_t d : fixed_list_) triplets.emplace_back(int(d), int(d), fixed_scale_);
+  for (std::int64_t d = 0; d < 3 * fine_.nodes(); ++d)
+    if (is_fixed(d)) triplets.emplace_back(int(d), int(d), fixed_scale_);
   const int n = static_cast<int>(3 * fine_.nodes());
   SpMat A(n, n);
   A.setFromTriplets(triplets.begin(), triplets.end());
@@ -587,12 +652,15 @@ SpMat DirichletGridMultigrid::prolongation() const {
   if (components_) {
     const ComponentTransfer& t = components_->transfers()[0];
     std::vector<Eigen::Triplet<double>> triplets;
-    for (int p = 0; p < t.fine_rows(); ++p)
+    for (std::int64_t node = 0; node < fine_.nodes(); ++node) {
+      const int p = row_of(node);
+      if (p < 0) continue;
       for (int s = t.parent_start[std::size_t(p)]; s < t.parent_start[std::size_t(p) + 1]; ++s)
         for (int d = 0; d < 3; ++d)
-          if (!is_fixed(3 * std::int64_t(p) + d))
-            triplets.emplace_back(3 * p + d, 3 * t.parent[std::size_t(s)] + d, t.parent_weight[std::size_t(s)]);
-    SpMat P(3 * t.fine_rows(), 3 * t.coarse_copies());
+          if (!is_fixed(3 * node + d))
+            triplets.emplace_back(int(3 * node + d), 3 * t.parent[std::size_t(s)] + d, t.parent_weight[std::size_t(s)]);
+    }
+    SpMat P(int(3 * fine_.nodes()), 3 * t.coarse_copies());
     P.setFromTriplets(triplets.begin(), triplets.end());
     return P;
   }

@@ -10,9 +10,12 @@
 // K_e = sum_b w_eb K_b (a VoxelStiffnessField), D the 0/1 diagonal of free
 // unknowns, s the mean diagonal of the free unknowns (fixed_scale()). A
 // fixed unknown's row is s x_d, so b_d = s u_d prescribes u_d. Memory:
-// the weights, a dozen vectors and 18 numbers per node (the smoother's
-// diagonal blocks and their inverses) on the grid itself; nothing per
-// matrix entry.
+// the weights, a dozen vectors and 9 numbers per row (the inverses of the
+// smoother's diagonal blocks); nothing per matrix entry. Rows: every grid
+// node, or with material_coarse_space only the nodes that touch a voxel
+// with stiffness (a node only void touches must have all three unknowns
+// fixed; its solution is b / s without entering CG), so a printed
+// structure's vectors hold its material's nodes, not the box's.
 //
 // Levels: the grid, matrix-free (products element by element in 8 parity
 // colours: bitwise deterministic for any thread count); level 1 (every
@@ -76,12 +79,16 @@ class DirichletGridMultigrid {
 
   double fixed_scale() const { return fixed_scale_; }
   const VoxelStiffnessField& field() const { return field_; }
-  // x with A x = b. Throws NumericalError if CG does not converge.
+  // x with A x = b (one entry per grid unknown). Throws NumericalError if
+  // CG does not converge.
   VecX solve(const VecX& b);
-  // y = A x, matrix-free.
+  // y = A x, matrix-free (one entry per grid unknown).
   void multiply(const VecX& x, VecX& y) const;
-  // One cycle z = M^-1 r.
+  // One cycle z = M^-1 r (one entry per grid unknown; z = r / s at nodes
+  // without a row).
   VecX apply_preconditioner(const VecX& r);
+  // Nodes that carry unknowns in CG (all nodes without material_coarse_space).
+  std::int64_t rows() const { return first_ ? first_->back() : 0; }
   const LinearSolveStats& stats() const { return stats_; }
 
   // Inspection (small grids): A assembled, level 1 and the masked P.
@@ -99,6 +106,9 @@ class DirichletGridMultigrid {
     std::int64_t element(int i, int j, int k) const { return i + std::int64_t(n[0]) * (j + std::int64_t(n[1]) * k); }
   };
   void build_fine_smoother();
+  // With material_coarse_space: the node copies for the field's solid
+  // voxels (rebuilt when they change) and the rows they number.
+  void build_material_components();
   void build_coarse_pattern();
   void assemble_coarse();
   void assemble_material_coarse();
@@ -108,15 +118,37 @@ class DirichletGridMultigrid {
   // P_pos^T D K_e D P_pos (D: its corners' free unknowns).
   void add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P,
                           const std::vector<Mat24>& galerkin, Mat24& KE) const;
+  // Rows from a numbering of the nodes (first[p + 1] > first[p]: node p
+  // has row first[p]): the per-row masks and fixed list. NumericalError if
+  // a node without a row has a free unknown.
+  void number_rows(const std::vector<int>& first);
+  int row_of(std::int64_t node) const {
+    const int* f = first_->data() + node;
+    return f[1] > f[0] ? f[0] : -1;
+  }
+  // Bit d set if component d of the node is fixed; 7 for a node without a row.
+  std::uint8_t node_mask(std::int64_t node) const {
+    const int r = row_of(node);
+    return r < 0 ? std::uint8_t(7) : row_mask_[std::size_t(r)];
+  }
+  // Grid vectors (3 per node) to and from row vectors (3 per row); a node
+  // without a row takes scale times its entries of `grid`.
+  VecX gather_rows(const VecX& grid) const;
+  VecX scatter_rows(const VecX& rows_vector, const VecX& grid, double scale) const;
+  // y = A x over the rows.
+  void multiply_rows(const VecX& x, VecX& y) const;
   void cycle(const VecX& r, VecX& z);
   void restrict_residual(const VecX& fine, VecX& coarse) const;
   void add_prolongation(const VecX& coarse, VecX& fine) const;
   bool is_fixed(std::int64_t unknown) const { return fixed_[std::size_t(unknown)] != 0; }
 
   Grid fine_, coarse_;
-  std::vector<char> fixed_;
-  std::vector<std::uint8_t> node_mask_;    // per fine node: bit d set if component d is fixed
-  std::vector<std::int64_t> fixed_list_;   // the fixed unknowns, ascending
+  std::vector<char> fixed_;                // per grid unknown
+  std::int64_t fixed_count_ = 0;
+  std::vector<int> own_first_;             // the numbering of every node (lattice coarse space)
+  const std::vector<int>* first_ = nullptr;  // own_first_ or the material components' level 0
+  std::vector<std::uint8_t> row_mask_;     // per row: bit d set if component d is fixed
+  std::vector<std::int64_t> fixed_list_;   // the rows' fixed unknowns (3 row + d), ascending
   std::vector<char> coarse_reached_;       // per coarse unknown: some free fine unknown interpolates it
   DirichletMultigridOptions options_;
   VoxelStiffnessField field_;

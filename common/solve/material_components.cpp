@@ -178,27 +178,35 @@ MaterialComponents::MaterialComponents(int nx, int ny, int nz, const std::vector
     throw std::invalid_argument("MaterialComponents: one solid flag per voxel");
   if (coarse_copies < 1) throw InputError("material components: coarse_copies must be at least 1");
 
-  // Level 0: the grid's nodes, each represented by a solid voxel it touches.
+  // Level 0: the grid's nodes that touch a solid voxel, one copy each (in
+  // node order), represented by one such voxel. Nodes only void touches get
+  // no copy: the fine level carries unknowns only where there is material.
   ComponentLevel grid;
   grid.spacing = 1;
   for (int a = 0; a < 3; ++a) grid.points[a] = n_[a] + 1;
   const std::int64_t nodes = grid.num_points();
   if (nodes > (std::int64_t(1) << 31) - 1) throw InputError("material components: more than 2^31 grid nodes");
-  grid.first.resize(std::size_t(nodes) + 1);
-  for (std::int64_t p = 0; p <= nodes; ++p) grid.first[std::size_t(p)] = static_cast<int>(p);
-  grid.representative.assign(std::size_t(nodes), -1);
+  std::vector<std::int64_t> touching(std::size_t(nodes), -1);
   chunked_for(nodes, threads, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index p = begin; p < end; ++p) {
       const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
                 k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
-      for (int a = 0; a < 8 && grid.representative[std::size_t(p)] < 0; ++a) {
+      for (int a = 0; a < 8 && touching[std::size_t(p)] < 0; ++a) {
         const int vi = i - corner_x(a), vj = j - corner_y(a), vk = k - corner_z(a);
         if (vi < 0 || vj < 0 || vk < 0 || vi >= nx || vj >= ny || vk >= nz) continue;
         const std::int64_t v = vi + std::int64_t(nx) * (vj + std::int64_t(ny) * vk);
-        if (solid_[std::size_t(v)]) grid.representative[std::size_t(p)] = v;
+        if (solid_[std::size_t(v)]) touching[std::size_t(p)] = v;
       }
     }
   });
+  grid.first.resize(std::size_t(nodes) + 1);
+  grid.first[0] = 0;
+  for (std::int64_t p = 0; p < nodes; ++p)
+    grid.first[std::size_t(p) + 1] = grid.first[std::size_t(p)] + (touching[std::size_t(p)] >= 0 ? 1 : 0);
+  grid.representative.reserve(std::size_t(grid.copies()));
+  for (std::int64_t v : touching)
+    if (v >= 0) grid.representative.push_back(v);
+  std::vector<std::int64_t>().swap(touching);
   levels_.push_back(std::move(grid));
   for (;;) {
     const ComponentLevel& fine = levels_.back();
@@ -226,7 +234,7 @@ int MaterialComponents::element_copy(int i, int j, int k, int corner) const {
   const int target[3] = {i / 2 + ax, j / 2 + ay, k / 2 + az};
   const ComponentLevel& grid = levels_[0];
   const ComponentLevel& level1 = levels_[1];
-  const std::int64_t node = grid.point(p[0], p[1], p[2]);
+  const int node = grid.first[std::size_t(grid.point(p[0], p[1], p[2]))];  // its copy: the voxel is solid
   const ComponentTransfer& t = transfers_[0];
   const std::int64_t point = level1.point(target[0], target[1], target[2]);
   for (int s = t.parent_start[std::size_t(node)]; s < t.parent_start[std::size_t(node) + 1]; ++s) {

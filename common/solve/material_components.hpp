@@ -51,8 +51,9 @@ struct ComponentTransfer {
 };
 
 // The hierarchy over a grid of nx x ny x nz voxels (solid: one flag per
-// voxel, x fastest). levels()[0] is the grid itself: one copy per node, a
-// node that touches no solid voxel has no parents. levels()[l] (l >= 1)
+// voxel, x fastest). levels()[0] is the grid itself: one copy per node that
+// touches a solid voxel, in node order (levels()[0].first numbers the
+// nodes; a node only void touches has no copy). levels()[l] (l >= 1)
 // takes every other lattice point of level l - 1; transfers()[l]
 // interpolates levels()[l + 1] to levels()[l].
 class MaterialComponents {

@@ -114,6 +114,59 @@ TEST(MaterialComponents, CopiesPerPieceAndPartitionOfUnityAtEveryLevel) {
   }
 }
 
+// The fine level carries rows only for nodes that touch material; a node
+// that only void touches must be fixed, and its solution is b / s.
+TEST(MaterialComponents, OnlyNodesThatTouchMaterialCarryRows) {
+  const int nx = 12, ny = 8, nz = 4;
+  std::vector<char> solid = comb(nx, ny, nz);
+  for (int k = 0; k < nz; ++k)  // cut every tooth short: void at the far end
+    for (int j = 0; j < ny; ++j)
+      for (int i = nx - 3; i < nx; ++i) solid[std::size_t(voxel_of(nx, ny, i, j, k))] = 0;
+  std::vector<char> fixed = clamped_without_void(nx, ny, nz, solid);
+  std::int64_t touching = 0;
+  for (std::int64_t p = 0; p < std::int64_t(nx + 1) * (ny + 1) * (nz + 1); ++p) {
+    const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
+              k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
+    bool material = false;
+    for (int dz = -1; dz <= 0; ++dz)
+      for (int dy = -1; dy <= 0; ++dy)
+        for (int dx = -1; dx <= 0; ++dx) {
+          const int vi = i + dx, vj = j + dy, vk = k + dz;
+          if (vi >= 0 && vj >= 0 && vk >= 0 && vi < nx && vj < ny && vk < nz)
+            material = material || solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))];
+        }
+    touching += material;
+  }
+  DirichletMultigridOptions options;
+  options.material_coarse_space = true;
+  options.coarse_unknowns = 30;
+  options.tolerance = 1e-10;
+  DirichletGridMultigrid mg(nx, ny, nz, fixed, options);
+  mg.set_field(field_of(nx, ny, nz, solid));
+  EXPECT_EQ(mg.rows(), touching);
+  EXPECT_LT(touching, std::int64_t(nx + 1) * (ny + 1) * (nz + 1));
+  // Against a direct solve of the whole grid, fixed values prescribed
+  // through b = s u on every fixed unknown, void nodes included.
+  VecX b = VecX::Zero(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1));
+  for (Eigen::Index d = 0; d < b.size(); ++d) b[d] = fixed[std::size_t(d)] ? mg.fixed_scale() * 1e-3 * double(d % 7) : 1e-4;
+  const VecX x = mg.solve(b);
+  Eigen::SimplicialLDLT<SpMat> direct(mg.fine_operator());
+  ASSERT_EQ(direct.info(), Eigen::Success);
+  const VecX reference = direct.solve(b);
+  EXPECT_LT((x - reference).norm(), 1e-8 * reference.norm());
+  VecX y;
+  mg.multiply(x, y);
+  EXPECT_LT((y - mg.fine_operator() * x).norm(), 1e-12 * y.norm());
+  // A node that only void touches left free: refused.
+  for (std::size_t d = 0; d < fixed.size(); ++d)
+    if (fixed[d] && d / 3 % std::size_t(nx + 1) == std::size_t(nx)) {
+      fixed[d] = 0;
+      break;
+    }
+  DirichletGridMultigrid loose(nx, ny, nz, fixed, options);
+  EXPECT_THROW(loose.set_field(field_of(nx, ny, nz, solid)), NumericalError);
+}
+
 TEST(MaterialComponents, SolidBoxHasOneCopyPerLatticePoint) {
   const int nx = 8, ny = 6, nz = 4;
   const MaterialComponents components(nx, ny, nz, std::vector<char>(std::size_t(nx) * ny * nz, 1), 1, 1);
