@@ -27,8 +27,10 @@ inline constexpr int kLanczosSteps = 10;
 inline constexpr double kSafety = 1.1;
 inline constexpr double kSmoothingRange = 30.0;
 
-// z = D_i^-1 r with the inverse block `m` (row-major).
-inline void apply_block(const double* m, const double r[3], double* z) {
+// z = D_i^-1 r with the inverse block `m` (row-major; double, or float
+// where a large grid keeps its inverses in half the memory).
+template <class Scalar>
+inline void apply_block(const Scalar* m, const double r[3], double* z) {
   z[0] = m[0] * r[0] + m[1] * r[1] + m[2] * r[2];
   z[1] = m[3] * r[0] + m[4] * r[1] + m[5] * r[2];
   z[2] = m[6] * r[0] + m[7] * r[1] + m[8] * r[2];
@@ -146,8 +148,8 @@ void residual(int rows, RowProduct&& row_product, const VecX& b, const VecX& x, 
 // before_pass(x) runs before every pass that calls row_product on x: an
 // operator that is cheaper applied whole (element by element) computes A x
 // there and row_product reads it back.
-template <class RowProduct, class BeforePass>
-void smooth(int rows, const double* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
+template <class InverseScalar, class RowProduct, class BeforePass>
+void smooth(int rows, const InverseScalar* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
             BeforePass&& before_pass, const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next,
             int threads) {
   const double upper = kSafety * max_eigenvalue;

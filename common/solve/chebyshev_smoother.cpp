@@ -27,6 +27,7 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, boo
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
       A.rows, diagonal_.data(), inverse_.data(),
       [&](int i, const double* x, double out[3]) { row_product(i, x, out); }, [](const VecX&) {}, threads);
+  std::vector<double>().swap(diagonal_);  // the smoothing uses the inverses only
   return std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0;
 }
 

@@ -51,7 +51,7 @@ class ChebyshevSmoother {
   const BlockMatrix* pattern_ = nullptr;
   bool single_precision_ = true;
   std::vector<float> values_;    // A in single precision, laid out like A.values (if single_precision_)
-  std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major
+  std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major (released after setup)
   std::vector<double> inverse_;   // their inverses
   double max_eigenvalue_ = 0.0;
   int degree_ = 2;

@@ -15,10 +15,10 @@ using namespace hex_lattice;
 
 using namespace multigrid_cycle;
 // Level 1 of a large grid is the biggest matrix held (about 27 blocks per
-// copy). After set-up only its single-precision copy in the smoother is
-// used, so above this many blocks its double values are released (set-up
-// refills them).
-constexpr int kKeepLevel1Blocks = 1 << 20;
+// copy), level 2 the next. After set-up only their single-precision copies
+// in the smoothers are used, so above this many blocks the double values of
+// every level but the coarsest are released (set-up refills them).
+constexpr int kKeepLevelBlocks = 1 << 20;
 
 // Rows [begin, end) of a block matrix built range by range: per row its
 // sorted columns and 9 values per block.
@@ -34,10 +34,12 @@ void join_ranges(int rows, std::vector<RowRange>& ranges, BlockMatrix& M) {
   M.row_start.assign(std::size_t(rows) + 1, 0);
   std::size_t blocks = 0;
   for (const RowRange& r : ranges) blocks += r.column.size();
+  bool with_values = false;  // a pattern alone leaves M.values empty
+  for (const RowRange& r : ranges) with_values = with_values || !r.values.empty();
   M.column.clear();
   M.column.reserve(blocks);
   M.values.clear();
-  M.values.reserve(9 * blocks);
+  if (with_values) M.values.reserve(9 * blocks);
   int row = 0;
   for (RowRange& r : ranges) {
     for (int c : r.count) {
@@ -92,8 +94,7 @@ BlockMatrix level1_element_pattern(const MaterialComponents& components, int thr
   const int NX = nx / 2, NY = ny / 2, NZ = nz / 2;
   const int rows = level1.copies();
   std::vector<RowRange> ranges = by_ranges(rows, threads, [&](RowRange& out, int begin, int end) {
-    std::vector<int> columns, order;
-    std::vector<double> zeros;
+    std::vector<int> columns;
     // Rows of one lattice point are contiguous: walk points, not copies.
     std::int64_t point = std::upper_bound(level1.first.begin(), level1.first.end(), begin) - level1.first.begin() - 1;
     for (int row = begin; row < end; ++row) {
@@ -115,8 +116,9 @@ BlockMatrix level1_element_pattern(const MaterialComponents& components, int thr
       columns.push_back(row);  // a copy no free unknown reaches still has its diagonal
       std::sort(columns.begin(), columns.end());
       columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
-      zeros.assign(9 * columns.size(), 0.0);
-      sort_row(columns, zeros, order, out);
+      // The pattern only: level1() allocates the values once.
+      out.count.push_back(static_cast<int>(columns.size()));
+      out.column.insert(out.column.end(), columns.begin(), columns.end());
     }
   });
   BlockMatrix M;
@@ -223,7 +225,7 @@ bool ComponentMultigrid::factorize() {
                                levels_[l + 1]->matrix, threads_);
     const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * smoother_degree_;
     if (!level.smoother.setup(level.matrix, degree, threads_)) return false;
-    if (l == 0 && level.matrix.num_blocks() > kKeepLevel1Blocks) std::vector<double>().swap(level.matrix.values);
+    if (level.matrix.num_blocks() > kKeepLevelBlocks) std::vector<double>().swap(level.matrix.values);
   }
   const BlockMatrix& last = levels_.back()->matrix;
   if (!coarse_analyzed_ || coarsest_.rows() != last.unknowns() ||

@@ -22,7 +22,8 @@
 namespace msfab {
 
 // The block pattern of level 1's Galerkin operator for the grid's
-// hexahedra: copies are coupled when one solid voxel interpolates both.
+// hexahedra: copies are coupled when one solid voxel interpolates both
+// (values left empty).
 BlockMatrix level1_element_pattern(const MaterialComponents& components, int threads);
 
 // coarse = P^T fine P over a transfer (coarse's pattern and values are

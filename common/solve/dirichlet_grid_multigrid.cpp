@@ -203,6 +203,17 @@ VecX DirichletGridMultigrid::gather_rows(const VecX& grid) const {
   return out;
 }
 
+void DirichletGridMultigrid::scatter_rows_into(const VecX& rows_vector, VecX& grid, double scale) const {
+  chunked_for(fine_.nodes(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index p = begin; p < end; ++p) {
+      if (const int r = row_of(p); r >= 0)
+        grid.segment<3>(3 * p) = rows_vector.segment<3>(3 * Eigen::Index(r));
+      else
+        grid.segment<3>(3 * p) *= scale;
+    }
+  });
+}
+
 VecX DirichletGridMultigrid::scatter_rows(const VecX& rows_vector, const VecX& grid, double scale) const {
   VecX out(3 * Eigen::Index(fine_.nodes()));
   chunked_for(fine_.nodes(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
@@ -254,13 +265,14 @@ void DirichletGridMultigrid::build_fine_smoother() {
     for (int t = 0; t < 3; ++t) m[3 * c + t] = m[3 * t + c] = 0.0;
     m[4 * c] = fixed_scale_;
   }
-  const int bad = chebyshev::invert_diagonal_blocks(rows, diagonal.data(), inverse_, options_.threads);
+  std::vector<double> inverse;
+  const int bad = chebyshev::invert_diagonal_blocks(rows, diagonal.data(), inverse, options_.threads);
   if (bad != 0)
     throw NumericalError("matrix-free multigrid: " + std::to_string(bad) +
                          " nodes have a diagonal stiffness block that is not positive definite (nodes that only "
                          "cells without stiffness touch)");
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      rows, diagonal.data(), inverse_.data(),
+      rows, diagonal.data(), inverse.data(),
       [this](int i, const double*, double out[3]) {
         const double* y = product_.data() + 3 * std::size_t(i);
         out[0] = y[0], out[1] = y[1], out[2] = y[2];
@@ -268,6 +280,8 @@ void DirichletGridMultigrid::build_fine_smoother() {
       [this](const VecX& x) { multiply_rows(x, product_); }, options_.threads);
   if (!(max_eigenvalue_ > 0) || !std::isfinite(max_eigenvalue_))
     throw NumericalError("matrix-free multigrid: no usable eigenvalue bound for the smoother");
+  std::vector<double>().swap(diagonal);
+  inverse_.assign(inverse.begin(), inverse.end());
   spdlog::debug("matrix-free multigrid: largest eigenvalue of the block-Jacobi-scaled operator about {:.4g}",
                 max_eigenvalue_);
 }
@@ -562,8 +576,9 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
   chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
                     true, step_, next_, threads);
   apply(z);
-  chebyshev::residual(rows, row_product, r, z, residual_, threads);
-  restrict_residual(residual_, coarse_rhs_);
+  // r - A z into product_ itself (each row is read before it is written).
+  chebyshev::residual(rows, row_product, r, z, product_, threads);
+  restrict_residual(product_, coarse_rhs_);
   if (component_solver_)
     component_solver_->cycle(coarse_rhs_, coarse_solution_);
   else
@@ -580,7 +595,7 @@ VecX DirichletGridMultigrid::apply_preconditioner(const VecX& r) {
   return scatter_rows(z, r, 1.0 / fixed_scale_);
 }
 
-VecX DirichletGridMultigrid::solve(const VecX& b) {
+VecX DirichletGridMultigrid::solve(VecX b) {
   if (!has_field_) throw std::logic_error("DirichletGridMultigrid::solve: no field set");
   const Eigen::Index n = 3 * Eigen::Index(fine_.nodes());
   if (b.size() != n)
@@ -610,7 +625,8 @@ VecX DirichletGridMultigrid::solve(const VecX& b) {
     spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
   };
   // Nodes without a row have every unknown fixed: their rows of A are s I.
-  return scatter_rows(conjugate_gradient(op, preconditioner, gather_rows(b), settings, stats_), b, 1.0 / fixed_scale_);
+  scatter_rows_into(conjugate_gradient(op, preconditioner, gather_rows(b), settings, stats_), b, 1.0 / fixed_scale_);
+  return b;
 }
 
 int DirichletGridMultigrid::num_levels() const {

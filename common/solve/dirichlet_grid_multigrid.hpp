@@ -79,9 +79,10 @@ class DirichletGridMultigrid {
 
   double fixed_scale() const { return fixed_scale_; }
   const VoxelStiffnessField& field() const { return field_; }
-  // x with A x = b (one entry per grid unknown). Throws NumericalError if
-  // CG does not converge.
-  VecX solve(const VecX& b);
+  // x with A x = b (one entry per grid unknown; x is written over b, so a
+  // caller that moves b in holds one grid vector, not two). Throws
+  // NumericalError if CG does not converge.
+  VecX solve(VecX b);
   // y = A x, matrix-free (one entry per grid unknown).
   void multiply(const VecX& x, VecX& y) const;
   // One cycle z = M^-1 r (one entry per grid unknown; z = r / s at nodes
@@ -135,6 +136,8 @@ class DirichletGridMultigrid {
   // without a row takes scale times its entries of `grid`.
   VecX gather_rows(const VecX& grid) const;
   VecX scatter_rows(const VecX& rows_vector, const VecX& grid, double scale) const;
+  // The same, written over `grid` itself.
+  void scatter_rows_into(const VecX& rows_vector, VecX& grid, double scale) const;
   // y = A x over the rows.
   void multiply_rows(const VecX& x, VecX& y) const;
   void cycle(const VecX& r, VecX& z);
@@ -156,10 +159,14 @@ class DirichletGridMultigrid {
   double fixed_scale_ = 1.0;
   LinearSolveStats stats_;
 
-  // Grid level: inverses of A's diagonal blocks, Chebyshev bound, workspace.
-  std::vector<double> inverse_;
+  // Grid level: inverses of A's diagonal blocks in single precision (the
+  // smoother is only a preconditioner, and a voxel model's blocks are well
+  // conditioned: half the bytes of the largest per-row array after the
+  // vectors), Chebyshev bound, workspace (product_ also holds the residual
+  // that is restricted).
+  std::vector<float> inverse_;
   double max_eigenvalue_ = 0.0;
-  VecX product_, step_, next_, residual_, coarse_rhs_, coarse_solution_;
+  VecX product_, step_, next_, coarse_rhs_, coarse_solution_;
 
   // Level 1: block pattern (27 lattice neighbours, -1 outside the grid),
   // its compressed-column copy and the assembled multigrid below it.

@@ -20,7 +20,7 @@ struct PointPieces {
   struct Child {
     int piece;
     int copy;
-    double weight;
+    float weight;
   };
   std::vector<Child> children;
 };
@@ -99,7 +99,7 @@ void coarsen(const int n[3], const std::vector<char>& solid, const ComponentLeve
             if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= fine.points[0] || q[1] >= fine.points[1] ||
                 q[2] >= fine.points[2])
               continue;
-            const double weight = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
+            const float weight = (dx ? 0.5f : 1.0f) * (dy ? 0.5f : 1.0f) * (dz ? 0.5f : 1.0f);
             const std::int64_t Q = fine.point(q[0], q[1], q[2]);
             for (int c = fine.first[std::size_t(Q)]; c < fine.first[std::size_t(Q) + 1]; ++c) {
               const std::int64_t v = fine.representative[std::size_t(c)];

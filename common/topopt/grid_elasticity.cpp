@@ -224,18 +224,18 @@ MatX GridElasticity::element_matrix(std::int64_t cell) const {
   return grid_.element_stiffness(C);
 }
 
-VecX GridElasticity::run_solve(const VecX& rhs) {
+VecX GridElasticity::run_solve(VecX rhs) {
   const auto t0 = std::chrono::steady_clock::now();
-  VecX x = matrix_free_ ? matrix_free_->solve(rhs) : solver_->solve(rhs);
+  VecX x = matrix_free_ ? matrix_free_->solve(std::move(rhs)) : solver_->solve(rhs);
   ++stats_.solves;
   stats_.iterations += matrix_free_ ? matrix_free_->stats().iterations : solver_->stats().iterations;
   stats_.solve_seconds += seconds_since(t0);
   return x;
 }
 
-VecX GridElasticity::solve(const VecX& force, const VecX& prescribed) {
+VecX GridElasticity::solve(VecX force, const VecX& prescribed) {
   const std::int64_t n = grid_.unknowns();
-  VecX rhs = force;
+  VecX& rhs = force;
   for (std::int64_t d = 0; d < n; ++d)
     if (fixed_[d]) rhs[d] = 0;
   if (prescribed.size() == n) {
@@ -258,14 +258,14 @@ VecX GridElasticity::solve(const VecX& force, const VecX& prescribed) {
     for (std::int64_t d = 0; d < n; ++d)
       if (fixed_[d]) rhs[d] = fixed_scale_ * prescribed[d];
   }
-  return run_solve(rhs);
+  return run_solve(std::move(rhs));
 }
 
 VecX GridElasticity::solve_adjoint(const VecX& rhs) {
   VecX b = rhs;
   for (std::int64_t d = 0; d < grid_.unknowns(); ++d)
     if (fixed_[d]) b[d] = 0;
-  return run_solve(b);
+  return run_solve(std::move(b));
 }
 
 MatX GridElasticity::pair_products(const VecX& a, const VecX& b) const {

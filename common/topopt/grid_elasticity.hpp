@@ -67,7 +67,9 @@ class GridElasticity {
   void set_field(VoxelStiffnessField field);
   // Displacement for nodal forces with the fixed unknowns at `prescribed`
   // (entries at free unknowns are ignored; an empty vector means zeros).
-  VecX solve(const VecX& force, const VecX& prescribed = VecX());
+  // The right-hand side is built in `force`: move it in where it is not
+  // needed afterwards (a grid vector less on large voxel models).
+  VecX solve(VecX force, const VecX& prescribed = VecX());
   // K_ff^-1 restricted to the free unknowns; rhs must vanish on fixed ones.
   VecX solve_adjoint(const VecX& rhs);
   // Per cell and pair: a_e^T B_st b_e (cells x voigt_pairs).
@@ -78,7 +80,7 @@ class GridElasticity {
 
  private:
   void build_pattern();
-  VecX run_solve(const VecX& rhs);
+  VecX run_solve(VecX rhs);
   // K_e of a cell, from the field (matrix-free) or the pairs.
   MatX element_matrix(std::int64_t cell) const;
 

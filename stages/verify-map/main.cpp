@@ -381,13 +381,13 @@ int main(int argc, char** argv) {
       VecX u_hom(coarse.unknowns());
       for (std::int64_t n = 0; n < coarse.nodes(); ++n) u_hom.segment<3>(n * 3) = u_split.segment<3>(split.fine_node_of(n) * 3);
       CellRefinement::LoadStats load_stats;
-      const VecX fine_force = refinement.refine_forces(load.force, node_material, "load case '" + load.name + "'",
-                                                       &load_stats);
+      VecX fine_force = refinement.refine_forces(load.force, node_material, "load case '" + load.name + "'",
+                                                 &load_stats);
       const VecX fine_prescribed =
           load.prescribed.size() == coarse.unknowns() ? VecX(supports.values * load.prescribed) : VecX();
       const double t_full0 = full.stats().solve_seconds;
       const long long it0 = full.stats().iterations;
-      const VecX u_full = full.solve(fine_force, fine_prescribed);
+      const VecX u_full = full.solve(std::move(fine_force), fine_prescribed);
       vc.solve_seconds_full = full.stats().solve_seconds - t_full0;
       vc.iterations_full = full.stats().iterations - it0;
       if (!all_finite(u_split) || !all_finite(u_full))
