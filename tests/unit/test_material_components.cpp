@@ -44,6 +44,19 @@ VoxelStiffnessField field_of(int nx, int ny, int nz, const std::vector<char>& so
   return f;
 }
 
+// Whether node (i, j, k) is a corner of a solid voxel.
+bool touches_material(int nx, int ny, int nz, const std::vector<char>& solid, int i, int j, int k) {
+  for (int dz = -1; dz <= 0; ++dz)
+    for (int dy = -1; dy <= 0; ++dy)
+      for (int dx = -1; dx <= 0; ++dx) {
+        const int vi = i + dx, vj = j + dy, vk = k + dz;
+        if (vi >= 0 && vj >= 0 && vk >= 0 && vi < nx && vj < ny && vk < nz &&
+            solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))])
+          return true;
+      }
+  return false;
+}
+
 // Nodes at x = 0 clamped, nodes that touch no solid voxel fixed (void
 // carries no unknowns, as in msfab-verify-map).
 std::vector<char> clamped_without_void(int nx, int ny, int nz, const std::vector<char>& solid) {
@@ -51,15 +64,7 @@ std::vector<char> clamped_without_void(int nx, int ny, int nz, const std::vector
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i) {
-        bool material = false;
-        for (int dz = -1; dz <= 0; ++dz)
-          for (int dy = -1; dy <= 0; ++dy)
-            for (int dx = -1; dx <= 0; ++dx) {
-              const int vi = i + dx, vj = j + dy, vk = k + dz;
-              if (vi >= 0 && vj >= 0 && vk >= 0 && vi < nx && vj < ny && vk < nz)
-                material = material || solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))];
-            }
-        if (i == 0 || !material)
+        if (i == 0 || !touches_material(nx, ny, nz, solid, i, j, k))
           for (int d = 0; d < 3; ++d) fixed[3 * std::size_t(components_node_of(nx, ny, i, j, k)) + d] = 1;
       }
   return fixed;
@@ -124,19 +129,9 @@ TEST(MaterialComponents, OnlyNodesThatTouchMaterialCarryRows) {
       for (int i = nx - 3; i < nx; ++i) solid[std::size_t(voxel_of(nx, ny, i, j, k))] = 0;
   std::vector<char> fixed = clamped_without_void(nx, ny, nz, solid);
   std::int64_t touching = 0;
-  for (std::int64_t p = 0; p < std::int64_t(nx + 1) * (ny + 1) * (nz + 1); ++p) {
-    const int i = static_cast<int>(p % (nx + 1)), j = static_cast<int>((p / (nx + 1)) % (ny + 1)),
-              k = static_cast<int>(p / (std::int64_t(nx + 1) * (ny + 1)));
-    bool material = false;
-    for (int dz = -1; dz <= 0; ++dz)
-      for (int dy = -1; dy <= 0; ++dy)
-        for (int dx = -1; dx <= 0; ++dx) {
-          const int vi = i + dx, vj = j + dy, vk = k + dz;
-          if (vi >= 0 && vj >= 0 && vk >= 0 && vi < nx && vj < ny && vk < nz)
-            material = material || solid[std::size_t(voxel_of(nx, ny, vi, vj, vk))];
-        }
-    touching += material;
-  }
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) touching += touches_material(nx, ny, nz, solid, i, j, k);
   DirichletMultigridOptions options;
   options.material_coarse_space = true;
   options.coarse_unknowns = 30;
