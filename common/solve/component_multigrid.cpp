@@ -33,9 +33,11 @@ void join_ranges(int rows, std::vector<RowRange>& ranges, BlockMatrix& M) {
   M.rows = rows;
   M.row_start.assign(std::size_t(rows) + 1, 0);
   std::size_t blocks = 0;
-  for (const RowRange& r : ranges) blocks += r.column.size();
   bool with_values = false;  // a pattern alone leaves M.values empty
-  for (const RowRange& r : ranges) with_values = with_values || !r.values.empty();
+  for (const RowRange& r : ranges) {
+    blocks += r.column.size();
+    with_values = with_values || !r.values.empty();
+  }
   M.column.clear();
   M.column.reserve(blocks);
   M.values.clear();

@@ -215,15 +215,8 @@ void DirichletGridMultigrid::scatter_rows_into(const VecX& rows_vector, VecX& gr
 }
 
 VecX DirichletGridMultigrid::scatter_rows(const VecX& rows_vector, const VecX& grid, double scale) const {
-  VecX out(3 * Eigen::Index(fine_.nodes()));
-  chunked_for(fine_.nodes(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index p = begin; p < end; ++p) {
-      if (const int r = row_of(p); r >= 0)
-        out.segment<3>(3 * p) = rows_vector.segment<3>(3 * Eigen::Index(r));
-      else
-        out.segment<3>(3 * p) = scale * grid.segment<3>(3 * p);
-    }
-  });
+  VecX out = grid;
+  scatter_rows_into(rows_vector, out, scale);
   return out;
 }
 

@@ -233,9 +233,8 @@ VecX GridElasticity::run_solve(VecX rhs) {
   return x;
 }
 
-VecX GridElasticity::solve(VecX force, const VecX& prescribed) {
+VecX GridElasticity::solve(VecX rhs, const VecX& prescribed) {  // rhs: the forces, made the right-hand side in place
   const std::int64_t n = grid_.unknowns();
-  VecX& rhs = force;
   for (std::int64_t d = 0; d < n; ++d)
     if (fixed_[d]) rhs[d] = 0;
   if (prescribed.size() == n) {
