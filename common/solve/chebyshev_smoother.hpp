@@ -19,10 +19,13 @@ class ChebyshevSmoother {
  public:
   // Takes A's values in single precision as the smoother's operator (a
   // product then moves half the bytes; the smoother is only a
-  // preconditioner, and the rounded matrix is still exactly symmetric),
-  // inverts the diagonal blocks and estimates the largest eigenvalue of
-  // D^-1 A. A must stay alive (its pattern is used) until the next setup().
-  // Returns false if a diagonal block is not positive definite.
+  // preconditioner), inverts the diagonal blocks and estimates the largest
+  // eigenvalue of D^-1 A. Only the blocks on and above the diagonal are
+  // kept; a block below it is read as its mirror transposed, so the rounded
+  // operator is exactly symmetric and costs a little over half the bytes.
+  // A's pattern must be symmetric (std::logic_error if not) and stay alive
+  // until the next setup(). Returns false if a diagonal block is not
+  // positive definite.
   //
   // With single_precision = false the smoother uses A's double values. That
   // is needed where the stiffness contrast exceeds what single precision
@@ -44,13 +47,18 @@ class ChebyshevSmoother {
  private:
   void row_product(int i, const double* x, double out[3]) const {
     if (single_precision_)
-      block_row_product(*pattern_, values_.data(), i, x, out);
+      upper_row_product(i, x, out);
     else
       block_row_product(*pattern_, pattern_->values.data(), i, x, out);
   }
+  void upper_row_product(int i, const double* x, double out[3]) const;
   const BlockMatrix* pattern_ = nullptr;
   bool single_precision_ = true;
-  std::vector<float> values_;    // A in single precision, laid out like A.values (if single_precision_)
+  // If single_precision_: A's blocks on and above the diagonal in single
+  // precision (9 each, row-major), and per slot of A the block it reads
+  // (for a slot below the diagonal, its mirror's, used transposed).
+  std::vector<float> values_;
+  std::vector<int> block_of_slot_;
   std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major (released after setup)
   std::vector<double> inverse_;   // their inverses
   double max_eigenvalue_ = 0.0;

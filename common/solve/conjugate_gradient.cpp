@@ -64,7 +64,13 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
     return rz;
   };
 
-  VecX r = b, z, p, q;
+  // M^-1 r and A p live at different times (A p is consumed by the update
+  // of r before M^-1 r of the new r is formed, and M^-1 r by the update of
+  // p before A p is formed), so they share one vector: CG holds b, x, r, p
+  // and this one.
+  VecX r = b, p, zq;
+  VecX& z = zq;
+  VecX& q = zq;
   double rz = precondition(r, z);
   p = z;
   for (;;) {

@@ -617,9 +617,26 @@ VecX DirichletGridMultigrid::solve(VecX b) {
   settings.progress = [](int iteration, double residual) {
     spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
   };
-  // Nodes without a row have every unknown fixed: their rows of A are s I.
-  scatter_rows_into(conjugate_gradient(op, preconditioner, gather_rows(b), settings, stats_), b, 1.0 / fixed_scale_);
-  return b;
+  // Nodes without a row have every unknown fixed: their rows of A are s I,
+  // so their solution is b / s. Only its non-zero entries are kept, and the
+  // grid vector is released while CG runs: on a printed structure most
+  // nodes have no row, and this vector would be the largest one held.
+  VecX rows_b = gather_rows(b);
+  std::vector<std::pair<std::int64_t, double>> outside;
+  for (std::int64_t p = 0; p < fine_.nodes(); ++p)
+    if (row_of(p) < 0)
+      for (int d = 0; d < 3; ++d)
+        if (const double v = b[3 * p + d]; v != 0.0) outside.emplace_back(3 * p + d, v / fixed_scale_);
+  VecX().swap(b);
+  VecX x_rows = conjugate_gradient(op, preconditioner, rows_b, settings, stats_);
+  VecX().swap(rows_b);
+  VecX x = VecX::Zero(n);
+  chunked_for(fine_.nodes(), threads, [&](Eigen::Index begin, Eigen::Index end) {
+    for (Eigen::Index p = begin; p < end; ++p)
+      if (const int r = row_of(p); r >= 0) x.segment<3>(3 * p) = x_rows.segment<3>(3 * Eigen::Index(r));
+  });
+  for (const auto& [unknown, value] : outside) x[unknown] = value;
+  return x;
 }
 
 int DirichletGridMultigrid::num_levels() const {

@@ -78,6 +78,7 @@ class DirichletGridMultigrid {
   void set_field(VoxelStiffnessField field);
 
   double fixed_scale() const { return fixed_scale_; }
+  const std::vector<char>& fixed() const { return fixed_; }
   const VoxelStiffnessField& field() const { return field_; }
   // x with A x = b (one entry per grid unknown; x is written over b, so a
   // caller that moves b in holds one grid vector, not two). Throws

@@ -88,7 +88,9 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
     mg.coarse_unknowns = options_.mg_coarse_unknowns;
     mg.threads = options_.threads;
     mg.material_coarse_space = material_coarse_space;
-    matrix_free_ = std::make_unique<DirichletGridMultigrid>(grid_.nx(), grid_.ny(), grid_.nz(), fixed_, mg);
+    // The solver keeps the only copy of the flags (fixed() reads it there).
+    matrix_free_ = std::make_unique<DirichletGridMultigrid>(grid_.nx(), grid_.ny(), grid_.nz(), std::move(fixed_), mg);
+    std::vector<char>().swap(fixed_);
     return;
   }
   if (solver_name_ == "pcg-mg") {
@@ -108,6 +110,8 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
 }
 
 GridElasticity::~GridElasticity() = default;
+
+const std::vector<char>& GridElasticity::fixed() const { return matrix_free_ ? matrix_free_->fixed() : fixed_; }
 
 void GridElasticity::build_pattern() {
   const int ne = grid_.element_unknowns();
@@ -235,8 +239,9 @@ VecX GridElasticity::run_solve(VecX rhs) {
 
 VecX GridElasticity::solve(VecX rhs, const VecX& prescribed) {  // rhs: the forces, made the right-hand side in place
   const std::int64_t n = grid_.unknowns();
+  const std::vector<char>& fixed = this->fixed();
   for (std::int64_t d = 0; d < n; ++d)
-    if (fixed_[d]) rhs[d] = 0;
+    if (fixed[d]) rhs[d] = 0;
   if (prescribed.size() == n) {
     // Move the prescribed values to the right-hand side: rhs_f -= K_fp u_p.
     const int ne = grid_.element_unknowns();
@@ -246,24 +251,25 @@ VecX GridElasticity::solve(VecX rhs, const VecX& prescribed) {  // rhs: the forc
       grid_.cell_unknowns(c, dofs);
       bool any = false;
       for (int a = 0; a < ne; ++a) {
-        ue[a] = fixed_[dofs[a]] ? prescribed[dofs[a]] : 0.0;
+        ue[a] = fixed[dofs[a]] ? prescribed[dofs[a]] : 0.0;
         any = any || ue[a] != 0;
       }
       if (!any) continue;
       const VecX r = element_matrix(c) * ue;
       for (int a = 0; a < ne; ++a)
-        if (!fixed_[dofs[a]]) rhs[dofs[a]] -= r[a];
+        if (!fixed[dofs[a]]) rhs[dofs[a]] -= r[a];
     }
     for (std::int64_t d = 0; d < n; ++d)
-      if (fixed_[d]) rhs[d] = fixed_scale_ * prescribed[d];
+      if (fixed[d]) rhs[d] = fixed_scale_ * prescribed[d];
   }
   return run_solve(std::move(rhs));
 }
 
 VecX GridElasticity::solve_adjoint(const VecX& rhs) {
   VecX b = rhs;
+  const std::vector<char>& fixed = this->fixed();
   for (std::int64_t d = 0; d < grid_.unknowns(); ++d)
-    if (fixed_[d]) b[d] = 0;
+    if (fixed[d]) b[d] = 0;
   return run_solve(std::move(b));
 }
 

@@ -55,7 +55,7 @@ class GridElasticity {
   ~GridElasticity();
 
   const CellGrid& grid() const { return grid_; }
-  const std::vector<char>& fixed() const { return fixed_; }
+  const std::vector<char>& fixed() const;
   const std::string& solver_name() const { return solver_name_; }
 
   // C_st (s <= t, CellGrid::pair_index order) per cell: cells x voigt_pairs.

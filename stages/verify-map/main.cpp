@@ -197,11 +197,11 @@ void remove_void_from_voxels(const CellRefinement& refinement, const std::vector
 }
 
 // GridElasticity, with a bad solver name reported against its config key.
-std::unique_ptr<GridElasticity> make_model(const CellGrid& grid, const std::vector<char>& fixed,
+std::unique_ptr<GridElasticity> make_model(const CellGrid& grid, std::vector<char> fixed,
                                            const std::string& solver, const std::string& key,
                                            const LinearSolverOptions& options, bool material_coarse_space = false) {
   try {
-    return std::make_unique<GridElasticity>(grid, fixed, solver, options, material_coarse_space);
+    return std::make_unique<GridElasticity>(grid, std::move(fixed), solver, options, material_coarse_space);
   } catch (const InputError& e) {
     throw InputError(key + " = " + solver + ": " + e.what());
   }
@@ -339,7 +339,8 @@ int main(int argc, char** argv) {
                  report.voxels,
                  100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
                  fine.unknowns(), report.inactive_nodes_full);
-    const auto full_model = make_model(fine, supports.fixed, settings.solver, "solver", solver_options,
+    // The model keeps the support flags from here on (one grid-sized copy, not two).
+    const auto full_model = make_model(fine, std::move(supports.fixed), settings.solver, "solver", solver_options,
                                        settings.material_coarse_space);
     GridElasticity& full = *full_model;
     if (full.solver_name() == "matrix-free") {
