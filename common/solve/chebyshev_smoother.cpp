@@ -29,14 +29,20 @@ void ChebyshevSmoother::upper_row_product(int i, const double* x, double out[3])
   out[2] = y2;
 }
 
-bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, bool single_precision) {
+bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, SmootherValues values) {
   pattern_ = &A;
   degree_ = degree;
   threads_ = threads;
-  single_precision_ = single_precision;
+  values_kind_ = values;
   std::vector<float>().swap(values_);
   std::vector<int>().swap(block_of_slot_);
-  if (single_precision) {
+  if (values == SmootherValues::single) {
+    values_.resize(A.values.size());
+    chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
+      for (std::size_t k = 9 * std::size_t(A.row_start[begin]); k < 9 * std::size_t(A.row_start[end]); ++k)
+        values_[k] = static_cast<float>(A.values[k]);
+    });
+  } else if (values == SmootherValues::single_upper) {
     // Number the upper blocks row by row, then point every slot at its block.
     std::vector<int> first_upper(std::size_t(A.rows) + 1, 0);
     for (int i = 0; i < A.rows; ++i)
@@ -51,7 +57,8 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, boo
           if (j >= i) {
             const int block = first_upper[std::size_t(i)] + (slot - A.diagonal[std::size_t(i)]);
             block_of_slot_[std::size_t(slot)] = block;
-            for (int e = 0; e < 9; ++e) values_[9 * std::size_t(block) + e] = static_cast<float>(A.values[9 * std::size_t(slot) + e]);
+            for (int e = 0; e < 9; ++e)
+              values_[9 * std::size_t(block) + e] = static_cast<float>(A.values[9 * std::size_t(slot) + e]);
             continue;
           }
           // Block (j, i) sits in row j, above its diagonal.

@@ -15,25 +15,33 @@
 
 namespace msfab {
 
+// How a smoother holds its operator's values.
+enum class SmootherValues {
+  // Every block in single precision: a product moves half the bytes of A's
+  // (the smoother is only a preconditioner).
+  single,
+  // Only the blocks on and above the diagonal, in single precision; a block
+  // below is read as its mirror transposed. About 40% fewer bytes than
+  // `single` and an exactly symmetric operator, but a product takes about
+  // twice as long (the mirrors lie a lattice plane away in memory): for
+  // levels too large to hold otherwise.
+  single_upper,
+  // A's own double values: where the stiffness contrast exceeds what
+  // single precision resolves (about 1e7), rounding the stiff entries
+  // changes the operator by more than the soft entries are worth, so the
+  // rounded matrix can be indefinite and the V-cycle is no longer a
+  // positive definite preconditioner.
+  double_values,
+};
+
 class ChebyshevSmoother {
  public:
-  // Takes A's values in single precision as the smoother's operator (a
-  // product then moves half the bytes; the smoother is only a
-  // preconditioner), inverts the diagonal blocks and estimates the largest
-  // eigenvalue of D^-1 A. Only the blocks on and above the diagonal are
-  // kept; a block below it is read as its mirror transposed, so the rounded
-  // operator is exactly symmetric and costs a little over half the bytes.
-  // A's pattern must be symmetric (std::logic_error if not) and stay alive
-  // until the next setup(). Returns false if a diagonal block is not
-  // positive definite.
-  //
-  // With single_precision = false the smoother uses A's double values. That
-  // is needed where the stiffness contrast exceeds what single precision
-  // resolves (about 1e7): rounding the stiff entries then changes the
-  // operator by more than the soft entries are worth, so the rounded matrix
-  // can be indefinite and the V-cycle is no longer a positive definite
-  // preconditioner.
-  bool setup(const BlockMatrix& A, int degree, int threads, bool single_precision = true);
+  // Takes A's values as `values` says, inverts the diagonal blocks and
+  // estimates the largest eigenvalue of D^-1 A. A's pattern must stay alive
+  // until the next setup() (and A's values too with double_values); for
+  // single_upper it must be symmetric (std::logic_error if not). Returns
+  // false if a diagonal block is not positive definite.
+  bool setup(const BlockMatrix& A, int degree, int threads, SmootherValues values = SmootherValues::single);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).
@@ -46,17 +54,18 @@ class ChebyshevSmoother {
 
  private:
   void row_product(int i, const double* x, double out[3]) const {
-    if (single_precision_)
-      upper_row_product(i, x, out);
-    else
-      block_row_product(*pattern_, pattern_->values.data(), i, x, out);
+    switch (values_kind_) {
+      case SmootherValues::single: block_row_product(*pattern_, values_.data(), i, x, out); break;
+      case SmootherValues::single_upper: upper_row_product(i, x, out); break;
+      case SmootherValues::double_values: block_row_product(*pattern_, pattern_->values.data(), i, x, out); break;
+    }
   }
   void upper_row_product(int i, const double* x, double out[3]) const;
   const BlockMatrix* pattern_ = nullptr;
-  bool single_precision_ = true;
-  // If single_precision_: A's blocks on and above the diagonal in single
-  // precision (9 each, row-major), and per slot of A the block it reads
-  // (for a slot below the diagonal, its mirror's, used transposed).
+  SmootherValues values_kind_ = SmootherValues::single;
+  // single: A's values in single precision, laid out like A.values.
+  // single_upper: A's blocks on and above the diagonal (9 each, row-major),
+  // and per slot of A the block it reads (below the diagonal: its mirror's).
   std::vector<float> values_;
   std::vector<int> block_of_slot_;
   std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major (released after setup)

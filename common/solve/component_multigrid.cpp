@@ -17,7 +17,8 @@ using namespace multigrid_cycle;
 // Level 1 of a large grid is the biggest matrix held (about 27 blocks per
 // copy), level 2 the next. After set-up only their single-precision copies
 // in the smoothers are used, so above this many blocks the double values of
-// every level but the coarsest are released (set-up refills them).
+// every level but the coarsest are released (set-up refills them), and the
+// smoothers keep only the upper blocks (memory over speed).
 constexpr int kKeepLevelBlocks = 1 << 20;
 
 // Rows [begin, end) of a block matrix built range by range: per row its
@@ -226,8 +227,11 @@ bool ComponentMultigrid::factorize() {
     component_galerkin_product(level.matrix, level.decoupled, components_->transfers()[l + 1],
                                levels_[l + 1]->matrix, threads_);
     const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * smoother_degree_;
-    if (!level.smoother.setup(level.matrix, degree, threads_)) return false;
-    if (level.matrix.num_blocks() > kKeepLevelBlocks) std::vector<double>().swap(level.matrix.values);
+    // A level too large to keep in double is stored by its upper blocks.
+    const bool large = level.matrix.num_blocks() > kKeepLevelBlocks;
+    if (!level.smoother.setup(level.matrix, degree, threads_, large ? SmootherValues::single_upper : SmootherValues::single))
+      return false;
+    if (large) std::vector<double>().swap(level.matrix.values);
   }
   const BlockMatrix& last = levels_.back()->matrix;
   if (!coarse_analyzed_ || coarsest_.rows() != last.unknowns() ||

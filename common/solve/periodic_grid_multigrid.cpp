@@ -227,7 +227,8 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
       }
     }
   }
-  if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads, single_precision_smoothers_))
+  if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads,
+                              single_precision_smoothers_ ? SmootherValues::single : SmootherValues::double_values))
     throw NumericalError("periodic multigrid: a diagonal block of level " + std::to_string(l) + " (" +
                          dims_text(level.n) + ") is not positive definite");
 }

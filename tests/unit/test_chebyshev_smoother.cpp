@@ -1,7 +1,7 @@
-// The Chebyshev smoother's single-precision operator: it keeps only the
-// blocks on and above the diagonal, so its product must equal A's with
-// every block rounded to float and the lower ones read from their mirrors,
-// be exactly symmetric, and refuse a block pattern that is not symmetric.
+// The Chebyshev smoother's operator stored by its upper blocks in single
+// precision: its product must equal A's with every block rounded to float
+// and the lower ones read from their mirrors, be exactly symmetric, and
+// refuse a block pattern that is not symmetric.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -49,7 +49,7 @@ TEST(ChebyshevSmootherOperator, UpperBlocksInFloatReproduceTheRoundedProduct) {
   BlockMatrix M = block_pattern(A);
   copy_block_values(A, 0.0, M, 1);
   ChebyshevSmoother smoother;
-  ASSERT_TRUE(smoother.setup(M, 2, 2));
+  ASSERT_TRUE(smoother.setup(M, 2, 2, SmootherValues::single_upper));
 
   // The reference: every upper block (and the diagonal) rounded to float,
   // every lower block the transpose of its rounded mirror.
@@ -94,9 +94,10 @@ TEST(ChebyshevSmootherOperator, RefusesAPatternThatIsNotSymmetric) {
     break;
   }
   ChebyshevSmoother smoother;
-  EXPECT_THROW(smoother.setup(M, 2, 1), std::logic_error);
-  // The double-precision smoother reads A as stored and needs no mirror.
-  EXPECT_NO_THROW(smoother.setup(M, 2, 1, /*single_precision=*/false));
+  EXPECT_THROW(smoother.setup(M, 2, 1, SmootherValues::single_upper), std::logic_error);
+  // The other kinds read A's blocks as stored and need no mirror.
+  EXPECT_NO_THROW(smoother.setup(M, 2, 1, SmootherValues::single));
+  EXPECT_NO_THROW(smoother.setup(M, 2, 1, SmootherValues::double_values));
 }
 
 }  // namespace
