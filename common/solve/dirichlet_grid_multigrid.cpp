@@ -631,10 +631,7 @@ VecX DirichletGridMultigrid::solve(VecX b) {
   VecX x_rows = conjugate_gradient(op, preconditioner, rows_b, settings, stats_);
   VecX().swap(rows_b);
   VecX x = VecX::Zero(n);
-  chunked_for(fine_.nodes(), threads, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index p = begin; p < end; ++p)
-      if (const int r = row_of(p); r >= 0) x.segment<3>(3 * p) = x_rows.segment<3>(3 * Eigen::Index(r));
-  });
+  scatter_rows_into(x_rows, x, 0.0);
   for (const auto& [unknown, value] : outside) x[unknown] = value;
   return x;
 }

@@ -80,9 +80,9 @@ class DirichletGridMultigrid {
   double fixed_scale() const { return fixed_scale_; }
   const std::vector<char>& fixed() const { return fixed_; }
   const VoxelStiffnessField& field() const { return field_; }
-  // x with A x = b (one entry per grid unknown; x is written over b, so a
-  // caller that moves b in holds one grid vector, not two). Throws
-  // NumericalError if CG does not converge.
+  // x with A x = b (one entry per grid unknown). b is released once its
+  // rows are gathered, so a caller that moves b in holds no grid vector
+  // while CG runs. Throws NumericalError if CG does not converge.
   VecX solve(VecX b);
   // y = A x, matrix-free (one entry per grid unknown).
   void multiply(const VecX& x, VecX& y) const;
