@@ -290,6 +290,11 @@ double CellMaterialModel::constraint(const VecX& p, VecX* gradient) const {
   return -1.0;
 }
 
+double CellMaterialModel::density(const VecX& p, VecX* gradient) const {
+  if (gradient) *gradient = VecX::Unit(p.size(), density_index());
+  return p[density_index()];
+}
+
 std::vector<std::string> cell_material_spaces() {
   return {"cubic3d", "cubic2d", "orthotropic2d", "isotropic2d", "isotropic3d",
           "analytic2d", "analytic3d", "simp2d", "simp3d", "family3d"};

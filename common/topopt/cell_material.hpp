@@ -51,6 +51,16 @@ class CellMaterialModel {
   virtual double constraint(const VecX& p, VecX* gradient) const;
   // A point to start from: inside the constraint where there is one.
   virtual VecX initial_point(double rho) const = 0;
+  // Whether rho is a function of the other parameters (a family cell that
+  // holds exactly its members' mix of material) rather than a free
+  // parameter tied to them by Phi. The objective then overwrites the rho
+  // column of its physical parameters with density(p), and the model has
+  // no constraint, so a density filter on the parameters keeps the problem
+  // separable over the cells (topopt/cell_mma.hpp). By default rho is free
+  // and density(p) is p's rho.
+  virtual bool derives_density() const { return false; }
+  // rho at p; with `gradient`, d rho / d p (rho's own entry 0 where derived).
+  virtual double density(const VecX& p, VecX* gradient) const;
 
   // What the design artifact records for a cell: space, property names and
   // the unit and raw rows. By default the parameters themselves; a family

@@ -62,19 +62,29 @@ struct CellState {
 
 OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x0, const OptimizerSettings& settings,
                                      const CellFilter& gradient_smoothing) {
-  if (!objective.filter().identity())
-    throw InputError("cell MMA smooths the gradient instead of filtering the parameters: build the objective with "
-                     "filter radius 0 and pass the smoothing filter");
+  const CellMaterialModel& model = objective.model();
+  const int m = model.has_constraint() ? 1 + model.bound_conditions() : 0;
+  // A density filter makes every cell's physical parameters a mix of its
+  // neighbours' variables: fine for the objective and the mass, whose MMA
+  // approximations are separable in the variables whatever they depend on,
+  // but a per-cell constraint on filtered parameters would couple the cells.
+  const bool filtered = !objective.filter().identity();
+  if (filtered && m > 0)
+    throw InputError("cell MMA: a density filter on the parameters needs a space without per-cell constraints "
+                     "(simp, or family3d with rho derived from the family); this space smooths the gradient instead");
+  if (filtered && !gradient_smoothing.identity())
+    throw InputError("cell MMA: both a density filter and gradient smoothing; choose one");
   if (!(settings.mma_move > 0 && settings.mma_move <= 1)) throw InputError("cell MMA: the move limit must be in (0, 1]");
   if (!(settings.change_tolerance >= 0)) throw InputError("cell MMA: the change tolerance must be >= 0");
-  const CellMaterialModel& model = objective.model();
   const Eigen::Index N = x0.rows();
   const int d = int(x0.cols());
   if (d != model.parameters() || d > kCellMmaMaxVariables)
     throw InputError("cell MMA: " + std::to_string(d) + " columns for a space with " +
                      std::to_string(model.parameters()) + " parameters");
-  const int m = model.has_constraint() ? 1 + model.bound_conditions() : 0;
   const int rho = model.density_index();
+  // The mass is the variables' own rho column unless the filter or the
+  // model's derived density put it through other cells' variables.
+  const bool mass_is_rho = !filtered && !model.derives_density();
 
   OptimizationResult result;
   const auto t0 = std::chrono::steady_clock::now();
@@ -90,8 +100,10 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
   // The budget in cell volumes, less the forced-solid cells.
   const double V = objective.grid().cell_volume();
   const double domain = V * double(objective.grid().cells());
-  const double budget_cells =
-      settings.mass_limit ? (settings.mass_budget - objective.mass(MatX::Zero(N, d))) / V : 0.0;
+  double forced_mass = 0;  // as TopologyObjective::mass counts them
+  for (CellRole r : objective.setup().roles) forced_mass += r == CellRole::solid ? 1.0 : 0.0;
+  forced_mass *= V;
+  const double budget_cells = settings.mass_limit ? (settings.mass_budget - forced_mass) / V : 0.0;
   if (settings.mass_limit && budget_cells <= 0)
     throw InputError("cell MMA: the mass budget leaves nothing for the design cells (forced-solid cells use it all)");
 
@@ -166,8 +178,14 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
       a.p.row(c) = pc.transpose(), a.q.row(c) = qc.transpose();
     };
 
-    // 4. Asymptotes and the cells' approximations.
+    // 4. Asymptotes and the cells' approximations. Each cell's share of
+    //    the mass: its physical rho, with d mass / d (its variables).
     const auto tu = std::chrono::steady_clock::now();
+    MatX cell_mass, cell_mass_gradient;
+    if (settings.mass_limit && !mass_is_rho) {
+      cell_mass = objective.physical(x).col(rho);
+      cell_mass_gradient = objective.mass_gradient(x) / V;
+    }
 #pragma omp parallel for schedule(static)
     for (Eigen::Index i = 0; i < N; ++i) {
       CellMmaApproximation& a = cells[std::size_t(i)].approx;
@@ -201,7 +219,10 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
         raa[c] = std::max(kRaa0, kRaaDecay * raa[c]);
         build_constraint(i, c);
       }
-      if (settings.mass_limit) {
+      if (settings.mass_limit && !mass_is_rho) {
+        const CellMmaVec e = cell_mass_gradient.row(i).transpose();
+        a.bm = mma_coefficients(xi, a.lower, a.upper, e, cell_mass(i, 0), range, kRaa0, a.pm, a.qm);
+      } else if (settings.mass_limit) {
         CellMmaVec e = CellMmaVec::Zero(d);
         e[rho] = 1.0;
         a.bm = mma_coefficients(xi, a.lower, a.upper, e, xi[rho], range, kRaa0, a.pm, a.qm);

@@ -19,8 +19,15 @@
 // Regularization is the thesis's (§3.4: "a smoothing kernel on the
 // gradient"): the variables are the cells' physical parameters, so the
 // constraints stay per cell, and the gradient is smoothed with the cone
-// weights of the density filter before the approximations are built. The
-// objective must therefore be built without a density filter.
+// weights of the density filter before the approximations are built.
+// Where a space has no per-cell constraints (simp; family3d with rho
+// derived from the family) the objective may carry a density filter
+// instead: MMA's approximations of the objective and of the mass are
+// separable in the variables whatever cells they reach through the filter,
+// and the gradient is then exact. A smoothed gradient regularizes the
+// steps, not the design: nothing stops two stiff cells from meeting at an
+// edge only, which a model with a few hexahedra per cell holds far
+// stiffer than the printed joint (docs/topopt.md, "Edge joints").
 //
 // Stopping: no variable moves by more than settings.change_tolerance in an
 // iteration, or the objective changed by less than 1e-4 (relative) over
@@ -32,7 +39,9 @@
 namespace msfab {
 
 // x0: the cells' starting parameters (clamped into the box). InputError if
-// the objective has a density filter, or for a move limit outside (0, 1].
+// the objective has a density filter and the space per-cell constraints,
+// if both a density filter and gradient smoothing are given, or for a move
+// limit outside (0, 1].
 OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x0, const OptimizerSettings& settings,
                                      const CellFilter& gradient_smoothing);
 

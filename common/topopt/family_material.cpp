@@ -22,8 +22,8 @@ Eigen::Vector3d cubic_eigenvalues(const Mat6& C) {
 
 class FamilyGridModel : public CellMaterialModel {
  public:
-  FamilyGridModel(StructureGrid grid, GridInterpolant table, MaterialSpace space)
-      : grid_(std::move(grid)), table_(std::move(table)), space_(space) {}
+  FamilyGridModel(StructureGrid grid, GridInterpolant table, MaterialSpace space, bool derived_density)
+      : grid_(std::move(grid)), table_(std::move(table)), space_(space), derived_density_(derived_density) {}
 
   std::string space() const override { return "family3d"; }
   std::vector<std::string> names() const override {
@@ -53,17 +53,16 @@ class FamilyGridModel : public CellMaterialModel {
     return r;
   }
 
-  bool has_constraint() const override { return true; }
+  bool has_constraint() const override { return !derived_density_; }
   double constraint(const VecX& p, VecX* gradient) const override {
-    VecX v;
-    MatX dv;
-    table_.evaluate(p.head(axes()), v, gradient ? &dv : nullptr);
-    if (gradient) {
-      gradient->resize(p.size());
-      gradient->head(axes()) = dv.row(3).transpose();
-      (*gradient)[axes()] = -1;
-    }
-    return v[3] - p[axes()];
+    if (derived_density_) return CellMaterialModel::constraint(p, gradient);
+    const double phi = family_density(p, gradient) - p[axes()];
+    if (gradient) (*gradient)[axes()] = -1;
+    return phi;
+  }
+  bool derives_density() const override { return derived_density_; }
+  double density(const VecX& p, VecX* gradient) const override {
+    return derived_density_ ? family_density(p, gradient) : CellMaterialModel::density(p, gradient);
   }
 
   // The member mix whose solid fraction is nearest rho, on a 21-point scan
@@ -116,6 +115,18 @@ class FamilyGridModel : public CellMaterialModel {
 
  private:
   int axes() const { return table_.axes(); }
+  // The members' solid fraction interpolated at p's family parameters; the
+  // gradient's rho entry is 0.
+  double family_density(const VecX& p, VecX* gradient) const {
+    VecX v;
+    MatX dv;
+    table_.evaluate(p.head(axes()), v, gradient ? &dv : nullptr);
+    if (gradient) {
+      *gradient = VecX::Zero(p.size());
+      gradient->head(axes()) = dv.row(3).transpose();
+    }
+    return v[3];
+  }
   // Linear in the eigenvalues, so it also maps their derivatives.
   static MatX cubic_from_eigenvalues(const Eigen::Vector3d& l) {
     return cubic_tensor((l[0] + 2 * l[1]) / 3, (l[0] - l[1]) / 3, l[2]);
@@ -124,11 +135,13 @@ class FamilyGridModel : public CellMaterialModel {
   StructureGrid grid_;
   GridInterpolant table_;
   MaterialSpace space_;
+  bool derived_density_;
 };
 
 }  // namespace
 
-std::unique_ptr<CellMaterialModel> make_family_material_model(const MicrostructureSet& set, const std::string& path) {
+std::unique_ptr<CellMaterialModel> make_family_material_model(const MicrostructureSet& set, const std::string& path,
+                                                              bool derived_density) {
   if (set.grid.empty())
     throw InputError(path + ": the structures are not a parameter grid (/grid missing; make them with "
                             "msfab-family-generate and a `grid:` config)");
@@ -147,7 +160,8 @@ std::unique_ptr<CellMaterialModel> make_family_material_model(const Microstructu
   std::vector<int> sizes;
   for (const auto& axis : set.grid.axes) sizes.push_back(int(axis.size()));
   return std::make_unique<FamilyGridModel>(set.grid, GridInterpolant(sizes, values),
-                                           MaterialSpace(MaterialSpaceKind::cubic3d, set.E_stiff, set.decades));
+                                           MaterialSpace(MaterialSpaceKind::cubic3d, set.E_stiff, set.decades),
+                                           derived_density);
 }
 
 }  // namespace msfab

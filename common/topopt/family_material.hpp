@@ -26,8 +26,16 @@
 
 namespace msfab {
 
+//
+// With `derived_density`, rho is not free: it is the family's solid
+// fraction at the cell's parameters (CellMaterialModel::derives_density),
+// and Phi is gone. This is the form a density filter on the parameters
+// needs: a filtered cell is a mix of its neighbours' parameters, and a
+// per-cell Phi on it would couple every cell to its neighbours.
+//
 // InputError naming `path` when the set has no parameter grid, is not a
 // cubic3d set, or a member's C^H is not positive definite.
-std::unique_ptr<CellMaterialModel> make_family_material_model(const MicrostructureSet& set, const std::string& path);
+std::unique_ptr<CellMaterialModel> make_family_material_model(const MicrostructureSet& set, const std::string& path,
+                                                              bool derived_density = false);
 
 }  // namespace msfab

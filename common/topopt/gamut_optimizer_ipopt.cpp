@@ -202,6 +202,9 @@ class GamutProblem : public Ipopt::TNLP {
 }  // namespace
 
 OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings) {
+  // The mass constraint below is linear in q (the filter's column sums).
+  if (objective.model().derives_density())
+    throw InputError("ipopt: a space whose rho is derived from its other parameters is optimized by cell-mma only");
   OptimizationResult result;
   const auto t0 = std::chrono::steady_clock::now();
   Ipopt::SmartPtr<Ipopt::TNLP> problem = new GamutProblem(objective, q0, settings, result);

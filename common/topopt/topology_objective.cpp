@@ -54,6 +54,35 @@ TopologyObjective::TopologyObjective(TopologySetup setup, const CellMaterialMode
   fem_ = std::make_unique<GridElasticity>(fem_grid(), setup_.fixed, setup_.solver, setup_.solver_options);
 }
 
+MatX TopologyObjective::physical(const MatX& q) const {
+  MatX p = filter_.apply(q);
+  if (model_.derives_density()) {
+    const int rho = model_.density_index();
+    for (Eigen::Index r = 0; r < p.rows(); ++r) p(r, rho) = model_.density(p.row(r).transpose(), nullptr);
+  }
+  return p;
+}
+
+MatX TopologyObjective::to_variables(const MatX& p, MatX grad_p) const {
+  if (model_.derives_density()) {
+    const int rho = model_.density_index();
+    for (Eigen::Index r = 0; r < p.rows(); ++r) {
+      VecX dr;
+      model_.density(p.row(r).transpose(), &dr);
+      const double through = grad_p(r, rho);
+      grad_p(r, rho) = 0;
+      grad_p.row(r) += through * dr.transpose();
+    }
+  }
+  return filter_.apply_transpose(grad_p);
+}
+
+MatX TopologyObjective::mass_gradient(const MatX& q) const {
+  MatX grad_p = MatX::Zero(q.rows(), q.cols());
+  grad_p.col(model_.density_index()).setConstant(setup_.grid.cell_volume());
+  return to_variables(physical(q), std::move(grad_p));
+}
+
 double TopologyObjective::mass(const MatX& q) const {
   const MatX p = physical(q);
   const int rho = model_.density_index();
@@ -73,16 +102,10 @@ ObjectiveValue TopologyObjective::evaluate(const MatX& q, MatX* gradient) {
   return value_;
 }
 
-void TopologyObjective::compute_state(const MatX& q) {
+MatX TopologyObjective::cell_pairs(const MatX& p) const {
   const CellGrid& g = setup_.grid;
   const int m = g.voigt(), npairs = g.voigt_pairs();
   const Eigen::Index rows = Eigen::Index(design_cells_.size());
-  has_state_ = false;
-  last_q_ = q;
-  p_ = physical(q);
-  const MatX& p = p_;
-
-  // Cell stiffnesses.
   MatX pairs(g.cells(), npairs);
   Eigen::Matrix<double, 1, Eigen::Dynamic> solid(npairs), empty(npairs);
   upper_triangle(setup_.solid_C, m, solid.data());
@@ -100,6 +123,17 @@ void TopologyObjective::compute_state(const MatX& q) {
     pairs.row(design_cells_[r]) = row;
   }
   if (!finite) throw NumericalError("a cell's stiffness is not finite (parameters at a singular point of the space)");
+  return pairs;
+}
+
+void TopologyObjective::compute_state(const MatX& q) {
+  const CellGrid& g = setup_.grid;
+  const int npairs = g.voigt_pairs();
+  const Eigen::Index rows = Eigen::Index(design_cells_.size());
+  has_state_ = false;
+  last_q_ = q;
+  p_ = physical(q);
+  const MatX pairs = cell_pairs(p_);
   if (fem_parent_.empty()) {
     fem_->set_stiffness(pairs);
   } else {
@@ -107,8 +141,7 @@ void TopologyObjective::compute_state(const MatX& q) {
     for (std::size_t f = 0; f < fem_parent_.size(); ++f) fine.row(Eigen::Index(f)) = pairs.row(fem_parent_[f]);
     fem_->set_stiffness(fine);
   }
-
-
+  const MatX& p = p_;
 
   // Elasticity terms.
   ObjectiveValue value;
@@ -191,7 +224,7 @@ MatX TopologyObjective::gradient_from_state() {
       }
     }
   }
-  return filter_.apply_transpose(grad_p);
+  return to_variables(p, std::move(grad_p));
 }
 
 void TopologyObjective::hold_void_nodes() {

@@ -89,10 +89,19 @@ class TopologyObjective {
   // S at design variables q (design cells x parameters); with `gradient`,
   // dS/dq of the same shape.
   ObjectiveValue evaluate(const MatX& q, MatX* gradient);
-  // The physical parameters p = filter(q).
-  MatX physical(const MatX& q) const { return filter_.apply(q); }
+  // The physical parameters p = filter(q); where the model derives rho
+  // from the other parameters (CellMaterialModel::derives_density), p's rho
+  // column is that, not the filtered q.
+  MatX physical(const MatX& q) const;
   // Total mass sum rho_i V_i of a design (forced-solid cells count rho = 1).
   double mass(const MatX& q) const;
+  // d mass / d q (the shape of q).
+  MatX mass_gradient(const MatX& q) const;
+  // Every grid cell's Voigt stiffness at physical parameters p (the upper
+  // triangle, CellGrid::pair_index order): design cells the model's,
+  // forced cells the solid's or the void's. NumericalError where a cell's
+  // stiffness is not finite.
+  MatX cell_pairs(const MatX& p) const;
   // The value of the last evaluate().
   const ObjectiveValue& last_value() const { return value_; }
   // Displacements of the last evaluate(), one per load case, per unknown
@@ -117,6 +126,10 @@ class TopologyObjective {
   // (the gripper plate on 4^3 hexahedra per cell: CG met r' M^-1 r < 0 at
   // the start, where CHOLMOD solved the same matrix).
   void hold_void_nodes();
+  // d/dp of a function of the physical parameters, carried back to the
+  // design variables: through rho = density(p) where derived, then through
+  // the filter.
+  MatX to_variables(const MatX& p, MatX grad_p) const;
   // The state of the last evaluation.
   void compute_state(const MatX& q);
   MatX gradient_from_state();

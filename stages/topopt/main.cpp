@@ -27,6 +27,7 @@
 #include "topopt/cell_mma.hpp"
 #include "topopt/family_material.hpp"
 #include "topopt/simp_mma.hpp"
+#include "topopt/edge_joints.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
 #include "verify/design_refinement.hpp"
@@ -118,12 +119,25 @@ int main(int argc, char** argv) {
                                      std::to_string(family.stiff.nu));
     CellMaterialSettings ms{scene.space, scene.E0, scene.decades, scene.nu, scene.penalty, scene.E_min_ratio,
                             needs.empty() ? nullptr : &gamut.level_set};
-    const auto model = family_path.empty() ? make_cell_material_model(ms) : make_family_material_model(family, family_path);
+    // Regularization: cell-mma smooths the gradient as the thesis does
+    // (`filter.kind: smoothing`) or, in spaces without per-cell
+    // constraints, filters the parameters (`density`: family3d then derives
+    // each cell's rho from its family parameters); ipopt always filters.
+    const std::string optimizer =
+        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma", "cell-mma"}) : "auto";
+    const bool use_cell_mma = optimizer == "cell-mma";
+    const bool density_filter =
+        config.has("filter.kind") && config.one_of("filter.kind", {"smoothing", "density"}) == "density";
+    if (config.has("filter.kind") && !use_cell_mma)
+      config.fail("filter.kind", "is read by the cell-mma optimizer only (ipopt, oc and mma filter the parameters)");
+    if (density_filter && space != "family3d" && space != "simp2d" && space != "simp3d")
+      config.fail("filter.kind", "density needs a space without per-cell constraints (family3d, simp2d, simp3d); space " +
+                                     space + " has them, so cell-mma smooths its gradient instead");
+    const auto model = family_path.empty() ? make_cell_material_model(ms)
+                                           : make_family_material_model(family, family_path, density_filter);
     if (use_bound && gamut.bound_stiff.size() > 0) model->set_voigt_bound(gamut.bound_stiff, gamut.bound_soft);
 
     OptimizerSettings os;
-    const std::string optimizer =
-        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma", "cell-mma"}) : "auto";
     os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
     if (os.max_iterations < 1) config.fail("optimizer.max_iterations", "must be >= 1");
     os.tolerance = config.get_or<double>("optimizer.tolerance", os.tolerance);
@@ -135,7 +149,6 @@ int main(int argc, char** argv) {
       config.fail("optimizer.change_tolerance", "must be in [0, 1) (0: run max_iterations)");
     const bool use_oc = optimizer == "oc" || (optimizer == "auto" && model->parameters() == 1);
     const bool use_mma = optimizer == "mma";
-    const bool use_cell_mma = optimizer == "cell-mma";
     const std::string chosen = use_oc ? "oc" : use_mma ? "mma" : use_cell_mma ? "cell-mma" : "ipopt";
     if (config.has("optimizer.move")) {
       if (!use_cell_mma) config.fail("optimizer.move", "is read by the cell-mma optimizer only");
@@ -160,10 +173,10 @@ int main(int argc, char** argv) {
     TopologySetup setup = scene.setup;
     setup.solver_options.threads = ctx.options.threads;
     refine_fem_mesh(setup, scene.elements_per_cell);
-    // cell-mma regularizes as the thesis does, by smoothing the gradient
-    // (topopt/cell_mma.hpp): its cells' parameters are the physical ones.
-    const double smoothing_radius = use_cell_mma ? setup.filter_radius : 0.0;
-    if (use_cell_mma) setup.filter_radius = 0;
+    // cell-mma's default regularization smooths the gradient
+    // (topopt/cell_mma.hpp): its cells' parameters are then the physical ones.
+    const double smoothing_radius = use_cell_mma && !density_filter ? setup.filter_radius : 0.0;
+    if (use_cell_mma && !density_filter) setup.filter_radius = 0;
     TopologyObjective objective(setup, *model);
     const CellFilter smoothing(grid, objective.design_cells(), smoothing_radius);
     const MatX q0 = start.rows(objective.design_cells());
@@ -199,6 +212,10 @@ int main(int argc, char** argv) {
                   r.seconds, r.update_seconds / std::max(1, r.iterations));
     std::printf("  mass fraction %.4f, max constraint %.3e\n",
                 objective.mass(r.q) / (grid.cell_volume() * double(grid.cells())), r.max_violation);
+    const EdgeJoints joints = find_edge_joints(grid, objective.cell_pairs(objective.physical(r.q)));
+    std::printf("  edge joints: %lld (pairs of cells meeting only along an edge, or at a corner in 2D, both >= 10x "
+                "stiffer than the cells between them; largest ratio %.3g)\n",
+                static_cast<long long>(joints.count), joints.largest_ratio);
     const double per = 1.0 / std::max(1, st.factorizations);
     std::printf("  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve (assembly %.3f, "
                 "factorization %.3f, solves %.3f)\n",

@@ -28,6 +28,7 @@
 #include "io/artifact.hpp"
 #include "io/sha256.hpp"
 #include "models.hpp"
+#include "topopt/edge_joints.hpp"
 #include "topopt/grid_elasticity.hpp"
 #include "topopt/topopt_scene.hpp"
 #include "verify/refinement.hpp"
@@ -288,6 +289,13 @@ int main(int argc, char** argv) {
     GridElasticity& homogenized = *homogenized_model;
     {
       const MatX cell_pairs = homogenized_pairs(coarse, mapped, set, materials, settings.fill);
+      const EdgeJoints joints = find_edge_joints(coarse, cell_pairs);
+      report.edge_joints = joints.count, report.edge_joint_largest_ratio = joints.largest_ratio;
+      if (joints.count > 0)
+        spdlog::warn("{} edge joint(s): pairs of cells that meet only along an edge, both at least 10x stiffer than "
+                     "the cells between them (largest ratio {:.3g}); the homogenized model holds such a joint stiffer "
+                     "than the print, more so the finer the voxels (docs/topopt.md, \"Edge joints\")",
+                     joints.count, joints.largest_ratio);
       MatX pairs(hgrid.cells(), cell_pairs.cols());
       for (std::int64_t e = 0; e < hgrid.cells(); ++e) {
         const auto q = hgrid.cell_coords(e);
@@ -441,5 +449,7 @@ int main(int argc, char** argv) {
                 report.fill.c_str(), cases.c_str(), report.seconds_factorize_homogenized + hom_solve,
                 report.solver_homogenized.c_str(), elements.c_str(), report.seconds_factorize_full + full_solve,
                 report.solver_full.c_str(), static_cast<long long>(report.unknowns_full), out.c_str());
+    std::printf("  edge joints: %lld (largest stiffness ratio across an edge %.3g)\n",
+                static_cast<long long>(report.edge_joints), report.edge_joint_largest_ratio);
   });
 }

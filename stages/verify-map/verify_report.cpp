@@ -39,6 +39,8 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "point_supports", r.point_supports);
   f.write_attribute("/", "moved_point_supports", r.moved_point_supports);
   f.write_attribute("/", "lost_point_supports", r.lost_point_supports);
+  f.write_attribute("/", "edge_joints", r.edge_joints);
+  f.write_attribute("/", "edge_joint_largest_ratio", r.edge_joint_largest_ratio);
 
   f.create_group("/timings");
   f.write_attribute("/timings", "model", r.seconds_model);

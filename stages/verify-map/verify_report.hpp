@@ -41,6 +41,10 @@ struct VerifyReport {
   std::int64_t pieces_homogenized = 0, removed_pieces_homogenized = 0, removed_cells_homogenized = 0,
                inactive_nodes_homogenized = 0;
   int homogenized_elements = 1;  // hexahedra per cell edge in the homogenized model
+  // Cells that meet only along an edge, both >= 10x stiffer than the cells
+  // between them (topopt/edge_joints.hpp), in the homogenized model.
+  std::int64_t edge_joints = 0;
+  double edge_joint_largest_ratio = 0;
   std::string solver_homogenized, solver_full;  // as resolved by GridElasticity
   std::string coarse_space_full = "none";      // matrix-free: material | lattice
   std::int64_t unknowns_homogenized = 0, unknowns_full = 0;

@@ -50,7 +50,20 @@ out=$("$BIN/msfab-topopt" --config "$WORK/bar.yaml" --set elements_per_cell=2 --
 check "the elasticity on 2^3 hexahedra per cell" -- grep -q "2^3 elements per cell, 975 unknowns" <<<"$out"
 check "its design keeps the design grid's nodes" -- test "$(h5dump -H -d /nodes/displacement "$WORK/bar_m2.design.h5" | grep -c '( 63, 3 )')" = 1
 
+out=$("$BIN/msfab-topopt" --config "$WORK/bar.yaml" --set optimizer.name=cell-mma --set filter.kind=density \
+  --set filter.radius=1.5 --set optimizer.max_iterations=40 --out "$WORK/bar_density.design.h5" 2>&1)
+check "cell MMA with a density filter on the family's parameters" -- test -s "$WORK/bar_density.design.h5"
+check "density filter: within the budget" -- grep -Eq "mass fraction 0\.(3[89][0-9]|400)" <<<"$out"
+check "density filter: rho derived, so no cell constraint" -- grep -Eq "max constraint (-|0\.000)" <<<"$out"
+
 # Bad input.
+expect_exit 2 "filter.kind = density: is read by the cell-mma optimizer only" -- "$BIN/msfab-topopt" \
+  --config "$WORK/bar.yaml" --set filter.kind=density --out "$WORK/x.design.h5"
+expect_exit 2 "filter.kind = blur: " -- "$BIN/msfab-topopt" --config "$WORK/bar.yaml" --set optimizer.name=cell-mma \
+  --set filter.kind=blur --out "$WORK/x.design.h5"
+expect_exit 2 "filter.kind = density: density needs a space without per-cell constraints" -- "$BIN/msfab-topopt" \
+  --config "$WORK/bar.yaml" --set family=null --set space=analytic3d --set optimizer.name=cell-mma \
+  --set filter.kind=density --out "$WORK/x.design.h5"
 expect_exit 2 "family = \\(nothing\\): is missing: space family3d needs" -- "$BIN/msfab-topopt" --config "$WORK/bar.yaml" \
   --set family=null --out "$WORK/x.design.h5"
 check "re-homogenizing keeps the grid" -- "$BIN/msfab-homogenize" --structures "$WORK/grid.microstructures.h5" \

@@ -66,6 +66,8 @@ out=$("$V" "${A[@]}" --scene "$WORK/rollers.yaml" --set fill=solid --out "$WORK/
 echo "$out"
 check "(a) solid bar, uniform traction: displacement within 0.1%" -- below "$(percent traction "$out" displacement)" 0.1
 check "(a) solid bar, uniform traction: energy within 0.1%" -- below "$(percent traction "$out" energy)" 0.1
+check "(a) a solid bar has no edge joints" -- grep -q "edge joints: 0 (largest stiffness ratio across an edge 1)" <<<"$out"
+check "(a) and records none" -- bash -c "h5dump -a /edge_joints '$WORK/solid.verify.h5' | grep -q '(0): 0'"
 cat "$WORK/rollers.yaml" > "$WORK/pull.yaml"
 sed -i '/^loads:/,$d' "$WORK/pull.yaml"
 cat >> "$WORK/pull.yaml" <<'Y'
