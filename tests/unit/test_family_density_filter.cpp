@@ -10,6 +10,7 @@
 #include <random>
 
 #include "core/errors.hpp"
+#include "family_test_set.hpp"
 #include "gamut/material_space.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "io/config.hpp"
@@ -21,34 +22,6 @@
 
 namespace msfab {
 namespace {
-
-// A 3 x 2 grid of synthetic cubic members, denser and stiffer along the
-// first axis, more anisotropic along the second.
-MicrostructureSet filtered_family_set() {
-  MicrostructureSet set;
-  set.space = "cubic3d";
-  set.property_names = {"E", "nu", "G", "rho"};
-  set.E_stiff = 1e6;
-  set.decades = 4;
-  set.nx = set.ny = set.nz = 2;
-  set.stiff = {1e6, 0.3};
-  set.grid.names = {"axis", "diagonal"};
-  set.grid.axes = {{0.05, 0.2, 0.5}, {0.0, 0.1}};
-  const MaterialSpace space(MaterialSpaceKind::cubic3d, set.E_stiff, set.decades);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 2; ++j) {
-      Microstructure m;
-      m.ids.assign(8, 1);
-      const double rho = 0.1 + 0.35 * i + 0.05 * j;
-      VecX raw(4);
-      raw << 1e6 * std::pow(rho, 2.0), 0.1 + 0.08 * i + 0.05 * j, 1e6 * std::pow(rho, 2.0) * (0.3 + 0.2 * j), rho;
-      m.C = space.tensor_3d(raw);
-      m.properties = space.properties(m.C, rho);
-      m.unit = space.normalize(m.properties);
-      set.items.push_back(m);
-    }
-  return set;
-}
 
 // A cantilever 6 x 2 x 2 cells, clamped at x = 0, loaded down at the far
 // bottom edge, with a filter of radius 1.5 cells.
@@ -67,7 +40,7 @@ filter: {radius: 1.5}
 }
 
 TEST(FamilyDensityFilter, DerivedRhoIsTheFamilysSolidFractionWithoutAConstraint) {
-  const MicrostructureSet set = filtered_family_set();
+  const MicrostructureSet set = family_test_set();
   const auto free_rho = make_family_material_model(set, "test set");
   const auto derived = make_family_material_model(set, "test set", true);
   EXPECT_TRUE(free_rho->has_constraint());
@@ -99,7 +72,7 @@ TEST(FamilyDensityFilter, DerivedRhoIsTheFamilysSolidFractionWithoutAConstraint)
 }
 
 TEST(FamilyDensityFilter, ObjectiveAndMassGradientsMatchFiniteDifferences) {
-  const MicrostructureSet set = filtered_family_set();
+  const MicrostructureSet set = family_test_set();
   const auto model = make_family_material_model(set, "test set", true);
   TopoptScene sc = filtered_family_cantilever("mass: {target: 3, weight: 0.5}\n");
   TopologyObjective obj(sc.setup, *model);
@@ -133,7 +106,7 @@ TEST(FamilyDensityFilter, ObjectiveAndMassGradientsMatchFiniteDifferences) {
 }
 
 TEST(FamilyDensityFilter, CellMmaEndsWithinBudgetBelowItsStart) {
-  const MicrostructureSet set = filtered_family_set();
+  const MicrostructureSet set = family_test_set();
   const auto model = make_family_material_model(set, "test set", true);
   TopoptScene sc = filtered_family_cantilever("");
   TopologyObjective obj(sc.setup, *model);
