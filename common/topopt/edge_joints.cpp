@@ -1,6 +1,7 @@
 #include "topopt/edge_joints.hpp"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 #include <stdexcept>
 #include <vector>

@@ -26,7 +26,6 @@
 
 namespace msfab {
 
-//
 // With `derived_density`, rho is not free: it is the family's solid
 // fraction at the cell's parameters (CellMaterialModel::derives_density),
 // and Phi is gone. This is the form a density filter on the parameters
