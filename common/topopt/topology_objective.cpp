@@ -58,6 +58,7 @@ MatX TopologyObjective::physical(const MatX& q) const {
   MatX p = filter_.apply(q);
   if (model_.derives_density()) {
     const int rho = model_.density_index();
+#pragma omp parallel for schedule(static)
     for (Eigen::Index r = 0; r < p.rows(); ++r) p(r, rho) = model_.density(p.row(r).transpose(), nullptr);
   }
   return p;
@@ -66,6 +67,7 @@ MatX TopologyObjective::physical(const MatX& q) const {
 MatX TopologyObjective::to_variables(const MatX& p, MatX grad_p) const {
   if (model_.derives_density()) {
     const int rho = model_.density_index();
+#pragma omp parallel for schedule(static)
     for (Eigen::Index r = 0; r < p.rows(); ++r) {
       VecX dr;
       model_.density(p.row(r).transpose(), &dr);

@@ -25,9 +25,9 @@
 #include "gamut/gamut_artifact.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "topopt/cell_mma.hpp"
+#include "topopt/edge_joints.hpp"
 #include "topopt/family_material.hpp"
 #include "topopt/simp_mma.hpp"
-#include "topopt/edge_joints.hpp"
 #include "topopt/topology_optimizers.hpp"
 #include "topopt/topopt_scene.hpp"
 #include "verify/design_refinement.hpp"
@@ -130,12 +130,12 @@ int main(int argc, char** argv) {
         config.has("filter.kind") && config.one_of("filter.kind", {"smoothing", "density"}) == "density";
     if (config.has("filter.kind") && !use_cell_mma)
       config.fail("filter.kind", "is read by the cell-mma optimizer only (ipopt, oc and mma filter the parameters)");
-    if (density_filter && space != "family3d" && space != "simp2d" && space != "simp3d")
-      config.fail("filter.kind", "density needs a space without per-cell constraints (family3d, simp2d, simp3d); space " +
-                                     space + " has them, so cell-mma smooths its gradient instead");
     const auto model = family_path.empty() ? make_cell_material_model(ms)
                                            : make_family_material_model(family, family_path, density_filter);
     if (use_bound && gamut.bound_stiff.size() > 0) model->set_voigt_bound(gamut.bound_stiff, gamut.bound_soft);
+    if (density_filter && (model->has_constraint() || model->bound_conditions() > 0))
+      config.fail("filter.kind", "density needs a space without per-cell constraints (family3d, simp2d, simp3d); space " +
+                                     space + " has them, so cell-mma smooths its gradient instead");
 
     OptimizerSettings os;
     os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
