@@ -11,6 +11,7 @@
 
 #include "cli/allocator_tuning.hpp"
 #include "cli/logging.hpp"
+#include "cli/memory_budget.hpp"
 #include "cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
@@ -86,6 +87,18 @@ const std::string& StageContext::require_out() const {
   return options.out;
 }
 
+void StageContext::check_memory(double estimated_bytes, const std::string& what, const std::string& remedy) const {
+  const bool given = !options.memory_limit.empty();
+  const double limit = given ? double(parse_memory_size(options.memory_limit, "--memory-limit"))
+                             : double(available_memory_bytes());
+  spdlog::debug("memory: {} needs about {} (limit {}, {})", what, format_bytes(estimated_bytes), format_bytes(limit),
+                given ? "--memory-limit" : "available now");
+  if (limit <= 0 || estimated_bytes <= limit) return;
+  throw InputError(what + " needs about " + format_bytes(estimated_bytes) + ", more than the " + format_bytes(limit) +
+                   (given ? " of --memory-limit" : " available") + "; " + remedy +
+                   (given ? "" : ", or set --memory-limit if the estimate is too cautious"));
+}
+
 void StageContext::check_out_folder() const {
   const std::string& out = require_out();
   if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
@@ -117,6 +130,20 @@ void StageApp::add_common_options() {
       ->type_name("LEVEL")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   cli_.add_flag("-q,--quiet", options_.quiet, "only warnings and errors; no progress display");
+  cli_.add_option("--memory-limit", options_.memory_limit,
+                  "memory a run may use, e.g. 64G (default: what the system has available); a run estimated "
+                  "above it is refused before it starts")
+      ->type_name("SIZE")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            try {
+              parse_memory_size(text, "--memory-limit");
+            } catch (const InputError& e) {
+              return e.what();
+            }
+            return {};
+          },
+          ""));
   cli_.set_version_flag("--version", name_ + " " + version() + " (revision " + git_revision() + ")");
 }
 

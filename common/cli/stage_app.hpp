@@ -36,6 +36,7 @@ struct StageOptions {
   std::uint64_t seed = 0;              // --seed
   std::string log_level = "info";      // --log-level
   bool quiet = false;                  // --quiet
+  std::string memory_limit;            // --memory-limit; empty = available memory
 };
 
 struct StageContext {
@@ -50,6 +51,12 @@ struct StageContext {
   // --out writes into exists; stages call it after validating their config,
   // before any long work.
   void check_out_folder() const;
+  // Refuses (InputError, exit 2) a run whose estimated peak memory exceeds
+  // the limit (cli/memory_budget.hpp): "<what> needs about 31.2 GiB, more
+  // than the 22.1 GiB available; <remedy>, or set --memory-limit". Stages
+  // call it with their dominant arrays, before any long work. Logs the
+  // estimate at debug level either way.
+  void check_memory(double estimated_bytes, const std::string& what, const std::string& remedy) const;
 };
 
 class StageApp {

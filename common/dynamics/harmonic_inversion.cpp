@@ -163,6 +163,8 @@ HarmonicFit harmonic_inversion(const VecX& samples, double dt, const HarmonicInv
     const double b = p.real ? 0.0 : coef[c++];
     m.amplitude = std::hypot(a, b);
     m.phase = std::atan2(a, b);
+    m.decay_uncertainty = m.amplitude > 0.0 ? std::sqrt(24.0 / n) * fit.rms_residual / (m.amplitude * n * dt)
+                                            : std::numeric_limits<double>::infinity();
     fit.modes.push_back(m);
   }
   std::stable_sort(fit.modes.begin(), fit.modes.end(),

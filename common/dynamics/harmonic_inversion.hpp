@@ -35,6 +35,11 @@ namespace msfab {
 struct DampedMode {
   double frequency = 0.0;  // Hz, in [0, 1/(2 dt)]
   double decay = 0.0;      // 1/s; negative for a growing mode
+  // Standard error of `decay` if the fit's residual were white noise:
+  // sqrt(24 / N) rms / (A N dt), the Cramer-Rao bound of a sinusoid's
+  // frequency, which its decay shares for light damping. A decay within a
+  // few of these of zero cannot be told from an undamped mode.
+  double decay_uncertainty = 0.0;
   double amplitude = 0.0;  // A >= 0 at the first sample
   double phase = 0.0;      // theta in (-pi, pi]
   // A real pole: a pure exponential (f = 0) or a sample-to-sample

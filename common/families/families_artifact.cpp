@@ -93,7 +93,7 @@ FamiliesResult read_families_artifact(const std::string& path) {
   r.stiff_nu = f.read_attribute<double>("/", "stiff_nu");
   const int families = f.read_attribute<std::int32_t>("/", "families");
   r.selection = f.read_vector<std::int64_t>("/selection");
-  r.embedding = f.read_matrix<double>("/embedding/coordinates");
+  r.embedding = f.read_matrix<double>("/embedding/coordinates", -1, Finite::nan_means_missing);
   const std::vector<double> eigenvalues = f.read_vector<double>("/embedding/eigenvalues");
   r.eigenvalues = Eigen::Map<const VecX>(eigenvalues.data(), Eigen::Index(eigenvalues.size()));
   r.residual_variance = f.read_attribute<double>("/embedding", "residual_variance");
@@ -126,10 +126,10 @@ FamiliesResult read_families_artifact(const std::string& path) {
     range("E_range", fam.E_range);
     range("nu_range", fam.nu_range);
     range("shear_ratio_range", fam.shear_ratio_range);
-    fam.member_difference = f.read_vector<double>(g + "/member_difference");
+    fam.member_difference = f.read_vector<double>(g + "/member_difference", Finite::nan_means_missing);
     const std::vector<std::uint8_t> kept = f.read_vector<std::uint8_t>(g + "/member_kept");
     fam.member_kept.assign(kept.begin(), kept.end());
-    fam.member_parameters = f.read_matrix<double>(g + "/member_parameters");
+    fam.member_parameters = f.read_matrix<double>(g + "/member_parameters", -1, Finite::nan_means_missing);
     if (fam.member_difference.size() != fam.members.size() || fam.member_kept.size() != fam.members.size())
       throw InputError(path + ": " + g + ": member datasets disagree in length with " + g + "/members");
     fam.has_reduced = f.read_attribute<std::int32_t>(g, "has_reduced") != 0;

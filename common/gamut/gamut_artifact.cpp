@@ -29,7 +29,11 @@ double coverage(const GamutLevelSet& ls) {
 void write_gamut_artifact(const std::string& path, const Gamut& g, const std::string& executable,
                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
   ArtifactWriter out(path, kGamutSchema, kGamutSchemaVersion, executable, config_text, inputs, seed);
-  H5File& f = out.file();
+  write_gamut(out.file(), g);
+  out.commit();
+}
+
+void write_gamut(H5File& f, const Gamut& g) {
   f.write_attribute("/", "space", g.space);
   f.write_attribute("/", "property_names", format_name_list(g.property_names));
   f.write_attribute("/", "E_stiff", g.E_stiff);
@@ -67,7 +71,6 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
     f.write_vector("/history/coverage", cover);
     f.write_vector("/history/seconds", seconds);
   }
-  out.commit();
 }
 
 namespace {

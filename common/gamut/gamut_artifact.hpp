@@ -11,6 +11,8 @@
 
 namespace msfab {
 
+class H5File;
+
 inline constexpr const char* kGamutSchema = "msfab.gamut";
 inline constexpr int kGamutSchemaVersion = 1;
 
@@ -42,6 +44,9 @@ double coverage(const GamutLevelSet& level_set);
 
 void write_gamut_artifact(const std::string& path, const Gamut& gamut, const std::string& executable,
                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
+// The gamut's datasets and attributes into an artifact being written (a
+// member of a commit group, io/commit_group.hpp).
+void write_gamut(H5File& file, const Gamut& gamut);
 Gamut read_gamut_artifact(const std::string& path);
 
 }  // namespace msfab

@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "core/version.hpp"
+#include "io/commit_group.hpp"
 #include "io/input_file.hpp"
 #include "io/sha256.hpp"
 
@@ -84,6 +85,22 @@ ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_
       throw InputError(path_ + ": the output is also an input of this run; writing it would destroy the input");
     inputs.push_back({input, sha256_file_hex(input)});
   }
+  create(schema, schema_version, executable, config_text, inputs, seed);
+}
+
+ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
+                               const std::string& executable, const std::string& config_text,
+                               HashedInputs inputs, std::uint64_t seed)
+    : path_(std::move(path)) {
+  for (const ArtifactInput& input : inputs.list)
+    if (same_file(input.path, path_))
+      throw InputError(path_ + ": the output is also an input of this run; writing it would destroy the input");
+  create(schema, schema_version, executable, config_text, inputs.list, seed);
+}
+
+void ArtifactWriter::create(const std::string& schema, int schema_version, const std::string& executable,
+                            const std::string& config_text, const std::vector<ArtifactInput>& inputs,
+                            std::uint64_t seed) {
   tmp_ = std::make_unique<AtomicFile>(path_);
   try {
     file_.emplace(H5File::create_in(*tmp_));
@@ -117,10 +134,27 @@ H5File& ArtifactWriter::file() {
   return *file_;
 }
 
-void ArtifactWriter::commit() {
-  if (committed_) throw std::logic_error(path_ + ": commit() called twice");
+void ArtifactWriter::prepare() {
+  if (committed_) throw std::logic_error(path_ + ": prepare() after commit()");
+  if (prepared_) return;
   file_->flush();
   file_->close();
+  tmp_->sync();
+  prepared_ = true;
+}
+
+std::string ArtifactWriter::release_temporary() {
+  prepare();
+  committed_ = true;
+  return tmp_->release();
+}
+
+void ArtifactWriter::commit() {
+  if (committed_) throw std::logic_error(path_ + ": commit() called twice");
+  prepare();
+  // An older group commit left unfinished over this path would otherwise
+  // roll its stale temporary over what is committed now.
+  complete_interrupted_commit(path_);
   tmp_->commit();
   committed_ = true;
 }
@@ -128,13 +162,22 @@ void ArtifactWriter::commit() {
 // ---------------------------------------------------------------------------
 // ArtifactReader
 
+namespace {
+// A member of an interrupted group commit is opened only once the group is
+// whole again (io/commit_group.hpp).
+H5File open_finished(const std::string& path) {
+  complete_interrupted_commit(path);
+  return H5File::open(path);
+}
+}  // namespace
+
 ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
                                int supported_version)
     : ArtifactReader(path, expected_schema, supported_version, supported_version) {}
 
 ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
                                int min_version, int max_version)
-    : file_(H5File::open(path)) {
+    : file_(open_finished(path)) {
   const std::string expected =
       "expected schema '" + expected_schema + "' " + versions_text(min_version, max_version);
   if (!file_.has_attribute("/", "schema") || !file_.has_attribute("/", "schema_version")) {

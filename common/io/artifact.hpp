@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/atomic_file.hpp"
@@ -52,6 +53,15 @@ class ArtifactWriter {
   ArtifactWriter(std::string path, std::string schema, int schema_version,
                  const std::string& executable, const std::string& config_text,
                  const std::vector<std::string>& input_paths, std::uint64_t seed);
+  // The same with inputs already hashed (an artifact of the same commit
+  // group, io/commit_group.hpp, whose final path does not hold it yet).
+  struct HashedInputs {
+    explicit HashedInputs(std::vector<ArtifactInput> inputs) : list(std::move(inputs)) {}
+    std::vector<ArtifactInput> list;
+  };
+  ArtifactWriter(std::string path, std::string schema, int schema_version,
+                 const std::string& executable, const std::string& config_text,
+                 HashedInputs inputs, std::uint64_t seed);
   ArtifactWriter(const ArtifactWriter&) = delete;
   ArtifactWriter& operator=(const ArtifactWriter&) = delete;
   ~ArtifactWriter();
@@ -64,13 +74,22 @@ class ArtifactWriter {
   // Throws std::runtime_error if the data cannot be made durable; the final
   // path then still holds its previous content.
   void commit();
+  // The first half of commit(): the HDF5 file closed and its temporary
+  // synced to disk (file() is then no longer usable). Idempotent.
+  void prepare();
+  // After prepare(): the temporary's name, handed over to a commit group's
+  // journal; this writer no longer removes it.
+  std::string release_temporary();
 
  private:
+  void create(const std::string& schema, int schema_version, const std::string& executable,
+              const std::string& config_text, const std::vector<ArtifactInput>& inputs, std::uint64_t seed);
   void discard() noexcept;
 
   std::string path_;
   std::unique_ptr<AtomicFile> tmp_;
   std::optional<H5File> file_;
+  bool prepared_ = false;
   bool committed_ = false;
 };
 

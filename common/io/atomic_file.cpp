@@ -36,7 +36,8 @@ std::string hex16(std::uint64_t word) {
 
 std::string error_text(int err) { return std::strerror(err); }
 
-// Pushes a folder's entries to the disk, so the rename survives a power loss.
+}  // namespace
+
 // Some file systems do not allow opening or syncing a folder; that is not an
 // error of ours.
 void sync_directory(const std::string& directory) {
@@ -45,8 +46,6 @@ void sync_directory(const std::string& directory) {
   (void)::fsync(fd);
   ::close(fd);
 }
-
-}  // namespace
 
 std::string parent_directory(const std::string& path) {
   const fs::path parent = fs::path(path).parent_path();
@@ -126,15 +125,30 @@ void AtomicFile::check_is_this_file(int other_fd) const {
     throw std::runtime_error(path_ + ": the temporary " + tmp_path_ + " was replaced while it was being opened");
 }
 
-void AtomicFile::commit() {
-  if (committed_) throw std::logic_error(path_ + ": commit() called twice");
-  if (fd_ < 0) throw std::logic_error(path_ + ": commit() after discard()");
+void AtomicFile::sync() {
+  if (committed_) throw std::logic_error(path_ + ": sync() after commit()");
+  if (synced_) return;
+  if (fd_ < 0) throw std::logic_error(path_ + ": sync() after discard()");
   if (::fsync(fd_) != 0)
     throw std::runtime_error(path_ + ": fsync of " + tmp_path_ + " failed (" + error_text(errno) + ")");
   const int status = ::close(fd_);
   fd_ = -1;
   if (status != 0)
     throw std::runtime_error(path_ + ": closing " + tmp_path_ + " failed (" + error_text(errno) + ")");
+  synced_ = true;
+}
+
+std::string AtomicFile::release() {
+  if (!synced_ || committed_) throw std::logic_error(path_ + ": release() needs sync() and no commit()");
+  std::string tmp = tmp_path_;
+  tmp_path_.clear();
+  committed_ = true;  // nothing left for the destructor to do
+  return tmp;
+}
+
+void AtomicFile::commit() {
+  if (committed_) throw std::logic_error(path_ + ": commit() called twice");
+  sync();
   if (::rename(tmp_path_.c_str(), path_.c_str()) != 0) {
     const int err = errno;
     throw std::runtime_error("cannot rename " + tmp_path_ + " to " + path_ + " (" + error_text(err) + ")");

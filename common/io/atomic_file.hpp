@@ -60,6 +60,13 @@ class AtomicFile {
   // std::runtime_error if the data cannot be made durable; path() then
   // still holds its previous content.
   void commit();
+  // The first half of commit(): fsync and close the temporary, which then
+  // holds its final content on disk (further writes are logic errors).
+  void sync();
+  // After sync(): hands the temporary over to someone else (a commit group's
+  // journal, io/commit_group.hpp) and returns its name; the destructor no
+  // longer removes it.
+  std::string release();
   // Closes and removes the temporary now (the destructor's job otherwise).
   void discard() noexcept;
 
@@ -67,6 +74,7 @@ class AtomicFile {
   std::string path_;
   std::string tmp_path_;
   int fd_ = -1;
+  bool synced_ = false;
   bool committed_ = false;
 };
 
@@ -75,5 +83,9 @@ void write_file_atomically(const std::string& path, const std::string& contents)
 
 // The folder a path lies in ("." for a bare file name).
 std::string parent_directory(const std::string& path);
+
+// Pushes a folder's entries (renames, removals) to the disk, so they
+// survive a power loss.
+void sync_directory(const std::string& directory);
 
 }  // namespace msfab

@@ -199,6 +199,13 @@ struct Reader<double> {
   static double read(const std::string& where, const std::string& path, const YAML::Node& node) {
     double v = 0;
     if (!node.IsScalar() || is_quoted(node) || !parse_double(node.Scalar(), v)) type_error(where, path, node, name);
+    // Refused here, for every number of every stage, rather than key by key:
+    // a NaN passes every range test written as `v < lo || v > hi`, and a
+    // modulus of 1e308 overflows the first product it enters.
+    if (!std::isfinite(v)) throw InputError(where + ": " + path + " = " + node.Scalar() + ": expected a finite number");
+    if (std::abs(v) > kLargestConfigNumber)
+      throw InputError(where + ": " + path + " = " + node.Scalar() + ": beyond ±" + format_number(kLargestConfigNumber) +
+                       "; no quantity read from a config needs such a value, and its products overflow");
     return v;
   }
 };

@@ -25,6 +25,10 @@
 
 namespace msfab {
 
+// Every number read from a config is finite and at most this in magnitude
+// (.inf, .nan and 1e308 are InputErrors naming the key).
+inline constexpr double kLargestConfigNumber = 1e100;
+
 // Which ends of an interval belong to it: Open = (lo, hi), Closed = [lo, hi].
 enum class Bounds { Closed, Open, OpenClosed, ClosedOpen };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -426,6 +427,21 @@ void H5File::read_raw(const std::string& path, H5Dtype dtype, void* data, std::s
       H5Dread(dataset.get(), memory_type_of(dtype), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     throw InputError(path_ + ": reading dataset '" + path + "' failed (file corrupt? " +
                      hdf5_error_detail() + ")");
+  }
+}
+
+void H5File::check_finite(const std::string& object, const std::string& attribute, H5Dtype dtype, const void* data,
+                          std::size_t count, Finite finite) const {
+  if (dtype != H5Dtype::kFloat64) return;
+  const double* values = static_cast<const double*>(data);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double v = values[i];
+    if (std::isfinite(v) || (finite == Finite::nan_means_missing && std::isnan(v))) continue;
+    const std::string where =
+        attribute.empty() ? "dataset '" + object + "'" : "attribute '" + attribute + "' on '" + object + "'";
+    throw InputError(path_ + ": " + where + " holds " + (std::isnan(v) ? "NaN" : "an infinite value") +
+                     (count > 1 ? " at index " + std::to_string(i) : std::string()) +
+                     "; the file is damaged or was not written by msfab");
   }
 }
 

@@ -10,6 +10,11 @@
 // Errors: failures while reading throw InputError naming the file, the
 // object and what was wrong ("out.h5: dataset '/u' not found"); failures
 // while writing throw std::runtime_error. HDF5's own error printing is off.
+// Floating-point values read back must be finite unless the caller passes
+// Finite::nan_means_missing (for the few datasets where NaN marks a value
+// that was not computed): a NaN or infinity that a damaged or hand-edited
+// file carries is refused where it is read, naming the file, the object and
+// the index, instead of surfacing later as "error nan".
 // The HDF5 library is used from one thread at a time.
 #include <hdf5.h>
 
@@ -35,6 +40,9 @@ template <> struct H5DtypeOf<std::uint8_t> { static constexpr H5Dtype value = H5
 template <> struct H5DtypeOf<std::uint64_t> { static constexpr H5Dtype value = H5Dtype::kUInt64; };
 
 const char* dtype_name(H5Dtype dtype);  // "float64", "int32", ...
+
+// What a reader accepts in floating-point data (see the header comment).
+enum class Finite { required, nan_means_missing };
 
 // Owns one HDF5 identifier and releases it with the matching close call.
 class H5Id {
@@ -166,9 +174,10 @@ class H5File {
   }
   template <class T>
   std::vector<T> read_slab(const std::string& path, const std::vector<hsize_t>& offset,
-                           const std::vector<hsize_t>& count) const {
+                           const std::vector<hsize_t>& count, Finite finite = Finite::required) const {
     std::vector<T> values(element_count(count));
     read_slab_raw(path, H5DtypeOf<T>::value, values.data(), offset, count);
+    check_finite(path, {}, H5DtypeOf<T>::value, values.data(), values.size(), finite);
     return values;
   }
 
@@ -177,32 +186,35 @@ class H5File {
   // enough integer type, floats (and integers up to 32 bit) into double.
   std::vector<hsize_t> dataset_shape(const std::string& path) const;
   template <class T>
-  NdArray<T> read_dataset(const std::string& path) const {
+  NdArray<T> read_dataset(const std::string& path, Finite finite = Finite::required) const {
     NdArray<T> array;
     array.shape = dataset_shape(path);
     array.values.resize(element_count(array.shape));
     read_raw(path, H5DtypeOf<T>::value, array.values.data(), array.values.size());
+    check_finite(path, {}, H5DtypeOf<T>::value, array.values.data(), array.values.size(), finite);
     return array;
   }
   // Requires rank 1.
   template <class T>
-  std::vector<T> read_vector(const std::string& path) const {
+  std::vector<T> read_vector(const std::string& path, Finite finite = Finite::required) const {
     const std::vector<hsize_t> shape = dataset_shape(path);
     check_rank(path, shape, 1);
     std::vector<T> values(shape[0]);
     read_raw(path, H5DtypeOf<T>::value, values.data(), values.size());
+    check_finite(path, {}, H5DtypeOf<T>::value, values.data(), values.size(), finite);
     return values;
   }
   // Requires rank 2 and, when expected_cols >= 0, that many columns.
   template <class T>
   Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_matrix(
-      const std::string& path, Eigen::Index expected_cols = -1) const {
+      const std::string& path, Eigen::Index expected_cols = -1, Finite finite = Finite::required) const {
     const std::vector<hsize_t> shape = dataset_shape(path);
     check_rank(path, shape, 2);
     if (expected_cols >= 0) check_cols(path, shape, expected_cols);
     Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major(
         static_cast<Eigen::Index>(shape[0]), static_cast<Eigen::Index>(shape[1]));
     read_raw(path, H5DtypeOf<T>::value, row_major.data(), std::size_t(row_major.size()));
+    check_finite(path, {}, H5DtypeOf<T>::value, row_major.data(), std::size_t(row_major.size()), finite);
     return row_major;
   }
 
@@ -225,15 +237,18 @@ class H5File {
   std::string read_string_attribute(const std::string& object, const std::string& name) const;
   // Requires a single value.
   template <class T>
-  T read_attribute(const std::string& object, const std::string& name) const {
+  T read_attribute(const std::string& object, const std::string& name, Finite finite = Finite::required) const {
     T value{};
     read_attribute_raw(object, name, H5DtypeOf<T>::value, &value, 1, true);
+    check_finite(object, name, H5DtypeOf<T>::value, &value, 1, finite);
     return value;
   }
   template <class T>
-  std::vector<T> read_attribute_vector(const std::string& object, const std::string& name) const {
+  std::vector<T> read_attribute_vector(const std::string& object, const std::string& name,
+                                       Finite finite = Finite::required) const {
     std::vector<T> values(attribute_size(object, name));
     read_attribute_raw(object, name, H5DtypeOf<T>::value, values.data(), values.size(), false);
+    check_finite(object, name, H5DtypeOf<T>::value, values.data(), values.size(), finite);
     return values;
   }
 
@@ -249,6 +264,11 @@ class H5File {
   void write_raw(const std::string& path, H5Dtype dtype, const void* data,
                  const std::vector<hsize_t>& shape, const H5WriteOptions& options);
   void read_raw(const std::string& path, H5Dtype dtype, void* data, std::size_t count) const;
+  // InputError naming the file, the dataset (or the attribute `attribute` on
+  // `object`) and the first bad index unless every float64 value is finite
+  // (NaN allowed with Finite::nan_means_missing). Other dtypes pass.
+  void check_finite(const std::string& object, const std::string& attribute, H5Dtype dtype, const void* data,
+                    std::size_t count, Finite finite) const;
   void create_chunked_raw(const std::string& path, H5Dtype dtype, const std::vector<hsize_t>& shape,
                           const std::vector<hsize_t>& chunk, int gzip_level);
   void write_slab_raw(const std::string& path, H5Dtype dtype, const void* data,

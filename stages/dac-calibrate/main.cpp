@@ -14,8 +14,11 @@
 //      material's `dac_model:` key
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <string>
 
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
@@ -47,6 +50,24 @@ DynamicsScene scene_at_voxel_size(const std::string& path, double voxel_size) {
     c.apply_override(buf);
   }
   return read_dynamics_scene(c);
+}
+
+// A rig without damping rings at constant amplitude, and harmonic inversion
+// returns a decay scattered about zero by the other modes and the noise in
+// the track, of either sign. A decay within three standard errors of zero
+// (or below what the record's length resolves in double precision) cannot
+// be told from none: the rig is taken as undamped. A track that clearly
+// grows is not a free decay and cannot be calibrated on.
+double undamped_if_unresolved(const std::string& track_path, double decay, double uncertainty, double duration) {
+  const double resolvable = std::max(3 * uncertainty, std::sqrt(std::numeric_limits<double>::epsilon()) / duration);
+  if (std::abs(decay) <= resolvable) {
+    spdlog::info("{}: decay {:.3g} 1/s lies within {:.2g} of zero: the rig is taken as undamped (d = 0)", track_path,
+                 decay, resolvable);
+    return 0.0;
+  }
+  if (decay > 0) return decay;
+  throw InputError(track_path + ": the tracked oscillation grows (decay " + std::to_string(decay) + " ± " +
+                   std::to_string(uncertainty) + " 1/s): not the free decay of a rig, cannot calibrate on it");
 }
 
 }  // namespace
@@ -127,8 +148,10 @@ int main(int argc, char** argv) {
       f_t = m.frequency;
       d_t = m.decay;
       rms = fit.rms_residual;
-      spdlog::info("{}: {} samples at {:.4g} s, dominant mode f = {:.6g} Hz, d = {:.6g} 1/s (rms residual {:.3g})",
-                   marker_path, track.values.size(), track.sample_interval, f_t, d_t, rms);
+      spdlog::info("{}: {} samples at {:.4g} s, dominant mode f = {:.6g} Hz, d = {:.6g} ± {:.2g} 1/s (rms residual {:.3g})",
+                   marker_path, track.values.size(), track.sample_interval, f_t, d_t, m.decay_uncertainty, rms);
+      d_t = undamped_if_unresolved(marker_path, d_t, m.decay_uncertainty,
+                                   double(track.values.size()) * track.sample_interval);
     }
 
     // 5. Numerical modulus and damping.

@@ -48,6 +48,12 @@ int main(int argc, char** argv) {
     if (k > static_cast<int>(full.entries.size()))
       throw InputError("representatives = " + std::to_string(k) + " exceeds the " +
                        std::to_string(full.entries.size()) + " coarse materials of " + input);
+    // The feature matrix (one energy per material and deformation), twice
+    // over, and the deformations themselves.
+    ctx.check_memory(16.0 * double(full.entries.size()) * deformations + 192.0 * deformations,
+                     std::to_string(deformations) + " deformations of " + std::to_string(full.entries.size()) +
+                         " coarse materials (deformations)",
+                     "use fewer deformations");
     CompressionReport report;
     const CoarseDatabase small = compress_database(full, k, deformations, strain, seed, &report);
     write_coarse_db(out, small, ctx.config.resolved_text(), ctx.command_line, seed, "msfab-ddfem-compress");

@@ -36,6 +36,7 @@
 #include "gamut_plots.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "io/atomic_file.hpp"
+#include "io/commit_group.hpp"
 #include "parallel/fan_out.hpp"
 #include "sampler.hpp"
 #include "sampler_checkpoint.hpp"
@@ -102,6 +103,19 @@ int main(int argc, char** argv) {
     const SamplerOptions options = read_sampler_options(ctx.config);
     ctx.config.check_no_unknown_keys();
     ctx.check_out_folder();
+    {
+      // What must fit at once: the population, its children and their copies
+      // in the set (4 bytes per voxel each), and one cell problem per thread
+      // (1.3 kB per voxel in 3D, 24 kB in 2D; docs/cli.md, "Memory").
+      const bool three_d = options.kind == MaterialSpaceKind::cubic3d;
+      const double voxels = std::pow(double(options.resolution), three_d ? 3 : 2);
+      const double at_once = 3.0 * (double(options.population) + options.continuous_per_cycle +
+                                    options.directed_per_cycle);
+      const double bytes = at_once * voxels * 4 + omp_get_max_threads() * voxels * (three_d ? 1.3e3 : 24e3);
+      ctx.check_memory(bytes, "a population of " + std::to_string(options.population) + " structures of " +
+                                  std::to_string(options.resolution) + (three_d ? "^3" : "^2") + " voxels",
+                       "lower population or resolution");
+    }
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
     if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
     // The second artifact and the plots folder are checked before any work,
@@ -208,8 +222,18 @@ int main(int argc, char** argv) {
       g.bound_stiff = base_tensor(options.stiff, three_d);
       g.bound_soft = options.soft_is_void ? MatX::Zero(g.bound_stiff.rows(), g.bound_stiff.cols())
                                           : base_tensor(options.soft, three_d);
-      write_microstructures_artifact(structures_path, state.set, "msfab-gamut-sample", run_text, {}, ctx.options.seed);
-      write_gamut_artifact(out, g, "msfab-gamut-sample", run_text, {structures_path}, ctx.options.seed);
+      // The structures and the gamut (and their void variants) are one
+      // commit: a run killed while writing them leaves the old ones or the
+      // new ones, never a new set beside an old gamut.
+      CommitGroup artifacts;
+      const std::uint64_t seed = ctx.options.seed;
+      ArtifactWriter& set_out = artifacts.add(structures_path, kMicrostructuresSchema, kMicrostructuresSchemaVersion,
+                                              "msfab-gamut-sample", run_text, {}, seed);
+      write_microstructure_set(set_out.file(), "/", state.set);
+      const ArtifactInput set_input = artifacts.as_input(set_out);
+      write_gamut(artifacts.add(out, kGamutSchema, kGamutSchemaVersion, "msfab-gamut-sample", run_text, {set_input}, seed)
+                      .file(),
+                  g);
       plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
                             options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
       plot_shear_projections(plots_dir + "/gamut", state.set, sampler.space());
@@ -222,15 +246,21 @@ int main(int argc, char** argv) {
         vg.history.clear();
         vg.bound_soft.setZero();
         const std::string vstem = stem_of(out) + ".void";
-        write_microstructures_artifact(vstem + ".microstructures.h5", voids.set, "msfab-gamut-sample", run_text,
-                                       {structures_path}, ctx.options.seed);
-        write_gamut_artifact(vstem + ".gamut.h5", vg, "msfab-gamut-sample", run_text,
-                             {vstem + ".microstructures.h5"}, ctx.options.seed);
+        ArtifactWriter& void_set_out =
+            artifacts.add(vstem + ".microstructures.h5", kMicrostructuresSchema, kMicrostructuresSchemaVersion,
+                          "msfab-gamut-sample", run_text, {set_input}, seed);
+        write_microstructure_set(void_set_out.file(), "/", voids.set);
+        const ArtifactInput void_set_input = artifacts.as_input(void_set_out);
+        write_gamut(artifacts.add(vstem + ".gamut.h5", kGamutSchema, kGamutSchemaVersion, "msfab-gamut-sample", run_text,
+                                  {void_set_input}, seed)
+                        .file(),
+                    vg);
         plot_gamut_projection(plots_dir + "/void_variants.png", voids.set, vg.level_set, sampler.space(),
                               "VOID VARIANTS, " + std::to_string(voids.set.items.size()) + " STRUCTURES");
         std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",
                     voids.set.items.size(), state.set.items.size(), vstem.c_str());
       }
+      artifacts.commit();
       write_history_csv(plots_dir + "/history.csv", state.history);
       std::filesystem::remove(ckpt);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

@@ -78,10 +78,14 @@ CellInput read_set_structure(const Config& config, const Config& c) {
 
 }  // namespace
 
-CellInput read_cell_input(const Config& config) {
+CellInput read_cell_input(const Config& config, const std::function<void(int, int, int)>& check_size) {
   const Config c = config.child("cell");
+  const auto checked = [&](int nx, int ny, int nz) {
+    if (check_size) check_size(nx, ny, nz);
+  };
   if (c.has("structures")) {
     CellInput in = read_set_structure(config, c);
+    checked(in.cell.nx, in.cell.ny, in.cell.nz);
     in.cell.voxel_size = c.get_or<double>("voxel_size", 1.0 / in.cell.nx);
     if (!(in.cell.voxel_size > 0)) c.fail("voxel_size", "must be > 0");
     return in;
@@ -91,13 +95,15 @@ CellInput read_cell_input(const Config& config) {
   const bool has_voxels = c.has("voxels"), has_layout = config.has("layout");
   if (has_voxels == has_layout) config.fail("layout", "give either cell.voxels (a voxel file) or a layout, not both");
   if (has_voxels) {
-    in.cell = read_voxel_text(c.get_path("voxels"), 1.0);
+    in.cell = read_voxel_text(c.get_path("voxels"), 1.0);  // at most kMaxTextInputBytes of text
     if (c.has("size")) c.fail("size", "comes from the voxel file; drop it");
+    checked(in.cell.nx, in.cell.ny, in.cell.nz);
   } else {
     const auto size = c.get<std::vector<int>>("size");
     if (size.size() != 3) c.fail("size", "expected [nx, ny, nz]");
     for (int n : size)
       if (n < 1 || n > 4096) c.fail("size", "cell dimensions must be 1..4096");
+    checked(size[0], size[1], size[2]);
     in.cell = VoxelGrid(size[0], size[1], size[2], 1.0, 0);
   }
   // The cell spans [0, 1] along x by default: C^H does not depend on the scale.

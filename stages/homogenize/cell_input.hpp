@@ -4,6 +4,7 @@
 // coordinates [0, size * voxel_size]) or a `voxels` text file; or one
 // structure of a microstructures artifact (`structures`, `index`) with the
 // set's base materials as Neo-Hookean.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,9 @@ struct CellInput {
 };
 
 // InputError naming the key (or the voxel file and line) on bad input.
-CellInput read_cell_input(const Config& config);
+// `check_size(nx, ny, nz)` runs once the cell's size is known and before a
+// cell given by `size` is allocated (the memory check of the stage).
+CellInput read_cell_input(const Config& config, const std::function<void(int, int, int)>& check_size = {});
 
 // Voxel text file: "nx ny nz" then nx*ny*nz integer ids, x fastest; '#'
 // starts a comment. InputError naming the file and what is wrong.

@@ -14,8 +14,11 @@
 // Batch mode (--structures X.microstructures.h5): steps 2-4 for every
 // structure of a gamut's set, optionally refined, written as a new
 // `msfab.microstructures` artifact with the properties recomputed.
+#include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -54,6 +57,18 @@ refine: 1
 use_symmetry: true
 )";
 
+// Peak memory of one cell's homogenization, measured with /usr/bin/time on
+// this code (docs/cli.md, "Memory"): plane strain about 24 kB per voxel;
+// 3D multigrid about 1.3 kB per voxel; the 3D direct solver's factor grows
+// as n^(4/3) (3.3 kB x n^(4/3) bytes for n voxels). Whole-cell figures: an
+// octant solve of a mirror-symmetric cell needs less.
+double homogenization_bytes(int nx, int ny, int nz, const std::string& solver) {
+  const double n = double(nx) * ny * nz;
+  if (nz == 1) return 24e3 * n;
+  const bool direct = solver == "direct" || (solver == "auto" && n <= 12.0 * 12 * 12);
+  return direct ? 3.3e3 * std::pow(n, 4.0 / 3.0) : 1.3e3 * n;
+}
+
 HomogenizationOptions read_solver_options(const Config& config) {
   HomogenizationOptions options;
   options.void_stiffness = config.get_or<double>("void_stiffness", options.void_stiffness);
@@ -85,6 +100,15 @@ void run_batch(StageContext& ctx, const std::string& structures) {
   if (set.items.empty()) throw InputError(structures + ": the set holds no structures");
   spdlog::info("{}: {} structures, {} x {} x {} voxels, space {}, refine {}", structures, set.items.size(), set.nx,
                set.ny, set.nz, set.space, options.refine);
+  {
+    const int threads = std::max(1, ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads());
+    const int r = options.refine;
+    const int nz = set.nz > 1 ? set.nz * r : 1;
+    ctx.check_memory(threads * homogenization_bytes(set.nx * r, set.ny * r, nz, options.homogenization.solver),
+                     std::to_string(threads) + " cells of " + std::to_string(set.nx * r) + " x " +
+                         std::to_string(set.ny * r) + " x " + std::to_string(nz) + " voxels solved at once",
+                     "use fewer --threads or a smaller refine");
+  }
   const BatchReport report = homogenize_set(set, options);
   write_microstructures_artifact(out, set, "msfab-homogenize", ctx.config.resolved_text(), {structures},
                                  ctx.options.seed);
@@ -116,8 +140,13 @@ int main(int argc, char** argv) {
     if (!structures.empty()) return run_batch(ctx, structures);
     const std::string& out = ctx.require_out();
     // 1. Materials and cell.
-    const CellInput in = read_cell_input(ctx.config);
     HomogenizationOptions options = read_solver_options(ctx.config);
+    const CellInput in = read_cell_input(ctx.config, [&](int nx, int ny, int nz) {
+      ctx.check_memory(homogenization_bytes(nx, ny, nz, options.solver),
+                       "a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
+                           " cell with the " + options.solver + " solver",
+                       "use a smaller cell" + std::string(nz > 1 && options.solver == "direct" ? " or solver: multigrid" : ""));
+    });
     options.threads = ctx.options.threads;
     std::optional<FiniteStrainCheck> finite_strain = read_finite_strain_check(ctx.config);
     if (finite_strain && in.cell.nz < 2) ctx.config.fail("finite_strain", "needs a 3D cell (this one is 2D)");

@@ -15,6 +15,7 @@
 //   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -35,6 +36,26 @@
 using namespace msfab;
 
 namespace {
+
+// Peak memory of an optimization on a grid, measured with /usr/bin/time
+// (docs/cli.md, "Memory"): 2D grids are solved by CHOLMOD, about
+// 265 n log2(n) bytes for n cells (4.3 kB per cell at 512 x 256); 3D grids
+// with the default solvers about 5 kB per finite element (1.13 GB for cell
+// MMA at 128 x 64 x 32). Read before the scene, so that a grid that cannot
+// fit is refused before its per-cell arrays are allocated.
+void check_grid_memory(const StageContext& ctx, const Config& config) {
+  if (!config.has("grid.size")) return;  // read_topopt_scene names the missing key
+  const auto size = config.get<std::vector<int>>("grid.size");
+  double cells = 1;
+  for (int n : size) cells *= std::max(n, 1);
+  const int m = std::clamp(config.get_or<int>("elements_per_cell", 1), 1, 8);
+  const double elements = cells * (size.size() == 3 ? double(m) * m * m : 1.0);
+  const double bytes = size.size() == 2 ? 265.0 * elements * std::log2(std::max(elements, 2.0)) : 5e3 * elements;
+  std::string text;
+  for (int n : size) text += (text.empty() ? "" : " x ") + std::to_string(n);
+  ctx.check_memory(bytes, "a grid of " + text + " cells (grid.size)" + (m > 1 ? " with elements_per_cell " + std::to_string(m) : std::string()),
+                   "use a coarser grid");
+}
 // A 2D cantilever (Fig. 3-16's loading): left side clamped, a downward load
 // spread over the right half of the bottom side; SIMP p = 3 needs no gamut.
 constexpr const char* kDefaults = R"(
@@ -112,7 +133,9 @@ int main(int argc, char** argv) {
                    config.get_path("gamut"));
     }
 
-    // 1. The scene.
+    // 1. The scene (its size checked against memory before anything is
+    // allocated per cell).
+    check_grid_memory(ctx, config);
     const TopoptScene scene = read_topopt_scene(config, gamut.E_stiff, gamut.decades);
     if (!family_path.empty() && std::abs(scene.nu - family.stiff.nu) > 1e-12)
       config.fail("material.nu", "is " + std::to_string(scene.nu) + " but the family's base material has " +

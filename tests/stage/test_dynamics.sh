@@ -72,7 +72,8 @@ expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dyn
   --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=-1e-4
-expect_exit 2 "time_step.*longer than duration" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=1e308
+expect_exit 2 "time_step.*longer than duration" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=1e50
+expect_exit 2 "time_step = 1e308: beyond" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=1e308
 expect_exit 2 "time_step.*steps over duration.*at most" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \
   --set simulation.time_step=1e-300
 expect_exit 2 "friction coefficient must be >= 0" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set friction.default=-0.2
@@ -83,5 +84,18 @@ for i in $(seq 2 40); do printf '0.%03d,1\n' $i >> "$WORK/nan.csv"; done
 expect_exit 2 "nan.csv.*line 3.*finite" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" --set marker_csv="$WORK/nan.csv" --out "$WORK/x.h5"
 printf 't,z\n0,1\n0.001,2\n0.002,1\n' > "$WORK/short.csv"
 expect_exit 2 "short.csv.*samples" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" --set marker_csv="$WORK/short.csv" --out "$WORK/x.h5"
+# A track that grows is no free decay; one from a rig without damping is
+# calibrated as undamped (its fitted decay scatters about zero).
+awk 'BEGIN { print "t,z"; for (k = 0; k < 400; ++k) { t = k / 24000; printf "%.8f,%.9f\n", t, exp(60 * t) * sin(2 * 3.14159265 * 340 * t) } }' \
+  > "$WORK/growing.csv"
+expect_exit 2 "growing.csv: the tracked oscillation grows" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" \
+  --set marker_csv="$WORK/growing.csv" --out "$WORK/x.h5"
 check "failed runs leave no artifact" -- test ! -e "$WORK/x.h5"
+sed -e "s|damping_b: 2.0e-5|damping_b: 0|" $S/cantilever_pluck.yaml > "$WORK/undamped_rig.yaml"
+"$BIN/msfab-dynamics" --quiet --config "$WORK/undamped_rig.yaml" --set simulation.duration=0.03 \
+  --marker 0.06 0 0.006 --marker-csv "$WORK/undamped_tip.csv" --out "$WORK/undamped.h5" > /dev/null
+sed -e "s|$WORK/fine_tip.csv|$WORK/undamped_tip.csv|" "$WORK/cal.yaml" > "$WORK/undamped_cal.yaml"
+check "a track of an undamped rig calibrates" -- "$BIN/msfab-dac-calibrate" --config "$WORK/undamped_cal.yaml" \
+  --out "$WORK/dac_undamped.h5" --log-level info
+check "... as undamped" -- test "$(h5dump -a /target_decay "$WORK/dac_undamped.h5" 2>/dev/null | grep -oE '\(0\): [-0-9.e+]+' | awk '{print $2}')" = 0
 finish

@@ -26,6 +26,11 @@ check "history has cycles 0..3" -- bash -c "h5dump -d /history/cycle '$WORK/one.
 check "plots written" -- bash -c "for f in gamut coverage cycle_00 cycle_03; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
 check "history.csv written" -- bash -c "[ \$(wc -l < '$WORK/one.plots/history.csv') = 5 ]"
 check "no checkpoint left" -- test ! -e "$WORK/one.gamut.h5.checkpoint.h5"
+# The two artifacts are one commit (io/commit_group.hpp): no journal left,
+# and the gamut records the hash of the very set beside it.
+check "no commit journal left" -- bash -c "! ls '$WORK' | grep -q '\.pending$'"
+check "the gamut records the set's hash" -- bash -c \
+  "h5dump -a /inputs '$WORK/one.gamut.h5' | grep -q \$(sha256sum '$WORK/one.microstructures.h5' | cut -c1-64)"
 
 check "three ranks" -- mpirun -np 3 --oversubscribe -x OMP_NUM_THREADS=1 "$SAMPLE" --config "$TINY" --seed 7 \
   --out "$WORK/three.gamut.h5" --quiet

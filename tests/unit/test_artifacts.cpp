@@ -17,6 +17,7 @@
 #include "core/version.hpp"
 #include "io/artifact.hpp"
 #include "io/atomic_file.hpp"
+#include "io/commit_group.hpp"
 #include "io/hdf5_file.hpp"
 #include "io/sha256.hpp"
 #include "io/xdmf.hpp"
@@ -256,6 +257,34 @@ TEST_F(ArtifactH5File, ReadErrorsNameFileAndDataset) {
   EXPECT_NE(lossy.find("int32"), std::string::npos) << lossy;
   const std::string absent = input_error_message([&] { H5File::open(file("absent.h5")); });
   EXPECT_EQ(absent, file("absent.h5") + ": no such file");
+}
+
+TEST_F(ArtifactH5File, NonFiniteValuesAreRefusedWhereTheyAreRead) {
+  const std::string path = file("damaged.h5");
+  {
+    H5File out = H5File::create(path);
+    out.write_vector("/fine", std::vector<double>{1.0, 2.0});
+    out.write_vector("/reference", std::vector<double>{1.0, std::nan(""), 3.0});
+    out.write_matrix("/field", Eigen::MatrixXd::Constant(2, 2, HUGE_VAL));
+    out.write_vector("/missing", std::vector<double>{std::nan(""), 2.0});
+    out.write_attribute("/", "scale", -HUGE_VAL);
+    out.write_vector("/counts", std::vector<std::int32_t>{1, 2});
+  }
+  const H5File in = H5File::open(path);
+  EXPECT_EQ(in.read_vector<double>("/fine").size(), 2u);
+  EXPECT_EQ(input_error_message([&] { in.read_vector<double>("/reference"); }),
+            path + ": dataset '/reference' holds NaN at index 1; the file is damaged or was not written by msfab");
+  EXPECT_NE(input_error_message([&] { in.read_matrix<double>("/field"); }).find("'/field' holds an infinite value"),
+            std::string::npos);
+  EXPECT_NE(input_error_message([&] { in.read_dataset<double>("/reference"); }).find("index 1"), std::string::npos);
+  EXPECT_NE(input_error_message([&] { in.read_slab<double>("/reference", {1}, {2}); }).find("index 0"),
+            std::string::npos);
+  EXPECT_NE(input_error_message([&] { in.read_attribute<double>("/", "scale"); }).find("attribute 'scale' on '/'"),
+            std::string::npos);
+  // NaN as "not computed" where a reader says so; infinity never.
+  EXPECT_TRUE(std::isnan(in.read_vector<double>("/missing", Finite::nan_means_missing)[0]));
+  EXPECT_THROW(in.read_matrix<double>("/field", -1, Finite::nan_means_missing), InputError);
+  EXPECT_EQ(in.read_vector<std::int32_t>("/counts")[1], 2);
 }
 
 // ---------------------------------------------------------------------------
@@ -676,6 +705,128 @@ TEST_F(XdmfFiles, UnsupportedComponentsThrowAndWriteNothing) {
                std::invalid_argument);
   EXPECT_FALSE(fs::exists(xmf));
   EXPECT_TRUE(temporaries().empty());
+}
+
+
+// ---------------------------------------------------------------------------
+// Commit groups
+
+
+using CommitGroupTest = ScratchDir;
+
+// A member with one dataset holding `value`.
+ArtifactWriter& add_member(CommitGroup& group, const std::string& path, double value,
+                           std::vector<ArtifactInput> inputs = {}) {
+  ArtifactWriter& w = group.add(path, "msfab.test", 1, "msfab-test", "", std::move(inputs), 1);
+  w.file().write_vector("/value", std::vector<double>{value});
+  return w;
+}
+
+double value_of(const std::string& path) {
+  return ArtifactReader(path, "msfab.test", 1).file().read_vector<double>("/value")[0];
+}
+
+
+TEST_F(CommitGroupTest, MembersAppearTogetherAndALaterOneRecordsAnEarliersHash) {
+  CommitGroup group;
+  ArtifactWriter& set = add_member(group, file("a.h5"), 1.0);
+  const ArtifactInput set_input = group.as_input(set);
+  add_member(group, file("b.h5"), 2.0, {set_input});
+  EXPECT_FALSE(fs::exists(file("a.h5")));
+  group.commit();
+  EXPECT_EQ(value_of(file("a.h5")), 1.0);
+  EXPECT_EQ(value_of(file("b.h5")), 2.0);
+  const std::vector<ArtifactInput> inputs = ArtifactReader(file("b.h5"), "msfab.test", 1).inputs();
+  ASSERT_EQ(inputs.size(), 1u);
+  EXPECT_EQ(inputs[0].path, file("a.h5"));
+  EXPECT_EQ(inputs[0].sha256, sha256_file_hex(file("a.h5")));
+  EXPECT_TRUE(temporaries().empty());
+  EXPECT_FALSE(fs::exists(pending_journal_path(file("a.h5"))));
+}
+
+TEST_F(CommitGroupTest, AGroupNotCommittedLeavesTheOldFilesAndNoTemporaries) {
+  {
+    CommitGroup old_group;
+    add_member(old_group, file("a.h5"), 1.0);
+    add_member(old_group, file("b.h5"), 2.0);
+    old_group.commit();
+  }
+  {
+    CommitGroup group;
+    add_member(group, file("a.h5"), 10.0);
+    add_member(group, file("b.h5"), 20.0);
+  }  // an exception before commit()
+  EXPECT_EQ(value_of(file("a.h5")), 1.0);
+  EXPECT_EQ(value_of(file("b.h5")), 2.0);
+  EXPECT_TRUE(temporaries().empty());
+}
+
+// Killed between the renames: one member new, one old on disk. Opening
+// either one as an artifact first finishes the group, so no reader sees
+// the mixture; the journals are gone afterwards.
+TEST_F(CommitGroupTest, AnInterruptedCommitIsFinishedByTheNextReaderOfAnyMember) {
+  for (const char* opened_first : {"a.h5", "b.h5"}) {
+    {
+      CommitGroup old_group;
+      add_member(old_group, file("a.h5"), 1.0);
+      add_member(old_group, file("b.h5"), 2.0);
+      old_group.commit();
+    }
+    for (std::size_t renames : {std::size_t(0), std::size_t(1)}) {
+      {
+        CommitGroup group;
+        add_member(group, file("a.h5"), 10.0 + double(renames));
+        add_member(group, file("b.h5"), 20.0 + double(renames));
+        group.commit_interrupted_after(renames);
+      }
+      EXPECT_TRUE(fs::exists(pending_journal_path(file("a.h5"))));
+      EXPECT_EQ(temporaries().size(), 2 - renames);
+      EXPECT_EQ(H5File::open(file("a.h5")).read_vector<double>("/value")[0], renames == 1 ? 10.0 + 1 : 1.0)
+          << "the raw file is mixed before a reader finishes the group";
+      const std::string other = std::string(opened_first) == "a.h5" ? "b.h5" : "a.h5";
+      const double first = value_of(file(opened_first));
+      EXPECT_EQ(first, (std::string(opened_first) == "a.h5" ? 10.0 : 20.0) + double(renames));
+      EXPECT_EQ(value_of(file(other)), (other == "a.h5" ? 10.0 : 20.0) + double(renames));
+      EXPECT_TRUE(temporaries().empty());
+      EXPECT_FALSE(fs::exists(pending_journal_path(file("a.h5"))));
+      EXPECT_FALSE(fs::exists(pending_journal_path(file("b.h5"))));
+    }
+  }
+}
+
+// A stale journal must not roll its temporaries over a newer commit.
+TEST_F(CommitGroupTest, ACommitOverAnInterruptedGroupFinishesItFirst) {
+  {
+    CommitGroup group;
+    add_member(group, file("a.h5"), 1.0);
+    add_member(group, file("b.h5"), 2.0);
+    group.commit_interrupted_after(0);
+  }
+  ArtifactWriter single(file("a.h5"), "msfab.test", 1, "msfab-test", "", std::vector<std::string>{}, 1);
+  single.file().write_vector("/value", std::vector<double>{5.0});
+  single.commit();
+  EXPECT_EQ(value_of(file("a.h5")), 5.0);
+  EXPECT_EQ(value_of(file("b.h5")), 2.0);
+  EXPECT_TRUE(temporaries().empty());
+}
+
+TEST_F(CommitGroupTest, AForeignJournalIsRefusedAndNothingIsRenamed) {
+  write_bytes(file("victim"), "keep");
+  write_bytes(file("a.h5"), "old");
+  write_bytes(pending_journal_path(file("a.h5")),
+              "msfab commit group 1\n" + file("victim") + "\t" + file("a.h5") + "\n");
+  const std::string message = input_error_message([&] { complete_interrupted_commit(file("a.h5")); });
+  EXPECT_NE(message.find(pending_journal_path(file("a.h5")) + ": not a commit journal"), std::string::npos) << message;
+  EXPECT_EQ(read_bytes(file("victim")), "keep");
+  EXPECT_EQ(read_bytes(file("a.h5")), "old");
+  write_bytes(pending_journal_path(file("a.h5")), "something else\n");
+  EXPECT_THROW(ArtifactReader(file("a.h5"), "msfab.test", 1), InputError);
+}
+
+TEST_F(CommitGroupTest, OneOutputNamedTwiceIsAnInputError) {
+  CommitGroup group;
+  add_member(group, file("a.h5"), 1.0);
+  EXPECT_THROW(add_member(group, file("a.h5"), 2.0), InputError);
 }
 
 }  // namespace

@@ -344,3 +344,43 @@ TEST(MarkerTrack, RejectsBadFiles) {
     expect_input_error([&] { read_marker_track(csv.path(), "x"); }, {csv.path(), "line 5", "2 cells"});
   }
 }
+
+// An undamped mode in white noise: the fitted decays scatter about zero
+// with the spread the reported standard error predicts (the Cramer-Rao
+// bound), so "within three standard errors of zero" is a sound test for an
+// undamped rig, and a light but real damping stands out of it.
+TEST(HarmonicInversion, DecayUncertaintyPredictsTheScatterOfAnUndampedMode) {
+  const double dt = 1.0 / kFps;
+  const int n = 720;
+  const Mode undamped{7.3, 0.0, 1.0, 0.4};
+  double sum_sq = 0, mean_uncertainty = 0;
+  int within_three = 0;
+  const int trials = 60;
+  for (int seed = 1; seed <= trials; ++seed) {
+    VecX y = synthesize({undamped}, 0.0, n, dt);
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.02);
+    for (int k = 0; k < n; ++k) y[k] += noise(rng);
+    HarmonicInversionOptions opt;
+    opt.num_modes = 1;
+    const HarmonicFit fit = harmonic_inversion(y, dt, opt);
+    const DampedMode& m = dominant_mode(fit);
+    sum_sq += m.decay * m.decay;
+    mean_uncertainty += m.decay_uncertainty / trials;
+    if (std::abs(m.decay) <= 3 * m.decay_uncertainty) ++within_three;
+  }
+  const double scatter = std::sqrt(sum_sq / trials);
+  EXPECT_GT(scatter, 0.5 * mean_uncertainty);
+  EXPECT_LT(scatter, 2.0 * mean_uncertainty);
+  EXPECT_GE(within_three, trials - 2);
+  // The same record with d = 0.3 1/s (the amplitude falls 26% over it).
+  VecX y = synthesize({{7.3, 0.3, 1.0, 0.4}}, 0.0, n, dt);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (int k = 0; k < n; ++k) y[k] += noise(rng);
+  HarmonicInversionOptions opt;
+  opt.num_modes = 1;
+  const HarmonicFit fit = harmonic_inversion(y, dt, opt);
+  const DampedMode& damped = dominant_mode(fit);
+  EXPECT_GT(damped.decay, 10 * damped.decay_uncertainty);
+}

@@ -88,7 +88,7 @@ Trajectory synthetic_trajectory() {
     s.time = i * t.time_step;
     s.phase = phases[i];
     s.kinetic = 0.5 * std::sqrt(2.0 + i);
-    s.elastic = i == 2 ? std::numeric_limits<double>::quiet_NaN() : 1e-300 * i;
+    s.elastic = i == 2 ? std::numeric_limits<double>::denorm_min() : 1e-300 * i;
     s.gravity = -9.81 * std::sin(0.3 * i);
     s.center_of_mass = Vec3(0.005, 0.005, 0.105 - 1e-3 * i * i / 7.0);
     s.com_velocity = Vec3(-0.0, 1e-17 * i, -std::cbrt(3.0 + i));
