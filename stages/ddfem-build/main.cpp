@@ -94,6 +94,19 @@ int main(int argc, char** argv) {
     const BuildOptions options = read_build_options(ctx.config);
     ctx.config.check_no_unknown_keys();
     ctx.check_out_folder();
+    {
+      // Every block in flight (one per thread) holds its force patterns (4
+      // kinds per direction and 12 edge pinches) and their samples at both
+      // signs and every magnitude, about 1 kB each with a patch's loads and
+      // the fit's rows (docs/cli.md, "Memory").
+      const ForceSamplingOptions& f = options.fit.sampling;
+      const double patterns = 4.0 * ((f.include_axes ? 3.0 : 0.0) + f.sphere_directions) + 12.0;
+      const double bytes = omp_get_max_threads() * patterns * (1.0 + 2.0 * f.magnitudes) * 1024.0;
+      ctx.check_memory(bytes,
+                       std::to_string(f.sphere_directions) + " sampling directions x " + std::to_string(f.magnitudes) +
+                           " magnitudes per block (sampling.sphere_directions, sampling.magnitudes)",
+                       "sample fewer directions or magnitudes");
+    }
 
     // 2. What to fit.
     const bool level2 = !options.base_database.empty();

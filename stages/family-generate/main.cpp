@@ -14,6 +14,7 @@
 // config (`templates:`, beams in unit-cell coordinates), each drawn at
 // `count` cross-section scales evenly spread over `scale`: hand-made
 // families, e.g. to check that family discovery finds them again.
+#include <omp.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -260,11 +261,22 @@ int main(int argc, char** argv) {
     std::vector<std::string> labels;
     std::vector<std::string> inputs;
     double E_stiff = material.E;
+    // The cells (4 bytes per voxel, twice: the rasterized grids and the set)
+    // and, when homogenizing, one 3D multigrid cell problem per thread
+    // (1.3 kB per voxel; docs/cli.md, "Memory").
+    const auto check_memory = [&](std::size_t count, int n, const std::string& what) {
+      const double voxels = double(n) * n * n;
+      const double threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
+      ctx.check_memory(8.0 * voxels * double(count) + (homogenize ? threads * 1.3e3 * voxels : 0.0),
+                       std::to_string(count) + " structures of " + std::to_string(n) + "^3 voxels (" + what + ")",
+                       "generate fewer structures or lower the resolution");
+    };
     if (!grid.empty()) {
       // One template over a grid of half-sizes, first axis slowest.
       if (family != 0 || sweep != 0 || !reduced_options.empty())
         throw InputError("--family, --reduced and --sweep need --families");
       if (resolution == 0) resolution = 16;
+      check_memory(grid.grid.points(), resolution, "grid.parameters");
       for (std::size_t i = 0; i < grid.grid.points(); ++i) {
         std::vector<int> index(grid.grid.axes.size());
         std::size_t rest = i;
@@ -288,6 +300,9 @@ int main(int argc, char** argv) {
       if (family != 0 || sweep != 0 || !reduced_options.empty())
         throw InputError("--family, --reduced and --sweep need --families");
       if (resolution == 0) resolution = 16;
+      std::size_t members = 0;
+      for (const TemplateRequest& req : templates) members += req.scales.size() * std::size_t(req.moves);
+      check_memory(members, resolution, "templates");
       for (std::size_t t = 0; t < templates.size(); ++t) {
         const TemplateRequest& req = templates[t];
         const std::size_t count = req.scales.size() * std::size_t(req.moves);
@@ -327,6 +342,8 @@ int main(int argc, char** argv) {
       std::vector<std::vector<double>> requests;
       for (const std::string& text : reduced_options) requests.push_back(parse_reduced(text));
       const std::size_t reduced_count = fam.reduced.plus.size();
+      check_memory(std::max<std::size_t>(1, reduced_options.size() + (sweep >= 2 ? reduced_count * std::size_t(sweep) : 0)),
+                   resolution, "--sweep and --reduced");
       for (std::size_t j = 0; sweep >= 2 && j < reduced_count; ++j)
         for (int s = 0; s < sweep; ++s) {
           std::vector<double> r(reduced_count, 0.0);

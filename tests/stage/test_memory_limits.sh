@@ -21,6 +21,12 @@ expect_exit 2 "grid of 400 x 400 x 400 cells \(grid.size\) with elements_per_cel
 expect_exit 2 "population of 1000000000 structures of 8\^2 voxels needs about" -- \
   $T "$BIN/msfab-gamut-sample" --config "$SRC/configs/gamut/tiny2d.yaml" --set population=1000000000 \
   --out "$WORK/g.gamut.h5"
+expect_exit 2 "1000030 structures of 64\^3 voxels \(templates\) needs about" -- \
+  $T "$BIN/msfab-family-generate" --config "$SRC/configs/families/two_templates.yaml" \
+  --set 'templates[0].moves=1000' --set 'templates[0].count=1000' --set resolution=64 --out "$WORK/f.h5"
+expect_exit 2 "2000000000 sampling directions x 3 magnitudes per block \(sampling.sphere_directions" -- \
+  $T "$BIN/msfab-ddfem-build" --config "$SRC/configs/ddfem/tiny.yaml" --set sampling.sphere_directions=2000000000 \
+  --out "$WORK/d.h5"
 check "refused runs leave nothing" -- bash -c "! ls '$WORK' | grep -q '\.h5'"
 
 # The limit given by hand: a small run refused under 1 MiB, the refused
