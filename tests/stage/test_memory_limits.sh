@@ -16,7 +16,7 @@ expect_exit 2 "64 x 64 x 64 cell with the direct solver .* or solver: multigrid"
 expect_exit 2 "grid of 100000 x 100000 cells \(grid.size\) needs about" -- \
   $T "$BIN/msfab-topopt" --set 'grid.size=[100000,100000]' --out "$WORK/t.h5"
 expect_exit 2 "grid of 400 x 400 x 400 cells \(grid.size\) with elements_per_cell 4" -- \
-  $T "$BIN/msfab-topopt" --config "$SRC/configs/topopt/bridge_cubic.yaml" --set 'grid.size=[400,400,400]' \
+  $T "$BIN/msfab-topopt" --config "$SRC/configs/topopt/cantilever3d_simp.yaml" --set 'grid.size=[400,400,400]' \
   --set elements_per_cell=4 --out "$WORK/t.h5"
 expect_exit 2 "population of 1000000000 structures of 8\^2 voxels needs about" -- \
   $T "$BIN/msfab-gamut-sample" --config "$SRC/configs/gamut/tiny2d.yaml" --set population=1000000000 \
