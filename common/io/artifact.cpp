@@ -75,32 +75,34 @@ std::vector<ArtifactInput> parse_inputs(const std::string& text) {
 // ---------------------------------------------------------------------------
 // ArtifactWriter
 
+namespace {
+void refuse_output_as_input(const std::string& output, const std::string& input) {
+  if (same_file(input, output))
+    throw InputError(output + ": the output is also an input of this run; writing it would destroy the input");
+}
+
+// The inputs with their hashes, each checked before it is read.
+std::vector<ArtifactInput> hash_inputs(const std::string& output, const std::vector<std::string>& input_paths) {
+  std::vector<ArtifactInput> inputs;
+  for (const std::string& input : input_paths) {
+    refuse_output_as_input(output, input);
+    inputs.push_back({input, sha256_file_hex(input)});
+  }
+  return inputs;
+}
+}  // namespace
+
 ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
                                const std::string& executable, const std::string& config_text,
                                const std::vector<std::string>& input_paths, std::uint64_t seed)
-    : path_(std::move(path)) {
-  std::vector<ArtifactInput> inputs;
-  for (const std::string& input : input_paths) {
-    if (same_file(input, path_))
-      throw InputError(path_ + ": the output is also an input of this run; writing it would destroy the input");
-    inputs.push_back({input, sha256_file_hex(input)});
-  }
-  create(schema, schema_version, executable, config_text, inputs, seed);
-}
+    : ArtifactWriter(path, std::move(schema), schema_version, executable, config_text,
+                     HashedInputs(hash_inputs(path, input_paths)), seed) {}
 
 ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
                                const std::string& executable, const std::string& config_text,
                                HashedInputs inputs, std::uint64_t seed)
     : path_(std::move(path)) {
-  for (const ArtifactInput& input : inputs.list)
-    if (same_file(input.path, path_))
-      throw InputError(path_ + ": the output is also an input of this run; writing it would destroy the input");
-  create(schema, schema_version, executable, config_text, inputs.list, seed);
-}
-
-void ArtifactWriter::create(const std::string& schema, int schema_version, const std::string& executable,
-                            const std::string& config_text, const std::vector<ArtifactInput>& inputs,
-                            std::uint64_t seed) {
+  for (const ArtifactInput& input : inputs.list) refuse_output_as_input(path_, input.path);
   tmp_ = std::make_unique<AtomicFile>(path_);
   try {
     file_.emplace(H5File::create_in(*tmp_));
@@ -109,7 +111,7 @@ void ArtifactWriter::create(const std::string& schema, int schema_version, const
     out.write_attribute("/", "schema_version", std::int32_t(schema_version));
     out.write_attribute("/", "producer", producer_string(executable));
     out.write_attribute("/", "config", config_text);
-    out.write_attribute("/", "inputs", format_inputs(inputs));
+    out.write_attribute("/", "inputs", format_inputs(inputs.list));
     out.write_attribute("/", "seed", std::uint64_t(seed));
     out.write_attribute("/", "created", utc_timestamp_now());
   } catch (...) {

@@ -82,8 +82,6 @@ class ArtifactWriter {
   std::string release_temporary();
 
  private:
-  void create(const std::string& schema, int schema_version, const std::string& executable,
-              const std::string& config_text, const std::vector<ArtifactInput>& inputs, std::uint64_t seed);
   void discard() noexcept;
 
   std::string path_;

@@ -64,6 +64,23 @@ void log_step(const char* name, const StepReport& r) {
                name, r.tried, r.added, r.duplicates, r.outside, r.thin, r.failed);
 }
 
+// A structure set and the gamut sampled from it, as two members of one
+// commit; the gamut records the set by the hash of its content. Returns the
+// set as an input for later members.
+ArtifactInput add_set_and_gamut(CommitGroup& group, const std::string& set_path, const MicrostructureSet& set,
+                                const std::string& gamut_path, const Gamut& gamut,
+                                std::vector<ArtifactInput> set_inputs, const std::string& run_text,
+                                std::uint64_t seed) {
+  ArtifactWriter& set_out = group.add(set_path, kMicrostructuresSchema, kMicrostructuresSchemaVersion,
+                                      "msfab-gamut-sample", run_text, std::move(set_inputs), seed);
+  write_microstructure_set(set_out.file(), "/", set);
+  const ArtifactInput set_input = group.as_input(set_out);
+  ArtifactWriter& gamut_out =
+      group.add(gamut_path, kGamutSchema, kGamutSchemaVersion, "msfab-gamut-sample", run_text, {set_input}, seed);
+  write_gamut(gamut_out.file(), gamut);
+  return set_input;
+}
+
 void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {
   std::ostringstream f;
   f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
@@ -226,14 +243,8 @@ int main(int argc, char** argv) {
       // commit: a run killed while writing them leaves the old ones or the
       // new ones, never a new set beside an old gamut.
       CommitGroup artifacts;
-      const std::uint64_t seed = ctx.options.seed;
-      ArtifactWriter& set_out = artifacts.add(structures_path, kMicrostructuresSchema, kMicrostructuresSchemaVersion,
-                                              "msfab-gamut-sample", run_text, {}, seed);
-      write_microstructure_set(set_out.file(), "/", state.set);
-      const ArtifactInput set_input = artifacts.as_input(set_out);
-      write_gamut(artifacts.add(out, kGamutSchema, kGamutSchemaVersion, "msfab-gamut-sample", run_text, {set_input}, seed)
-                      .file(),
-                  g);
+      const ArtifactInput set_input =
+          add_set_and_gamut(artifacts, structures_path, state.set, out, g, {}, run_text, ctx.options.seed);
       plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
                             options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
       plot_shear_projections(plots_dir + "/gamut", state.set, sampler.space());
@@ -246,15 +257,8 @@ int main(int argc, char** argv) {
         vg.history.clear();
         vg.bound_soft.setZero();
         const std::string vstem = stem_of(out) + ".void";
-        ArtifactWriter& void_set_out =
-            artifacts.add(vstem + ".microstructures.h5", kMicrostructuresSchema, kMicrostructuresSchemaVersion,
-                          "msfab-gamut-sample", run_text, {set_input}, seed);
-        write_microstructure_set(void_set_out.file(), "/", voids.set);
-        const ArtifactInput void_set_input = artifacts.as_input(void_set_out);
-        write_gamut(artifacts.add(vstem + ".gamut.h5", kGamutSchema, kGamutSchemaVersion, "msfab-gamut-sample", run_text,
-                                  {void_set_input}, seed)
-                        .file(),
-                    vg);
+        add_set_and_gamut(artifacts, vstem + ".microstructures.h5", voids.set, vstem + ".gamut.h5", vg, {set_input},
+                          run_text, ctx.options.seed);
         plot_gamut_projection(plots_dir + "/void_variants.png", voids.set, vg.level_set, sampler.space(),
                               "VOID VARIANTS, " + std::to_string(voids.set.items.size()) + " STRUCTURES");
         std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",

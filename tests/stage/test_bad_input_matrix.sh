@@ -114,6 +114,13 @@ for s in assign families homogenize fill-targets map verify-map ddfem-compress; 
   bad "$s: wrong schema" "good.gamut.h5: expected schema .*found schema 'msfab.gamut'" -- \
     "$BIN/msfab-$s" "${a[@]}" --out "$OUTDIR/o.h5"
 done
+# A NaN written into the level set of a valid gamut (its contiguous
+# storage patched in place): refused where it is read, naming the dataset.
+cp "$WORK/good.gamut.h5" "$WORK/nan.gamut.h5"
+offset=$(h5dump -p -H -d /level_set/phi "$WORK/nan.gamut.h5" | awk '/OFFSET/ { print $2 }')
+printf '\x00\x00\x00\x00\x00\x00\xf8\x7f' | dd of="$WORK/nan.gamut.h5" bs=1 seek=$((offset + 40)) conv=notrunc 2>/dev/null
+bad "topopt: NaN inside an artifact" "nan.gamut.h5: dataset '/level_set/phi' holds NaN at index 5" -- \
+  "$BIN/msfab-topopt" --set space=cubic2d --set gamut="$WORK/nan.gamut.h5" --out "$OUTDIR/o.h5"
 bad "inspect: wrong schema" "good.gamut.h5: expected schema 'msfab.result'" -- \
   "$BIN/msfab-inspect" "$WORK/good.gamut.h5" --schema msfab.result
 finish
