@@ -337,7 +337,9 @@ void check_keys_are_unique(const YAML::Node& node, const std::string& path, Expa
   if (node.IsMap()) {
     std::set<std::string> seen;
     for (auto it = node.begin(); it != node.end(); ++it) {
-      const YAML::Node& key = it->first;
+      // A copy: the iterator's -> hands out a proxy that dies with the
+      // statement, so a reference to its member would dangle.
+      const YAML::Node key = it->first;
       if (!key.IsScalar())
         throw InputError(source + ": line " + std::to_string(key.Mark().line + 1) + ": key under " +
                          (path.empty() ? std::string("top level") : "'" + path + "'") + " is not a plain name");
