@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
 #include <sstream>
 
@@ -128,6 +129,12 @@ std::string homogenization_solver(int nx, int ny, int nz, const std::string& opt
                ? "multigrid"
                : "direct";
   throw InputError("homogenization: unknown solver '" + option + "' (choose auto, direct or multigrid)");
+}
+
+double homogenization_peak_bytes(int nx, int ny, int nz, const std::string& option) {
+  const double n = double(nx) * ny * nz;
+  if (nz == 1) return 24e3 * n;
+  return homogenization_solver(nx, ny, nz, option) == "direct" ? 3.3e3 * std::pow(n, 4.0 / 3.0) : 1.3e3 * n;
 }
 
 namespace {

@@ -97,6 +97,14 @@ HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const
 // The solver homogenize_elements() uses for this grid and option.
 std::string homogenization_solver(int nx, int ny, int nz, const std::string& option);
 
+// Peak memory of one cell's homogenization in bytes, for the stages'
+// up-front memory checks (docs/cli.md, "Memory"); measured with
+// /usr/bin/time on this code: a plane-strain cell (nz = 1) about 24 kB per
+// voxel, the 3D multigrid about 1.3 kB per voxel, the 3D direct solver
+// 3.3 kB x n^(4/3) for n voxels (its factor's fill). Whole-cell figures: an
+// octant solve of a mirror-symmetric cell needs less.
+double homogenization_peak_bytes(int nx, int ny, int nz, const std::string& option);
+
 // Corner positions of one voxel of size h (corner a at (a>>2&1, a>>1&1, a&1) h).
 hex8::NodeMatrix voxel_corners(double h);
 

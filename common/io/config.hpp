@@ -89,6 +89,8 @@ class Config {
   template <class T = double>
   T require_range(const std::string& key, T lo, T hi, Bounds bounds = Bounds::Closed,
                   const std::string& what = {}) const;
+  // get<double>: every number the reader returns is finite (and at most
+  // kLargestConfigNumber); the name states the requirement at call sites.
   double require_finite(const std::string& key, const std::string& what = {}) const;
   std::string one_of(const std::string& key, const std::vector<std::string>& choices) const;
   // Throws InputError "<source>: <path> = <value>: <problem>" for checks the

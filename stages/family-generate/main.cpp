@@ -30,6 +30,7 @@
 #include "gamut/microstructure_set.hpp"
 #include "gamut/structure_ops.hpp"
 #include "homog/batch_homogenization.hpp"
+#include "homog/periodic_homogenization.hpp"
 
 using namespace msfab;
 
@@ -262,12 +263,13 @@ int main(int argc, char** argv) {
     std::vector<std::string> inputs;
     double E_stiff = material.E;
     // The cells (4 bytes per voxel, twice: the rasterized grids and the set)
-    // and, when homogenizing, one 3D multigrid cell problem per thread
-    // (1.3 kB per voxel; docs/cli.md, "Memory").
+    // and, when homogenizing, one cell problem per thread (docs/cli.md,
+    // "Memory").
     const auto check_memory = [&](std::size_t count, int n, const std::string& what) {
       const double voxels = double(n) * n * n;
       const double threads = ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads();
-      ctx.check_memory(8.0 * voxels * double(count) + (homogenize ? threads * 1.3e3 * voxels : 0.0),
+      const double per_cell = homogenize ? homogenization_peak_bytes(n, n, n, "auto") : 0.0;
+      ctx.check_memory(8.0 * voxels * double(count) + threads * per_cell,
                        std::to_string(count) + " structures of " + std::to_string(n) + "^3 voxels (" + what + ")",
                        "generate fewer structures or lower the resolution");
     };

@@ -35,6 +35,7 @@
 #include "core/errors.hpp"
 #include "gamut_plots.hpp"
 #include "homog/elastic_tensor.hpp"
+#include "homog/periodic_homogenization.hpp"
 #include "io/atomic_file.hpp"
 #include "io/commit_group.hpp"
 #include "parallel/fan_out.hpp"
@@ -123,12 +124,14 @@ int main(int argc, char** argv) {
     {
       // What must fit at once: the population, its children and their copies
       // in the set (4 bytes per voxel each), and one cell problem per thread
-      // (1.3 kB per voxel in 3D, 24 kB in 2D; docs/cli.md, "Memory").
+      // (docs/cli.md, "Memory").
       const bool three_d = options.kind == MaterialSpaceKind::cubic3d;
-      const double voxels = std::pow(double(options.resolution), three_d ? 3 : 2);
+      const int n = options.resolution;
+      const double voxels = std::pow(double(n), three_d ? 3 : 2);
       const double at_once = 3.0 * (double(options.population) + options.continuous_per_cycle +
                                     options.directed_per_cycle);
-      const double bytes = at_once * voxels * 4 + omp_get_max_threads() * voxels * (three_d ? 1.3e3 : 24e3);
+      const double bytes = at_once * voxels * 4 + omp_get_max_threads() *
+                                                      homogenization_peak_bytes(n, n, three_d ? n : 1, "auto");
       ctx.check_memory(bytes, "a population of " + std::to_string(options.population) + " structures of " +
                                   std::to_string(options.resolution) + (three_d ? "^3" : "^2") + " voxels",
                        "lower population or resolution");

@@ -18,7 +18,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <optional>
 
@@ -57,18 +56,6 @@ refine: 1
 use_symmetry: true
 )";
 
-// Peak memory of one cell's homogenization, measured with /usr/bin/time on
-// this code (docs/cli.md, "Memory"): plane strain about 24 kB per voxel;
-// 3D multigrid about 1.3 kB per voxel; the 3D direct solver's factor grows
-// as n^(4/3) (3.3 kB x n^(4/3) bytes for n voxels). Whole-cell figures: an
-// octant solve of a mirror-symmetric cell needs less.
-double homogenization_bytes(int nx, int ny, int nz, const std::string& solver) {
-  const double n = double(nx) * ny * nz;
-  if (nz == 1) return 24e3 * n;
-  const bool direct = solver == "direct" || (solver == "auto" && n <= 12.0 * 12 * 12);
-  return direct ? 3.3e3 * std::pow(n, 4.0 / 3.0) : 1.3e3 * n;
-}
-
 HomogenizationOptions read_solver_options(const Config& config) {
   HomogenizationOptions options;
   options.void_stiffness = config.get_or<double>("void_stiffness", options.void_stiffness);
@@ -104,7 +91,7 @@ void run_batch(StageContext& ctx, const std::string& structures) {
     const int threads = std::max(1, ctx.options.threads > 0 ? ctx.options.threads : omp_get_max_threads());
     const int r = options.refine;
     const int nz = set.nz > 1 ? set.nz * r : 1;
-    ctx.check_memory(threads * homogenization_bytes(set.nx * r, set.ny * r, nz, options.homogenization.solver),
+    ctx.check_memory(threads * homogenization_peak_bytes(set.nx * r, set.ny * r, nz, options.homogenization.solver),
                      std::to_string(threads) + " cells of " + std::to_string(set.nx * r) + " x " +
                          std::to_string(set.ny * r) + " x " + std::to_string(nz) + " voxels solved at once",
                      "use fewer --threads or a smaller refine");
@@ -142,7 +129,7 @@ int main(int argc, char** argv) {
     // 1. Materials and cell.
     HomogenizationOptions options = read_solver_options(ctx.config);
     const CellInput in = read_cell_input(ctx.config, [&](int nx, int ny, int nz) {
-      ctx.check_memory(homogenization_bytes(nx, ny, nz, options.solver),
+      ctx.check_memory(homogenization_peak_bytes(nx, ny, nz, options.solver),
                        "a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
                            " cell with the " + options.solver + " solver",
                        "use a smaller cell" + std::string(nz > 1 && options.solver == "direct" ? " or solver: multigrid" : ""));
