@@ -85,7 +85,7 @@ HexMesh scale_materials(const HexMesh& mesh, const std::vector<double>& factor) 
     if (inserted) {
       QuadratureMaterials q;
       for (const auto& m : mesh.materials[base].at_point)
-        q.at_point.push_back(std::make_shared<ScaledMaterial>(m, factor[e], /*project_psd=*/true));
+        q.at_point.push_back(std::make_shared<ScaledMaterial>(m, factor[e], ScaledTangent::material_psd));
       scaled.materials.push_back(std::move(q));
     }
     scaled.element_material[e] = it->second;
@@ -301,11 +301,17 @@ StepReport NewmarkIntegrator::step() {
   SpMat Kb_t;
   if (damping_assembler_) {
     Kb_t = damping_assembler_->pattern();
-    damping_assembler_->evaluate(q_, nullptr, &Kb_t);
+    // At the predicted midpoint: D's forces are torque-free about the
+    // configuration it is evaluated at, and the step's angular momentum
+    // balance is taken about the midpoint. Held at q^t, the lever arms are
+    // off by delta/2 and a ringing, spinning body loses spin at first order.
+    VecX q_half = q_ + 0.5 * h * v_;
+    if (!std::isfinite(assembler_.energy(q_half))) q_half = q_;
+    damping_assembler_->evaluate(q_half, nullptr, &Kb_t);
   }
   assemble_damping(damping_assembler_ ? &Kb_t : nullptr);
   const VecX force_t = gravity_force_ - grad_t;
-  // With D held at q^t, the -h^2/4 D v^t of b^t cancels against the same
+  // With D held fixed, the -h^2/4 D v^t of b^t cancels against the same
   // term of the end-of-step damping force h^2/4 D (2/h delta - v^t), whose
   // remaining h/2 D delta lives in inertia_.
   step_rhs_ = h * (mass_ * v_) + h * h / 4 * force_t;

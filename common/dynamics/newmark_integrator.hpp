@@ -3,12 +3,18 @@
 // frictional contact against static obstacles and between bodies (thesis Eq. 4.2-4.14, 4.19,
 // App. B.1). One step from (q^t, v^t):
 //
-//   1. b^t = h M v^t + h^2/4 F(q^t) - h^2/4 D(q^t) v^t               (4.6)
-//      The damping matrix is held at q^t for the whole step (the thesis
-//      evaluates it at q^{t+1} and drops dD/dq from the Jacobian, B.8). With
-//      D fixed the step minimizes an incremental potential, Newton is exact
-//      and the line search has a merit function; the dropped term made
-//      Newton diverge on stiff, strongly damped impacts (docs/dynamics.md).
+//   1. b^t = h M v^t + h^2/4 F(q^t) - h^2/4 D v^t                     (4.6)
+//      The damping matrix D = a M + b K_m is held fixed for the whole step
+//      (the thesis evaluates it at q^{t+1} and drops dD/dq from the
+//      Jacobian, B.8). With D fixed the step minimizes an incremental
+//      potential, Newton is exact and the line search has a merit function;
+//      the dropped term made Newton diverge on stiff, strongly damped
+//      impacts. K_m is the material part of the stiffness (no geometric
+//      term, clamped PSD), so D spares rigid motion of a stressed body, and
+//      it is evaluated at the predicted midpoint q^t + h/2 v^t, so its
+//      forces carry no torque about the step's midpoint to second order:
+//      b K(q^t) lost a spinning jumper most of its angular momentum in
+//      flight (docs/dynamics.md, "Damping that spares rigid motion").
 //   2. continuous collision detection of each boundary node along the
 //      predicted path q^t -> q^t + h v^t + h^2/2 g gathers the contact set:
 //      node-obstacle contacts and, with body contact on, five-node
@@ -106,9 +112,9 @@ class NewmarkIntegrator {
   void add_penetrating_contacts(const VecX& delta, std::vector<Contact>& contacts) const;
   // Newton on (B.1) with a fixed contact set; returns the iterations.
   int solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses, StepReport& report);
-  // D(q^t) = sum a_e M_e + sum b_e K_e(q^t)_+ and M + h/2 D for the current
-  // step; K_e(q)_+ is the element stiffness with dP/dF clamped to its
-  // positive semidefinite part (material/scaled_material.hpp).
+  // D = sum a_e M_e + sum b_e K_e(q^t + h/2 v^t)_m and M + h/2 D for the
+  // current step; K_e(q)_m is the element stiffness with dP/dF reduced to
+  // its material part and clamped PSD (material/scaled_material.hpp).
   void assemble_damping(const SpMat* Kb);
   void assemble_jacobian(const SpMat& K);
   // Phi(delta) = 1/2 delta^T (M + h/2 D) delta - b^T delta + h^2/4 (E(q^t + delta) - f_g^T delta),

@@ -17,6 +17,7 @@ class LinearAnisotropic final : public Material {
   double shear_modulus() const override { return mu_; }
   double lame_lambda() const override { return lambda_; }
   std::string name() const override { return "linear_anisotropic"; }
+  bool frame_indifferent() const override { return false; }
 
   const Mat6& stiffness() const { return C_; }
 

@@ -16,6 +16,7 @@ class LinearIsotropic final : public Material {
   double shear_modulus() const override { return mu_; }
   double lame_lambda() const override { return lambda_; }
   std::string name() const override { return "linear_isotropic"; }
+  bool frame_indifferent() const override { return false; }
 
   double youngs_modulus() const { return E_; }
   double poisson_ratio() const { return nu_; }

@@ -28,6 +28,12 @@ class Material {
 
   virtual std::string name() const = 0;
 
+  // Psi(R F) = Psi(F) for every rotation R. Then dP/dF applied to a rigid
+  // velocity W F (W skew) gives W P, so its geometric part is what makes a
+  // stressed body's stiffness see rotation (material/scaled_material.hpp).
+  // Small-strain models, whose energy grows under rotation, say false.
+  virtual bool frame_indifferent() const { return true; }
+
   double energy(const Mat3& F) const {
     double e = 0;
     evaluate(F, &e, nullptr, nullptr);

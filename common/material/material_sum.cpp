@@ -1,5 +1,7 @@
 #include "material/material_sum.hpp"
 
+#include <algorithm>
+
 #include "core/errors.hpp"
 
 namespace msfab {
@@ -41,6 +43,10 @@ std::string MaterialSum::name() const {
   std::string s = "sum(";
   for (size_t i = 0; i < terms_.size(); ++i) s += (i ? "+" : "") + terms_[i]->name();
   return s + ")";
+}
+
+bool MaterialSum::frame_indifferent() const {
+  return std::all_of(terms_.begin(), terms_.end(), [](const MaterialPtr& t) { return t->frame_indifferent(); });
 }
 
 }  // namespace msfab

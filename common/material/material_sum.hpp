@@ -19,6 +19,7 @@ class MaterialSum final : public Material {
   double lame_lambda() const override;
   // "sum(a+b+...)" of the terms' names.
   std::string name() const override;
+  bool frame_indifferent() const override;
 
   const std::vector<MaterialPtr>& terms() const { return terms_; }
 

@@ -17,6 +17,7 @@
 #include "material/linear_isotropic.hpp"
 #include "material/material_sum.hpp"
 #include "material/neo_hookean.hpp"
+#include "material/scaled_material.hpp"
 #include "material/voigt.hpp"
 
 namespace msfab {
@@ -488,6 +489,56 @@ void materials_expect_input_error(const std::function<void()>& make, const std::
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(must_mention), std::string::npos) << e.what();
   }
+}
+
+// The damping tangent that spares rigid motion (material/scaled_material.hpp):
+// the full dP/dF maps a rigid velocity W F to W P (so a stressed body's b K
+// brakes its spin), the material part maps it to zero, and the two agree
+// where there is no stress.
+TEST(ScaledTangent, MaterialPartVanishesOnRigidVelocitiesAndAgreesWithoutStress) {
+  std::mt19937 rng(7);
+  const double b = 1.64e-4;
+  const auto neo = std::make_shared<NeoHookean>(kE, kNu);
+  const auto spring = std::make_shared<AnisotropicSpring>(kSpringC, Vec3(1, 2, 0.5));
+  const MaterialPtr sum = std::make_shared<MaterialSum>(std::vector<MaterialPtr>{neo, spring});
+  for (const MaterialPtr& base : {MaterialPtr(neo), sum}) {
+    ASSERT_TRUE(base->frame_indifferent());
+    const ScaledMaterial full(base, b, ScaledTangent::full), psd(base, b, ScaledTangent::psd),
+        material(base, b, ScaledTangent::material_psd);
+    for (int trial = 0; trial < 20; ++trial) {
+      const Mat3 F = random_rotation(rng) * (Mat3::Identity() + random_matrix(rng, 0.15));
+      ASSERT_GT(F.determinant(), 0);
+      const Mat3 W0 = random_matrix(rng, 1.0), W = W0 - W0.transpose();
+      const Mat3 WF = W * F;
+      const Eigen::Map<const Vec9> rigid(WF.data());
+      Mat3 P;
+      Mat9 Hf, Hm;
+      full.evaluate(F, nullptr, &P, &Hf);
+      material.evaluate(F, nullptr, nullptr, &Hm);
+      const Mat3 WP = W * P;
+      const double scale = Hf.norm() * rigid.norm();
+      EXPECT_LT((Hf * rigid - Eigen::Map<const Vec9>(WP.data())).norm(), 1e-9 * scale) << base->name();
+      EXPECT_GT(WP.norm(), 1e-3 * scale) << "the stress should be visible to the full tangent";
+      EXPECT_LT((Hm * rigid).norm(), 1e-9 * scale) << base->name();
+      EXPECT_LT((Hm - Hm.transpose()).norm(), 1e-12 * Hm.norm());
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat9>(Hm).eigenvalues().minCoeff(), -1e-9 * Hm.norm());
+      // Without stress (a pure rotation) the material part is the whole PSD tangent.
+      const Mat3 R = random_rotation(rng);
+      Mat9 Hr_psd, Hr_material;
+      psd.evaluate(R, nullptr, nullptr, &Hr_psd);
+      material.evaluate(R, nullptr, nullptr, &Hr_material);
+      EXPECT_LT((Hr_psd - Hr_material).norm(), 1e-9 * Hr_psd.norm()) << base->name();
+    }
+  }
+  // A small-strain material has no such split and keeps the PSD tangent.
+  const auto linear = std::make_shared<LinearIsotropic>(kE, kNu);
+  EXPECT_FALSE(linear->frame_indifferent());
+  EXPECT_FALSE(MaterialSum({neo, linear}).frame_indifferent());
+  const Mat3 F = Mat3::Identity() + random_matrix(rng, 0.1);
+  Mat9 Hp, Hm;
+  ScaledMaterial(linear, b, ScaledTangent::psd).evaluate(F, nullptr, nullptr, &Hp);
+  ScaledMaterial(linear, b, ScaledTangent::material_psd).evaluate(F, nullptr, nullptr, &Hm);
+  EXPECT_EQ(Hp, Hm);
 }
 
 TEST(MaterialParameters, BadValuesThrowInputErrorNamingTheParameter) {

@@ -414,6 +414,80 @@ TEST(Newmark, DropTestReboundOrdersTheImpactModels) {
 
 namespace {
 
+struct SpinRun {
+  double momentum_drift;   // largest |L(t) - L(0)| / |L(0)| about the centre of mass
+  double elastic_fraction; // elastic energy at the end over that at the start
+};
+
+// A stretched 3x2x2 Neo-Hookean bar set spinning about z in free space (no
+// gravity, no contact): it rings while it turns, so it is stressed while
+// it rotates, and its stiffness damping must take the ringing out without
+// taking angular momentum away.
+SpinRun spinning_bar(double h, int steps) {
+  BlockSpec s;
+  s.n[0] = 3, s.n[1] = 2, s.n[2] = 2;
+  s.size = 0.03;
+  // Lowest ringing ~1e3 rad/s (omega h ~ 0.2), damping ratio ~0.3.
+  s.material = std::make_shared<NeoHookean>(1e5, 0.45);
+  s.b = 6e-4;
+  DynamicsModel model = block_model(s);
+  model.gravity.setZero();
+  NewmarkOptions opt;
+  opt.time_step = h;
+  opt.newton_tolerance = 1e-12;
+  NewmarkIntegrator sim(model, opt);
+  const VecX X = sim.assembler().rest_positions();
+  const Vec3 c = X.reshaped(3, X.size() / 3).rowwise().mean();
+  const Vec3 omega(0, 0, 60.0);  // rad/s; omega h stays small, the rotation large
+  VecX q = X, v = VecX::Zero(X.size());
+  for (int i = 0; i < model.mesh.num_nodes(); ++i) {
+    const Vec3 r = X.segment<3>(3 * i) - c;
+    q.segment<3>(3 * i) = c + Vec3(1.06 * r.x(), r.y(), 0.97 * r.z());
+    v.segment<3>(3 * i) = omega.cross(r);
+  }
+  sim.set_state(q, v);
+  auto momentum = [&] {
+    const VecX p = sim.mass_matrix() * sim.velocities();
+    const Vec3 com = center_of_mass(sim);
+    Vec3 L = Vec3::Zero();
+    for (int i = 0; i < model.mesh.num_nodes(); ++i) L += (sim.positions().segment<3>(3 * i) - com).cross(p.segment<3>(3 * i));
+    return L;
+  };
+  const Vec3 L0 = momentum();
+  const double e0 = sim.energies().elastic;
+  SpinRun run{0, 0};
+  for (int k = 0; k < steps; ++k) {
+    sim.step();
+    run.momentum_drift = std::max(run.momentum_drift, (momentum() - L0).norm() / L0.norm());
+  }
+  run.elastic_fraction = sim.energies().elastic / e0;
+  return run;
+}
+
+}  // namespace
+
+// b K(q) brakes a stressed body's rotation (K(q) W F = W P), and a damping
+// matrix held at q^t has its lever arms at q^t, not at the step's midpoint:
+// the flipper jumper lost three quarters of its spin in flight at h = 1e-4 s.
+// The damping tangent keeps only the material part and is evaluated at the
+// predicted midpoint, so the spin is kept to second order in h, as well as
+// the undamped trapezoidal rule keeps it, while the ringing still decays.
+TEST(Newmark, DampedSpinningBodyKeepsItsAngularMomentum) {
+  const double T = 0.05;  // three radians of spin, eight periods of the ringing
+  const SpinRun coarse = spinning_bar(2e-4, static_cast<int>(std::lround(T / 2e-4)));
+  const SpinRun fine = spinning_bar(1e-4, static_cast<int>(std::lround(T / 1e-4)));
+  std::printf("  angular momentum drift: %.3e at h = 2e-4 s, %.3e at 1e-4 s; elastic energy left %.3e\n",
+              coarse.momentum_drift, fine.momentum_drift, fine.elastic_fraction);
+  EXPECT_LT(coarse.elastic_fraction, 0.05) << "the ringing should be damped out";
+  // Measured: 1.6e-3 and 4.0e-4; the undamped trapezoidal rule drifts by
+  // 3.0e-3 and 7.6e-4 here, and b K(q^t) with the geometric part lost 20%
+  // and 17% (no convergence: the braking is in the model, not the step).
+  EXPECT_LT(coarse.momentum_drift, 4e-3);
+  EXPECT_GT(coarse.momentum_drift / fine.momentum_drift, 3.0) << "second order in h";
+}
+
+namespace {
+
 // A damped 4x4x4 block (375 DOFs: large enough for CHOLMOD's own parallel
 // regions) thrown onto the ground at an angle, with friction, through the
 // impact and into sliding; returns the final positions and velocities.
