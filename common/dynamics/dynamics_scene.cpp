@@ -40,6 +40,10 @@ Mat3 rotation_from_degrees(const Vec3& deg) {
 
 std::vector<SceneMaterial> read_materials(const Config& c) {
   std::vector<SceneMaterial> out;
+  // Every modulus times this: a printer's material variation, for studies
+  // of how robust a design is (msfab-jump-design's robustness check).
+  const double modulus_scale = c.get_or<double>("modulus_scale", 1.0);
+  if (!(modulus_scale > 0)) c.fail("modulus_scale", "must be positive (a factor on every material's E)");
   for (const Config& m : c.children("materials")) {
     SceneMaterial s;
     s.name = m.get<std::string>("name");
@@ -58,6 +62,7 @@ std::vector<SceneMaterial> read_materials(const Config& c) {
       s.damping_a = m.get_or<double>("damping_a", 0.0);
       s.damping_b = m.get_or<double>("damping_b", 0.0);
     }
+    s.E *= modulus_scale;
     if (!(s.damping_a >= 0) || !std::isfinite(s.damping_a)) m.fail("damping_a", "must be finite and >= 0");
     if (!(s.damping_b >= 0) || !std::isfinite(s.damping_b)) m.fail("damping_b", "must be finite and >= 0");
     for (const SceneMaterial& other : out)

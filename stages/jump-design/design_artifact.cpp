@@ -97,6 +97,33 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
   }
   f.write_dataset("/evaluations/outcome", outcome, {hsize_t(n), hsize_t(nk)});
   f.write_attribute("/evaluations/outcome", "columns", format_name_list(outcome_columns()));
+  if (!run.robustness.samples.empty()) {
+    const RobustnessResult& r = run.robustness;
+    const std::size_t m = r.samples.size();
+    std::vector<double> scale(m), rparameters(m * np), robjective(m), routcome(m * nk);
+    std::vector<std::int32_t> success(m), simulated(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      const Evaluation& e = r.samples[i].evaluation;
+      scale[i] = r.samples[i].modulus_scale;
+      success[i] = r.samples[i].success;
+      simulated[i] = e.ok;
+      robjective[i] = e.objective;
+      std::copy(e.parameters.begin(), e.parameters.end(), rparameters.begin() + i * np);
+      const std::vector<double> row = outcome_row(e);
+      std::copy(row.begin(), row.end(), routcome.begin() + i * nk);
+    }
+    f.create_group("/robustness");
+    f.write_attribute("/robustness", "modulus", p.robustness.modulus);
+    f.write_attribute("/robustness", "geometry", p.robustness.geometry);
+    f.write_attribute("/robustness", "success_fraction", r.fraction());
+    f.write_vector("/robustness/modulus_scale", scale);
+    f.write_dataset("/robustness/parameters", rparameters, {hsize_t(m), hsize_t(np)});
+    f.write_vector("/robustness/objective", robjective);
+    f.write_vector("/robustness/success", success);
+    f.write_vector("/robustness/simulated", simulated);
+    f.write_dataset("/robustness/outcome", routcome, {hsize_t(m), hsize_t(nk)});
+    f.write_attribute("/robustness/outcome", "columns", format_name_list(outcome_columns()));
+  }
   write_design(f, "/initial", run.evaluations[run.initial]);
   write_design(f, "/final", run.evaluations[run.final]);
   out.commit();

@@ -1,18 +1,21 @@
 #pragma once
 // The `msfab.jump_design` artifact (docs/artifacts.md): every evaluation of
-// the design loop and the initial and final designs with their outcomes.
+// the design loop, the initial and final designs with their outcomes, and
+// the final design's print-variation samples.
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "design_config.hpp"
 #include "design_evaluation.hpp"
+#include "design_robustness.hpp"
 
 namespace msfab {
 
 struct DesignRun {
   std::vector<Evaluation> evaluations;  // by start, then index
   std::size_t initial = 0, final = 0;   // indices into evaluations
+  RobustnessResult robustness;          // empty without robustness.samples
   double wall_seconds = 0;
   int ranks = 1, threads = 1;
 };

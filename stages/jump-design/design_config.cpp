@@ -66,6 +66,19 @@ void read_optimizer(const Config& c, DesignProblem& p) {
   if (!(p.length_scale > 0) || !std::isfinite(p.length_scale)) o.fail("length_scale", "must be positive (m)");
 }
 
+void read_robustness(const Config& c, RobustnessCheck& r) {
+  if (!c.has("robustness")) return;
+  const Config s = c.child("robustness");
+  r.samples = s.get_or<int>("samples", r.samples);
+  if (r.samples < 0 || r.samples > 100000) s.fail("samples", "must be in [0, 100000]");
+  r.modulus = s.get_or<double>("modulus", r.modulus);
+  if (!(r.modulus >= 0) || !(r.modulus < 1)) s.fail("modulus", "must be in [0, 1) (relative variation of E)");
+  r.geometry = s.get_or<double>("geometry", r.geometry);
+  if (!(r.geometry >= 0)) s.fail("geometry", "must be >= 0 (m, variation of every design parameter)");
+  r.target_distance = s.get_or<double>("target_distance", r.target_distance);
+  if (!(r.target_distance > 0)) s.fail("target_distance", "must be positive (m)");
+}
+
 }  // namespace
 
 DesignProblem read_design_problem(const Config& c) {
@@ -115,6 +128,7 @@ DesignProblem read_design_problem(const Config& c) {
   }
   read_measure(c, p.measure, p.settle, p.body);
   read_optimizer(c, p);
+  read_robustness(c, p.robustness);
   return p;
 }
 

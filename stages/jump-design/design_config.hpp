@@ -25,6 +25,19 @@ enum class DesignTask {
 };
 const char* design_task_name(DesignTask task);
 
+// After the search, the final design is simulated again under print
+// variation (thesis §4.5: > 85% of printed designs succeeded): every
+// material's modulus times a factor uniform in [1 - modulus, 1 + modulus]
+// and every design parameter (a length) moved uniformly within
+// +-geometry. What counts as success depends on the task
+// (design_robustness.hpp).
+struct RobustnessCheck {
+  int samples = 0;              // 0: no check
+  double modulus = 0.2;         // relative
+  double geometry = 2e-4;       // m
+  double target_distance = 0.01;  // m: a target-task landing within this counts as a hit
+};
+
 struct DesignProblem {
   std::string scene_path;
   std::vector<std::string> scene_set;  // --set style overrides of the scene
@@ -44,6 +57,7 @@ struct DesignProblem {
   double xtol = 0.01;        // stop when a step changes no normalized parameter by more
   double stop_below = 0;     // stop a start once its objective is below this (0: never)
   double length_scale = 0.01;  // m: constraints and distances are divided by it for COBYLA
+  RobustnessCheck robustness;
   std::string config_source;
 };
 

@@ -108,10 +108,15 @@ std::string number_text(double x) {
   return buf;
 }
 
-// The scene at `values`, meshed at the initial design (reference_parameters).
-DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double>& values) {
+// The scene at `values`, meshed at the initial design (reference_parameters),
+// with every modulus times `modulus_scale` (on top of the scene's own).
+DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double>& values, double modulus_scale = 1.0) {
   Config scene = Config::load_file(problem.scene_path);
   scene.apply_overrides(problem.scene_set);
+  if (modulus_scale != 1.0) {
+    const double own = scene.has("modulus_scale") ? scene.get<double>("modulus_scale") : 1.0;
+    scene.apply_override("modulus_scale=" + number_text(own * modulus_scale));
+  }
   for (std::size_t i = 0; i < problem.parameters.size(); ++i) {
     const DesignParameter& q = problem.parameters[i];
     scene.apply_override("parameters." + q.name + "=" + number_text(values[i]));
@@ -165,7 +170,8 @@ DesignEvaluator::DesignEvaluator(const DesignProblem& problem) : problem_(proble
   }
 }
 
-Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index) const {
+Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index,
+                                     double modulus_scale) const {
   const auto t0 = std::chrono::steady_clock::now();
   Evaluation e;
   e.start = start;
@@ -174,7 +180,7 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
   e.elements = elements_;
   const std::size_t nc = constraint_names(problem_.task).size();
   try {
-    const DynamicsScene scene = build_scene(problem_, values);
+    const DynamicsScene scene = build_scene(problem_, values, modulus_scale);
     // The observer stops the run shortly after the landing (jump_observer.hpp).
     JumpObserver observer(scene, {problem_.measure.min_flight, problem_.settle, 0.01, problem_.body});
     RunCallbacks callbacks;

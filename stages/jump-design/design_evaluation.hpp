@@ -42,8 +42,9 @@ class DesignEvaluator {
 
   // Safe to call from several threads at once (each call reads its own
   // copy of the scene). A simulation that fails gives ok = false and
-  // penalty values; bad input still throws.
-  Evaluation evaluate(const std::vector<double>& parameters, int start, int index) const;
+  // penalty values; bad input still throws. `modulus_scale` multiplies
+  // every material's modulus (print variation).
+  Evaluation evaluate(const std::vector<double>& parameters, int start, int index, double modulus_scale = 1.0) const;
 
   int elements() const { return elements_; }
   const Obstacle* obstacle() const { return has_obstacle_ ? &obstacle_ : nullptr; }

@@ -58,6 +58,10 @@ void print_design_summary(const DesignProblem& p, const DesignRun& run, const st
   row("simulation (s)", num(a.seconds, "%.1f"), num(b.seconds, "%.1f"));
   std::printf("  simulations: %.1f s in total, %.1f s each on average; wall time %.1f s (%.2f min)\n", simulated,
               simulated / run.evaluations.size(), run.wall_seconds, run.wall_seconds / 60);
+  if (!run.robustness.samples.empty())
+    std::printf("  print variation (E +-%.0f%%, parameters +-%.2g mm): %d of %zu samples succeed (%.0f%%)\n",
+                100 * p.robustness.modulus, 1e3 * p.robustness.geometry, run.robustness.successes,
+                run.robustness.samples.size(), 100 * run.robustness.fraction());
   std::printf("  artifact: %s\n", out.c_str());
 }
 

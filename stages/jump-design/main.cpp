@@ -10,8 +10,11 @@
 //      quasistatically, releases it into Newmark dynamics with BBI impact
 //      and rigid flight, and measures the jump
 //   3. the final design is the best feasible evaluation of all starts
-//   4. write `msfab.jump_design` (every evaluation, initial and final
-//      designs) and print initial against final
+//   4. with robustness.samples > 0, the final design again under print
+//      variation (modulus and geometry), fanned out like the starts: the
+//      fraction of samples that still meet the goal
+//   5. write `msfab.jump_design` (every evaluation, initial and final
+//      designs, the variation samples) and print initial against final
 #include <mpi.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
@@ -26,6 +29,7 @@
 #include "design_config.hpp"
 #include "design_evaluation.hpp"
 #include "design_report.hpp"
+#include "design_robustness.hpp"
 #include "design_search.hpp"
 #include "parallel/fan_out.hpp"
 
@@ -64,9 +68,13 @@ int main(int argc, char** argv) {
       at_initial = std::abs(first.parameters[i] - problem.parameters[i].initial) <=
                    1e-12 * (problem.parameters[i].upper - problem.parameters[i].lower);
     if (!at_initial) throw NumericalError("design loop: start 0 did not begin with the initial design");
+
+    // 4. Print variation.
+    if (problem.robustness.samples > 0)
+      run.robustness = check_robustness(problem, evaluator, run.evaluations[run.final].parameters, ctx.options.seed);
     run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
-    // 4. Artifact and summary.
+    // 5. Artifact and summary.
     if (rank == 0) {
       write_jump_design_artifact(out, problem, run, ctx.config.resolved_text(), ctx.options.seed);
       print_design_summary(problem, run, out);

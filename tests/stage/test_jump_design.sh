@@ -52,6 +52,28 @@ same() {
 }
 check "1 and 2 ranks give identical evaluations and designs" -- same "$WORK/one.h5" "$WORK/two.h5"
 
+# Print variation of the final design: the samples are recorded, do not
+# depend on the rank count, and a throw that hits within 2 mm still hits
+# within 1 cm with E +-20% and the length +-0.2 mm.
+check "robustness, one rank" -- "$DESIGN" --config "$WORK/design.yaml" --set robustness.samples=4 --threads 2 \
+  --out "$WORK/robust1.h5" --quiet
+check "robustness, two ranks" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 "$DESIGN" --config "$WORK/design.yaml" \
+  --set robustness.samples=4 --out "$WORK/robust2.h5" --quiet
+check "four samples recorded" -- bash -c "h5dump -H -d /robustness/parameters '$WORK/robust1.h5' | grep -q '( 4, 2 )'"
+check "moduli varied within 20%" -- bash -c "h5dump -d /robustness/modulus_scale '$WORK/robust1.h5' | \
+  awk '/\(0\)/ { for (i = 2; i <= NF; ++i) { x = \$i + 0; if (x < 0.8 || x > 1.2 || x == 1) bad = 1 } } END { exit bad }'"
+check "every sample hits the target" -- bash -c "h5dump -a /robustness/success_fraction '$WORK/robust1.h5' | grep -q '(0): 1$'"
+samples_same() {
+  for d in /robustness/modulus_scale /robustness/parameters /robustness/success /robustness/outcome; do
+    [ "$(h5dump -d $d "$1" | tail -n +3)" = "$(h5dump -d $d "$2" | tail -n +3)" ] || { echo "differs: $d"; return 1; }
+  done
+}
+check "1 and 2 ranks give the same samples" -- samples_same "$WORK/robust1.h5" "$WORK/robust2.h5"
+expect_exit 2 "robustness.modulus.*must be in \[0, 1\)" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set robustness.modulus=1.5 --out "$WORK/bad.h5"
+expect_exit 2 "modulus_scale.*must be positive" -- "$BIN/msfab-dynamics" --config "$WORK/throw.yaml" \
+  --set modulus_scale=0 --out "$WORK/bad.h5"
+
 # The parameterized scene runs directly, with overrides of its parameters.
 check "msfab-dynamics runs a parameterized scene" -- "$BIN/msfab-dynamics" --config "$WORK/throw.yaml" \
   --set parameters.length=0.015 --set simulation.duration=0.01 --out "$WORK/direct.h5" --quiet

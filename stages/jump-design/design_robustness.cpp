@@ -1,0 +1,57 @@
+#include "design_robustness.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <random>
+
+#include "parallel/fan_out.hpp"
+
+namespace msfab {
+
+bool design_succeeded(const DesignProblem& p, const Evaluation& e) {
+  if (!e.ok || !e.outcome.landed) return false;
+  const double turn = e.outcome.flip_at_landing - p.target_flip;
+  const double tolerance = p.measure.upright_tolerance;
+  switch (p.task) {
+    case DesignTask::kFlip: return std::abs(turn) <= tolerance;
+    case DesignTask::kTarget: return std::abs(e.outcome.com_at_landing.x() - p.target_x) <= p.robustness.target_distance;
+    case DesignTask::kJumpOnto:
+    case DesignTask::kJumpOver: return e.feasible() && std::abs(std::remainder(turn, 2 * M_PI)) <= tolerance;
+  }
+  return false;
+}
+
+RobustnessResult check_robustness(const DesignProblem& p, const DesignEvaluator& evaluator,
+                                  const std::vector<double>& design, std::uint64_t seed) {
+  const RobustnessCheck& r = p.robustness;
+  const std::size_t np = design.size();
+  // Every rank draws all samples, so sample i is the same wherever it runs.
+  std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<double> modulus(r.samples);
+  std::vector<std::vector<double>> parameters(r.samples, design);
+  for (int i = 0; i < r.samples; ++i) {
+    modulus[i] = 1.0 + r.modulus * (2 * unit(rng) - 1);
+    for (std::size_t j = 0; j < np; ++j) parameters[i][j] += r.geometry * (2 * unit(rng) - 1);
+  }
+  const int per = evaluation_record_size(p);
+  const std::vector<double> records = fan_out(r.samples, per, [&](int i, double* row) {
+    const Evaluation e = evaluator.evaluate(parameters[i], -1, i, modulus[i]);
+    spdlog::info("print variation {}: E x {:.3f}, {} : {} ({:.1f} s)", i, modulus[i],
+                 fmt::join(parameters[i], ", "), design_succeeded(p, e) ? "succeeds" : "fails", e.seconds);
+    pack_evaluation(e, row);
+  });
+  RobustnessResult result;
+  for (int i = 0; i < r.samples; ++i) {
+    RobustnessSample s;
+    s.modulus_scale = modulus[i];
+    s.evaluation = unpack_evaluation(p, records.data() + static_cast<std::size_t>(i) * per);
+    s.success = design_succeeded(p, s.evaluation);
+    result.successes += s.success;
+    result.samples.push_back(std::move(s));
+  }
+  return result;
+}
+
+}  // namespace msfab
