@@ -100,6 +100,9 @@ DesignProblem read_design_problem(const Config& c) {
       d.fail("name", "'" + q.name + "' is not a parameter of " + p.scene_path + " (its parameters: " + known + ")");
     }
     q.initial = scene_parameters.require_finite(q.name, "parameter value");
+    q.reference = q.initial;
+    if (scene.has("reference_parameters") && scene.child("reference_parameters").has(q.name))
+      q.reference = scene.child("reference_parameters").require_finite(q.name, "reference value");
     q.lower = d.require_finite("lower");
     q.upper = d.require_finite("upper");
     if (!(q.lower < q.upper)) d.fail("upper", "must exceed lower (" + std::to_string(q.lower) + ")");

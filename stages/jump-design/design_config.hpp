@@ -15,6 +15,9 @@ struct DesignParameter {
   std::string name;
   double lower = 0, upper = 0, step = 0;
   double initial = 0;  // the scene's value: the initial design
+  // The value the scene is meshed at and morphed from: the scene's
+  // reference_parameters entry if it has one, else the initial design.
+  double reference = 0;
 };
 
 enum class DesignTask {

@@ -108,7 +108,8 @@ std::string number_text(double x) {
   return buf;
 }
 
-// The scene at `values`, meshed at the initial design (reference_parameters),
+// The scene at `values`, meshed at the reference values (the scene's
+// reference_parameters, else the initial design),
 // with every modulus times `modulus_scale` (on top of the scene's own).
 DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double>& values, double modulus_scale = 1.0) {
   Config scene = Config::load_file(problem.scene_path);
@@ -120,7 +121,7 @@ DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double
   for (std::size_t i = 0; i < problem.parameters.size(); ++i) {
     const DesignParameter& q = problem.parameters[i];
     scene.apply_override("parameters." + q.name + "=" + number_text(values[i]));
-    scene.apply_override("reference_parameters." + q.name + "=" + number_text(q.initial));
+    scene.apply_override("reference_parameters." + q.name + "=" + number_text(q.reference));
   }
   DynamicsScene s = read_dynamics_scene(scene);
   scene.check_no_unknown_keys();

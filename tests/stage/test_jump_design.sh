@@ -69,6 +69,12 @@ samples_same() {
   done
 }
 check "1 and 2 ranks give the same samples" -- samples_same "$WORK/robust1.h5" "$WORK/robust2.h5"
+# A given design checked without a search: meshed at voxel-aligned
+# reference values, morphed to the design.
+check "a given design on its reference mesh" -- "$DESIGN" --config "$WORK/design.yaml" \
+  --set 'scene_set=["parameters.length=0.0137", "reference_parameters.length=0.010"]' \
+  --set optimizer.max_evaluations=1 --set optimizer.starts=1 --set robustness.samples=2 --out "$WORK/given.h5" --quiet
+check "the given design is the one evaluated" -- bash -c "h5dump -d /final/parameters '$WORK/given.h5' | grep -q '0.0137, 0.5'"
 expect_exit 2 "robustness.modulus.*must be in \[0, 1\)" -- \
   "$DESIGN" --config "$WORK/design.yaml" --set robustness.modulus=1.5 --out "$WORK/bad.h5"
 expect_exit 2 "modulus_scale.*must be positive" -- "$BIN/msfab-dynamics" --config "$WORK/throw.yaml" \
