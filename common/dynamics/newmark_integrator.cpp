@@ -305,9 +305,10 @@ StepReport NewmarkIntegrator::step() {
     // configuration it is evaluated at, and the step's angular momentum
     // balance is taken about the midpoint. Held at q^t, the lever arms are
     // off by delta/2 and a ringing, spinning body loses spin at first order.
-    VecX q_half = q_ + 0.5 * h * v_;
-    if (!std::isfinite(assembler_.energy(q_half))) q_half = q_;
-    damping_assembler_->evaluate(q_half, nullptr, &Kb_t);
+    // Where the prediction inverts an element its energy is not finite
+    // (or NaN where b = 0) and q^t is used.
+    if (!std::isfinite(damping_assembler_->evaluate(q_ + 0.5 * h * v_, nullptr, &Kb_t)))
+      damping_assembler_->evaluate(q_, nullptr, &Kb_t);
   }
   assemble_damping(damping_assembler_ ? &Kb_t : nullptr);
   const VecX force_t = gravity_force_ - grad_t;

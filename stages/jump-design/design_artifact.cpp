@@ -30,6 +30,28 @@ void write_design(H5File& f, const std::string& group, const Evaluation& e) {
   f.write_attribute(group, "simulated", static_cast<std::int32_t>(e.ok));
 }
 
+// A group with one row per evaluation: simulated, objective, parameters and
+// outcome (the columns /evaluations and /robustness share).
+void write_evaluation_table(H5File& f, const std::string& group, const std::vector<const Evaluation*>& rows) {
+  const std::size_t n = rows.size(), np = rows.front()->parameters.size(), nk = outcome_columns().size();
+  std::vector<std::int32_t> simulated(n);
+  std::vector<double> objective(n), parameters(n * np), outcome(n * nk);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Evaluation& e = *rows[i];
+    simulated[i] = e.ok;
+    objective[i] = e.objective;
+    std::copy(e.parameters.begin(), e.parameters.end(), parameters.begin() + i * np);
+    const std::vector<double> row = outcome_row(e);
+    std::copy(row.begin(), row.end(), outcome.begin() + i * nk);
+  }
+  f.create_group(group);
+  f.write_vector(group + "/simulated", simulated);
+  f.write_vector(group + "/objective", objective);
+  f.write_dataset(group + "/parameters", parameters, {hsize_t(n), hsize_t(np)});
+  f.write_dataset(group + "/outcome", outcome, {hsize_t(n), hsize_t(nk)});
+  f.write_attribute(group + "/outcome", "columns", format_name_list(outcome_columns()));
+}
+
 }  // namespace
 
 std::vector<std::string> outcome_columns() {
@@ -65,64 +87,46 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
   f.write_attribute("/", "ranks", static_cast<std::int32_t>(run.ranks));
   f.write_attribute("/", "threads", static_cast<std::int32_t>(run.threads));
 
-  const std::size_t n = run.evaluations.size(), np = names.size(), nc = constraint_names(p.task).size();
-  const std::size_t nk = outcome_columns().size();
-  std::vector<std::int32_t> start(n), index(n), ok(n), feasible(n);
-  std::vector<double> objective(n), seconds(n), parameters(n * np), constraints(n * nc), outcome(n * nk);
+  std::vector<const Evaluation*> evaluations;
+  for (const Evaluation& e : run.evaluations) evaluations.push_back(&e);
+  write_evaluation_table(f, "/evaluations", evaluations);
+  const std::size_t n = evaluations.size(), nc = constraint_names(p.task).size();
+  std::vector<std::int32_t> start(n), index(n), feasible(n);
+  std::vector<double> seconds(n), constraints(n * nc);
   for (std::size_t i = 0; i < n; ++i) {
     const Evaluation& e = run.evaluations[i];
     start[i] = e.start;
     index[i] = e.index;
-    ok[i] = e.ok;
     feasible[i] = e.feasible();
-    objective[i] = e.objective;
     seconds[i] = e.seconds;
-    std::copy(e.parameters.begin(), e.parameters.end(), parameters.begin() + i * np);
     std::copy(e.constraints.begin(), e.constraints.end(), constraints.begin() + i * nc);
-    const std::vector<double> row = outcome_row(e);
-    std::copy(row.begin(), row.end(), outcome.begin() + i * nk);
   }
-  f.create_group("/evaluations");
   f.write_vector("/evaluations/start", start);
   f.write_vector("/evaluations/index", index);
-  f.write_vector("/evaluations/simulated", ok);
   f.write_vector("/evaluations/feasible", feasible);
-  f.write_vector("/evaluations/objective", objective);
   f.write_vector("/evaluations/seconds", seconds);
   f.write_attribute("/evaluations/seconds", "units", "s (wall time; the only field that varies between runs)");
-  f.write_dataset("/evaluations/parameters", parameters, {hsize_t(n), hsize_t(np)});
   if (nc > 0) {
     f.write_dataset("/evaluations/constraints", constraints, {hsize_t(n), hsize_t(nc)});
     f.write_attribute("/evaluations/constraints", "units", "m (feasible when <= 0)");
   }
-  f.write_dataset("/evaluations/outcome", outcome, {hsize_t(n), hsize_t(nk)});
-  f.write_attribute("/evaluations/outcome", "columns", format_name_list(outcome_columns()));
+
   if (!run.robustness.samples.empty()) {
     const RobustnessResult& r = run.robustness;
-    const std::size_t m = r.samples.size();
-    std::vector<double> scale(m), rparameters(m * np), robjective(m), routcome(m * nk);
-    std::vector<std::int32_t> success(m), simulated(m);
-    for (std::size_t i = 0; i < m; ++i) {
-      const Evaluation& e = r.samples[i].evaluation;
-      scale[i] = r.samples[i].modulus_scale;
-      success[i] = r.samples[i].success;
-      simulated[i] = e.ok;
-      robjective[i] = e.objective;
-      std::copy(e.parameters.begin(), e.parameters.end(), rparameters.begin() + i * np);
-      const std::vector<double> row = outcome_row(e);
-      std::copy(row.begin(), row.end(), routcome.begin() + i * nk);
+    std::vector<const Evaluation*> samples;
+    std::vector<double> scale;
+    std::vector<std::int32_t> success;
+    for (const RobustnessSample& sample : r.samples) {
+      samples.push_back(&sample.evaluation);
+      scale.push_back(sample.modulus_scale);
+      success.push_back(sample.success);
     }
-    f.create_group("/robustness");
+    write_evaluation_table(f, "/robustness", samples);
     f.write_attribute("/robustness", "modulus", p.robustness.modulus);
     f.write_attribute("/robustness", "geometry", p.robustness.geometry);
     f.write_attribute("/robustness", "success_fraction", r.fraction());
     f.write_vector("/robustness/modulus_scale", scale);
-    f.write_dataset("/robustness/parameters", rparameters, {hsize_t(m), hsize_t(np)});
-    f.write_vector("/robustness/objective", robjective);
     f.write_vector("/robustness/success", success);
-    f.write_vector("/robustness/simulated", simulated);
-    f.write_dataset("/robustness/outcome", routcome, {hsize_t(m), hsize_t(nk)});
-    f.write_attribute("/robustness/outcome", "columns", format_name_list(outcome_columns()));
   }
   write_design(f, "/initial", run.evaluations[run.initial]);
   write_design(f, "/final", run.evaluations[run.final]);
