@@ -322,4 +322,10 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
   return out;
 }
 
+double dynamics_peak_bytes(const DynamicsScene& scene) {
+  const double elements = scene.model.mesh.num_elements();
+  const double frames = std::ceil(scene.duration / scene.newmark.time_step / scene.output_every) + 2;
+  return 30e3 * elements + 1e3 * std::pow(elements, 4.0 / 3.0) + frames * 2 * 8.0 * scene.model.mesh.num_dofs();
+}
+
 }  // namespace msfab

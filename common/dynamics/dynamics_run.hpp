@@ -23,4 +23,12 @@ struct RunCallbacks {
 
 Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& callbacks = {});
 
+// Peak memory of run_dynamics_scene, from /usr/bin/time on dropped cubes of
+// 1 000 to 15 625 elements (docs/cli.md, "Memory"): about 30 kB per element
+// for the stiffness, damping, mass and contact matrices and the Newton
+// vectors, CHOLMOD's factor (about 1 kB x elements^(4/3)), and the output
+// frames the trajectory keeps (positions and velocities every
+// output_every steps).
+double dynamics_peak_bytes(const DynamicsScene& scene);
+
 }  // namespace msfab

@@ -212,4 +212,14 @@ DistanceSummary summarize_distances(const CellCandidates& candidates, const Mapp
   return s;
 }
 
+double mapping_peak_bytes(const Design& design, const MicrostructureSet& set, const MapperOptions& options) {
+  const double shifts = options.half_shift ? 2 : 1, k = options.candidates.k;
+  std::int64_t design_cells = 0;
+  for (CellRole role : design.roles) design_cells += role == CellRole::design;
+  const double per_cell = 16 + 256 + 16.0 * double(design.raw.cols());
+  const double per_design_cell = 12 * k + 4 * k * shifts;
+  const double faces = 6.0 * (double(set.nx) * set.ny + double(set.ny) * set.nz + double(set.nx) * set.nz) / 3;
+  return per_cell * double(design.cells()) + per_design_cell * double(design_cells) + 4 * faces * shifts * double(set.items.size());
+}
+
 }  // namespace msfab

@@ -65,6 +65,17 @@ std::string format_history(const std::vector<NewtonIteration>& history, size_t m
   return out.str();
 }
 
+std::string static_linear_solver(double dofs, const NewtonOptions& options) {
+  if (options.linear_solver != "auto") return options.linear_solver;
+  return dofs < options.auto_iterative_dofs ? "cholmod" : "pcg-mg";
+}
+
+double static_solve_peak_bytes(double elements, double dofs, const NewtonOptions& options) {
+  const double assembled = 10e3 * elements;
+  return static_linear_solver(dofs, options) == "cholmod" ? assembled + 1e3 * std::pow(elements, 4.0 / 3.0)
+                                                          : assembled;
+}
+
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                           const VecX& force, const NewtonOptions& options, const VecX& x0) {
   const auto t_start = Clock::now();
@@ -78,8 +89,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
   result.x = x0.size() == n ? x0 : X;
   SpMat K = assembler.pattern();
   LinearSolverOptions linear = options.linear;
-  std::string solver_name = options.linear_solver;
-  if (solver_name == "auto") solver_name = n < options.auto_iterative_dofs ? "cholmod" : "pcg-mg";
+  const std::string solver_name = static_linear_solver(n, options);
   if (solver_name == "pcg-mg" && !linear.node_positions)
     linear.node_positions = std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
   auto solver = make_linear_solver(solver_name, linear);

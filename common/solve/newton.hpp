@@ -77,6 +77,17 @@ struct NewtonResult {
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                           const VecX& force, const NewtonOptions& options, const VecX& x0 = VecX());
 
+// The linear solver solve_static runs for `dofs` unknowns: options'
+// linear_solver with "auto" resolved by auto_iterative_dofs.
+std::string static_linear_solver(double dofs, const NewtonOptions& options);
+
+// Peak memory of solve_static on a hexahedral mesh of `elements` elements
+// and `dofs` unknowns, from /usr/bin/time on cubes of 24^3 to 64^3 voxels
+// (docs/cli.md, "Memory"): about 10 kB per element for the assembled
+// matrix, its multigrid hierarchy and Newton's vectors, and for CHOLMOD
+// the factor's nested-dissection fill, about 1 kB x elements^(4/3).
+double static_solve_peak_bytes(double elements, double dofs, const NewtonOptions& options);
+
 // Zeroes the rows and columns of fixed DOFs and puts `diag` on their
 // diagonal, so the system decouples into the free block and an identity-like
 // block whose solution is the prescribed gap.

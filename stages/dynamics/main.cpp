@@ -136,6 +136,10 @@ int main(int argc, char** argv) {
     const DynamicsScene scene = read_dynamics_scene(ctx.config);
     ctx.config.check_no_unknown_keys();
     ctx.check_out_folder();
+    ctx.check_memory(dynamics_peak_bytes(scene),
+                     fmt::format("a run of {} elements over {} s with a frame every {} steps",
+                                 scene.model.mesh.num_elements(), scene.duration, scene.output_every),
+                     "use a coarser geometry.voxel_size, a larger simulation.output_every or a shorter duration");
     spdlog::info("scene '{}': {} elements, {} DOFs, {} obstacles, contact {}, friction {}, impact {}, h = {} s, {} s",
                  scene.name, scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(),
                  scene.model.obstacles.size(), scene.model.contact ? "on" : "off",

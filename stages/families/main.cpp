@@ -155,6 +155,18 @@ VoxelGrid cell_of(const MicrostructureSet& set, std::int64_t s) {
 }
 
 // The members a family's template is refitted to: all, or an even spread.
+// Peak memory of steps 2-3 (docs/cli.md, "Memory"): per structure its
+// smoothed field and half spectrum (about 16 B per pooled voxel), and the
+// Isomap matrices of selected^2 entries (distances, geodesic distances,
+// the double-centred Gram matrix and its eigen-decomposition: about 40 B
+// per pair).
+void check_distance_memory(const StageContext& ctx, std::size_t selected, int pooled_n) {
+  const double m = double(selected);
+  ctx.check_memory(16.0 * m * std::pow(double(pooled_n), 3) + 40.0 * m * m,
+                   "distances between " + std::to_string(selected) + " selected structures",
+                   "narrow the selection window or pool the fields (distance.pool)");
+}
+
 std::vector<std::size_t> members_to_fit(std::size_t members, int max_fits) {
   std::vector<std::size_t> chosen;
   if (members <= std::size_t(max_fits)) {
@@ -269,6 +281,7 @@ int main(int argc, char** argv) {
                        std::to_string(settings.min_members) + " and more than isomap.neighbours = " +
                        std::to_string(settings.isomap.neighbors));
     spdlog::info("{} of {} structures selected ({}^3 voxels)", selected, set.items.size(), set.nx);
+    check_distance_memory(ctx, selected, set.nx / settings.field.pool_factor);
 
     // 2. Distances.
     std::vector<VoxelField> fields(selected);

@@ -34,6 +34,7 @@
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "core/timing.hpp"
+#include "homog/periodic_homogenization.hpp"
 #include "mapping/mapper.hpp"
 #include "mapping/set_lineage.hpp"
 #include "mapping/target_fill.hpp"
@@ -157,6 +158,14 @@ int main(int argc, char** argv) {
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
     check_set_belongs_to_design(design_path, structures_path);
+    MapperOptions coverage_options;
+    coverage_options.candidates = settings.plan.candidates;
+    coverage_options.half_shift = false;
+    ctx.check_memory(mapping_peak_bytes(design, set, coverage_options) +
+                         omp_get_max_threads() * homogenization_peak_bytes(set.nx, set.ny, set.nz, "auto"),
+                     "the coverage of " + std::to_string(design.cells()) + " cells and one cell problem of " +
+                         std::to_string(set.nx) + "^" + (set.nz > 1 ? "3" : "2") + " voxels per thread",
+                     "use fewer threads (OMP_NUM_THREADS) or candidates");
     const auto start = std::chrono::steady_clock::now();
     const std::size_t given = set.items.size();
     set.grid = {};  // generated structures lie off any parameter grid the set had

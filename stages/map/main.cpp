@@ -108,6 +108,10 @@ int main(int argc, char** argv) {
     const Design design = read_design_artifact(design_path);
     check_mapping_inputs(design, design_path, set, structures_path);
     check_set_belongs_to_design(design_path, structures_path);
+    ctx.check_memory(mapping_peak_bytes(design, set, settings.mapper),
+                     "mapping " + std::to_string(design.cells()) + " cells with " +
+                         std::to_string(settings.mapper.candidates.k) + " candidates each",
+                     "use fewer candidates");
     const std::int64_t tiles =
         std::int64_t(settings.tiling) * settings.tiling * (design.dimension == 3 ? settings.tiling : 1);
     const std::int64_t model_voxels = design.cells() * set.nx * set.ny * set.nz * tiles;

@@ -19,6 +19,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <vector>
 
 #include "cli/progress.hpp"
 #include "core/timing.hpp"
@@ -46,6 +48,51 @@ NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticCondi
     throw NumericalError(std::string(label) + ": " + result.failure + "\nresidual history:\n" +
                          format_history(result.history));
   return result;
+}
+
+// Elements of the scene's mesh at coarsening level L: the 2^L blocks that
+// hold a solid voxel.
+double elements_at_level(const VoxelGrid& grid, int level) {
+  const int b = 1 << level;
+  std::int64_t count = 0;
+  for (int k = 0; k < grid.nz; k += b)
+    for (int j = 0; j < grid.ny; j += b)
+      for (int i = 0; i < grid.nx; i += b) {
+        bool solid = false;
+        for (int c = k; c < std::min(k + b, grid.nz) && !solid; ++c)
+          for (int r = j; r < std::min(j + b, grid.ny) && !solid; ++r)
+            for (int q = i; q < std::min(i + b, grid.nx) && !solid; ++q) solid = grid.ids[grid.index(q, r, c)] != 0;
+        count += solid;
+      }
+  return double(count);
+}
+
+// The grid's voxel ids are read before anything can be estimated from
+// them: refuse a grid that cannot even be held.
+void check_grid_memory(const StageContext& ctx) {
+  if (!ctx.config.has("grid.size")) return;  // read_scene names the missing key
+  const auto size = ctx.config.get<std::vector<int>>("grid.size");
+  double voxels = 1;
+  std::string text;
+  for (int n : size) voxels *= std::max(n, 1), text += (text.empty() ? "" : " x ") + std::to_string(n);
+  ctx.check_memory(sizeof(int) * voxels, "a grid of " + text + " voxels (grid.size)",
+                   "use a coarser grid");
+}
+
+// The models this run solves: the scene's level (adaptive: levels 2 and
+// 1; the mixed mesh chosen from them is not known yet), and the fine one
+// when compared.
+void check_solve_memory(const StageContext& ctx, const Scene& scene, std::vector<int> levels, bool solves_fine) {
+  if (solves_fine && levels.front() > 0) levels.push_back(0);
+  double bytes = 0, largest = 0;
+  for (int level : levels) {
+    const double elements = elements_at_level(scene.grid, level);
+    bytes += static_solve_peak_bytes(elements, 3 * elements, scene.newton);
+    largest = std::max(largest, elements);
+  }
+  ctx.check_memory(bytes, fmt::format("a model of {:.0f} elements ({} solver)", largest,
+                                      static_linear_solver(3 * largest, scene.newton)),
+                   levels.front() == 0 ? "coarsen it (--coarsen 1 or 2) or use a coarser grid" : "use a coarser grid");
 }
 
 }  // namespace
@@ -87,15 +134,17 @@ int main(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
 
     // 1. Scene.
+    check_grid_memory(ctx);
     const Scene scene = read_scene(ctx.config);
     ctx.config.check_no_unknown_keys();
+    const bool adaptive = target_option->count() > 0;
+    check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level}, compare_fine);
 
     // 2. Fine mesh and conditions.
     const VoxelMesh fine = build_voxel_mesh(scene.grid, scene.material_by_id);
     const StaticConditions fine_conditions = build_static_conditions(scene, fine);
 
     // 3. Coarse model: uniform, or adaptive from the uniform level-2 and level-1 solves.
-    const bool adaptive = target_option->count() > 0;
     if (adaptive) {
       if (!(target_error > 0) || !std::isfinite(target_error))
         throw InputError("--target-error: must be a finite number > 0 (the mean-vertex error), got " +

@@ -31,6 +31,11 @@ check "(a) each family has 30 members and a one-beam template" -- \
 check "(a) plots" -- test -s "$WORK/two.plots/embedding.png" -a -s "$WORK/two.plots/coverage_nu_G.png" -a \
   -s "$WORK/two.plots/family1.png"
 
+# Memory (docs/cli.md): the distance matrices refused up front under a small limit.
+expect_exit 2 "distances between 60 selected structures needs about .*, more than the 1 MiB of --memory-limit" -- \
+  "$F" "${A[@]}" --memory-limit 1M --out "$WORK/small.families.h5"
+check "the refused run writes nothing" -- test ! -e "$WORK/small.families.h5"
+
 # (b) Three structures along r1 of family 1: E must follow the predicted slope.
 gen=$("$G" --families "$WORK/two.families.h5" --family 1 --reduced=-1,0 --reduced=0,0 --reduced=1,0 \
   --out "$WORK/gen.microstructures.h5" 2>&1)

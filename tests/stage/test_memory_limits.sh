@@ -27,7 +27,40 @@ expect_exit 2 "1000030 structures of 64\^3 voxels \(templates\) needs about" -- 
 expect_exit 2 "2000000000 sampling directions x 3 magnitudes per block \(sampling.sphere_directions" -- \
   $T "$BIN/msfab-ddfem-build" --config "$SRC/configs/ddfem/tiny.yaml" --set sampling.sphere_directions=2000000000 \
   --out "$WORK/d.h5"
+expect_exit 2 "grid of 3000 x 3000 x 3000 voxels \(grid.size\) needs about .* GiB" -- \
+  $T "$BIN/msfab-simulate" --set 'grid.size=[3000,3000,3000]' --out "$WORK/s.h5"
+expect_exit 2 "model of 8000000 elements \(pcg-mg solver\) needs about .* GiB.*coarsen it" -- \
+  $T "$BIN/msfab-simulate" --set 'grid.size=[200,200,200]' --set 'layout=[{fill: 1}]' --out "$WORK/s.h5"
+expect_exit 2 "model of 13824 elements \(cholmod solver\) needs about .* MiB, more than the 100 MiB" -- \
+  $T "$BIN/msfab-simulate" --set 'grid.size=[24,24,24]' --set 'layout=[{fill: 1}]' --set solver.linear_solver=cholmod \
+  --memory-limit 100M --out "$WORK/s.h5"
+expect_exit 2 "run of 8 elements over 10 s with a frame every 1 steps needs about .* GiB" -- \
+  $T "$BIN/msfab-dynamics" --set simulation.time_step=2e-7 --set simulation.duration=10 \
+  --set simulation.output_every=1 --out "$WORK/d.h5"
 check "refused runs leave nothing" -- bash -c "! ls '$WORK' | grep -q '\.h5'"
+
+# The stages that read a design and a set: a 2D set, a design assigned
+# from it, each refused under a small limit.
+check "a 2D set" -- "$BIN/msfab-gamut-sample" --config "$SRC/configs/gamut/tiny2d.yaml" --set cycles=1 \
+  --out "$WORK/set.gamut.h5" --quiet
+cat > "$WORK/assign.yaml" <<'EOF_ASSIGN'
+grid: {size: [64, 32], cell_size: 1.0}
+space: cubic2d
+supports: [{box: {min: [0, 0], max: [0, 32]}}]
+loads: [{name: tip, objective: compliance, forces: [{box: {min: [64, 0], max: [64, 0]}, force: [0, -1]}]}]
+pattern: {kind: random, structures: [0, 1, 2]}
+EOF_ASSIGN
+S="$WORK/set.microstructures.h5"
+check "a design assigned from it" -- "$BIN/msfab-assign" --config "$WORK/assign.yaml" --structures "$S" \
+  --out "$WORK/design.h5" --quiet
+expect_exit 2 "design of 100000 x 100000 cells \(grid.size\) needs about .* GiB" -- \
+  $T "$BIN/msfab-assign" --config "$WORK/assign.yaml" --set 'grid.size=[100000,100000]' --structures "$S" \
+  --out "$WORK/big.h5"
+expect_exit 2 "mapping 2048 cells with 16 candidates each needs about .* MiB, more than the 1 MiB" -- \
+  $T "$BIN/msfab-map" --design "$WORK/design.h5" --structures "$S" --memory-limit 1M --out "$WORK/m.h5"
+expect_exit 2 "coverage of 2048 cells and one cell problem of 8\^2 voxels per thread needs about" -- \
+  $T "$BIN/msfab-fill-targets" --design "$WORK/design.h5" --structures "$S" --memory-limit 1M --out "$WORK/f.h5"
+check "refused runs leave nothing" -- bash -c "! ls '$WORK' | grep -Eq '^(big|m|f)\.h5'"
 
 # The limit given by hand: a small run refused under 1 MiB, the refused
 # 64^3 direct solve let through to its first step by a large limit.
