@@ -39,12 +39,12 @@ void read_measure(const Config& c, JumpMeasureOptions& m, double& settle, std::s
   const Config s = c.child("measure");
   body = s.get_or("body", "");
   settle = s.get_or<double>("settle", settle);
-  if (!(settle >= 0) || !std::isfinite(settle)) s.fail("settle", "must be >= 0 (s)");
+  if (!(settle >= 0)) s.fail("settle", "must be >= 0 (s)");
   const std::string axis = s.get_or("flip_axis", "y");
   if (axis != "x" && axis != "y" && axis != "z") s.fail("flip_axis", "must be x, y or z");
   m.flip_axis = axis[0] - 'x';
   m.min_flight = s.get_or<double>("min_flight", m.min_flight);
-  if (!(m.min_flight >= 0) || !std::isfinite(m.min_flight)) s.fail("min_flight", "must be >= 0 (s)");
+  if (!(m.min_flight >= 0)) s.fail("min_flight", "must be >= 0 (s)");
   if (s.has("upright_tolerance_deg"))
     m.upright_tolerance = s.require_range<double>("upright_tolerance_deg", 0.0, 180.0, Bounds::OpenClosed) * M_PI / 180;
 }
@@ -57,13 +57,13 @@ void read_optimizer(const Config& c, DesignProblem& p) {
   p.starts = o.get_or<int>("starts", p.starts);
   if (p.starts < 1 || p.starts > 1000) o.fail("starts", "must be in [1, 1000]");
   p.spread = o.get_or<double>("spread", p.spread);
-  if (!(p.spread >= 0) || !std::isfinite(p.spread)) o.fail("spread", "must be >= 0 (initial steps)");
+  if (!(p.spread >= 0)) o.fail("spread", "must be >= 0 (initial steps)");
   p.xtol = o.get_or<double>("xtol", p.xtol);
   if (!(p.xtol > 0) || !(p.xtol < 1)) o.fail("xtol", "must be in (0, 1) (normalized parameters)");
   p.stop_below = o.get_or<double>("stop_below", p.stop_below);
-  if (!(p.stop_below >= 0) || !std::isfinite(p.stop_below)) o.fail("stop_below", "must be >= 0");
+  if (!(p.stop_below >= 0)) o.fail("stop_below", "must be >= 0");
   p.length_scale = o.get_or<double>("length_scale", p.length_scale);
-  if (!(p.length_scale > 0) || !std::isfinite(p.length_scale)) o.fail("length_scale", "must be positive (m)");
+  if (!(p.length_scale > 0)) o.fail("length_scale", "must be positive (m)");
 }
 
 void read_robustness(const Config& c, RobustnessCheck& r) {
@@ -121,13 +121,11 @@ DesignProblem read_design_problem(const Config& c) {
   if (p.task == DesignTask::kTarget) {
     p.target_x = c.require_finite("target_x", "target position (m)");
   } else {
-    p.target_flip = c.get_or<double>("target_flip_deg", 0.0) * M_PI / 180;
-    if (!std::isfinite(p.target_flip)) c.fail("target_flip_deg", "must be finite");
+    p.target_flip = c.get_or<double>("target_flip_deg", 0.0) * M_PI / 180;  // finite: the reader refuses others
   }
   if (p.task == DesignTask::kJumpOnto || p.task == DesignTask::kJumpOver) {
     p.obstacle = c.get<std::string>("obstacle");
     p.clearance = c.get_or<double>("clearance", 0.0);
-    if (!std::isfinite(p.clearance)) c.fail("clearance", "must be finite (m)");
   }
   read_measure(c, p.measure, p.settle, p.body);
   read_optimizer(c, p);
