@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <algorithm>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -183,7 +184,7 @@ QuasistaticResult press_until_touch(const DynamicsScene& scene, const NewmarkInt
 // The preloaded state: the scene's initial positions, or the equilibrium
 // under the pluck or press load (with gravity).
 VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder& rec, Trajectory& out) {
-  if (scene.preload == Preload::kNone) return scene.initial_positions;
+  if (scene.preload == Preload::kNone || scene.preload == Preload::kDynamicPress) return scene.initial_positions;
   const auto t0 = std::chrono::steady_clock::now();
   const VecX load = region_force(scene, scene.load, scene.preload == Preload::kStaticPluck ? "pluck" : "press");
   const PreloadFoldCheck fold(scene, sim);
@@ -246,9 +247,18 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
   NewmarkIntegrator sim(scene.model, scene.newmark);
   Recorder rec(scene, sim, out);
   const VecX q0 = preload(scene, sim, rec, out);
-  const VecX v0 = scene.preload == Preload::kNone ? scene.initial_velocities : VecX::Zero(q0.size());
+  const bool from_scene = scene.preload == Preload::kNone || scene.preload == Preload::kDynamicPress;
+  const VecX v0 = from_scene ? scene.initial_velocities : VecX::Zero(q0.size());
   sim.set_state(q0, v0, 0.0);
-  if (scene.preload == Preload::kNone) rec.sample(SimulationPhase::kElastic, q0, v0, StepReport{}, 0.0);
+  if (scene.preload == Preload::kDynamicPress) {
+    const double ramp = scene.press_ramp_time;
+    sim.set_applied_load(region_force(scene, scene.load, "press"),
+                         [ramp](double t) { return std::clamp(t / ramp, 0.0, 1.0); });
+    std::ostringstream detail;
+    detail << "dynamic press: " << scene.load.force.norm() << " N ramped on over " << ramp << " s, then held";
+    rec.event(0.0, "press", detail.str());
+  }
+  if (from_scene) rec.sample(SimulationPhase::kElastic, q0, v0, StepReport{}, 0.0);
 
   const double h = scene.newmark.time_step;
   const int steps = static_cast<int>(std::ceil(scene.duration / h - 1e-9));

@@ -311,11 +311,20 @@ DynamicsScene read_dynamics_scene(const Config& c) {
     s.preload_steps = c.child("pluck").get_or<int>("steps", s.preload_steps);
     if (model.fixed.empty()) c.fail("pluck", "needs a clamp (a free body has no static equilibrium)");
   } else if (c.has("press")) {
-    s.preload = Preload::kQuasistaticPress;
-    s.load = read_region_load(c.child("press"));
-    s.preload_steps = c.child("press").get_or<int>("steps", s.preload_steps);
-    s.stop_at_touch = c.child("press").get_or<bool>("stop_at_touch", false);
+    const Config press = c.child("press");
+    const bool dynamic = press.has("mode") && press.one_of("mode", {"quasistatic", "dynamic"}) == "dynamic";
+    s.preload = dynamic ? Preload::kDynamicPress : Preload::kQuasistaticPress;
+    s.load = read_region_load(press);
+    s.preload_steps = press.get_or<int>("steps", s.preload_steps);
+    s.stop_at_touch = press.get_or<bool>("stop_at_touch", false);
     if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
+    if (dynamic) {
+      s.press_ramp_time = press.require_positive<double>("ramp_time", "seconds from zero to the full load");
+      if (s.stop_at_touch) press.fail("stop_at_touch", "belongs to the quasistatic press (mode: quasistatic)");
+      if (s.rigid.enabled) c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
+    } else if (press.has("ramp_time")) {
+      press.fail("ramp_time", "belongs to mode: dynamic (the quasistatic press steps its load with press.steps)");
+    }
     if (s.body_names.size() > 1)
       c.fail("press", "the quasistatic press handles one body; a scene with several bodies preloads with a pluck");
   }

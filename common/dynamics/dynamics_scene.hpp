@@ -27,7 +27,10 @@ struct RegionLoad {
   Vec3 force = Vec3::Zero();
 };
 
-enum class Preload { kNone, kStaticPluck, kQuasistaticPress };
+// kDynamicPress is B.3's reference for the quasistatic press: the press
+// load is not a preload but acts during the run, ramped from zero to full
+// over `press_ramp_time` and then held (`press.mode: dynamic`).
+enum class Preload { kNone, kStaticPluck, kQuasistaticPress, kDynamicPress };
 
 struct RigidFlightSettings {
   bool enabled = false;
@@ -58,6 +61,7 @@ struct DynamicsScene {
   // not, i.e. when the pressed part touches the part below it, instead of
   // refusing the scene (`press.stop_at_touch`).
   bool stop_at_touch = false;
+  double press_ramp_time = 0;  // kDynamicPress: seconds from zero to the full load
   RigidFlightSettings rigid;
 };
 

@@ -286,7 +286,15 @@ double NewmarkIntegrator::step_potential(const VecX& delta) const {
   const double h = options_.time_step;
   const double elastic = assembler_.energy(q_ + delta);
   if (!std::isfinite(elastic)) return elastic;
-  return 0.5 * delta.dot(inertia_ * delta) - step_rhs_.dot(delta) + h * h / 4 * (elastic - gravity_force_.dot(delta));
+  return 0.5 * delta.dot(inertia_ * delta) - step_rhs_.dot(delta) + h * h / 4 * (elastic - end_force_.dot(delta));
+}
+
+void NewmarkIntegrator::set_applied_load(const VecX& load, std::function<double(double)> scale) {
+  if (load.size() != model_.mesh.num_dofs() || !load.allFinite())
+    throw std::invalid_argument("NewmarkIntegrator::set_applied_load: load does not match the mesh or is not finite");
+  applied_load_ = load;
+  apply_fixed(applied_load_);
+  applied_scale_ = std::move(scale);
 }
 
 StepReport NewmarkIntegrator::step() {
@@ -311,13 +319,18 @@ StepReport NewmarkIntegrator::step() {
       damping_assembler_->evaluate(q_, nullptr, &Kb_t);
   }
   assemble_damping(damping_assembler_ ? &Kb_t : nullptr);
-  const VecX force_t = gravity_force_ - grad_t;
+  VecX force_t = gravity_force_ - grad_t;
+  end_force_ = gravity_force_;
+  if (applied_scale_) {
+    force_t += applied_scale_(time_) * applied_load_;
+    end_force_ += applied_scale_(time_ + h) * applied_load_;
+  }
   // With D held fixed, the -h^2/4 D v^t of b^t cancels against the same
   // term of the end-of-step damping force h^2/4 D (2/h delta - v^t), whose
   // remaining h/2 D delta lives in inertia_.
   step_rhs_ = h * (mass_ * v_) + h * h / 4 * force_t;
   apply_fixed(step_rhs_);
-  force_scale_ = std::max({(mass_ * v_).norm() * h, h * h / 4 * gravity_force_.norm(), h * h / 4 * grad_t.norm(),
+  force_scale_ = std::max({(mass_ * v_).norm() * h, h * h / 4 * end_force_.norm(), h * h / 4 * grad_t.norm(),
                            1e-300});
 
   // Predicted path for collision detection: free flight under gravity.
@@ -380,7 +393,7 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
   for (int it = 1; it <= options_.max_newton_iterations; ++it) {
     const VecX x = q_ + delta;
     assembler_.evaluate(x, &grad, &K);
-    f = inertia_ * delta - step_rhs_ + h * h / 4 * (grad - gravity_force_);
+    f = inertia_ * delta - step_rhs_ + h * h / 4 * (grad - end_force_);
     apply_fixed(f);
     const double residual = (f - contact_force(impulses)).norm() / force_scale_;
     history.push_back(residual);

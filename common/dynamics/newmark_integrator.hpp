@@ -32,6 +32,7 @@
 //      onto zero normal velocity at the contacts that carry force, in the
 //      lumped-mass metric (DKE) or A = M + h^2/4 K + h/2 D (BBI). docs/dynamics.md
 //      explains this reading of Eq. 4.19 / B.20.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -85,6 +86,10 @@ class NewmarkIntegrator {
   // InputError if sizes mismatch, a value is not finite or an element is
   // inverted.
   void set_state(const VecX& q, const VecX& v, double time = 0.0);
+  // An applied force scale(t) * load besides gravity (a press ramped on
+  // during the run). The trapezoidal rule takes it at both ends of a step.
+  // It does no work on Energies (they hold gravity's potential only).
+  void set_applied_load(const VecX& load, std::function<double(double time)> scale);
   // One time step; NumericalError with the residual history if Newton or
   // the contact solve does not converge.
   StepReport step();
@@ -136,6 +141,9 @@ class NewmarkIntegrator {
   std::unique_ptr<CholmodSolver> solver_;
   VecX lumped_mass_;  // per node, the DKE projection's metric
   VecX gravity_force_;
+  VecX applied_load_;
+  std::function<double(double)> applied_scale_;
+  VecX end_force_;  // gravity and the applied load at the end of the current step
   std::vector<int> boundary_nodes_;
   std::unique_ptr<BoundarySurface> surface_;  // with body contact
   std::vector<std::string> node_material_;

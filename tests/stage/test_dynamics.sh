@@ -68,6 +68,28 @@ share=$(awk '/stopped at touch/ { for (i = 1; i <= NF; ++i) if ($i ~ /%$/) print
 echo "press with stop_at_touch: stopped at ${share}% of 3 N"
 check "press.stop_at_touch stops short of a load that folds" -- awk -v s="$share" 'BEGIN { exit !(s > 10 && s < 100) }'
 check "press.stop_at_touch: the run continues" -- test -s "$WORK/touch.h5"
+# The press applied dynamically (B.3; tools/bench_press.sh compares it with
+# the quasistatic press): ramped on over 2 ms, the plate is pushed down and
+# the body stays on the ground; its keys are checked.
+"$BIN/msfab-dynamics" --quiet --config $S/flipper_jumper.yaml --out "$WORK/dynamic_press.h5" \
+  --set press.mode=dynamic --set press.ramp_time=0.002 --set simulation.duration=0.003 \
+  --set simulation.time_step=1e-4 --set simulation.rigid_flight.enabled=false > "$WORK/dynamic_press.txt"
+check "press.mode dynamic: the press event" -- grep -q "event press .* dynamic press: 1.2 N ramped on over 0.002 s" \
+  "$WORK/dynamic_press.txt"
+check "press.mode dynamic: the load puts energy into the body (> 1 mJ)" -- \
+  awk '/energy start/ { gsub(/,/, ""); for (i = 1; i <= NF; ++i) if ($i == "end") e = $(i + 1) } END { exit !(e > 1e-3) }' \
+  "$WORK/dynamic_press.txt"
+expect_exit 2 "missing required key 'press.ramp_time'" -- "$BIN/msfab-dynamics" --config $S/flipper_jumper.yaml --out "$WORK/x.h5" \
+  --set press.mode=dynamic
+expect_exit 2 "press.ramp_time = 0.01: belongs to mode: dynamic" -- "$BIN/msfab-dynamics" --config $S/flipper_jumper.yaml \
+  --out "$WORK/x.h5" --set press.ramp_time=0.01
+expect_exit 2 "stop_at_touch = true: belongs to the quasistatic press" -- "$BIN/msfab-dynamics" \
+  --config $S/flipper_jumper.yaml --out "$WORK/x.h5" --set press.mode=dynamic --set press.ramp_time=0.01 \
+  --set press.stop_at_touch=true --set simulation.rigid_flight.enabled=false
+expect_exit 2 "rigid_flight.enabled = true: a body under a dynamic press is not in free flight" -- "$BIN/msfab-dynamics" --config $S/flipper_jumper.yaml \
+  --out "$WORK/x.h5" --set press.mode=dynamic --set press.ramp_time=0.01
+expect_exit 2 "press.mode = sudden: .*quasistatic, dynamic" -- "$BIN/msfab-dynamics" --config $S/flipper_jumper.yaml \
+  --out "$WORK/x.h5" --set press.mode=sudden
 expect_exit 2 "boxes\[5\].*overlaps a box of body 'catapult'" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml \
   --out "$WORK/x.h5" --set 'geometry.boxes[5].min=[0.030,0.002,0.010]'
 expect_exit 2 "time_step.*must be positive" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" --set simulation.time_step=0

@@ -1,0 +1,37 @@
+#!/bin/bash
+# The quasistatic press against dynamic loading (thesis App. B.3): each
+# scene's press solved by the quasistatic contact solver, and the same load
+# applied in a dynamic run (press.mode: dynamic, ramped on over RAMP s and
+# held until the Rayleigh damping has taken the motion out). Prints, per
+# scene, the Hausdorff distance and elastic-energy difference between the
+# two pressed states and the wall-time ratio (tools/compare_press.py), at
+# the end of the run and at half of it.
+#
+#   tools/bench_press.sh build/bin out/bench/press
+#   DURATION=0.01 tools/bench_press.sh ...   # a quick check of the script
+set -euo pipefail
+source "$(dirname "$0")/dac_bench_lib.sh"
+bench_folders "${1:-build/bin}" "${2:-out/bench/press}"
+H=${TIME_STEP:-1e-4} RAMP=${RAMP:-0.05} DURATION=${DURATION:-0.2}
+PY=/usr/bin/python3
+common=(--threads 1 --quiet --set "simulation.time_step=$H" --set simulation.rigid_flight.enabled=false)
+for scene in flipper_jumper jumper_onto; do
+  cfg=$SRC/configs/dynamics/$scene.yaml
+  qs=$("$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" --set "simulation.duration=$H" --out "${scene}_qs.h5")
+  # A press that stops at touch (press.stop_at_touch) ends at a fraction of
+  # its load; the dynamic run gets that fraction.
+  load=()
+  percent=$(sed -n 's/.*stopped at touch: \([0-9.e+-]*\)% of the load.*/\1/p' <<<"$qs")
+  if [ -n "$percent" ]; then
+    force=$(sed -n '/^press:/,/^[a-z]/p' "$cfg" | sed -n 's/.*force: \[\(.*\)\].*/\1/p' | head -1)
+    scaled=$(awk -v p="$percent" -v f="$force" 'BEGIN { n = split(f, c, ","); s = "";
+      for (i = 1; i <= n; ++i) s = s (i > 1 ? ", " : "") c[i] * p / 100; print "[" s "]" }')
+    load=(--set "press.force=$scaled")
+    echo "== $scene: the quasistatic press stopped at touch at $percent% of its load; dynamic load $scaled N"
+  fi
+  "$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" "${load[@]}" --set press.stop_at_touch=false --set press.mode=dynamic \
+    --set "press.ramp_time=$RAMP" --set "simulation.duration=$DURATION" --out "${scene}_dynamic.h5" > /dev/null
+  echo "== $scene (h = $H s, ramp $RAMP s)"
+  $PY "$SRC/tools/compare_press.py" "${scene}_qs.h5" "${scene}_dynamic.h5"
+  $PY "$SRC/tools/compare_press.py" "${scene}_qs.h5" "${scene}_dynamic.h5" --at "$(awk -v d="$DURATION" 'BEGIN { print d / 2 }')"
+done
