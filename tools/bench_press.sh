@@ -15,22 +15,35 @@ bench_folders "${1:-build/bin}" "${2:-out/bench/press}"
 H=${TIME_STEP:-1e-4} RAMP=${RAMP:-0.05} DURATION=${DURATION:-0.2}
 PY=/usr/bin/python3
 common=(--threads 1 --quiet --set "simulation.time_step=$H" --set simulation.rigid_flight.enabled=false)
-for scene in flipper_jumper jumper_onto; do
-  cfg=$SRC/configs/dynamics/$scene.yaml
-  qs=$("$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" --set "simulation.duration=$H" --out "${scene}_qs.h5")
+# name | config | extra --set arguments (separated by ';')
+SCENES=(
+  "flipper_jumper|flipper_jumper.yaml|"
+  "flipper_short_low|flipper_param.yaml|parameters.length=0.034;parameters.hinge_height=0.006;press.force=[0, 0, -2]"
+  "soft_block|block_drop_face.yaml|materials[0].E=2e6;geometry.voxel_size=0.0025;placement.translation=[0, 0, 0];press={region: {min: [0, 0, 0.01], max: [0.005, 0.01, 0.01]}, force: [0.3, 0, -3]}"
+)
+for entry in "${SCENES[@]}"; do
+  IFS='|' read -r scene file sets <<<"$entry"
+  cfg=$SRC/configs/dynamics/$file
+  extra=()
+  IFS=';' read -r -a pairs <<<"$sets"
+  for kv in "${pairs[@]}"; do [ -n "$kv" ] && extra+=(--set "$kv"); done
+  qs=$("$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" "${extra[@]}" --set "simulation.duration=$H" \
+    --out "${scene}_qs.h5")
   # A press that stops at touch (press.stop_at_touch) ends at a fraction of
   # its load; the dynamic run gets that fraction.
   load=()
   percent=$(sed -n 's/.*stopped at touch: \([0-9.e+-]*\)% of the load.*/\1/p' <<<"$qs")
   if [ -n "$percent" ]; then
-    force=$(sed -n '/^press:/,/^[a-z]/p' "$cfg" | sed -n 's/.*force: \[\(.*\)\].*/\1/p' | head -1)
+    force=$(sed -n 's/.*press\.force=\[\([^]]*\)\].*/\1/p' <<<"$sets")
+    [ -n "$force" ] || { echo "$scene: a press that stops at touch needs its press.force in the scene list" >&2; exit 1; }
     scaled=$(awk -v p="$percent" -v f="$force" 'BEGIN { n = split(f, c, ","); s = "";
       for (i = 1; i <= n; ++i) s = s (i > 1 ? ", " : "") c[i] * p / 100; print "[" s "]" }')
     load=(--set "press.force=$scaled")
     echo "== $scene: the quasistatic press stopped at touch at $percent% of its load; dynamic load $scaled N"
   fi
-  "$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" "${load[@]}" --set press.stop_at_touch=false --set press.mode=dynamic \
-    --set "press.ramp_time=$RAMP" --set "simulation.duration=$DURATION" --out "${scene}_dynamic.h5" > /dev/null
+  "$BIN/msfab-dynamics" --config "$cfg" "${common[@]}" "${extra[@]}" "${load[@]}" --set press.stop_at_touch=false \
+    --set press.mode=dynamic --set "press.ramp_time=$RAMP" --set "simulation.duration=$DURATION" \
+    --out "${scene}_dynamic.h5" > /dev/null
   echo "== $scene (h = $H s, ramp $RAMP s)"
   $PY "$SRC/tools/compare_press.py" "${scene}_qs.h5" "${scene}_dynamic.h5"
   $PY "$SRC/tools/compare_press.py" "${scene}_qs.h5" "${scene}_dynamic.h5" --at "$(awk -v d="$DURATION" 'BEGIN { print d / 2 }')"
