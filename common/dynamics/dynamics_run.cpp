@@ -1,9 +1,9 @@
 #include "dynamics/dynamics_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <algorithm>
 #include <sstream>
 
 #include "core/errors.hpp"

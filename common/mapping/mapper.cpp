@@ -219,7 +219,8 @@ double mapping_peak_bytes(const Design& design, const MicrostructureSet& set, co
   const double per_cell = 16 + 256 + 16.0 * double(design.raw.cols());
   const double per_design_cell = 12 * k + 4 * k * shifts;
   const double faces = 6.0 * (double(set.nx) * set.ny + double(set.ny) * set.nz + double(set.nx) * set.nz) / 3;
-  return per_cell * double(design.cells()) + per_design_cell * double(design_cells) + 4 * faces * shifts * double(set.items.size());
+  return per_cell * double(design.cells()) + per_design_cell * double(design_cells) +
+         4 * faces * shifts * double(set.items.size());
 }
 
 }  // namespace msfab

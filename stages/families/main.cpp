@@ -154,7 +154,6 @@ VoxelGrid cell_of(const MicrostructureSet& set, std::int64_t s) {
   return cell;
 }
 
-// The members a family's template is refitted to: all, or an even spread.
 // Peak memory of steps 2-3 (docs/cli.md, "Memory"): per structure its
 // smoothed field and half spectrum (about 16 B per pooled voxel), and the
 // Isomap matrices of selected^2 entries (distances, geodesic distances,
@@ -167,6 +166,7 @@ void check_distance_memory(const StageContext& ctx, std::size_t selected, int po
                    "narrow the selection window or pool the fields (distance.pool)");
 }
 
+// The members a family's template is refitted to: all, or an even spread.
 std::vector<std::size_t> members_to_fit(std::size_t members, int max_fits) {
   std::vector<std::size_t> chosen;
   if (members <= std::size_t(max_fits)) {
