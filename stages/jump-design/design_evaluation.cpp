@@ -2,8 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -135,6 +135,7 @@ DesignEvaluator::DesignEvaluator(const DesignProblem& problem) : problem_(proble
   for (const DesignParameter& q : problem.parameters) initial.push_back(q.initial);
   const DynamicsScene scene = build_scene(problem, initial);
   elements_ = scene.model.mesh.num_elements();
+  peak_bytes_ = dynamics_peak_bytes(scene);
   // Every corner of the bounds must give a valid scene (box faces in the
   // same order as at the initial design), so that bad bounds stop the run
   // here rather than as failed evaluations later; with faces linear in the

@@ -47,6 +47,8 @@ class DesignEvaluator {
   Evaluation evaluate(const std::vector<double>& parameters, int start, int index, double modulus_scale = 1.0) const;
 
   int elements() const { return elements_; }
+  // Peak memory of one evaluation at the initial design (dynamics_peak_bytes).
+  double peak_bytes() const { return peak_bytes_; }
   const Obstacle* obstacle() const { return has_obstacle_ ? &obstacle_ : nullptr; }
 
  private:
@@ -54,6 +56,7 @@ class DesignEvaluator {
   Obstacle obstacle_;
   bool has_obstacle_ = false;
   int elements_ = 0;
+  double peak_bytes_ = 0;
 };
 
 // The penalty a failed simulation gets: far worse than any outcome, finite

@@ -50,6 +50,10 @@ int main(int argc, char** argv) {
     ctx.config.check_no_unknown_keys();
     const DesignEvaluator evaluator(problem);
     ctx.check_out_folder();
+    ctx.check_memory(omp_get_max_threads() * evaluator.peak_bytes(),
+                     "one simulation of " + std::to_string(evaluator.elements()) + " elements per thread (" +
+                         std::to_string(omp_get_max_threads()) + " threads)",
+                     "use fewer threads (--threads) or a coarser scene");
     if (rank == 0)
       spdlog::info("{} design of {}: {} parameters, {} elements, {} start(s) x <= {} evaluations; {} rank(s) x {} thread(s)",
                    design_task_name(problem.task), problem.scene_path, problem.parameters.size(), evaluator.elements(),

@@ -75,6 +75,9 @@ check "a given design on its reference mesh" -- "$DESIGN" --config "$WORK/design
   --set 'scene_set=["parameters.length=0.0137", "reference_parameters.length=0.010"]' \
   --set optimizer.max_evaluations=1 --set optimizer.starts=1 --set robustness.samples=2 --out "$WORK/given.h5" --quiet
 check "the given design is the one evaluated" -- bash -c "h5dump -d /final/parameters '$WORK/given.h5' | grep -q '0.0137, 0.5'"
+expect_exit 2 "one simulation of 2 elements per thread \(2 threads\) needs about .*, more than the 64 kiB of --memory-limit" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --threads 2 --memory-limit 64K --out "$WORK/big.h5"
+check "the refused design loop writes nothing" -- test ! -e "$WORK/big.h5"
 expect_exit 2 "robustness.modulus.*must be in \[0, 1\)" -- \
   "$DESIGN" --config "$WORK/design.yaml" --set robustness.modulus=1.5 --out "$WORK/bad.h5"
 expect_exit 2 "modulus_scale.*must be positive" -- "$BIN/msfab-dynamics" --config "$WORK/throw.yaml" \
