@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <filesystem>
@@ -85,6 +86,15 @@ void check_output_path(const CLI::App& cli, const std::string& out) {
 const std::string& StageContext::require_out() const {
   if (options.out.empty()) throw InputError("missing --out PATH (where to write the result)");
   return options.out;
+}
+
+ConfigGridSize config_grid_size(const Config& config, const std::string& key) {
+  ConfigGridSize size;
+  if (!config.has(key)) return size;
+  size.counts = config.get<std::vector<int>>(key);
+  size.cells = 1;
+  for (int n : size.counts) size.cells *= std::max(n, 1), size.text += (size.text.empty() ? "" : " x ") + std::to_string(n);
+  return size;
 }
 
 void StageContext::check_memory(double estimated_bytes, const std::string& what, const std::string& remedy) const {

@@ -39,6 +39,16 @@ struct StageOptions {
   std::string memory_limit;            // --memory-limit; empty = available memory
 };
 
+// A `grid.size`-style list of cell counts from the config, for memory
+// estimates made before the scene is read: the counts, their product and
+// "nx x ny x nz". Empty when the key is absent (the scene reader names it).
+struct ConfigGridSize {
+  std::vector<int> counts;
+  double cells = 0;
+  std::string text;
+};
+ConfigGridSize config_grid_size(const Config& config, const std::string& key = "grid.size");
+
 struct StageContext {
   std::string stage_name;
   Config config;  // loaded, overrides applied

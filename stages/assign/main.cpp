@@ -67,12 +67,8 @@ const char* kind_name(PatternKind kind) {
 // node loads; about 250 B, measured with /usr/bin/time on 200 x 200 x 100
 // cells (1.0 GB). Checked from grid.size before the scene is read.
 void check_grid_memory(const StageContext& ctx) {
-  if (!ctx.config.has("grid.size")) return;  // read_topopt_scene names the missing key
-  double cells = 1;
-  std::string text;
-  for (int n : ctx.config.get<std::vector<int>>("grid.size"))
-    cells *= std::max(n, 1), text += (text.empty() ? "" : " x ") + std::to_string(n);
-  ctx.check_memory(250.0 * cells, "a design of " + text + " cells (grid.size)", "use a coarser grid");
+  const ConfigGridSize size = config_grid_size(ctx.config);
+  ctx.check_memory(250.0 * size.cells, "a design of " + size.text + " cells (grid.size)", "use a coarser grid");
 }
 
 }  // namespace

@@ -70,13 +70,8 @@ double elements_at_level(const VoxelGrid& grid, int level) {
 // The grid's voxel ids are read before anything can be estimated from
 // them: refuse a grid that cannot even be held.
 void check_grid_memory(const StageContext& ctx) {
-  if (!ctx.config.has("grid.size")) return;  // read_scene names the missing key
-  const auto size = ctx.config.get<std::vector<int>>("grid.size");
-  double voxels = 1;
-  std::string text;
-  for (int n : size) voxels *= std::max(n, 1), text += (text.empty() ? "" : " x ") + std::to_string(n);
-  ctx.check_memory(sizeof(int) * voxels, "a grid of " + text + " voxels (grid.size)",
-                   "use a coarser grid");
+  const ConfigGridSize size = config_grid_size(ctx.config);
+  ctx.check_memory(sizeof(int) * size.cells, "a grid of " + size.text + " voxels (grid.size)", "use a coarser grid");
 }
 
 // The models this run solves: the scene's level (adaptive: levels 2 and

@@ -44,16 +44,13 @@ namespace {
 // MMA at 128 x 64 x 32). Read before the scene, so that a grid that cannot
 // fit is refused before its per-cell arrays are allocated.
 void check_grid_memory(const StageContext& ctx, const Config& config) {
-  if (!config.has("grid.size")) return;  // read_topopt_scene names the missing key
-  const auto size = config.get<std::vector<int>>("grid.size");
-  double cells = 1;
-  for (int n : size) cells *= std::max(n, 1);
+  const ConfigGridSize size = config_grid_size(config);
+  if (size.counts.empty()) return;  // read_topopt_scene names the missing key
   const int m = std::clamp(config.get_or<int>("elements_per_cell", 1), 1, 8);
-  const double elements = cells * (size.size() == 3 ? double(m) * m * m : 1.0);
-  const double bytes = size.size() == 2 ? 265.0 * elements * std::log2(std::max(elements, 2.0)) : 5e3 * elements;
-  std::string text;
-  for (int n : size) text += (text.empty() ? "" : " x ") + std::to_string(n);
-  ctx.check_memory(bytes, "a grid of " + text + " cells (grid.size)" + (m > 1 ? " with elements_per_cell " + std::to_string(m) : std::string()),
+  const double elements = size.cells * (size.counts.size() == 3 ? double(m) * m * m : 1.0);
+  const double bytes =
+      size.counts.size() == 2 ? 265.0 * elements * std::log2(std::max(elements, 2.0)) : 5e3 * elements;
+  ctx.check_memory(bytes, "a grid of " + size.text + " cells (grid.size)" + (m > 1 ? " with elements_per_cell " + std::to_string(m) : std::string()),
                    "use a coarser grid");
 }
 // A 2D cantilever (Fig. 3-16's loading): left side clamped, a downward load
