@@ -47,6 +47,16 @@ hex8::NodeMatrix deformed(const hex8::NodeMatrix& X, const Vec24& u) {
 
 }  // namespace
 
+std::string fit_residual_name(CoarseFitOptions::Residual residual) {
+  return residual == CoarseFitOptions::Residual::absolute ? "absolute" : "relative";
+}
+
+CoarseFitOptions::Residual parse_fit_residual(const std::string& name) {
+  for (auto r : {CoarseFitOptions::Residual::relative, CoarseFitOptions::Residual::absolute})
+    if (fit_residual_name(r) == name) return r;
+  throw InputError("unknown fit residual '" + name + "' (relative or absolute)");
+}
+
 void CoarseMaterialFit::resize(int points) {
   mu.assign(points, 0.0), lambda.assign(points, 0.0), C.assign(points, 0.0);
   mu0.assign(points, 0.0), lambda0.assign(points, 0.0);
@@ -262,15 +272,24 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     double total = 0;
     for (int s = 0; s < ns; ++s)
       if (held[s] == split) {
-        weight[s] = kind_weight[int(kind[s])] / count[int(kind[s])];
+        weight[s] = kind_weight[int(kind[s])] / (options.balance_kinds ? count[int(kind[s])] : 1);
         total += weight[s];
       }
     for (int s = 0; s < ns; ++s)
       if (held[s] == split && total > 0) weight[s] /= total;
   }
 
-  // Rows: each training sample's residual relative to its own energy, times
+  // Rows: each training sample's residual relative to its own energy (or to
+  // the block's RMS training energy for the absolute residual), times
   // sqrt(weight); then sqrt(reg) * (p_j - p0_j) / scale_j.
+  double energy_ref = 0;
+  for (int s = 0; s < ns; ++s)
+    if (!held[s]) energy_ref += weight[s] * V0[s] * V0[s];
+  energy_ref = std::sqrt(energy_ref);
+  if (options.residual == CoarseFitOptions::Residual::absolute && !(energy_ref > 0)) {
+    fit.not_fitted_reason = "no training sample has a weight";
+    return fit;
+  }
   const int rows = fit.samples_train + np;
   MatX A = MatX::Zero(rows, np);
   VecX b = VecX::Zero(rows);
@@ -278,7 +297,8 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     int r = 0;
     for (int s = 0; s < ns; ++s) {
       if (held[s]) continue;
-      const double w = std::sqrt(weight[s]) / V0[s];
+      const double w =
+          std::sqrt(weight[s]) / (options.residual == CoarseFitOptions::Residual::absolute ? energy_ref : V0[s]);
       for (int k = 0; k < points; ++k) {
         A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
         A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];

@@ -64,8 +64,24 @@ struct CoarseFitOptions {
   // deform differently, and the fit stiffens it (docs/ddfem.md, "Affine
   // samples on the enhanced element"). Level 1; meant for periodic sampling.
   bool mixed_blocks_affine_only = false;
+  // How a sample's energy error enters the data term. relative: against the
+  // sample's own fine energy, (V1 - V0) / V0, so small and large loads count
+  // alike. absolute: Eq. 2.8 as written, (V1 - V0) / V_ref with one V_ref for
+  // the block (the weighted RMS fine energy of its training samples, which
+  // keeps the regularizer's scale), so the largest loads dominate.
+  enum class Residual { relative, absolute };
+  Residual residual = Residual::relative;
+  // Share each kind's weight among its samples, so that a kind counts the
+  // same whatever its sample count. false: every sample weighs its kind's
+  // weight, as in Eq. 2.8's plain sum (with unit weights, kinds with more
+  // patterns count more).
+  bool balance_kinds = true;
   std::uint64_t split_seed = 11;
 };
+
+// "relative", "absolute"; parse_fit_residual throws InputError on anything else.
+std::string fit_residual_name(CoarseFitOptions::Residual residual);
+CoarseFitOptions::Residual parse_fit_residual(const std::string& name);
 
 struct CoarseMaterialFit {
   bool fitted = false;
