@@ -406,6 +406,13 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   return result;
 }
 
+double modal_analysis_peak_bytes(double elements, double dofs, const ModalOptions& options) {
+  const double wanted = options.num_modes + (options.skip_rigid ? 6 : 0);
+  const double width = options.block_size > 0 ? options.block_size : std::max(2 * wanted, wanted + 6);
+  return 12e3 * elements + 0.7e3 * std::pow(elements, 4.0 / 3.0) +
+         8.0 * dofs * (3.0 * options.krylov_blocks + 6.0) * width;
+}
+
 ModalResult modal_analysis(const HexMesh& mesh, const std::vector<double>& density,
                            const std::vector<char>& fixed, const ModalOptions& options) {
   ElasticAssembler assembler(mesh);

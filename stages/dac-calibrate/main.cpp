@@ -12,6 +12,7 @@
 //      E_n = lambda_t / lambda_1^0 E_m (Eq. 4.16-4.18)
 //   6. write the `msfab.dac_model` artifact; scenes use it through a
 //      material's `dac_model:` key
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -109,6 +110,18 @@ int main(int argc, char** argv) {
     if (material_index < 0) c.fail("material", "the scene has no material '" + material + "'");
     const double E_m = rig.materials[material_index].E;
     ctx.check_out_folder();
+    {
+      // The finest mesh searched has 8^search_levels times the rig's elements.
+      ModalOptions modal;
+      modal.num_modes = num_modes;
+      modal.skip_rigid = rig.model.fixed.empty();
+      const double refinement = std::pow(8.0, search_levels);
+      const double elements = refinement * rig.model.mesh.num_elements();
+      ctx.check_memory(modal_analysis_peak_bytes(elements, refinement * rig.model.mesh.num_dofs(), modal),
+                       fmt::format("the modes of {:.0f} elements ({} modes{})", elements, num_modes,
+                                   search_levels > 0 ? fmt::format(", search_levels {}", search_levels) : ""),
+                       "use fewer search_levels or a coarser geometry.voxel_size in the scene");
+    }
 
     // 2-3. Mesh and modes.
     double voxel_size = rig.grid.voxel_size;

@@ -37,6 +37,9 @@ expect_exit 2 "model of 13824 elements \(cholmod solver\) needs about .* MiB, mo
 expect_exit 2 "run of 8 elements over 10 s with a frame every 1 steps needs about .* GiB" -- \
   $T "$BIN/msfab-dynamics" --set simulation.time_step=2e-7 --set simulation.duration=10 \
   --set simulation.output_every=1 --out "$WORK/d.h5"
+expect_exit 2 "the modes of 2621440 elements \(4 modes, search_levels 5\) needs about .* GiB" -- \
+  $T "$BIN/msfab-dac-calibrate" --set "scene=$SRC/configs/dynamics/cantilever_pluck.yaml" --set search_levels=5 \
+  --out "$WORK/c.h5"
 check "refused runs leave nothing" -- bash -c "! ls '$WORK' | grep -q '\.h5'"
 
 # The stages that read a design and a set: a 2D set, a design assigned
