@@ -12,6 +12,7 @@
 #   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
 #   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
+#   make -f Makefile.pipeline ddfem-table-thesis-settings  the thesis's sampling and fit, and level 2 over 100/400/1024 materials
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
 # cluster MPIRUN="srun" (pipelines/slurm/ddfem_build.sbatch). A build that is
@@ -112,3 +113,27 @@ ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(
 	  COARSE_ARGS="--coarse-fallback $(FALLBACK)" \
 	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-$(ENHANCED_DB)-$(FALLBACK) docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+
+# The thesis's own settings (docs/ddfem.md, "The thesis's settings"), level 1:
+# palette3.yaml against palette3_thesis.yaml (about 2500 force samples, 500
+# stretches, Eq. 2.8's absolute residual) and the two halves of the change
+# alone; and palette3 compressed to 100, 400 and 1024 materials, the bases
+# that level 2 pairs. Level 2 over each of those bases.
+DDFEM_K1_SWEEP := 100 400 1024
+DDFEM_SETTINGS_L1 := palette3 palette3_thesis palette3_eq28fit palette3_thesis_sampling
+$(foreach k,$(DDFEM_K1_SWEEP),$(OUT)/ddfem/palette3.k$(k).coarse_db.h5): \
+  $(OUT)/ddfem/palette3.k%.coarse_db.h5: $(OUT)/ddfem/palette3.coarse_db.h5 $(BIN)/msfab-ddfem-compress
+	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$* --out $@
+$(OUT)/ddfem/palette3.level2.k%.coarse_db.h5: configs/ddfem/palette3_level2.yaml $(OUT)/ddfem/palette3.k%.coarse_db.h5 \
+                                             $(BIN)/msfab-ddfem-build
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
+	  --set base_database=$(OUT)/ddfem/palette3.k$*.coarse_db.h5 --out $@ --resume
+.PHONY: ddfem-table-thesis-settings
+ddfem-table-thesis-settings: build $(foreach d,$(DDFEM_SETTINGS_L1),$(OUT)/ddfem/$(d).coarse_db.h5) \
+                             $(foreach k,$(DDFEM_K1_SWEEP),$(OUT)/ddfem/palette3.level2.k$(k).coarse_db.h5)
+	BENCH_SECTION=ddfem-thesis-settings bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-settings \
+	  docs/BENCHMARKS.md $(foreach d,$(DDFEM_SETTINGS_L1),$(d)=$(OUT)/ddfem/$(d).coarse_db.h5) \
+	  $(foreach k,$(DDFEM_K1_SWEEP),k$(k)=$(OUT)/ddfem/palette3.k$(k).coarse_db.h5)
+	LEVEL=2 BENCH_SECTION=ddfem-thesis-settings-level2 bash tools/bench_ddfem_databases.sh $(BIN) \
+	  $(OUT)/bench/ddfem-settings docs/BENCHMARKS.md \
+	  $(foreach k,$(DDFEM_K1_SWEEP),over-k$(k)=$(OUT)/ddfem/palette3.level2.k$(k).coarse_db.h5)
