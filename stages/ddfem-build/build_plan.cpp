@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "core/errors.hpp"
 #include "ddfem/cube_symmetry.hpp"
@@ -65,7 +67,7 @@ BuildPlan plan_level1(const BuildOptions& options) {
   return plan;
 }
 
-BuildPlan plan_level2(const BuildOptions& options) {
+BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memory) {
   auto base = std::make_shared<CoarseDatabase>(read_coarse_db(options.base_database));
   if (base->level != 1)
     throw InputError(options.base_database + ": base_database must be a level-1 database, this one is level " +
@@ -76,9 +78,21 @@ BuildPlan plan_level2(const BuildOptions& options) {
                        "with void children without usable samples); compress it first with msfab-ddfem-compress, "
                        "which keeps the fitted ones");
   const int k1 = static_cast<int>(base->entries.size());
-  if (k1 > 1024)
+  // The first pairing stage holds every one of the (k1 + 1)^2 candidates'
+  // log-energy features (8 B each) and the farthest-point search's distance
+  // and nearest representative (12 B); the later stages pair at most
+  // max(representatives)^2. The thesis paired all 6561 level-1 materials of
+  // its palette: 43 M candidates, about 11.5 GB with 32 deformations.
+  const double pairs = std::pow(std::max<double>(k1 + 1, *std::max_element(options.hierarchy.representatives.begin(),
+                                                                           options.hierarchy.representatives.end())),
+                                2.0);
+  check_memory(pairs * (8.0 * options.hierarchy.deformations + 12.0),
+               "pairing " + std::to_string(k1) + " level-1 materials (" + std::to_string(std::int64_t(k1) * k1) +
+                   " candidates x " + std::to_string(options.hierarchy.deformations) + " level2.deformations)",
+               "compress the base first (msfab-ddfem-compress --set representatives=K)");
+  if (std::int64_t(k1 + 1) * (k1 + 1) > std::numeric_limits<int>::max())
     throw InputError(options.base_database + ": " + std::to_string(k1) +
-                     " coarse materials (k1^2 pair candidates); compress it to at most 1024 with msfab-ddfem-compress");
+                     " coarse materials give more pair candidates than a lookup table can index; compress it first");
   BuildPlan plan;
   plan.db.level = 2;
   plan.db.materials = base->materials;

@@ -31,8 +31,12 @@ struct BuildPlan {
 // cube symmetries (or one orbit each without symmetry).
 BuildPlan plan_level1(const BuildOptions& options);
 // Level 2: reads options.base_database (InputError if it is not a level-1
-// database or has more than 1024 coarse materials) and builds the hierarchy.
-BuildPlan plan_level2(const BuildOptions& options);
+// database of fitted materials) and builds the hierarchy.
+// check_memory(bytes, what, remedy) is called with the pair candidates'
+// features and search state before the hierarchy is built (it throws to
+// refuse; StageContext::check_memory).
+using MemoryCheck = std::function<void(double, const std::string&, const std::string&)>;
+BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memory);
 
 // The finished database from the fits of every item. NumericalError if an
 // item could not be fitted.

@@ -110,7 +110,9 @@ int main(int argc, char** argv) {
 
     // 2. What to fit.
     const bool level2 = !options.base_database.empty();
-    const BuildPlan plan = level2 ? plan_level2(options) : plan_level1(options);
+    const BuildPlan plan = level2 ? plan_level2(options, [&](double bytes, const std::string& what, const std::string& remedy) {
+                                              ctx.check_memory(bytes, what, remedy);
+                                            }) : plan_level1(options);
     const std::string config_text = ctx.config.resolved_text() + (plan.fingerprint.empty() ? "" : "# " + plan.fingerprint + "\n");
     if (rank == 0) {
       if (level2)

@@ -86,6 +86,11 @@ expect_exit 2 "takes its palette from base_database" -- "$BUILD" --config "$L2" 
 expect_exit 2 "level2.representatives" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
   --set 'level2.representatives=[4, 4]' --out "$WORK/bad.h5"
 expect_exit 2 "needs base_database" -- "$BUILD" --config "$TINY" --set 'level2.deformations=4' --out "$WORK/bad.h5"
+# The pairing's memory is checked before the hierarchy is built (the thesis
+# paired all 6561 level-1 materials of its palette; a machine decides).
+expect_exit 2 "pairing 256 level-1 materials \(65536 candidates x [0-9]+ level2.deformations\) needs about .* MiB, more than the 4 MiB" -- \
+  "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" --memory-limit 4M --out "$WORK/l2mem.h5"
+check "a refused level-2 build writes nothing" -- test ! -e "$WORK/l2mem.h5"
 
 # Bad palettes.
 sed 's/nu: 0.45, density: 1200/nu: 0.5, density: 1200/' "$TINY" > "$WORK/nu05.yaml"
