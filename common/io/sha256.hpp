@@ -1,11 +1,15 @@
 #pragma once
 // SHA-256 (FIPS 180-4), used to record the content hash of every input
-// artifact in an output's provenance.
+// artifact in an output's provenance. The digest is OpenSSL's libcrypto
+// (EVP interface); this header keeps libcrypto out of its includers.
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
+
+struct evp_md_ctx_st;  // OpenSSL's EVP_MD_CTX
 
 namespace msfab {
 
@@ -14,18 +18,19 @@ namespace msfab {
 class Sha256 {
  public:
   Sha256();
+  ~Sha256();
+  Sha256(const Sha256&) = delete;
+  Sha256& operator=(const Sha256&) = delete;
   void update(const void* data, std::size_t size);
   void update(std::string_view data) { update(data.data(), data.size()); }
   std::array<std::uint8_t, 32> digest();
   std::string hex();  // 64 lowercase hex digits
 
  private:
-  void compress(const std::uint8_t* block);
-
-  std::array<std::uint32_t, 8> state_;
-  std::array<std::uint8_t, 64> buffer_;
-  std::size_t buffered_ = 0;
-  std::uint64_t total_bytes_ = 0;
+  struct FreeContext {
+    void operator()(evp_md_ctx_st* context) const;
+  };
+  std::unique_ptr<evp_md_ctx_st, FreeContext> context_;
   bool finished_ = false;
 };
 

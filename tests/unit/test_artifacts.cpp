@@ -10,6 +10,7 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -552,6 +553,11 @@ TEST(Sha256, PiecewiseUpdatesMatchOneShot) {
     }
   }
   EXPECT_NE(sha256_hex(message.substr(0, 55)), sha256_hex(message.substr(0, 56)));
+  Sha256 finished;
+  finished.update("abc");
+  EXPECT_EQ(finished.hex(), sha256_hex("abc"));
+  EXPECT_THROW(finished.update("d"), std::logic_error);
+  EXPECT_THROW(finished.digest(), std::logic_error);
 }
 
 using Sha256File = ScratchDir;
