@@ -9,7 +9,8 @@
 #   tools/bench_ddfem_databases.sh BIN OUTDIR BENCHMARKS.md LABEL=DATABASE [LABEL=DATABASE ...]
 # Env: LEVEL (1), SCENES (the Table 2.2 and mixed-block scenes), BENCH_SECTION
 # (ddfem-databases), COARSE_ARGS (extra msfab-simulate arguments for the
-# coarse runs, e.g. "--coarse-fallback galerkin").
+# coarse runs, e.g. "--coarse-fallback galerkin"), BENCH_TIMES (1; 0 leaves the
+# seconds out, for runs measured beside other work).
 set -euo pipefail
 BIN=$1 OUTDIR=$2 DOC=$3
 shift 3
@@ -41,7 +42,7 @@ for scene in "${SCENE_LIST[@]}"; do
   naive=failed naive_t=""
   run "$naive_out" --config "$cfg" --coarsen "$LEVEL" --reference "$fine" --coarse-material naive &&
     naive=$(attr "$naive_out" /coarsening error_vs_fine) && naive_t=$(attr "$naive_out" /timings newton_total)
-  row="| $scene | $naive |"
+  row="| $scene | $(awk -v n="$naive" 'BEGIN { if (n == "failed") print n; else printf "%.2e", n }') |"
   time_row="| $scene | $(printf %.3f "$fine_seconds") | ${naive_t:-—} |"
   for i in "${!LABELS[@]}"; do
     out="$OUTDIR/$scene-L$LEVEL-${LABELS[$i]}.h5"
@@ -63,7 +64,8 @@ table="Measured $(date -u +%Y-%m-%d) on $machine, revision $(git -C "$SRC" rev-p
 
 $header
 $rule
-${rows}
+${rows}"
+[ "${BENCH_TIMES:-1}" = 0 ] || table+="
 Newton seconds of the same runs (in brackets the speedup over the fine solve):
 
 $theader
