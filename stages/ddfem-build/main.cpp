@@ -110,9 +110,10 @@ int main(int argc, char** argv) {
 
     // 2. What to fit.
     const bool level2 = !options.base_database.empty();
-    const BuildPlan plan = level2 ? plan_level2(options, [&](double bytes, const std::string& what, const std::string& remedy) {
-                                              ctx.check_memory(bytes, what, remedy);
-                                            }) : plan_level1(options);
+    const MemoryCheck check_memory = [&](double bytes, const std::string& what, const std::string& remedy) {
+      ctx.check_memory(bytes, what, remedy);
+    };
+    const BuildPlan plan = level2 ? plan_level2(options, check_memory) : plan_level1(options);
     const std::string config_text = ctx.config.resolved_text() + (plan.fingerprint.empty() ? "" : "# " + plan.fingerprint + "\n");
     if (rank == 0) {
       if (level2)
