@@ -282,13 +282,16 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   // Rows: each training sample's residual relative to its own energy (or to
   // the block's RMS training energy for the absolute residual), times
   // sqrt(weight); then sqrt(reg) * (p_j - p0_j) / scale_j.
+  const bool absolute = options.residual == CoarseFitOptions::Residual::absolute;
   double energy_ref = 0;
-  for (int s = 0; s < ns; ++s)
-    if (!held[s]) energy_ref += weight[s] * V0[s] * V0[s];
-  energy_ref = std::sqrt(energy_ref);
-  if (options.residual == CoarseFitOptions::Residual::absolute && !(energy_ref > 0)) {
-    fit.not_fitted_reason = "no training sample has a weight";
-    return fit;
+  if (absolute) {
+    for (int s = 0; s < ns; ++s)
+      if (!held[s]) energy_ref += weight[s] * V0[s] * V0[s];
+    energy_ref = std::sqrt(energy_ref);
+    if (!(energy_ref > 0)) {
+      fit.not_fitted_reason = "no training sample has a weight";
+      return fit;
+    }
   }
   const int rows = fit.samples_train + np;
   MatX A = MatX::Zero(rows, np);
@@ -297,8 +300,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     int r = 0;
     for (int s = 0; s < ns; ++s) {
       if (held[s]) continue;
-      const double w =
-          std::sqrt(weight[s]) / (options.residual == CoarseFitOptions::Residual::absolute ? energy_ref : V0[s]);
+      const double w = std::sqrt(weight[s]) / (absolute ? energy_ref : V0[s]);
       for (int k = 0; k < points; ++k) {
         A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
         A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];

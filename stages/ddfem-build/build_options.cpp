@@ -103,9 +103,11 @@ BuildOptions read_build_options(const Config& config) {
     }
     o.fit.mixed_blocks_affine_only = f.get_or<bool>("mixed_affine_only", o.fit.mixed_blocks_affine_only);
     const std::string residual = f.get_or<std::string>("residual", fit_residual_name(o.fit.residual));
-    if (residual != "relative" && residual != "absolute")
-      f.fail("residual", "must be relative or absolute, got '" + residual + "'");
-    o.fit.residual = parse_fit_residual(residual);
+    try {
+      o.fit.residual = parse_fit_residual(residual);
+    } catch (const InputError& e) {
+      f.fail("residual", e.what());
+    }
     o.fit.balance_kinds = f.get_or<bool>("balance_kinds", o.fit.balance_kinds);
     f.check_no_unknown_keys();
   }
