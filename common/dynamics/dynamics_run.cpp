@@ -104,8 +104,9 @@ class Recorder {
   std::vector<int> node_body_;  // empty with one body
 };
 
-// Neither preload solver knows contact between or within bodies, so a load
-// too large for the geometry folds a body through itself (a pressed plate
+// The pluck, and the press without press.self_contact, know no contact
+// between or within bodies, so a load too large for the geometry folds a
+// body through itself (a pressed plate
 // through the plate below it) and the dynamics would start from an
 // impossible state. The boundary surface is built once per preload: the
 // press that stops at touch asks about a dozen trial states.
@@ -131,8 +132,10 @@ class PreloadFoldCheck {
     msg << (scene_.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
         << through.size() << " boundary nodes end behind a face; node at rest (" << mesh.nodes(c.node, 0) << ", "
         << mesh.nodes(c.node, 1) << ", " << mesh.nodes(c.node, 2) << ") ends " << -c.gap_end * 1e3
-        << " mm deep); the preload solvers have no self-contact: reduce the force"
-        << (scene_.preload == Preload::kQuasistaticPress ? " or set press.stop_at_touch" : "");
+        << " mm deep); "
+        << (scene_.preload == Preload::kQuasistaticPress
+                ? "set press.self_contact (the parts then rest on each other), press.stop_at_touch, or reduce the force"
+                : "the pluck has no self-contact: reduce the force");
     throw InputError(msg.str());
   }
 
@@ -149,6 +152,7 @@ QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& 
   QuasistaticOptions options;
   options.load_steps = scene.preload_steps;
   options.threads = 1;  // as the Newmark factorization: same bits for any --threads
+  options.self_contact = scene.press_self_contact;
   return solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, scale * load + sim.gravity_force(),
                                    scene.initial_positions, options);
 }
@@ -218,6 +222,7 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
         scene.stop_at_touch ? press_until_touch(scene, sim, fold, load, scale) : press_at(scene, sim, load, 1.0);
     q = r.x;
     detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
+    if (scene.press_self_contact) detail << ", " << r.self_contacts.size() << " self-contact ties";
     if (scale < 1.0)
       detail << "; stopped at touch: " << 100 * scale << "% of the load (" << scale * scene.load.force.norm() << " N)";
   }

@@ -290,6 +290,7 @@ DynamicsScene read_dynamics_scene(const Config& c) {
   if (model.contact && model.obstacles.empty() && !model.body_contact)
     sim.fail("contact", "is on but the scene has no obstacles and body_contact is off");
   if (model.body_contact && !model.contact) sim.fail("body_contact", "needs contact on");
+  s.newmark.edge_contact = sim.get_or<bool>("edge_contact", s.newmark.edge_contact);
   model.impact = parse_impact_model(sim.get_or("impact", "bbi"), sim.key_path("impact"));
   s.newmark.newton_tolerance = sim.get_or<double>("newton_tolerance", s.newmark.newton_tolerance);
   if (sim.has("rigid_flight")) {
@@ -317,10 +318,16 @@ DynamicsScene read_dynamics_scene(const Config& c) {
     s.load = read_region_load(press);
     s.preload_steps = press.get_or<int>("steps", s.preload_steps);
     s.stop_at_touch = press.get_or<bool>("stop_at_touch", false);
+    s.press_self_contact = press.get_or<bool>("self_contact", false);
+    if (s.press_self_contact && s.stop_at_touch)
+      press.fail("self_contact", "and stop_at_touch exclude each other (with self-contact the press carries the load "
+                                 "on through the parts that touch)");
     if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
     if (dynamic) {
       s.press_ramp_time = press.require_positive<double>("ramp_time", "seconds from zero to the full load");
       if (s.stop_at_touch) press.fail("stop_at_touch", "belongs to the quasistatic press (mode: quasistatic)");
+      if (s.press_self_contact)
+        press.fail("self_contact", "belongs to the quasistatic press (a dynamic press uses simulation.body_contact)");
       if (s.rigid.enabled) c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
     } else if (press.has("ramp_time")) {
       press.fail("ramp_time", "belongs to mode: dynamic (the quasistatic press steps its load with press.steps)");

@@ -57,10 +57,13 @@ struct DynamicsScene {
   RegionLoad load;
   int preload_steps = 4;
   // Press only: when the full load would fold the body through itself (the
-  // press solver has no self-contact), stop at the largest load that does
+  // press solver without self-contact), stop at the largest load that does
   // not, i.e. when the pressed part touches the part below it, instead of
   // refusing the scene (`press.stop_at_touch`).
   bool stop_at_touch = false;
+  // Press only: the quasistatic press with self-contact (parts that touch
+  // are tied without slip and carry the load on; `press.self_contact`).
+  bool press_self_contact = false;
   double press_ramp_time = 0;  // kDynamicPress: seconds from zero to the full load
   RigidFlightSettings rigid;
 };

@@ -18,8 +18,8 @@
 //   2. continuous collision detection of each boundary node along the
 //      predicted path q^t -> q^t + h v^t + h^2/2 g gathers the contact set:
 //      node-obstacle contacts and, with body contact on, five-node
-//      node-face contacts between and within bodies (B.5,
-//      surface_contact.hpp)
+//      node-face contacts between and within bodies (B.5) and edge-edge
+//      contacts (surface_contact.hpp)
 //   3. Newton on (B.1): per iterate factor H = M + h^2/4 K + h/2 D, take
 //      the free step,
 //      and solve the contacts' normal and friction impulses by Gauss-Seidel
@@ -56,6 +56,10 @@ struct NewmarkOptions {
   // Reported (never enforced silently): the largest penetration tolerated
   // at the end of a step, as a fraction of the smallest element edge.
   double penetration_tolerance = 1e-3;
+  // With body contact: edge-edge contacts besides the vertex-face ones, so
+  // that crossing edges cannot pass through each other
+  // (surface_contact.hpp).
+  bool edge_contact = true;
   int gauss_seidel_sweeps = 2000;
   double gauss_seidel_tolerance = 1e-11;
 };

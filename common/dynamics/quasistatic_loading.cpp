@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -187,8 +188,24 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
   CholmodSolver solver(linear);
   solver.analyze(K);
 
-  VecX g(n), g_trial(n), rhs(n), step(n), trial(n);
-  std::vector<char> fixed(n, 0);
+  std::unique_ptr<SelfContactTies> ties;
+  if (opt.self_contact) ties = std::make_unique<SelfContactTies>(mesh);
+  // A node starting deeper than this behind a face is on its far side, not
+  // touching it (surface_contact.hpp).
+  const double tie_depth_limit = 0.25 * dx;
+  int analyzed = -1;  // the ties' version whose reduced pattern the solver holds (-1: K's own)
+  auto tied = [&](int d) { return ties && ties->is_slave(d / 3); };
+  auto reduced_gradient = [&](const VecX& grad) { return ties ? ties->reduce(grad) : grad; };
+  // Nodes touching a face at the start are tied from the start, as
+  // vertices touching an obstacle start active.
+  if (ties) {
+    ties->activate(q, q, touch, tie_depth_limit, [&](int node) { return active.obstacle[node] != kFree; });
+    if (!std::isfinite(assembler.energy(q)))
+      throw InputError("quasistatic loading: initial positions: putting touching nodes onto faces inverts an element");
+  }
+
+  VecX g(n), g_trial(n), rhs(n), step(n), trial(n), r(n);
+  std::vector<char> fixed(n, 0), held(n, 0);
   auto update_fixed = [&]() {
     for (int i = 0; i < nodes; ++i) fixed[3 * i] = fixed[3 * i + 1] = fixed[3 * i + 2] = active.obstacle[i] != kFree;
   };
@@ -210,7 +227,7 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
       double diag = 0, reaction_sq = 0;
       int free_dofs = 0;
       for (int d = 0; d < n; ++d) {
-        if (fixed[d]) {
+        if (fixed[d] || tied(d)) {
           reaction_sq += g[d] * g[d];
         } else {
           diag += std::abs(K.coeff(d, d));
@@ -241,10 +258,14 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
           ++released;
         }
       }
+      if (ties) released += ties->release(q, g, opt.relative_tolerance * scale);
       if (released) update_fixed();
+      r = reduced_gradient(g);
       double free_sq = 0;
-      for (int d = 0; d < n; ++d)
-        if (!fixed[d]) free_sq += g[d] * g[d];
+      for (int d = 0; d < n; ++d) {
+        held[d] = fixed[d] || tied(d);
+        if (!held[d]) free_sq += r[d] * r[d];
+      }
 
       QuasistaticIteration rec;
       rec.load_step = load_step;
@@ -252,7 +273,7 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
       rec.iteration = it;
       rec.residual = std::sqrt(free_sq) / scale;
       rec.energy = potential;
-      rec.active = active.count();
+      rec.active = active.count() + (ties ? static_cast<int>(ties->ties().size()) : 0);
       rec.released = released;
       // Converged at the tolerance, or at the round-off floor: with the
       // active set settled, a residual within 1000x the tolerance that has
@@ -272,15 +293,23 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
         return false;
       }
 
-      // Newton step with the active vertices fixed where they are; an
-      // indefinite Hessian (or a non-descent step) gets a growing shift.
-      constrain_matrix(K, fixed, diag);
+      // Newton step with the active vertices fixed where they are and the
+      // tied ones following their faces; an indefinite Hessian (or a
+      // non-descent step) gets a growing shift.
+      SpMat reduced;
+      SpMat& system = ties && !ties->empty() ? (reduced = ties->reduce(K)) : K;
+      constrain_matrix(system, held, diag);
+      const int pattern = &system == &K ? -1 : ties->version();
+      if (pattern != analyzed) {
+        solver.analyze(system);
+        analyzed = pattern;
+      }
       double shift = 0;
       bool ok = false;
       for (int attempt = 0; attempt < 12 && !ok; ++attempt) {
         if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
-        if (!solver.factorize(K, shift)) continue;
-        for (int d = 0; d < n; ++d) rhs[d] = fixed[d] ? 0.0 : -g[d];
+        if (!solver.factorize(system, shift)) continue;
+        for (int d = 0; d < n; ++d) rhs[d] = held[d] ? 0.0 : -r[d];
         try {
           step = solver.solve(rhs);
         } catch (const NumericalError& e) {
@@ -289,7 +318,8 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
         }
         if (!step.allFinite()) continue;
         for (int d = 0; d < n; ++d)
-          if (fixed[d]) step[d] = 0;
+          if (held[d]) step[d] = 0;
+        if (ties) ties->expand(step);
         ok = g.dot(step) < 0 || free_sq == 0;
       }
       rec.shift = shift;
@@ -316,7 +346,7 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
               break;
             }
         }
-        if (too_deep) continue;
+        if (too_deep || (ties && ties->penetrates(q, trial, max_depth, tie_depth_limit))) continue;
         const double Et = assembler.energy(trial);
         if (!std::isfinite(Et)) continue;
         const double pt = Et - fs.dot(trial - X);
@@ -329,9 +359,10 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
         if (std::abs(pt - potential) <= noise_floor) {
           assembler.evaluate(trial, &g_trial, nullptr);
           g_trial -= fs;
+          const VecX r_trial = reduced_gradient(g_trial);
           double trial_sq = 0;
           for (int d = 0; d < n; ++d)
-            if (!fixed[d]) trial_sq += g_trial[d] * g_trial[d];
+            if (!held[d]) trial_sq += r_trial[d] * r_trial[d];
           if (trial_sq < free_sq) {
             accepted = true;
             break;
@@ -345,9 +376,10 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
       }
 
       // Free vertices that went into an obstacle: back onto its face, held.
+      // (A tied node follows its face and is left to it.)
       activated = 0;
       for (int i = 0; i < nodes; ++i) {
-        if (active.obstacle[i] != kFree) continue;
+        if (active.obstacle[i] != kFree || tied(3 * i)) continue;
         for (int round = 0; round < 4; ++round) {  // a corner may need one projection per face
           const Nearest c = nearest_obstacle(obstacles, trial.segment<3>(3 * i));
           if (c.obstacle == kFree || c.distance >= 0) break;
@@ -357,9 +389,12 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
           active.plane[i] = c.plane;
         }
       }
+      // Free nodes that went behind a face of the mesh: onto it, tied.
+      if (ties)
+        activated += ties->activate(q, trial, 0.0, tie_depth_limit, [&](int node) { return active.obstacle[node] != kFree; });
       if (activated && !std::isfinite(assembler.energy(trial))) {
         result.history.push_back(rec);
-        why = "projecting penetrating vertices onto the obstacles inverted an element";
+        why = "projecting penetrating vertices onto the obstacles (or faces) inverted an element";
         return false;
       }
       rec.step_length = alpha;
@@ -381,6 +416,7 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
     const double s = std::min(1.0, s_done + ds);
     const VecX q_saved = q;
     const ActiveSet active_saved = active;
+    const std::vector<SelfContactTie> ties_saved = ties ? ties->ties() : std::vector<SelfContactTie>();
     std::string why;
     ++load_step;
     if (newton_at(s, load_step, why)) {
@@ -391,6 +427,7 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
     }
     q = q_saved;
     active = active_saved;
+    if (ties) ties->assign(ties_saved);
     if (halvings >= opt.max_step_halvings) {
       std::ostringstream msg;
       msg << "quasistatic loading failed at load factor " << s << " after " << halvings
@@ -414,6 +451,10 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
     c.plane = active.plane[i];
     c.reaction = g.segment<3>(3 * i);
     result.contacts.push_back(c);
+  }
+  if (ties) {
+    ties->record_reactions(g);
+    result.self_contacts = ties->ties();
   }
   return result;
 }

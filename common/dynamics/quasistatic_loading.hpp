@@ -12,11 +12,13 @@
 // off the obstacle (reaction . n < 0) is released, and a free vertex that
 // penetrates is projected back onto the obstacle face and becomes active.
 // The load is applied in increments (continuation); a failing increment is
-// halved.
+// halved. With self_contact, boundary nodes that reach a face of the mesh
+// are tied to it in the same way (self_contact_ties.hpp).
 #include <string>
 #include <vector>
 
 #include "dynamics/obstacles.hpp"
+#include "dynamics/self_contact_ties.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "solve/newton.hpp"
 
@@ -38,6 +40,10 @@ struct QuasistaticOptions {
   // A vertex of the initial state within this distance (units of dx) of an
   // obstacle counts as touching it and starts active.
   double touch_tolerance = 1e-6;
+  // Contact of the mesh with itself and between its bodies: a boundary node
+  // that reaches a boundary face is tied to it without slip
+  // (self_contact_ties.hpp), as the obstacles hold vertices.
+  bool self_contact = false;
   // Threads of the linear solver; 0 uses the OpenMP default. Assembly always
   // follows the OpenMP default (set by the stage).
   int threads = 0;
@@ -61,7 +67,7 @@ struct QuasistaticIteration {
   double energy = 0;       // total potential E(q) - F . (q - X)
   double step_length = 0;  // accepted line-search step (0 when none taken)
   double shift = 0;        // diagonal regularization of the Newton system
-  int active = 0;          // active vertices after this iteration's release
+  int active = 0;          // active vertices (obstacle and self-contact) after this iteration's release
   int released = 0;        // vertices released at the start of this iteration
   int activated = 0;       // free vertices projected and activated after the step
 };
@@ -69,6 +75,7 @@ struct QuasistaticIteration {
 struct QuasistaticResult {
   VecX x;                              // equilibrium positions (3N, node-major)
   std::vector<ContactVertex> contacts;  // active vertices, ascending node order
+  std::vector<SelfContactTie> self_contacts;  // nodes tied to faces, with their reactions
   int iterations = 0;                  // Newton steps taken, all increments
   int load_steps = 0;                  // increments attempted (including cut ones)
   double elastic_energy = 0;           // E(x)

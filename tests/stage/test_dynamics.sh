@@ -58,7 +58,7 @@ check "the cube is thrown upward (> 1 cm in 20 ms)" -- awk -v s="${cube% *}" -v 
 check "no body penetrates beyond 1e-3 voxel" -- awk '/deepest penetration/ { exit !($NF + 0 <= 2e-6 || $(NF-1) + 0 <= 2e-6) }' "$WORK/catapult.txt"
 
 # Bad input.
-expect_exit 2 "press: the preload folds the body through itself" -- "$BIN/msfab-dynamics" \
+expect_exit 2 "press: the preload folds the body through itself.*set press.self_contact" -- "$BIN/msfab-dynamics" \
   --config $S/flipper_jumper.yaml --out "$WORK/x.h5" --set 'press.force=[0,0,-3]'
 # The same press with stop_at_touch stops where the top plate meets the
 # base, short of the full load, and the run goes on from there.
@@ -68,6 +68,16 @@ share=$(awk '/stopped at touch/ { for (i = 1; i <= NF; ++i) if ($i ~ /%$/) print
 echo "press with stop_at_touch: stopped at ${share}% of 3 N"
 check "press.stop_at_touch stops short of a load that folds" -- awk -v s="$share" 'BEGIN { exit !(s > 10 && s < 100) }'
 check "press.stop_at_touch: the run continues" -- test -s "$WORK/touch.h5"
+# With press.self_contact the top plate rests on the base and the full 3 N
+# is carried through the contact: the press ties nodes and the run goes on.
+"$BIN/msfab-dynamics" --quiet --config $S/flipper_jumper.yaml --out "$WORK/tied.h5" --set 'press.force=[0,0,-3]' \
+  --set press.self_contact=true --set simulation.duration=0.0005 > "$WORK/tied.txt"
+ties=$(awk '/self-contact ties/ { for (i = 1; i <= NF; ++i) if ($i == "self-contact") print $(i - 1) + 0 }' "$WORK/tied.txt")
+echo "press with self-contact: ${ties} ties at the full 3 N"
+check "press.self_contact carries the full load through tied nodes" -- awk -v t="$ties" 'BEGIN { exit !(t > 0) }'
+check "press.self_contact: the run continues" -- test -s "$WORK/tied.h5"
+expect_exit 2 "press.self_contact = true: and stop_at_touch exclude each other" -- "$BIN/msfab-dynamics" \
+  --config $S/flipper_jumper.yaml --out "$WORK/x.h5" --set press.self_contact=true --set press.stop_at_touch=true
 # The press applied dynamically (B.3; tools/bench_press.sh compares it with
 # the quasistatic press): ramped on over 2 ms, the plate is pushed down and
 # the body stays on the ground; its keys are checked.
