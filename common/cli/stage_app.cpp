@@ -83,9 +83,25 @@ void check_output_path(const CLI::App& cli, const std::string& out) {
 
 }  // namespace
 
+namespace {
+
+// Thrown by finish_config() under --print-config; run() ends with exit 0.
+struct ConfigPrinted {};
+
+}  // namespace
+
 const std::string& StageContext::require_out() const {
+  static const std::string kNothingWritten = "(nothing is written under --print-config)";
+  if (options.out.empty() && options.print_config) return kNothingWritten;
   if (options.out.empty()) throw InputError("missing --out PATH (where to write the result)");
   return options.out;
+}
+
+void StageContext::finish_config() const {
+  config.check_no_unknown_keys();
+  if (!options.print_config) return;
+  std::cout << config.effective_text() << std::flush;
+  throw ConfigPrinted{};
 }
 
 ConfigGridSize config_grid_size(const Config& config, const std::string& key) {
@@ -110,6 +126,7 @@ void StageContext::check_memory(double estimated_bytes, const std::string& what,
 }
 
 void StageContext::check_out_folder() const {
+  if (options.print_config) return;
   const std::string& out = require_out();
   if (!std::filesystem::is_directory(std::filesystem::absolute(out).parent_path()))
     throw InputError(out + ": output folder does not exist");
@@ -154,6 +171,9 @@ void StageApp::add_common_options() {
             return {};
           },
           ""));
+  cli_.add_flag("--print-config", options_.print_config,
+                "print the effective config (the file, --set overrides and the defaults this stage reads) as YAML "
+                "and exit without running");
   cli_.set_version_flag("--version", name_ + " " + version() + " (revision " + git_revision() + ")");
 }
 
@@ -192,6 +212,8 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
                   omp_get_max_threads(), options_.seed);
     spdlog::debug("command line: {}", ctx.command_line);
     body(ctx);
+    return kExitOk;
+  } catch (const ConfigPrinted&) {
     return kExitOk;
   } catch (const InputError& e) {
     print_error(name_, e.what());

@@ -7,7 +7,7 @@
 //     app.cli().add_flag("--resume", resume, "continue from the last checkpoint");
 //     return app.run(argc, argv, [&](msfab::StageContext& ctx) {
 //       double E = ctx.config.require_positive("E", "Young's modulus");
-//       ctx.config.check_no_unknown_keys();   // before any long work
+//       ctx.finish_config();   // unknown keys refused; --print-config stops here
 //       ...
 //     });
 //   }
@@ -37,6 +37,7 @@ struct StageOptions {
   std::string log_level = "info";      // --log-level
   bool quiet = false;                  // --quiet
   std::string memory_limit;            // --memory-limit; empty = available memory
+  bool print_config = false;           // --print-config
 };
 
 // A `grid.size`-style list of cell counts from the config, for memory
@@ -55,8 +56,14 @@ struct StageContext {
   StageOptions options;
   std::string command_line;  // shell-quoted argv, for provenance
 
-  // The --out path; InputError when it was not given.
+  // The --out path; InputError when it was not given (under --print-config
+  // a stand-in, since nothing will be written).
   const std::string& require_out() const;
+  // Called once the stage has read its config, before any work: refuses
+  // unknown keys (Config::check_no_unknown_keys); with --print-config,
+  // prints the effective config (Config::effective_text) to stdout and ends
+  // the run with exit code 0.
+  void finish_config() const;
   // InputError ("<out>: output folder does not exist") unless the folder
   // --out writes into exists; stages call it after validating their config,
   // before any long work.
@@ -78,7 +85,7 @@ class StageApp {
   const std::string& name() const { return name_; }
 
   // --config, --set, --out, --threads, --seed, --log-level, --quiet,
-  // --version (--help is always there).
+  // --memory-limit, --print-config, --version (--help is always there).
   void add_common_options();
   // YAML used when --config is not given; its display name in messages is
   // "<built-in defaults of NAME>". Without it the config starts empty.

@@ -1,6 +1,7 @@
 #include "io/config.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -25,6 +26,8 @@ struct Config::Document {
   std::set<std::string> asked;                    // key paths some accessor asked for
   std::set<std::string> accepted;                 // key paths whose whole subtree was read
   std::map<std::string, std::string> overridden;  // key path -> "--set" text
+  // Defaults get_or() returned for absent keys, by full key path.
+  std::map<std::string, YAML::Node> defaults;
 
   // The --set assignment that wrote `full_path` or one of its ancestors.
   const std::string* override_of(const std::string& full_path) const {
@@ -546,11 +549,40 @@ T Config::get(const std::string& key) const {
   return Reader<T>::read(where(path), path, *value);
 }
 
+namespace {
+
+// A default as YAML; doubles in their shortest form that reads back to the
+// same bits (1e-09, not 1.0000000000000001e-09).
+std::string shortest_text(double v) {
+  char buffer[64];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+  return std::string(buffer, end);
+}
+template <class T>
+YAML::Node default_node(const T& value) {
+  return YAML::Node(value);
+}
+template <>
+YAML::Node default_node<double>(const double& value) {
+  return YAML::Node(shortest_text(value));
+}
+template <>
+YAML::Node default_node<std::vector<double>>(const std::vector<double>& values) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  for (double v : values) list.push_back(YAML::Node(shortest_text(v)));
+  return list;
+}
+
+}  // namespace
+
 template <class T>
 T Config::get_or(const std::string& key, const T& fallback) const {
   auto value = lookup(key, true);
-  if (!value || value->IsNull()) return fallback;
   const std::string path = key_path(key);
+  if (!value || value->IsNull()) {
+    doc_->defaults.try_emplace(path, default_node(fallback));
+    return fallback;
+  }
   return Reader<T>::read(where(path), path, *value);
 }
 
@@ -739,6 +771,62 @@ std::string Config::resolved_text() const {
   YAML::Emitter out;
   emit(out, node_);
   return std::string(out.c_str()) + "\n";
+}
+
+namespace {
+
+// Sets `value` at a full key path ("a.b", "materials[1].E") below `node`,
+// creating missing mappings; false where the path leads through a list
+// item that is not there or through a value that is not a mapping.
+bool set_at_path(YAML::Node node, const std::string& path, const YAML::Node& value) {
+  std::vector<std::string> keys;
+  std::vector<std::vector<int>> indices;  // list indices after each key
+  for (const std::string& part : split_dots(path)) {
+    const size_t bracket = part.find('[');
+    keys.push_back(part.substr(0, bracket));
+    indices.emplace_back();
+    for (size_t at = bracket; at != std::string::npos; at = part.find('[', at + 1))
+      indices.back().push_back(std::stoi(part.substr(at + 1)));
+  }
+  YAML::Node cur;
+  cur.reset(node);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (!cur.IsMap()) return false;
+    const bool last = i + 1 == keys.size() && indices[i].empty();
+    if (last) {
+      cur[keys[i]] = value;
+      return true;
+    }
+    if (!cur[keys[i]].IsDefined() || cur[keys[i]].IsNull()) {
+      if (!indices[i].empty()) return false;
+      cur[keys[i]] = YAML::Node(YAML::NodeType::Map);
+    }
+    YAML::Node next = cur[keys[i]];
+    for (int index : indices[i]) {
+      if (!next.IsSequence() || index < 0 || index >= static_cast<int>(next.size())) return false;
+      YAML::Node item = next[index];
+      next.reset(item);
+    }
+    cur.reset(next);
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string Config::effective_text() const {
+  YAML::Node effective = YAML::Clone(doc_->root);
+  std::string listing;
+  for (const auto& [path, value] : doc_->defaults) {
+    if (!set_at_path(effective, path, value)) continue;
+    YAML::Emitter v;
+    v << YAML::Flow << value;
+    listing += "#   " + path + " = " + v.c_str() + "\n";
+  }
+  YAML::Emitter out;
+  emit(out, effective);
+  return "# effective config: " + doc_->source + " with --set overrides applied" +
+         (listing.empty() ? std::string("\n") : "; defaults filled in:\n" + listing) + out.c_str() + "\n";
 }
 
 // ---- explicit instantiations -------------------------------------------------------

@@ -54,8 +54,8 @@ class Config {
   // std::vector<double>, std::vector<int>, std::vector<std::string>.
   template <class T>
   T get(const std::string& key) const;
-  // Optional value: `fallback` when the key is absent or null; a present
-  // value of the wrong type is still an error.
+  // Optional value: `fallback` when the key is absent or null (recorded for
+  // effective_text()); a present value of the wrong type is still an error.
   template <class T>
   T get_or(const std::string& key, const T& fallback) const;
   std::string get_or(const std::string& key, const char* fallback) const {
@@ -104,6 +104,11 @@ class Config {
 
   // The effective configuration (overrides applied) as YAML text.
   std::string resolved_text() const;
+  // The same with every default a get_or() has used so far written in at
+  // its key, preceded by comment lines listing those defaults: what a run
+  // would read (--print-config). Sections a stage never asked about stay
+  // as given.
+  std::string effective_text() const;
 
   const std::string& source() const;
   // Key path of this mapping inside the document ("" at top level).

@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
     const CellGrid& grid = scene.setup.grid;
     // 2. The pattern.
     const CellPattern pattern = read_pattern(config, grid.dimension(), ctx.options.seed);
-    config.check_no_unknown_keys();
+    ctx.finish_config();
     for (std::int32_t s : pattern.structures)
       if (std::size_t(s) >= set.items.size())
         config.fail("pattern.structures", "index " + std::to_string(s) + " is outside the set " + structures_path +

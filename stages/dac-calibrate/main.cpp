@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
       d_t = c.get<double>("target.decay");
       if (!(d_t >= 0)) c.fail("target.decay", "must be >= 0 (1/s)");
     }
-    c.check_no_unknown_keys();
+    ctx.finish_config();
     const DynamicsScene rig = scene_at_voxel_size(scene_path, 0);
     int material_index = -1;
     for (size_t i = 0; i < rig.materials.size(); ++i)

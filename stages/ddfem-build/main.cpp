@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
 
     // 1. Palette (or the level-1 database) and options.
     const BuildOptions options = read_build_options(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
     {
       // Every block in flight (one per thread) holds its force patterns (4

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     const int deformations = ctx.config.require_positive<int>("deformations", "number of common deformations");
     const double strain = ctx.config.require_range<double>("strain", 0.0, 0.5, Bounds::Open, "deformation strain");
     const auto seed = ctx.config.get_or<std::uint64_t>("seed", 3);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
 
     const CoarseDatabase full = read_coarse_db(input);

@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
 
     // 1. Scene.
     const DynamicsScene scene = read_dynamics_scene(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
     ctx.check_memory(dynamics_peak_bytes(scene),
                      fmt::format("a run of {} elements over {} s with a frame every {} steps",

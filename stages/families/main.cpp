@@ -253,7 +253,7 @@ int main(int argc, char** argv) {
   return app.run(argc, argv, [&](StageContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
     const Settings settings = read_settings(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const std::string out = ctx.require_out();
     ctx.check_out_folder();
     if (settings.selection.boundary_margin >= 0 && gamut_path.empty())

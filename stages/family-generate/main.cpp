@@ -254,7 +254,7 @@ int main(int argc, char** argv) {
     const GridRequest grid = read_grid(ctx.config);
     if (!grid.empty() && !templates.empty()) ctx.config.fail("grid", "give either templates or a grid, not both");
     if (!grid.empty() && !families_path.empty()) ctx.config.fail("grid", "is for generating without --families");
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const std::string out = ctx.require_out();
     ctx.check_out_folder();
 

@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
       spdlog::set_level(spdlog::level::warn);
     }
     const Settings settings = read_settings(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const std::string& out = ctx.require_out();
     ctx.check_out_folder();
     MicrostructureSet set = read_microstructures_artifact(structures_path);

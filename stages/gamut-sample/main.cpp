@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
 
     // 1. Settings.
     const SamplerOptions options = read_sampler_options(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
     {
       // What must fit at once: the population, its children and their copies

@@ -81,7 +81,7 @@ void run_batch(StageContext& ctx, const std::string& structures) {
   for (const char* key : {"materials", "cell", "layout"})
     if (ctx.config.has(key))
       ctx.config.fail(key, "batch mode (--structures) takes materials and cells from the structures artifact; drop it");
-  ctx.config.check_no_unknown_keys();
+  ctx.finish_config();
   ctx.check_out_folder();
   MicrostructureSet set = read_microstructures_artifact(structures);
   if (set.items.empty()) throw InputError(structures + ": the set holds no structures");
@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
     options.threads = ctx.options.threads;
     std::optional<FiniteStrainCheck> finite_strain = read_finite_strain_check(ctx.config);
     if (finite_strain && in.cell.nz < 2) ctx.config.fail("finite_strain", "needs a 3D cell (this one is 2D)");
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
     spdlog::info("cell {} x {} x {}, {} materials", in.cell.nx, in.cell.ny, in.cell.nz, in.palette.size());
 

@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
 
     // 1. Problem and scene checks.
     const DesignProblem problem = read_design_problem(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const DesignEvaluator evaluator(problem);
     ctx.check_out_folder();
     ctx.check_memory(omp_get_max_threads() * evaluator.peak_bytes(),

@@ -99,7 +99,7 @@ int main(int argc, char** argv) {
       ->required();
   return app.run(argc, argv, [&](StageContext& ctx) {
     const Settings settings = read_settings(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const std::string out = ctx.require_out();
     ctx.check_out_folder();
     const std::string stem = stem_of(out);

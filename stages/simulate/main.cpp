@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
     // 1. Scene.
     check_grid_memory(ctx);
     const Scene scene = read_scene(ctx.config);
-    ctx.config.check_no_unknown_keys();
+    ctx.finish_config();
     const bool adaptive = target_option->count() > 0;
     check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level}, compare_fine);
 

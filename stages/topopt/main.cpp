@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
     // 3. The start.
     const DesignStart start = read_design_start(config, *model, grid);
     if (!start.path.empty()) inputs.push_back(start.path);
-    config.check_no_unknown_keys();
+    ctx.finish_config();
     ctx.check_out_folder();
 
     TopologySetup setup = scene.setup;

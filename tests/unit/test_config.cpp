@@ -79,6 +79,26 @@ TEST(Config, DefaultsApplyOnlyWhenKeyIsAbsent) {
   EXPECT_CONTAINS(input_error_of([&] { bad.get_or("tol", 1.0); }), ("s.yaml: tol: expected a number"));
 }
 
+TEST(Config, EffectiveTextWritesInTheDefaultsThatWereRead) {
+  Config c = Config::from_string(kScene, "scene.yaml");
+  EXPECT_EQ(c.get_or<double>("grid.spacing", 9.0), 0.5);             // present: not a default
+  EXPECT_EQ(c.get_or<double>("solver.tolerance", 1e-9), 1e-9);       // a new section
+  EXPECT_EQ(c.children("materials")[1].get_or<double>("density", 1200.0 / 7), 1200.0 / 7);
+  EXPECT_EQ(c.get_or<std::string>("name", "unnamed"), "bar");
+  const std::string text = c.effective_text();
+  EXPECT_CONTAINS(text, "#   solver.tolerance = 1e-09\n");
+  EXPECT_CONTAINS(text, "#   materials[1].density = 171.42857142857142\n");
+  EXPECT_EQ(text.find("grid.spacing ="), std::string::npos);
+  // The text reads back as a config holding the defaults, to the bit.
+  Config back = Config::from_string(text, "effective");
+  EXPECT_EQ(back.get<double>("solver.tolerance"), 1e-9);
+  EXPECT_EQ(back.children("materials")[1].get<double>("density"), 1200.0 / 7);
+  EXPECT_EQ(back.children("materials")[1].get<double>("nu"), 0.45);
+  EXPECT_EQ(back.get<double>("grid.spacing"), 0.5);
+  // Nothing was added to the document itself.
+  EXPECT_FALSE(c.has("solver.tolerance"));
+}
+
 TEST(Config, NestedChildrenCarryTheirKeyPath) {
   Config c = Config::from_string(kScene, "bar.yaml");
   Config boundary = c.child("boundary");
