@@ -174,6 +174,10 @@ void StageApp::add_common_options() {
   cli_.add_flag("--print-config", options_.print_config,
                 "print the effective config (the file, --set overrides and the defaults this stage reads) as YAML "
                 "and exit without running");
+  add_version_option();
+}
+
+void StageApp::add_version_option() {
   cli_.set_version_flag("--version", name_ + " " + version() + " (revision " + git_revision() + ")");
 }
 

@@ -87,6 +87,8 @@ class StageApp {
   // --config, --set, --out, --threads, --seed, --log-level, --quiet,
   // --memory-limit, --print-config, --version (--help is always there).
   void add_common_options();
+  // --version alone, for tools that take none of the common options.
+  void add_version_option();
   // YAML used when --config is not given; its display name in messages is
   // "<built-in defaults of NAME>". Without it the config starts empty.
   void set_default_config(std::string yaml_text);

@@ -1,12 +1,17 @@
-// msfab-inspect: prints what an artifact holds (provenance, datasets and
-// their shapes) and, with --schema, checks it is the kind of artifact a
-// pipeline step expects. Exit code 2 for a missing, corrupt or mismatched file.
+// msfab-inspect: prints what an artifact holds (provenance, the config it
+// was made with, its inputs and whether they are still the files it read,
+// datasets and their shapes) and, with --schema, checks it is the kind of
+// artifact a pipeline step expects. Exit code 2 for a missing, corrupt or
+// mismatched file.
 #include <cstdio>
+#include <filesystem>
 #include <functional>
+#include <sstream>
 
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "io/sha256.hpp"
 
 using namespace msfab;
 
@@ -26,6 +31,27 @@ void list_tree(const H5File& f, const std::string& group, int depth) {
   }
 }
 
+// What an input is now: the file it names still there with the same bytes
+// (and, for an artifact, who made it), changed, or gone.
+std::string input_state(const ArtifactInput& in) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(in.path, ec)) return "missing now";
+  if (sha256_file_hex(in.path) != in.sha256) return "changed since (hash differs)";
+  std::string state = "unchanged";
+  try {
+    const H5File f = H5File::open(in.path);
+    if (f.has_attribute("/", "producer")) state += ", made by " + f.read_string_attribute("/", "producer");
+  } catch (const std::exception&) {
+    // Not an HDF5 artifact (a YAML scene, a voxel file): nothing more to say.
+  }
+  return state;
+}
+
+void print_indented(const std::string& text, const char* indent) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) std::printf("%s%s\n", indent, line.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,7 +61,9 @@ int main(int argc, char** argv) {
   app.cli().add_option("artifact", path, "artifact file (.h5)")->required();
   app.cli().add_option("--schema", schema, "fail (exit 2) unless the artifact has this schema, e.g. msfab.result");
   app.cli().add_option("--schema-version", version, "with --schema: the supported schema_version (default: any)");
-  app.add_common_options();
+  bool no_config = false;
+  app.cli().add_flag("--no-config", no_config, "leave out the config the artifact was made with");
+  app.add_version_option();
   return app.run(argc, argv, [&](StageContext&) {
     std::string found_schema;
     if (!schema.empty()) {
@@ -52,7 +80,13 @@ int main(int argc, char** argv) {
     std::printf("%s\n  schema    %s v%d\n  producer  %s\n  created   %s\n  seed      %llu\n", path.c_str(),
                 reader.schema().c_str(), reader.schema_version(), reader.producer().c_str(), reader.created().c_str(),
                 static_cast<unsigned long long>(reader.seed()));
-    for (const auto& in : reader.inputs()) std::printf("  input     %s  sha256 %s\n", in.path.c_str(), in.sha256.c_str());
+    for (const auto& in : reader.inputs())
+      std::printf("  input     %s  sha256 %s  (%s)\n", in.path.c_str(), in.sha256.c_str(), input_state(in).c_str());
+    if (!no_config) {
+      const std::string config = reader.config();
+      std::printf("config:\n");
+      print_indented(config.empty() ? "(none stored)" : config, "  ");
+    }
     std::printf("contents:\n");
     list_tree(reader.file(), "/", 1);
   });

@@ -74,6 +74,10 @@ for s in "${STAGES[@]}"; do
   x="$BIN/msfab-$s"
   read -r -a args <<<"$(artifact_args "$s")"
   with() { local a=() v; for v in "${args[@]}"; do a+=("${v//ART/$1}"); done; echo "${a[@]}"; }
+  # msfab-inspect reads no config and writes nothing: only its own options.
+  out=(--out "$OUTDIR/o.h5")
+  [ "$s" != inspect ] || out=()
+  if [ "$s" != inspect ]; then
   # Config kinds (with the stage's artifact options pointing at a valid
   # file: the config is read first).
   read -r -a good <<<"$(with "$WORK/good.gamut.h5")"
@@ -83,9 +87,15 @@ for s in "${STAGES[@]}"; do
   bad "$s: alias bomb" "bomb.yaml: YAML aliases expand" -- "$x" "${good[@]}" --config "$WORK/bomb.yaml" --out "$OUTDIR/o.h5"
   bad "$s: device as config" "/dev/zero: is a character device" -- \
     "$x" "${good[@]}" --config /dev/zero --out "$OUTDIR/o.h5"
-  bad "$s: unknown option" "zzz-option" -- "$x" "${good[@]}" --zzz-option --out "$OUTDIR/o.h5"
   bad "$s: bad --seed" "seed.*larger than" -- "$x" "${good[@]}" --seed 18446744073709551616 --out "$OUTDIR/o.h5"
   bad "$s: bad --memory-limit" "memory-limit 'lots'" -- "$x" "${good[@]}" --memory-limit lots --out "$OUTDIR/o.h5"
+  else
+    read -r -a good <<<"$(with "$WORK/good.gamut.h5")"
+    for option in --config --seed --memory-limit --out --threads; do
+      bad "$s: $option is not its option" "$option" -- "$x" "${good[@]}" "$option" 1
+    done
+  fi
+  bad "$s: unknown option" "zzz-option" -- "$x" "${good[@]}" --zzz-option "${out[@]}"
   if [ "$s" != inspect ]; then
     bad "$s: output folder missing" "output folder does not exist" -- "$x" "${good[@]}" --out "$OUTDIR/none/o.h5"
     bad "$s: output is the config" "--config '.*keep.yaml' and --out '.*keep.yaml' name the same file" -- \
@@ -98,13 +108,13 @@ for s in "${STAGES[@]}"; do
   # Artifact kinds.
   if [ ${#args[@]} -gt 0 ]; then
     read -r -a a <<<"$(with "$WORK/truncated.h5")"
-    bad "$s: truncated artifact" "truncated.h5: not a valid HDF5 file" -- "$x" "${a[@]}" --out "$OUTDIR/o.h5"
+    bad "$s: truncated artifact" "truncated.h5: not a valid HDF5 file" -- "$x" "${a[@]}" "${out[@]}"
     read -r -a a <<<"$(with "$WORK/text.h5")"
-    bad "$s: text as artifact" "text.h5: not a valid HDF5 file" -- "$x" "${a[@]}" --out "$OUTDIR/o.h5"
+    bad "$s: text as artifact" "text.h5: not a valid HDF5 file" -- "$x" "${a[@]}" "${out[@]}"
     read -r -a a <<<"$(with "$WORK/none.h5")"
-    bad "$s: missing artifact" "none.h5: no such file" -- "$x" "${a[@]}" --out "$OUTDIR/o.h5"
+    bad "$s: missing artifact" "none.h5: no such file" -- "$x" "${a[@]}" "${out[@]}"
     read -r -a a <<<"$(with /dev/zero)"
-    bad "$s: device as artifact" "/dev/zero: is a character device" -- "$x" "${a[@]}" --out "$OUTDIR/o.h5"
+    bad "$s: device as artifact" "/dev/zero: is a character device" -- "$x" "${a[@]}" "${out[@]}"
   fi
 done
 # A valid artifact of another schema.
