@@ -77,6 +77,20 @@ class BoxGrid {
   std::vector<std::pair<long long, int>> cells_;
 };
 
+// The box swept by `nodes` from `start` to `end`, grown by `inflate`.
+template <class Nodes>
+void swept_box(const Nodes& nodes, const VecX& start, const VecX& end, double inflate, Vec3& lo, Vec3& hi) {
+  lo = Vec3::Constant(INFINITY);
+  hi = Vec3::Constant(-INFINITY);
+  for (int node : nodes)
+    for (const VecX* x : {&start, &end}) {
+      lo = lo.cwiseMin(x->segment<3>(3 * node));
+      hi = hi.cwiseMax(x->segment<3>(3 * node));
+    }
+  lo.array() -= inflate;
+  hi.array() += inflate;
+}
+
 bool boxes_overlap(const Vec3& lo_a, const Vec3& hi_a, const Vec3& lo_b, const Vec3& hi_b) {
   return !((lo_a.array() > hi_b.array()).any() || (hi_a.array() < lo_b.array()).any());
 }
@@ -162,18 +176,7 @@ std::vector<NodeFaceContact> BoundarySurface::find(const VecX& start, const VecX
   // Swept boxes of the faces, inflated by the margin.
   const double inflate = std::max(margin, 0.0);
   std::vector<Vec3> lo(num_faces), hi(num_faces);
-  for (int f = 0; f < num_faces; ++f) {
-    lo[f] = Vec3::Constant(INFINITY);
-    hi[f] = Vec3::Constant(-INFINITY);
-    for (int node : boundary_.faces[f]) {
-      for (const VecX* x : {&start, &end}) {
-        lo[f] = lo[f].cwiseMin(x->segment<3>(3 * node));
-        hi[f] = hi[f].cwiseMax(x->segment<3>(3 * node));
-      }
-    }
-    lo[f].array() -= inflate;
-    hi[f].array() += inflate;
-  }
+  for (int f = 0; f < num_faces; ++f) swept_box(boundary_.faces[f], start, end, inflate, lo[f], hi[f]);
   const BoxGrid grid(lo, hi);
 
   // Vertex normals at `end` (area-weighted face normals): a node only
@@ -237,17 +240,7 @@ std::vector<EdgeEdgeContact> BoundarySurface::find_edges(const VecX& start, cons
 
   const double inflate = std::max(margin, 0.0);
   std::vector<Vec3> lo(num_edges), hi(num_edges);
-  for (int e = 0; e < num_edges; ++e) {
-    lo[e] = Vec3::Constant(INFINITY);
-    hi[e] = Vec3::Constant(-INFINITY);
-    for (int node : edges_[e].nodes)
-      for (const VecX* x : {&start, &end}) {
-        lo[e] = lo[e].cwiseMin(x->segment<3>(3 * node));
-        hi[e] = hi[e].cwiseMax(x->segment<3>(3 * node));
-      }
-    lo[e].array() -= inflate;
-    hi[e].array() += inflate;
-  }
+  for (int e = 0; e < num_edges; ++e) swept_box(edges_[e].nodes, start, end, inflate, lo[e], hi[e]);
   const BoxGrid grid(lo, hi);
 
   // Outward unit edge normals at `end`: along the sum of the bordering
