@@ -173,7 +173,10 @@ int main(int argc, char** argv) {
       else
         std::printf("msfab-ddfem-build: %lld combinations (%d orbits) of %d materials, level 1\n",
                     static_cast<long long>(db.num_combinations()), db.num_orbits, db.num_materials());
-      std::printf("  held-out relative energy error: mean %.4f, worst %.4f\n", mean, worst);
+      std::printf("  held-out relative energy error: mean %.4f, worst %.4f\n"
+                  "    (per block, the RMS of (coarse - fine energy) / fine energy over the force samples kept out of "
+                  "its fit, fit.heldout_fraction; 0 would be exact, 0.1 is 10%% energy error; docs/ddfem.md)\n",
+                  mean, worst);
       std::printf("  time: %.2f s wall, %.2f s of fitting (%.2f blocks/s per core)\n", wall, fit_seconds,
                   fit_seconds > 0 ? done.size() / fit_seconds : 0.0);
       std::printf("  artifact: %s (%.1f kB)\n", out.c_str(), std::filesystem::file_size(out) / 1024.0);
