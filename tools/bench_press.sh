@@ -24,16 +24,16 @@ SCENES=(
   "jumper_touching|jumper_over.yaml|parameters.length=0.050;parameters.hinge_height=0.004|press.stop_at_touch=false;press.self_contact=true|simulation.body_contact=true"
   "soft_block|block_drop_face.yaml|materials[0].E=2e6;geometry.voxel_size=0.0025;placement.translation=[0, 0, 0];press={region: {min: [0, 0, 0.01], max: [0.005, 0.01, 0.01]}, force: [0.3, 0, -3]}"
 )
+as_args() {  # as_args 'k=v;k=v': prints --set k=v, one per line
+  local pairs kv
+  IFS=';' read -r -a pairs <<<"$1"
+  for kv in "${pairs[@]}"; do [ -n "$kv" ] && printf '%s\n' --set "$kv"; done
+  return 0
+}
 for entry in "${SCENES[@]}"; do
   IFS='|' read -r scene file sets qs_sets dynamic_sets <<<"$entry"
   [ -z "${ONLY:-}" ] || [ "$ONLY" = "$scene" ] || continue
   cfg=$SRC/configs/dynamics/$file
-  as_args() {  # as_args 'k=v;k=v': prints --set k=v, one per line
-    local pairs kv
-    IFS=';' read -r -a pairs <<<"$1"
-    for kv in "${pairs[@]}"; do [ -n "$kv" ] && printf '%s\n' --set "$kv"; done
-    return 0
-  }
   mapfile -t extra < <(as_args "$sets")
   mapfile -t qs_extra < <(as_args "${qs_sets:-}")
   mapfile -t dynamic_extra < <(as_args "${dynamic_sets:-}")

@@ -1,6 +1,7 @@
 #include "dynamics/self_contact_ties.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "fem/hex_boundary.hpp"
 
@@ -14,10 +15,24 @@ Vec3 face_point(const SelfContactTie& t, const VecX& x) {
   return p;
 }
 
+// Every boundary node may touch: the press clamps nothing.
+BoundarySurface whole_boundary(const HexMesh& mesh) {
+  HexBoundary boundary = hex_boundary(mesh);
+  std::vector<int> nodes = boundary.nodes;
+  return BoundarySurface(std::move(boundary), std::move(nodes));
+}
+
 }  // namespace
 
+Vec3 SelfContactTie::face_normal(const VecX& x) const {
+  std::array<Vec3, 4> corners;
+  for (int i = 0; i < 4; ++i) corners[i] = x.segment<3>(3 * face_nodes[i]);
+  // (s, t) from the bilinear weights ((1-s)(1-t), s(1-t), st, (1-s)t).
+  return quad_normal(corners, weight[1] + weight[2], weight[2] + weight[3]);
+}
+
 SelfContactTies::SelfContactTies(const HexMesh& mesh)
-    : surface_(hex_boundary(mesh), hex_boundary(mesh).nodes),
+    : surface_(whole_boundary(mesh)),
       slave_(mesh.num_nodes(), 0),
       master_count_(mesh.num_nodes(), 0) {}
 
@@ -75,11 +90,7 @@ int SelfContactTies::release(const VecX& q, const VecX& g, double threshold) {
   const size_t before = ties_.size();
   std::vector<SelfContactTie> kept;
   for (const SelfContactTie& t : ties_) {
-    std::array<Vec3, 4> x;
-    for (int i = 0; i < 4; ++i) x[i] = q.segment<3>(3 * t.face_nodes[i]);
-    const double s = t.weight[1] + t.weight[2], u = t.weight[2] + t.weight[3];  // (s, t) of the bilinear weights
-    const Vec3 n = quad_normal(x, s, u);
-    if (n.dot(g.segment<3>(3 * t.node)) < -threshold) {
+    if (t.face_normal(q).dot(g.segment<3>(3 * t.node)) < -threshold) {
       slave_[t.node] = 0;
       for (int m : t.face_nodes) --master_count_[m];
     } else {

@@ -32,6 +32,9 @@ struct SelfContactTie {
   std::array<int, 4> face_nodes{};
   std::array<double, 4> weight{};  // bilinear weights of the point the node is tied to
   Vec3 reaction = Vec3::Zero();   // force the face exerts on the node (set by the solver)
+
+  // The face's outward unit normal at the tied point, face corners at `x`.
+  Vec3 face_normal(const VecX& x) const;
 };
 
 class SelfContactTies {

@@ -402,6 +402,49 @@ std::vector<PathStep> parse_override_path(const std::string& path, const std::st
   return steps;
 }
 
+// Why a path cannot be written (set_at_steps).
+struct PathError {
+  std::string why;
+};
+
+// Writes `value` at `steps` below `root`, creating mappings that do not
+// exist, and returns the path walked ("a.b[2].c"). Throws PathError where a
+// step meets a value that is not a mapping, or a list index out of range.
+std::string set_at_steps(const YAML::Node& root, const std::vector<PathStep>& steps, const YAML::Node& value) {
+  // reset() rebinds the handle; operator= would overwrite the node in place.
+  YAML::Node cur;
+  cur.reset(root);
+  std::string walked;
+  for (std::size_t s = 0; s < steps.size(); ++s) {
+    const PathStep& step = steps[s];
+    const bool last = s + 1 == steps.size();
+    if (step.key.empty()) {
+      if (!cur.IsSequence()) throw PathError{"'" + walked + "' is not a list"};
+      if (step.index >= cur.size())
+        throw PathError{"index " + std::to_string(step.index) + " is out of range for '" + walked + "' (" +
+                        std::to_string(cur.size()) + " elements)"};
+      walked += "[" + std::to_string(step.index) + "]";
+      if (last) {
+        cur[step.index] = value;
+      } else {
+        YAML::Node next = cur[step.index];
+        cur.reset(next);
+      }
+    } else {
+      if (cur.IsDefined() && !cur.IsMap() && !cur.IsNull())  // new keys start undefined
+        throw PathError{"'" + walked + "' is " + describe(cur) + ", not a mapping"};
+      walked = join(walked, step.key);
+      if (last) {
+        cur[step.key] = value;
+      } else {
+        YAML::Node next = cur[step.key];
+        cur.reset(next);
+      }
+    }
+  }
+  return walked;
+}
+
 }  // namespace
 
 // ---- construction ---------------------------------------------------------
@@ -458,37 +501,11 @@ void Config::apply_override(const std::string& assignment) {
   ExpansionBudget budget("--set '" + assignment + "'", value_text.size());
   check_keys_are_unique(value, path, budget);
 
-  // Walk down from the document root, creating mappings that do not exist.
-  // reset() rebinds the handle; operator= would overwrite the node in place.
-  YAML::Node cur;
-  cur.reset(doc_->root);
   std::string walked;
-  for (std::size_t s = 0; s < steps.size(); ++s) {
-    const PathStep& step = steps[s];
-    const bool last = s + 1 == steps.size();
-    if (step.key.empty()) {
-      if (!cur.IsSequence()) throw bad("'" + walked + "' is not a list");
-      if (step.index >= cur.size())
-        throw bad("index " + std::to_string(step.index) + " is out of range for '" + walked + "' (" +
-                  std::to_string(cur.size()) + " elements)");
-      walked += "[" + std::to_string(step.index) + "]";
-      if (last) {
-        cur[step.index] = value;
-      } else {
-        YAML::Node next = cur[step.index];
-        cur.reset(next);
-      }
-    } else {
-      if (cur.IsDefined() && !cur.IsMap() && !cur.IsNull())  // new keys start undefined
-        throw bad("'" + walked + "' is " + describe(cur) + ", not a mapping");
-      walked = join(walked, step.key);
-      if (last) {
-        cur[step.key] = value;
-      } else {
-        YAML::Node next = cur[step.key];
-        cur.reset(next);
-      }
-    }
+  try {
+    walked = set_at_steps(doc_->root, steps, value);
+  } catch (const PathError& e) {
+    throw bad(e.why);
   }
   doc_->overridden[walked] = assignment;
 }
@@ -773,52 +790,15 @@ std::string Config::resolved_text() const {
   return std::string(out.c_str()) + "\n";
 }
 
-namespace {
-
-// Sets `value` at a full key path ("a.b", "materials[1].E") below `node`,
-// creating missing mappings; false where the path leads through a list
-// item that is not there or through a value that is not a mapping.
-bool set_at_path(YAML::Node node, const std::string& path, const YAML::Node& value) {
-  std::vector<std::string> keys;
-  std::vector<std::vector<int>> indices;  // list indices after each key
-  for (const std::string& part : split_dots(path)) {
-    const size_t bracket = part.find('[');
-    keys.push_back(part.substr(0, bracket));
-    indices.emplace_back();
-    for (size_t at = bracket; at != std::string::npos; at = part.find('[', at + 1))
-      indices.back().push_back(std::stoi(part.substr(at + 1)));
-  }
-  YAML::Node cur;
-  cur.reset(node);
-  for (size_t i = 0; i < keys.size(); ++i) {
-    if (!cur.IsMap()) return false;
-    const bool last = i + 1 == keys.size() && indices[i].empty();
-    if (last) {
-      cur[keys[i]] = value;
-      return true;
-    }
-    if (!cur[keys[i]].IsDefined() || cur[keys[i]].IsNull()) {
-      if (!indices[i].empty()) return false;
-      cur[keys[i]] = YAML::Node(YAML::NodeType::Map);
-    }
-    YAML::Node next = cur[keys[i]];
-    for (int index : indices[i]) {
-      if (!next.IsSequence() || index < 0 || index >= static_cast<int>(next.size())) return false;
-      YAML::Node item = next[index];
-      next.reset(item);
-    }
-    cur.reset(next);
-  }
-  return false;
-}
-
-}  // namespace
-
 std::string Config::effective_text() const {
   YAML::Node effective = YAML::Clone(doc_->root);
   std::string listing;
   for (const auto& [path, value] : doc_->defaults) {
-    if (!set_at_path(effective, path, value)) continue;
+    try {
+      set_at_steps(effective, parse_override_path(path, path), value);
+    } catch (const PathError&) {
+      continue;  // under a list item that is not there, or a value that is not a mapping
+    }
     YAML::Emitter v;
     v << YAML::Flow << value;
     listing += "#   " + path + " = " + v.c_str() + "\n";

@@ -68,11 +68,7 @@ Obstacle floor_plane() {
 
 // The push of a tie's face on its node along the face's outward normal at
 // `x` (positive: pushing the node off).
-double tie_push(const SelfContactTie& t, const VecX& x) {
-  std::array<Vec3, 4> corners;
-  for (int i = 0; i < 4; ++i) corners[i] = x.segment<3>(3 * t.face_nodes[i]);
-  return quad_normal(corners, t.weight[1] + t.weight[2], t.weight[2] + t.weight[3]).dot(t.reaction);
-}
+double tie_push(const SelfContactTie& t, const VecX& x) { return t.face_normal(x).dot(t.reaction); }
 
 }  // namespace
 
