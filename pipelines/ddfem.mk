@@ -12,6 +12,7 @@
 #   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
 #   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
+#   make -f Makefile.pipeline ddfem-table-dynamics  DDFEM in dynamics: the fibre bar fine, level 1 and 2, trajectory error and speed
 #   make -f Makefile.pipeline ddfem-table-thesis-settings  the thesis's sampling and fit, and level 2 over 100/400/1024 materials
 #
 # RANKS=<n> runs the builder on n MPI ranks (THREADS threads each); on a
@@ -41,7 +42,8 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed \
+        ddfem-table-dynamics
 ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
 ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
@@ -85,6 +87,14 @@ ddfem-table-mixed: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_d
                    $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 	bash tools/bench_ddfem_mixed.sh $(BIN) $(OUT)/bench/ddfem-mixed docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
+
+# DDFEM in dynamics (docs/ddfem.md, "Coarsening in dynamics"): the fibre bar
+# fine and at both levels, naive and the isolated and periodic databases.
+ddfem-table-dynamics: build $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/palette3.level2.coarse_db.h5 \
+                      $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+	bash tools/bench_ddfem_dynamics.sh $(BIN) $(OUT)/bench/ddfem-dynamics \
+	  L1:isolated=$(OUT)/ddfem/palette3.coarse_db.h5 L1:periodic=$(OUT)/ddfem/palette3_periodic.coarse_db.h5 \
+	  L2:isolated=$(OUT)/ddfem/palette3.level2.coarse_db.h5 L2:periodic=$(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
 
 # Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
 # children fitted, periodic sampling at both levels.

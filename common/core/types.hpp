@@ -24,4 +24,7 @@ using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 inline Eigen::Map<const Vec9> flat(const Mat3& m) { return Eigen::Map<const Vec9>(m.data()); }
 inline Mat3 unflat(const Vec9& v) { return Eigen::Map<const Mat3>(v.data()); }
 
+// Index i of a periodic axis of n cells, for any integer i (also negative).
+inline int wrap_periodic(int i, int n) { return ((i % n) + n) % n; }
+
 }  // namespace msfab

@@ -5,11 +5,13 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "dynamics/coarse_dynamics.hpp"
 #include "dynamics/dac_model_artifact.hpp"
 #include "dynamics/scene_parameters.hpp"
 #include "fem/hex_mesh_bodies.hpp"
 #include "fem/voxel_shapes.hpp"
 #include "material/neo_hookean.hpp"
+#include "scene/scene.hpp"
 
 namespace msfab {
 
@@ -134,6 +136,17 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
     paint_box(body, b.lo, b.hi, b.body + 1);
   }
   for (int& v : body.ids) v = std::max(v - 1, 0);
+  if (g.has("layout")) {
+    // The layout of a static scene (fibres, layers, a random field, ...)
+    // repaints the materials inside the boxes; it never adds solid, and void
+    // it paints becomes a hole. Ids are 1-based indices into `materials`.
+    std::vector<MaterialPtr> palette{nullptr};
+    for (const SceneMaterial& m : materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
+    VoxelGrid painted = grid;
+    paint_layout(g, painted, palette);
+    for (size_t v = 0; v < grid.ids.size(); ++v)
+      if (grid.ids[v]) grid.ids[v] = painted.ids[v];
+  }
   if (grid.count_solid() == 0) g.fail("boxes", "paint no voxel");
   return grid;
 }
@@ -188,19 +201,27 @@ RegionLoad read_region_load(const Config& c) {
 }  // namespace
 
 VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::string& what) {
-  const int nodes = s.model.mesh.num_nodes();
+  // A coarsened design is loaded where the fine one is: on the fine nodes,
+  // restricted to the coarse ones by P^T.
+  const VecX& positions = s.coarsening ? s.coarsening->fine_initial_positions : s.initial_positions;
+  const int nodes = static_cast<int>(positions.size() / 3);
   std::vector<int> inside;
   for (int i = 0; i < nodes; ++i) {
-    const Vec3 x = s.initial_positions.segment<3>(3 * i);
+    const Vec3 x = positions.segment<3>(3 * i);
     if ((x.array() >= load.lo.array() - 1e-12).all() && (x.array() <= load.hi.array() + 1e-12).all()) inside.push_back(i);
   }
   if (inside.empty()) throw InputError(what + ": the region holds no node of the body");
   VecX f = VecX::Zero(3 * nodes);
   for (int i : inside) f.segment<3>(3 * i) = load.force / static_cast<double>(inside.size());
-  return f;
+  if (!s.coarsening) return f;
+  using NodeRows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  const SpMat& P = s.coarsening->to_fine;
+  VecX coarse(3 * P.cols());
+  Eigen::Map<NodeRows>(coarse.data(), P.cols(), 3) = P.transpose() * Eigen::Map<const NodeRows>(f.data(), nodes, 3);
+  return coarse;
 }
 
-DynamicsScene read_dynamics_scene(const Config& c) {
+DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coarsening) {
   DynamicsScene s;
   // Named parameters: expressions become numbers, the mesh is built at the
   // reference values and morphed to the current ones (scene_parameters.hpp).
@@ -213,18 +234,49 @@ DynamicsScene read_dynamics_scene(const Config& c) {
   std::vector<MaterialPtr> palette{nullptr};
   for (const SceneMaterial& m : s.materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
   DynamicsModel& model = s.model;
-  const VoxelMesh voxels = build_voxel_mesh(s.grid, palette);
-  model.mesh = voxels.mesh;
-  for (int e = 0; e < model.mesh.num_elements(); ++e) s.element_body.push_back(body_grid.ids[voxels.element_voxel[e]]);
-  if (s.body_names.size() > 1) separate_bodies(model.mesh, s.element_body);
-  morph.apply(model.mesh);
-  const int ne = model.mesh.num_elements();
-  for (int e = 0; e < ne; ++e) {
-    const SceneMaterial& m = s.materials[model.mesh.element_tag[e] - 1];
-    model.density.push_back(m.density);
-    model.damping_a.push_back(m.damping_a);
-    model.damping_b.push_back(m.damping_b);
-    model.element_material_name.push_back(m.name);
+  std::shared_ptr<DynamicsCoarsening> coarse_state;
+  if (coarsening.level > 0) {
+    // Coarse elements span several voxels: of one body, at the reference
+    // geometry, on the element the static fits were verified on.
+    if (s.body_names.size() > 1)
+      throw InputError("--coarsen: the scene has " + std::to_string(s.body_names.size()) +
+                       " bodies; coarse blocks would join them (coarsen scenes of one body)");
+    if (!morph.is_identity())
+      throw InputError("--coarsen: the scene's parameters move its geometry; coarse fits hold for the reference "
+                       "geometry only (coarsen a scene without geometry parameters)");
+    if (coarsening.element == "enhanced")
+      throw InputError("--coarse-element enhanced: dynamics runs trilinear coarse elements only");
+    coarse_state = std::make_shared<DynamicsCoarsening>();
+    DynamicsCoarsening* state = coarse_state.get();
+    state->request = coarsening;
+    state->coarse = coarsen_voxels(s.grid, palette, coarsening);
+    state->fine = build_voxel_mesh(s.grid, palette);
+    state->to_fine = coarse_to_fine_interpolation(s.grid, state->fine, state->coarse.grid, state->coarse.mesh);
+    if (state->coarse.element != "trilinear")
+      throw InputError(coarsening.database + ": fitted for the " + state->coarse.element +
+                       " element; dynamics runs trilinear coarse elements only");
+    const CoarseElementInertia inertia = coarse_element_inertia(s.grid, state->coarse, s.materials);
+    model.mesh = state->coarse.mesh.mesh;
+    model.density = inertia.density;
+    model.damping_a = inertia.damping_a;
+    model.damping_b = inertia.damping_b;
+    model.mesh.element_tag = inertia.material_id;
+    for (int id : inertia.material_id) model.element_material_name.push_back(s.materials[id - 1].name);
+    s.element_body.assign(model.mesh.num_elements(), 0);
+    s.coarsening = coarse_state;
+  } else {
+    const VoxelMesh voxels = build_voxel_mesh(s.grid, palette);
+    model.mesh = voxels.mesh;
+    for (int e = 0; e < model.mesh.num_elements(); ++e) s.element_body.push_back(body_grid.ids[voxels.element_voxel[e]]);
+    if (s.body_names.size() > 1) separate_bodies(model.mesh, s.element_body);
+    morph.apply(model.mesh);
+    for (int e = 0; e < model.mesh.num_elements(); ++e) {
+      const SceneMaterial& m = s.materials[model.mesh.element_tag[e] - 1];
+      model.density.push_back(m.density);
+      model.damping_a.push_back(m.damping_a);
+      model.damping_b.push_back(m.damping_b);
+      model.element_material_name.push_back(m.name);
+    }
   }
   model.gravity = c.has("gravity") ? vec3(c, "gravity") : Vec3(0, 0, -9.81);
 
@@ -234,11 +286,18 @@ DynamicsScene read_dynamics_scene(const Config& c) {
   const Mat3 R = c.has("placement") && place.has("rotation_deg") ? rotation_from_degrees(vec3(place, "rotation_deg"))
                                                                  : Mat3::Identity();
   const Vec3 t = c.has("placement") && place.has("translation") ? vec3(place, "translation") : Vec3::Zero();
-  const Vec3 center = 0.5 * (model.mesh.bbox_min() + model.mesh.bbox_max());
+  // About the fine design's centre also when coarsened: padded coarse cells
+  // may reach beyond it.
+  const HexMesh& design = s.coarsening ? s.coarsening->fine.mesh : model.mesh;
+  const Vec3 center = 0.5 * (design.bbox_min() + design.bbox_max());
+  auto placed = [&](const NodeArray& nodes) {
+    VecX x(3 * nodes.rows());
+    for (int i = 0; i < nodes.rows(); ++i) x.segment<3>(3 * i) = center + t + R * (nodes.row(i).transpose() - center);
+    return x;
+  };
   const int nn = model.mesh.num_nodes();
-  s.initial_positions.resize(3 * nn);
-  for (int i = 0; i < nn; ++i)
-    s.initial_positions.segment<3>(3 * i) = center + t + R * (model.mesh.nodes.row(i).transpose() - center);
+  s.initial_positions = placed(model.mesh.nodes);
+  if (coarse_state) coarse_state->fine_initial_positions = placed(design.nodes);
   s.initial_velocities = VecX::Zero(3 * nn);
   if (c.has("initial_velocity")) {
     const Vec3 v = vec3(c, "initial_velocity");
@@ -257,7 +316,10 @@ DynamicsScene read_dynamics_scene(const Config& c) {
         ++count;
       }
     }
-    if (count == 0) c.child("clamp").fail("min", "the clamp box holds no node of the body");
+    if (count == 0)
+      c.child("clamp").fail("min", s.coarsening ? "the clamp box holds no node of the coarse mesh (its nodes lie every " +
+                                                      std::to_string(s.coarsening->coarse.grid.fine_per_cell()) + " voxels)"
+                                                : "the clamp box holds no node of the body");
   }
 
   model.obstacles = read_obstacles(c);

@@ -5,15 +5,19 @@
 // obstacles and friction, an optional preload (a static pluck or a
 // quasistatic press against the obstacles) that is released at t = 0, and
 // the integration settings.
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "ddfem/voxel_coarsening.hpp"
 #include "dynamics/dynamics_model.hpp"
 #include "dynamics/newmark_integrator.hpp"
 #include "fem/voxel_grid.hpp"
 #include "io/config.hpp"
 
 namespace msfab {
+
+struct DynamicsCoarsening;
 
 struct SceneMaterial {
   std::string name;
@@ -66,11 +70,16 @@ struct DynamicsScene {
   bool press_self_contact = false;
   double press_ramp_time = 0;  // kDynamicPress: seconds from zero to the full load
   RigidFlightSettings rigid;
+  // Set when the design was coarsened (DDFEM or a baseline): `grid` stays
+  // the fine design, `model.mesh` is the coarse mesh (dynamics/coarse_dynamics.hpp).
+  std::shared_ptr<const DynamicsCoarsening> coarsening;
 };
 
 // Reads and validates everything (InputError naming file, key and problem);
-// the caller runs check_no_unknown_keys() afterwards.
-DynamicsScene read_dynamics_scene(const Config& config);
+// the caller runs check_no_unknown_keys() afterwards. A request of level 1
+// or 2 simulates the design on coarse elements (one body, no geometry
+// parameters, trilinear element; dynamics/coarse_dynamics.hpp).
+DynamicsScene read_dynamics_scene(const Config& config, const CoarseningRequest& coarsening = {});
 
 // The nodal force vector of a region load on the initial positions
 // (InputError if the region holds no node).

@@ -19,8 +19,6 @@ void require_symmetric_shape(const VoxelGrid& c) {
                      std::to_string(c.nx) + " x " + std::to_string(c.ny) + " x " + std::to_string(c.nz));
 }
 
-int wrap(int i, int n) { return ((i % n) + n) % n; }
-
 // Face-connected pieces of voxels for which `member` holds; for each, the
 // set of axes along which it wraps around the periodic cell. A piece wraps
 // along an axis when a voxel is reached twice with unwrapped positions
@@ -62,7 +60,7 @@ Pieces face_pieces(const VoxelGrid& c, Member member, bool periodic = true) {
             if (!periodic) continue;
             off[a] += q[a] < 0 ? -1 : 1;
           }
-          q[a] = wrap(q[a], n[a]);
+          q[a] = wrap_periodic(q[a], n[a]);
           const int w = static_cast<int>(c.index(q[0], q[1], q[2]));
           if (!member(c.ids[w])) continue;
           if (p.piece[w] < 0) {
@@ -219,7 +217,7 @@ CleanupReport clean_structure(VoxelGrid& c) {
     for (int a = 0; a < dims; ++a)
       for (int step : {-1, 1}) {
         int q[3] = {idx[0], idx[1], idx[2]};
-        q[a] = wrap(q[a] + step, n[a]);
+        q[a] = wrap_periodic(q[a] + step, n[a]);
         const int id = c.at(q[0], q[1], q[2]);
         if (id != 0) ++around[p][id];
       }
@@ -240,7 +238,6 @@ std::int64_t thin_feature_voxels(const VoxelGrid& c, int width) {
   const int wz = is_2d(c) ? 1 : width;
   if (width > c.nx || width > c.ny || wz > c.nz) return static_cast<std::int64_t>(c.size());
   std::vector<std::uint8_t> covered(c.size(), 0);
-  auto wrap = [](int i, int n) { return (i % n + n) % n; };
   // Each window origin whose window is uniformly solid or uniformly void
   // covers its voxels.
   for (int k = 0; k < c.nz; ++k)
@@ -251,12 +248,14 @@ std::int64_t thin_feature_voxels(const VoxelGrid& c, int width) {
         for (int dk = 0; dk < wz && uniform; ++dk)
           for (int dj = 0; dj < width && uniform; ++dj)
             for (int di = 0; di < width && uniform; ++di)
-              uniform = (c.at(wrap(i + di, c.nx), wrap(j + dj, c.ny), wrap(k + dk, c.nz)) != 0) == solid;
+              uniform = (c.at(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny),
+                              wrap_periodic(k + dk, c.nz)) != 0) == solid;
         if (!uniform) continue;
         for (int dk = 0; dk < wz; ++dk)
           for (int dj = 0; dj < width; ++dj)
             for (int di = 0; di < width; ++di)
-              covered[c.index(wrap(i + di, c.nx), wrap(j + dj, c.ny), wrap(k + dk, c.nz))] = 1;
+              covered[c.index(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny),
+                              wrap_periodic(k + dk, c.nz))] = 1;
       }
   std::int64_t thin = 0;
   for (std::uint8_t v : covered) thin += v == 0;

@@ -15,8 +15,6 @@
 namespace msfab {
 namespace {
 
-int wrap(int i, int n) { return ((i % n) + n) % n; }
-
 int find_root(std::vector<int>& parent, int v) {
   while (parent[v] != v) v = parent[v] = parent[parent[v]];
   return v;
@@ -36,7 +34,8 @@ int count_periodic_pieces(const VoxelGrid& cell) {
         for (int dk = -1; dk <= 1; ++dk)
           for (int dj = -1; dj <= 1; ++dj)
             for (int di = -1; di <= 1; ++di) {
-              const int w = static_cast<int>(cell.index(wrap(i + di, nx), wrap(j + dj, ny), wrap(k + dk, nz)));
+              const int w = static_cast<int>(
+                  cell.index(wrap_periodic(i + di, nx), wrap_periodic(j + dj, ny), wrap_periodic(k + dk, nz)));
               if (cell.ids[w] != 0) parent[find_root(parent, v)] = find_root(parent, w);
             }
       }
@@ -109,7 +108,8 @@ Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationRes
     e[m] = 1;
     const Mat3 eps = strain_tensor(e);
     for (int a = 0; a < 8; ++a) {
-      const std::int64_t q = wrap(i + (a >> 2 & 1), nx) + nx * (wrap(j + (a >> 1 & 1), ny) + std::int64_t(ny) * wrap(k + (a & 1), nz));
+      const std::int64_t q = wrap_periodic(i + (a >> 2 & 1), nx) +
+                             nx * (wrap_periodic(j + (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k + (a & 1), nz));
       U.col(m).segment<3>(3 * a) = eps * X.row(a).transpose() + r.fluctuation[m].segment<3>(3 * q);
     }
   }
@@ -162,7 +162,8 @@ Eigen::MatrixXd strain_loads(const VoxelStiffnessField& field) {
   for (std::int64_t p = 0; p < nodes; ++p) {
     const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny), k = static_cast<int>(p / (std::int64_t(nx) * ny));
     for (int a = 0; a < 8; ++a) {  // p is corner a of element (i, j, k) - offset(a)
-      const std::int64_t e = wrap(i - (a >> 2 & 1), nx) + nx * (wrap(j - (a >> 1 & 1), ny) + std::int64_t(ny) * wrap(k - (a & 1), nz));
+      const std::int64_t e = wrap_periodic(i - (a >> 2 & 1), nx) +
+                             nx * (wrap_periodic(j - (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k - (a & 1), nz));
       for (int b = 0; b < field.basis_size(); ++b)
         if (const double w = field.weight(e, b); w != 0.0) B.middleRows<3>(3 * p) += w * basis_loads[b].middleRows<3>(3 * a);
     }
@@ -176,7 +177,9 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
                   const std::vector<int>& cases) {
   const int nx = field.nx, ny = field.ny, nz = field.nz;
   const std::int64_t N = field.voxels();
-  auto node = [&](int i, int j, int k) -> std::int64_t { return wrap(i, nx) + nx * (wrap(j, ny) + std::int64_t(ny) * wrap(k, nz)); };
+  auto node = [&](int i, int j, int k) -> std::int64_t {
+    return wrap_periodic(i, nx) + nx * (wrap_periodic(j, ny) + std::int64_t(ny) * wrap_periodic(k, nz));
+  };
   out.unknowns = 3 * N - 3;
   // Assemble node by node (each column gathers its 8 elements): deterministic for any thread count.
   std::vector<std::vector<Eigen::Triplet<double>>> per_node(N);

@@ -26,7 +26,6 @@ namespace {
 // coarse operators from slowing CG down.
 using namespace multigrid_cycle;
 
-int wrap(int i, int n) { return ((i % n) + n) % n; }
 
 using namespace hex_lattice;
 
@@ -61,7 +60,9 @@ struct PeriodicGridMultigrid::Level {
   VecX rhs, solution, residual;   // cycle workspace
 
   int nodes() const { return n[0] * n[1] * n[2]; }
-  int node(int i, int j, int k) const { return wrap(i, n[0]) + n[0] * (wrap(j, n[1]) + n[1] * wrap(k, n[2])); }
+  int node(int i, int j, int k) const {
+    return wrap_periodic(i, n[0]) + n[0] * (wrap_periodic(j, n[1]) + n[1] * wrap_periodic(k, n[2]));
+  }
   std::array<int, 3> coords(int p) const { return {p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])}; }
 };
 

@@ -2,7 +2,8 @@
 // App. B), phase by phase:
 //
 //   1. read the scene: materials with identified E_n and Rayleigh damping,
-//      voxel geometry, placement, clamps, obstacles, friction, preload
+//      voxel geometry, placement, clamps, obstacles, friction, preload;
+//      with --coarsen, the design coarsened by DDFEM lookups (§2.5.2)
 //   2. preload: a static pluck or a quasistatic press with no-slip contact
 //      (B.3), released at t = 0
 //   3. implicit Newmark steps (Eq. 4.2-4.6) with frictional contact
@@ -11,7 +12,8 @@
 //   4. with rigid flight enabled: rigid projection (B.22), DMV free flight,
 //      projection back before the next contact (B.23)
 //   5. write the `msfab.trajectory` artifact, its ParaView time series and
-//      the energy and centre-of-mass plots
+//      the energy and centre-of-mass plots; with --reference, the run's
+//      difference from the fine run frame by frame
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -22,6 +24,7 @@
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "default_scene.hpp"
+#include "dynamics/coarse_dynamics.hpp"
 #include "dynamics/dynamics_run.hpp"
 #include "dynamics/dynamics_scene.hpp"
 #include "dynamics/trajectory.hpp"
@@ -116,6 +119,17 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
               t.seconds_elastic, t.seconds_rigid, t.seconds_total);
 }
 
+void print_difference(const TrajectoryDifference& d) {
+  std::printf("  vs fine (%s): error at release %.3e, max %.3e, mean %.3e, at the end %.3e over %zu frames\n"
+              "    (mean fine-vertex distance of this run's displacements interpolated to the fine nodes, over the\n"
+              "     longest side of the rest box; thesis 2.5.2); centre of mass apart by up to %.3e m\n",
+              d.model_nodes == d.fine_nodes ? "same mesh" : "interpolated", d.error.front(), d.max_error, d.mean_error, d.final_error,
+              d.error.size(), d.max_center_of_mass_distance);
+  std::printf("  Newmark step: fine %.3f ms, this run %.3f ms (%d and %d elastic steps): %.1fx faster\n",
+              1e3 * d.fine_seconds_per_step, 1e3 * d.model_seconds_per_step, d.fine_steps, d.model_steps,
+              d.model_seconds_per_step > 0 ? d.fine_seconds_per_step / d.model_seconds_per_step : 0.0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -128,13 +142,33 @@ int main(int argc, char** argv) {
       .add_option("--marker", marker, "rest position X Y Z of a tracked node (the node nearest to it)")
       ->expected(3);
   app.cli().add_option("--marker-csv", marker_csv, "write the tracked node's position at every step as CSV (t,x,y,z)");
+  CoarseningRequest coarsening;
+  app.cli()
+      .add_option("--coarsen", coarsening.level, "coarsening levels: 0 (fine), 1 (2x2x2 blocks), 2 (4x4x4)")
+      ->check(CLI::Range(0, 2));
+  app.cli()
+      .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged, homogenized or galerkin")
+      ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized", "galerkin"}));
+  app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build (trilinear element)");
+  app.cli()
+      .add_option("--coarse-fallback", coarsening.fallback,
+                  "ddfem: blocks the database holds no fit for are coarsened naive (default) or galerkin")
+      ->check(CLI::IsMember({"naive", "galerkin"}));
+  std::string reference;
+  app.cli().add_option("--reference", reference,
+                       "a msfab.trajectory of the same scene run fine (same time step and frames): report this "
+                       "run's difference from it frame by frame and the speedup");
   return app.run(argc, argv, [&](StageContext& ctx) {
     if (marker_csv.empty() != marker.empty()) throw InputError("--marker and --marker-csv go together");
     const std::string& out = ctx.require_out();
 
     // 1. Scene.
-    const DynamicsScene scene = read_dynamics_scene(ctx.config);
+    if (coarsening.level == 0 && (!coarsening.database.empty() || coarsening.material != "ddfem"))
+      throw InputError("--coarse-material and --database need --coarsen 1 or 2");
+    const DynamicsScene scene = read_dynamics_scene(ctx.config, coarsening);
     ctx.finish_config();
+    const Trajectory fine = reference.empty() ? Trajectory{} : read_trajectory_artifact(reference);
+    if (!reference.empty()) check_fine_reference(scene.grid, scene.materials, fine, reference);
     ctx.check_out_folder();
     ctx.check_memory(dynamics_peak_bytes(scene),
                      fmt::format("a run of {} elements over {} s with a frame every {} steps",
@@ -145,6 +179,14 @@ int main(int argc, char** argv) {
                  scene.model.obstacles.size(), scene.model.contact ? "on" : "off",
                  scene.model.friction ? "on" : "off", impact_model_name(scene.model.impact), scene.newmark.time_step,
                  scene.duration);
+    if (scene.coarsening)
+      spdlog::info("coarsened to level {} with {} materials: {} elements, {} distinct blocks, {:.1f} ms{}",
+                   coarsening.level, coarsening.material, scene.model.mesh.num_elements(),
+                   scene.coarsening->coarse.stats.distinct_combinations, 1e3 * scene.coarsening->coarse.seconds,
+                   scene.coarsening->coarse.fallback_blocks
+                       ? fmt::format(" ({} block kinds without a database fit coarsened {})",
+                                     scene.coarsening->coarse.fallback_blocks, coarsening.fallback)
+                       : std::string());
 
     // 2-4. Preload, release, dynamics and flight.
     const std::uint64_t total_steps = static_cast<std::uint64_t>(std::ceil(scene.duration / scene.newmark.time_step));
@@ -164,11 +206,18 @@ int main(int argc, char** argv) {
     TrajectoryProvenance provenance;
     provenance.config_text = ctx.config.resolved_text();
     provenance.seed = ctx.options.seed;
+    if (!coarsening.database.empty()) provenance.inputs.push_back(coarsening.database);
+    if (!reference.empty()) provenance.inputs.push_back(reference);
     const std::string xmf = write_trajectory_artifact(out, trajectory, provenance);
     const std::vector<std::string> plots = write_trajectory_plots(plot_prefix(out), trajectory);
 
     print_summary(scene, trajectory);
     std::printf("  artifact: %s\n  ParaView: %s\n", out.c_str(), xmf.c_str());
     for (const std::string& p : plots) std::printf("  plot: %s\n", p.c_str());
+    if (!reference.empty()) {
+      const TrajectoryDifference d =
+          compare_with_fine(scene.grid, scene.materials, scene.coarsening.get(), trajectory, fine, reference);
+      print_difference(d);
+    }
   });
 }

@@ -1,75 +1,10 @@
 #include "coarse_model.hpp"
 
-#include <chrono>
-#include <set>
-
-#include "core/errors.hpp"
-#include "ddfem/baseline_coarsening.hpp"
-
 namespace msfab {
 
-CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
-                                         const CoarseGrid* level1) {
-  if (name == "naive") return level1 ? naive_coarsening(palette, *level1) : naive_coarsening(palette);
-  if (name == "averaged") return level1 ? averaged_coarsening(palette, *level1) : averaged_coarsening(palette);
-  if (name == "galerkin") return level1 ? galerkin_coarsening(palette, *level1) : galerkin_coarsening(palette);
-  if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
-  throw InputError("coarse materials: expected naive, averaged, galerkin or homogenized, got '" + name + "'");
-}
-
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request) {
-  if (request.fallback != "naive" && request.fallback != "galerkin")
-    throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
-  if (request.level < 1 || request.level > 2)
-    throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
-  if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
-      request.material != "homogenized" && request.material != "galerkin")
-    throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized or galerkin, got '" +
-                     request.material + "'");
-  if (request.fallback != "naive" && request.material != "ddfem")
-    throw InputError("--coarse-fallback " + request.fallback + ": applies to --coarse-material ddfem only (got " +
-                     request.material + ")");
   CoarseModel m;
-  if (request.material == "ddfem") {
-    if (request.database.empty())
-      throw InputError("--coarse-material ddfem needs --database (a coarse_db from msfab-ddfem-build)");
-    m.database = std::make_shared<CoarseDatabase>(read_coarse_db(request.database));
-    if (request.level != m.database->level)
-      throw InputError(request.database + ": a level-" + std::to_string(m.database->level) +
-                       " database cannot coarsen to level " + std::to_string(request.level));
-    std::set<int> used(scene.grid.ids.begin(), scene.grid.ids.end());
-    check_scene_palette(*m.database, request.database, scene.material_by_id, std::vector<int>(used.begin(), used.end()));
-    // A fit is only right on the element it was fitted for.
-    const std::string fitted_for = m.database->enhanced_element() ? "enhanced" : "trilinear";
-    if (!request.element.empty() && request.element != fitted_for)
-      throw InputError(request.database + ": fitted for the " + fitted_for + " coarse element; --coarse-element " +
-                       request.element + " would put its materials on another element");
-    m.element = fitted_for;
-  }
-  if (!request.element.empty()) m.element = request.element;
-  const auto t0 = std::chrono::steady_clock::now();
-  m.level1 = coarsen_grid(scene.grid);
-  m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
-  const CoarseGrid* level1 = request.level == 2 ? &m.level1 : nullptr;
-  CoarseMaterialLookup lookup;
-  if (request.material != "ddfem") {
-    lookup = baseline_coarsening(request.material, scene.material_by_id, level1);
-  } else {
-    // Blocks the database holds no fit for (void children in a database
-    // built without them, blocks that could not be fitted) are coarsened
-    // naively or by the Galerkin element.
-    const CoarseMaterialLookup fallback = baseline_coarsening(request.fallback, scene.material_by_id, level1);
-    int* fallbacks = &m.fallback_blocks;
-    const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
-      ++*fallbacks;
-      return fallback(ids);
-    };
-    lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
-                                : database_coarsening(*m.database, counted);
-    m.fallback = request.fallback;
-  }
-  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
-  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  static_cast<CoarsenedVoxels&>(m) = coarsen_voxels(scene.grid, scene.material_by_id, request);
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   return m;
 }

@@ -1,49 +1,18 @@
 #pragma once
-// Online coarsening for msfab-simulate (thesis §2.4): the scene's voxel
-// grid in 2^level blocks, each one coarse element whose quadrature-point
-// materials come from the DDFEM database or from a baseline.
-#include <memory>
-#include <string>
-
-#include "ddfem/coarse_db.hpp"
-#include "ddfem/coarse_grid.hpp"
+// Online coarsening for msfab-simulate (thesis §2.4): the shared voxel
+// coarsening of ddfem/voxel_coarsening.hpp with the scene's static
+// conditions carried onto the coarse mesh.
+#include "ddfem/voxel_coarsening.hpp"
 #include "scene/scene.hpp"
 
 namespace msfab {
 
-struct CoarseningRequest {
-  int level = 0;                     // 0 = fine, 1, 2
-  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin
-  std::string database;              // coarse_db path (ddfem)
-  // ddfem: how blocks without a fit in the database are coarsened (naive |
-  // galerkin); blocks with void children are the usual ones.
-  std::string fallback = "naive";
-  // trilinear | enhanced (condensed bubble modes); empty: the database's
-  // element for ddfem, trilinear otherwise.
-  std::string element;
-};
-
-struct CoarseModel {
-  CoarseGrid level1, grid;           // grid = the level requested
-  VoxelMesh mesh;
+struct CoarseModel : CoarsenedVoxels {
   StaticConditions conditions;
-  CoarseMeshStats stats;
-  double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
-  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit (coarsened by request.fallback)
-  std::shared_ptr<CoarseDatabase> database;
-  std::string element = "trilinear"; // the coarse element used (request resolved)
-  std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
 };
 
-// A baseline of ddfem/baseline_coarsening.hpp by name (naive, averaged,
-// galerkin, homogenized): of level-1 blocks when level1 is null, of level-2
-// cells of that level-1 grid otherwise.
-CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
-                                         const CoarseGrid* level1);
-
-// InputError for a bad request: unknown material, ddfem without a database
-// or with a database of another level, a database whose palette disagrees
-// with the scene, an element other than the one the database was fitted for.
+// InputError for a bad request (coarsen_voxels) or conditions that select
+// nothing on the coarse mesh.
 CoarseModel build_coarse_model(const Scene& scene, const VoxelMesh& fine, const CoarseningRequest& request);
 
 }  // namespace msfab

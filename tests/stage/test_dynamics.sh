@@ -122,6 +122,28 @@ awk 'BEGIN { print "t,z"; for (k = 0; k < 400; ++k) { t = k / 24000; printf "%.8
   > "$WORK/growing.csv"
 expect_exit 2 "growing.csv: the tracked oscillation grows" -- "$BIN/msfab-dac-calibrate" --config "$WORK/cal.yaml" \
   --set marker_csv="$WORK/growing.csv" --out "$WORK/x.h5"
+# DDFEM in dynamics: the fibre bar at 4 mm voxels, fine and coarsened by the
+# tiny database (its stiff material as the fibre), compared frame by frame.
+"$BIN/msfab-ddfem-build" --config configs/ddfem/tiny.yaml --out "$WORK/tiny.coarse_db.h5" --quiet > /dev/null
+FIBER=(--config $S/fiber_bar.yaml --set geometry.voxel_size=0.004 --set simulation.duration=0.02
+       --set 'geometry.layout[0].id=2' --set 'materials[1].E=1.0e7')
+"$BIN/msfab-dynamics" --quiet "${FIBER[@]}" --out "$WORK/fiber_fine.h5" > /dev/null
+"$BIN/msfab-dynamics" --quiet "${FIBER[@]}" --coarsen 1 --database "$WORK/tiny.coarse_db.h5" \
+  --reference "$WORK/fiber_fine.h5" --out "$WORK/fiber_l1.h5" > "$WORK/fiber_l1.txt"
+check "a coarsened run reports its difference from the fine run" -- grep -q "vs fine (interpolated): error at release" "$WORK/fiber_l1.txt"
+err=$(awk '/vs fine/ { for (i = 1; i <= NF; ++i) if ($i == "max") print $(i + 1) }' "$WORK/fiber_l1.txt" | tr -d ,)
+check "... which is small and not zero (0 < $err < 0.05)" -- awk -v e="$err" 'BEGIN { exit !(e > 0 && e < 0.05) }'
+check "... and runs fewer DOFs" -- grep -q "msfab-dynamics: scene 'fiber-bar', 208 elements" "$WORK/fiber_l1.txt"
+"$BIN/msfab-dynamics" --quiet "${FIBER[@]}" --reference "$WORK/fiber_fine.h5" --out "$WORK/fiber_again.h5" > "$WORK/fiber_again.txt"
+check "the fine run against itself: no difference" -- grep -q "vs fine (same mesh): error at release 0.000e+00, max 0.000e+00" "$WORK/fiber_again.txt"
+expect_exit 2 "fiber_fine.h5: the reference has .* rest nodes" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \
+  --reference "$WORK/fiber_fine.h5"
+expect_exit 2 "tiny.coarse_db.h5.*palette" -- "$BIN/msfab-dynamics" --config $S/fiber_bar.yaml --set geometry.voxel_size=0.004 \
+  --coarsen 1 --database "$WORK/tiny.coarse_db.h5" --out "$WORK/x.h5"
+expect_exit 2 "--coarsen: the scene has 2 bodies" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml --coarsen 1 \
+  --coarse-material naive --out "$WORK/x.h5"
+expect_exit 2 "--coarse-material and --database need --coarsen 1 or 2" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \
+  --database "$WORK/tiny.coarse_db.h5"
 check "failed runs leave no artifact" -- test ! -e "$WORK/x.h5"
 sed -e "s|damping_b: 2.0e-5|damping_b: 0|" $S/cantilever_pluck.yaml > "$WORK/undamped_rig.yaml"
 "$BIN/msfab-dynamics" --quiet --config "$WORK/undamped_rig.yaml" --set simulation.duration=0.03 \

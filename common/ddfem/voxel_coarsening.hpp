@@ -1,0 +1,54 @@
+#pragma once
+// Online coarsening of a voxel design (thesis §2.4), shared by the static
+// simulator and the dynamics simulator: the grid in 2^level blocks, each one
+// coarse element whose quadrature-point materials come from a DDFEM
+// database or from a baseline. What a stage then puts on the coarse mesh
+// (static conditions, masses, clamps) is its own business.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ddfem/coarse_db.hpp"
+#include "ddfem/coarse_grid.hpp"
+
+namespace msfab {
+
+struct CoarseningRequest {
+  int level = 0;                     // 0 = fine, 1, 2
+  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin
+  std::string database;              // coarse_db path (ddfem)
+  // ddfem: how blocks without a fit in the database are coarsened (naive |
+  // galerkin); blocks with void children are the usual ones.
+  std::string fallback = "naive";
+  // trilinear | enhanced (condensed bubble modes); empty: the database's
+  // element for ddfem, trilinear otherwise.
+  std::string element;
+};
+
+struct CoarsenedVoxels {
+  CoarseGrid level1, grid;           // grid = the level requested
+  VoxelMesh mesh;
+  CoarseMeshStats stats;
+  double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
+  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit (coarsened by request.fallback)
+  std::shared_ptr<CoarseDatabase> database;
+  std::string element = "trilinear"; // the coarse element used (request resolved)
+  std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
+};
+
+// A baseline of ddfem/baseline_coarsening.hpp by name (naive, averaged,
+// galerkin, homogenized): of level-1 blocks when level1 is null, of level-2
+// cells of that level-1 grid otherwise.
+CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
+                                         const CoarseGrid* level1);
+
+// `palette` is indexed by voxel id ([0] = void). InputError for a bad
+// request: unknown material or fallback, a level other than 1 or 2, ddfem
+// without a database or with a database of another level, a database whose
+// palette disagrees with the grid's materials, an element other than the one
+// the database was fitted for. Option names in the messages are the
+// command-line ones (--coarsen, --coarse-material, ...).
+CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette,
+                               const CoarseningRequest& request);
+
+}  // namespace msfab

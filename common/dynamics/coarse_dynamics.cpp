@@ -1,0 +1,150 @@
+#include "dynamics/coarse_dynamics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "ddfem/coarsening_error.hpp"
+#include "dynamics/dynamics_scene.hpp"
+#include "material/neo_hookean.hpp"
+
+namespace msfab {
+
+namespace {
+
+using NodeRowsMap = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+VecX displacement_from_rest(const VecX& positions, const NodeArray& rest) {
+  VecX u = positions;
+  for (int n = 0; n < rest.rows(); ++n) u.segment<3>(3 * n) -= rest.row(n).transpose();
+  return u;
+}
+
+void seconds_per_elastic_step(const Trajectory& t, double& seconds, int& steps) {
+  double total = 0;
+  steps = 0;
+  for (const TrajectorySample& s : t.samples)
+    if (s.phase == SimulationPhase::kElastic && s.time > 0) total += s.seconds, ++steps;
+  seconds = steps ? total / steps : 0.0;
+}
+
+// Only the fine mesh's nodes matter here, not its materials.
+VoxelMesh fine_voxel_mesh(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials) {
+  std::vector<MaterialPtr> palette{nullptr};
+  for (const SceneMaterial& m : materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
+  return build_voxel_mesh(grid, palette);
+}
+
+}  // namespace
+
+void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
+                          const std::string& fine_path) {
+  const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
+  const int nf = fine_mesh.mesh.num_nodes();
+  if (fine.rest_nodes.rows() != nf)
+    throw InputError(fine_path + ": the reference has " + std::to_string(fine.rest_nodes.rows()) +
+                     " rest nodes; the fine mesh of this scene has " + std::to_string(nf) +
+                     " (not a fine run of this scene)");
+  if ((fine.rest_nodes - fine_mesh.mesh.nodes).cwiseAbs().maxCoeff() > 1e-9 * grid.voxel_size)
+    throw InputError(fine_path + ": dataset '/mesh/nodes' differs from this scene's fine mesh (not a fine run of "
+                     "this scene, or one with other scene parameters)");
+  if (fine.frames.empty()) throw InputError(fine_path + ": holds no output frame");
+}
+
+CoarseElementInertia coarse_element_inertia(const VoxelGrid& fine, const CoarsenedVoxels& coarse,
+                                            const std::vector<SceneMaterial>& materials) {
+  const CoarseGrid& g = coarse.grid;
+  const int f = g.fine_per_cell();
+  const int ne = coarse.mesh.mesh.num_elements();
+  CoarseElementInertia out;
+  out.density.resize(ne);
+  out.damping_a.resize(ne);
+  out.damping_b.resize(ne);
+  out.material_id.resize(ne);
+  std::vector<int> count(materials.size() + 1);
+  for (int e = 0; e < ne; ++e) {
+    const int cell = coarse.mesh.element_voxel[e];
+    const int ci = cell % g.nx, cj = (cell / g.nx) % g.ny, ck = cell / (g.nx * g.ny);
+    std::fill(count.begin(), count.end(), 0);
+    // Children beyond the fine grid (odd sizes, padded) are void.
+    for (int k = ck * f; k < std::min((ck + 1) * f, fine.nz); ++k)
+      for (int j = cj * f; j < std::min((cj + 1) * f, fine.ny); ++j)
+        for (int i = ci * f; i < std::min((ci + 1) * f, fine.nx); ++i) ++count[fine.at(i, j, k)];
+    double mass = 0, mass_a = 0, stiffness = 0, stiffness_b = 0;
+    int best = 0;
+    for (size_t id = 1; id < count.size(); ++id) {
+      if (!count[id]) continue;
+      const SceneMaterial& m = materials[id - 1];
+      mass += count[id] * m.density;
+      mass_a += count[id] * m.density * m.damping_a;
+      stiffness += count[id] * m.E;
+      stiffness_b += count[id] * m.E * m.damping_b;
+      if (!best || count[id] > count[best]) best = static_cast<int>(id);
+    }
+    if (!best) throw std::logic_error("coarse_element_inertia: an element of the coarse mesh covers no solid voxel");
+    out.density[e] = mass / double(f * f * f);
+    out.damping_a[e] = mass_a / mass;
+    out.damping_b[e] = stiffness_b / stiffness;
+    out.material_id[e] = best;
+  }
+  return out;
+}
+
+TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
+                                       const DynamicsCoarsening* coarsening, const Trajectory& model,
+                                       const Trajectory& fine, const std::string& fine_path) {
+  check_fine_reference(grid, materials, fine, fine_path);
+  const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
+  const int nf = fine_mesh.mesh.num_nodes();
+  if (model.frames.empty()) throw InputError("this run: holds no output frame");
+  if (fine.frames.size() != model.frames.size())
+    throw InputError(fine_path + ": the reference has " + std::to_string(fine.frames.size()) + " frames, this run " +
+                     std::to_string(model.frames.size()) + " (simulation.time_step, duration and output_every must "
+                     "be the same)");
+  const double step = std::max(fine.time_step, model.time_step);
+  for (size_t i = 0; i < fine.frames.size(); ++i)
+    if (std::abs(fine.frames[i].time - model.frames[i].time) > 1e-6 * step) {
+      std::ostringstream msg;
+      msg << fine_path << ": frame " << i << " is at t = " << fine.frames[i].time << " s, this run's at "
+          << model.frames[i].time << " s (simulation.time_step and output_every must be the same)";
+      throw InputError(msg.str());
+    }
+
+  SpMat P;
+  if (coarsening) {
+    P = coarsening->to_fine;
+  } else {
+    P.resize(nf, nf);
+    P.setIdentity();
+  }
+  if (P.cols() != model.rest_nodes.rows())
+    throw std::logic_error("compare_with_fine: the run's mesh is not the model it was compared as");
+
+  TrajectoryDifference d;
+  d.fine_nodes = nf;
+  d.model_nodes = static_cast<int>(model.rest_nodes.rows());
+  for (size_t i = 0; i < fine.frames.size(); ++i) {
+    const VecX uf = displacement_from_rest(fine.frames[i].positions, fine.rest_nodes);
+    const VecX um = displacement_from_rest(model.frames[i].positions, model.rest_nodes);
+    VecX interpolated(3 * nf);
+    Eigen::Map<NodeRowsMap>(interpolated.data(), nf, 3) = P * Eigen::Map<const NodeRowsMap>(um.data(), d.model_nodes, 3);
+    const double e = mean_vertex_error(fine_mesh, uf, interpolated);
+    d.time.push_back(fine.frames[i].time);
+    d.error.push_back(e);
+    d.max_error = std::max(d.max_error, e);
+    d.mean_error += e / double(fine.frames.size());
+  }
+  d.final_error = d.error.back();
+  const size_t samples = std::min(fine.samples.size(), model.samples.size());
+  for (size_t i = 0; i < samples; ++i)
+    if (std::abs(fine.samples[i].time - model.samples[i].time) <= 1e-6 * step)
+      d.max_center_of_mass_distance =
+          std::max(d.max_center_of_mass_distance,
+                   (fine.samples[i].center_of_mass - model.samples[i].center_of_mass).norm());
+  seconds_per_elastic_step(fine, d.fine_seconds_per_step, d.fine_steps);
+  seconds_per_elastic_step(model, d.model_seconds_per_step, d.model_steps);
+  return d;
+}
+
+}  // namespace msfab

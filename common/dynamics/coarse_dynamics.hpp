@@ -1,0 +1,71 @@
+#pragma once
+// DDFEM in dynamics (thesis §2.5.2: the coarsening is "equally applicable"
+// to dynamic simulation). A dynamics scene's voxel design is coarsened as a
+// static scene's is (ddfem/voxel_coarsening.hpp) and the coarse mesh
+// replaces the fine one in the Newmark integrator; what dynamics adds per
+// coarse element is its inertia and damping:
+//   density    rho_e = sum_c rho_c / 8^level       (children c, void 0: the block's mass is kept)
+//   mass damping      a_e = sum_c rho_c a_c / sum_c rho_c   (D = a M: the damping of the mass is kept)
+//   stiffness damping b_e = sum_c E_c b_c / sum_c E_c       (D = b K: weighted as the stiffness is)
+//   material   the child material of largest volume (friction lookups, outputs)
+// A run is then compared with the fine run of the same scene frame by frame
+// with §2.5.2's error: coarse displacements interpolated trilinearly to the
+// fine nodes, mean distance over the longest side of the rest box.
+#include <string>
+#include <vector>
+
+#include "ddfem/voxel_coarsening.hpp"
+#include "dynamics/trajectory.hpp"
+
+namespace msfab {
+
+struct SceneMaterial;
+
+struct CoarseElementInertia {
+  std::vector<double> density, damping_a, damping_b;
+  std::vector<int> material_id;  // voxel id (index in the scene's materials + 1)
+};
+
+// Per element of `coarse.mesh`, from the fine voxels each covers.
+// `materials[id - 1]` describes voxel id `id`.
+CoarseElementInertia coarse_element_inertia(const VoxelGrid& fine, const CoarsenedVoxels& coarse,
+                                            const std::vector<SceneMaterial>& materials);
+
+// The coarsened scene's bookkeeping: the fine voxel mesh it stands for, in
+// its initial placement, and the trilinear interpolation from the coarse
+// nodes to the fine ones. Region loads are applied to the fine nodes and
+// restricted by P^T (total force and moment kept, as in the static
+// coarsening); the comparison with a fine run interpolates by P.
+struct DynamicsCoarsening {
+  CoarseningRequest request;
+  CoarsenedVoxels coarse;
+  VoxelMesh fine;
+  VecX fine_initial_positions;  // 3 per fine node
+  SpMat to_fine;                // P: (fine nodes) x (coarse nodes)
+};
+
+struct TrajectoryDifference {
+  std::vector<double> time, error;  // per output frame: §2.5.2's error of the model against the fine run
+  double max_error = 0, final_error = 0, mean_error = 0;
+  double max_center_of_mass_distance = 0;  // m, over the steps both runs sampled
+  // Newmark cost: wall seconds per elastic step.
+  double fine_seconds_per_step = 0, model_seconds_per_step = 0;
+  int fine_steps = 0, model_steps = 0;
+  int fine_nodes = 0, model_nodes = 0;
+};
+
+// InputError naming `fine_path` unless `fine` is a run of `grid` on its fine
+// voxel mesh (rest nodes equal) with at least one output frame; cheap, so a
+// stage checks before it runs.
+void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
+                          const std::string& fine_path);
+
+// `model` is the run of `grid` (coarsened by `coarsening`, or fine when it is
+// null); `fine` the run of the same scene on the fine voxel mesh, read from
+// `fine_path`. InputError naming `fine_path` when it is not that: other rest
+// nodes, other frame times, a run without frames.
+TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
+                                       const DynamicsCoarsening* coarsening, const Trajectory& model,
+                                       const Trajectory& fine, const std::string& fine_path);
+
+}  // namespace msfab
