@@ -8,7 +8,9 @@
 #
 #   tools/bench_ddfem_dynamics.sh build/bin out/bench/ddfem_dynamics \
 #     L1:isolated=out/ddfem/palette3.coarse_db.h5 L2:isolated=out/ddfem/palette3.level2.k400.coarse_db.h5 ...
+#   REUSE_FINE=1 tools/bench_ddfem_dynamics.sh ...   # keep fine.h5 of an earlier run (same binary and scene)
 set -euo pipefail
+START=$PWD
 BIN=$(cd "${1:-build/bin}" && pwd)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "${2:-out/bench/ddfem_dynamics}"
@@ -24,7 +26,9 @@ field() {  # field LOG WORD: the number after WORD on the "vs fine" line
   awk -v w="$2" '/vs fine/ { for (i = 1; i <= NF; ++i) if ($i == w) { v = $(i + 1); gsub(/,/, "", v); print v } }' "$1"
 }
 
-"$BIN/msfab-dynamics" --config "$SCENE" --quiet --out fine.h5 > fine.txt
+if [ "${REUSE_FINE:-0}" != 1 ] || [ ! -s fine.h5 ] || [ ! -s fine.txt ]; then
+  "$BIN/msfab-dynamics" --config "$SCENE" --quiet --out fine.h5 > fine.txt
+fi
 echo "Fibre bar (configs/dynamics/fiber_bar.yaml, 16 x 50 x 16 voxels of 2 mm), $OMP_NUM_THREADS threads, revision $(git -C "$SRC" rev-parse --short HEAD)."
 echo
 echo "| model | level | DOFs | error at release | max error | error at the end | centre of mass apart (mm) | ms per step | Newton its per step | speedup |"
@@ -44,7 +48,10 @@ for level in 1 2; do
   run naive $level --coarse-material naive
   for spec in "$@"; do
     case $spec in
-      L$level:*) name=${spec#L$level:}; run "DDFEM ${name%%=*}" $level --database "${name#*=}" ;;
+      L$level:*)
+        name=${spec#L$level:} db=${spec#*=}
+        case $db in /*) ;; *) db=$START/$db ;; esac
+        run "DDFEM ${name%%=*}" $level --database "$db" ;;
     esac
   done
 done

@@ -443,6 +443,34 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
   f.write_attribute("/timings", "elastic", t.seconds_elastic);
   f.write_attribute("/timings", "rigid", t.seconds_rigid);
   f.write_attribute("/timings", "total", t.seconds_total);
+  if (t.coarsening.level > 0) {
+    const TrajectoryCoarsening& c = t.coarsening;
+    f.create_group("/coarsening");
+    f.write_attribute("/coarsening", "level", c.level);
+    f.write_attribute("/coarsening", "material", c.material);
+    f.write_attribute("/coarsening", "database", c.database);
+    f.write_attribute("/coarsening", "element", c.element);
+    f.write_attribute("/coarsening", "fallback", c.fallback);
+    f.write_attribute("/coarsening", "fallback_blocks", c.fallback_blocks);
+    f.write_attribute("/coarsening", "fine_elements", c.fine_elements);
+    f.write_attribute("/coarsening", "seconds", c.seconds);
+  }
+  if (!t.comparison.reference.empty()) {
+    const TrajectoryComparison& c = t.comparison;
+    f.create_group("/comparison");
+    f.write_attribute("/comparison", "reference", c.reference);
+    f.write_attribute("/comparison", "error_definition",
+                      std::string("per frame: mean distance of this run's displacements, interpolated trilinearly to "
+                                  "the fine nodes, to the fine run's, over the longest side of the rest box (thesis "
+                                  "2.5.2)"));
+    f.write_attribute("/comparison", "error_at_release", c.error_at_release);
+    f.write_attribute("/comparison", "error_max", c.error_max);
+    f.write_attribute("/comparison", "error_mean", c.error_mean);
+    f.write_attribute("/comparison", "error_final", c.error_final);
+    f.write_attribute("/comparison", "max_center_of_mass_distance", c.max_center_of_mass_distance);
+    f.write_attribute("/comparison", "fine_seconds_per_step", c.fine_seconds_per_step);
+    f.write_attribute("/comparison", "seconds_per_step", c.seconds_per_step);
+  }
   writer.commit();
 
   write_sidecar(path, t);
@@ -485,6 +513,28 @@ Trajectory read_trajectory_artifact(const std::string& path) {
   t.seconds_elastic = f.read_attribute<double>("/timings", "elastic");
   t.seconds_rigid = f.read_attribute<double>("/timings", "rigid");
   t.seconds_total = f.read_attribute<double>("/timings", "total");
+  if (f.exists("/coarsening")) {
+    TrajectoryCoarsening& c = t.coarsening;
+    c.level = f.read_attribute<int>("/coarsening", "level");
+    c.material = f.read_string_attribute("/coarsening", "material");
+    c.database = f.read_string_attribute("/coarsening", "database");
+    c.element = f.read_string_attribute("/coarsening", "element");
+    c.fallback = f.read_string_attribute("/coarsening", "fallback");
+    c.fallback_blocks = f.read_attribute<int>("/coarsening", "fallback_blocks");
+    c.fine_elements = f.read_attribute<int>("/coarsening", "fine_elements");
+    c.seconds = f.read_attribute<double>("/coarsening", "seconds");
+  }
+  if (f.exists("/comparison")) {
+    TrajectoryComparison& c = t.comparison;
+    c.reference = f.read_string_attribute("/comparison", "reference");
+    c.error_at_release = f.read_attribute<double>("/comparison", "error_at_release");
+    c.error_max = f.read_attribute<double>("/comparison", "error_max");
+    c.error_mean = f.read_attribute<double>("/comparison", "error_mean");
+    c.error_final = f.read_attribute<double>("/comparison", "error_final");
+    c.max_center_of_mass_distance = f.read_attribute<double>("/comparison", "max_center_of_mass_distance");
+    c.fine_seconds_per_step = f.read_attribute<double>("/comparison", "fine_seconds_per_step");
+    c.seconds_per_step = f.read_attribute<double>("/comparison", "seconds_per_step");
+  }
   return t;
 }
 

@@ -48,6 +48,25 @@ struct TrajectoryEvent {
   std::string detail;  // free text
 };
 
+// How the run's mesh was coarsened from the scene's voxel design
+// (msfab-dynamics --coarsen; level 0: the fine voxel mesh, nothing stored).
+struct TrajectoryCoarsening {
+  int level = 0;
+  std::string material, database, element, fallback;
+  int fallback_blocks = 0;  // ddfem: distinct blocks without a database fit
+  int fine_elements = 0;
+  double seconds = 0;       // online coarsening time
+};
+
+// The run against a fine run of the same scene (msfab-dynamics --reference):
+// §2.5.2's error frame by frame (empty reference: no comparison stored).
+struct TrajectoryComparison {
+  std::string reference;
+  double error_at_release = 0, error_max = 0, error_mean = 0, error_final = 0;
+  double max_center_of_mass_distance = 0;  // m
+  double fine_seconds_per_step = 0, seconds_per_step = 0;
+};
+
 struct Trajectory {
   std::string scene;
   NodeArray rest_nodes;                       // rest positions
@@ -62,6 +81,8 @@ struct Trajectory {
   double seconds_quasistatic = 0, seconds_elastic = 0, seconds_rigid = 0, seconds_total = 0;
   double time_step = 0;
   std::string impact_model;
+  TrajectoryCoarsening coarsening;
+  TrajectoryComparison comparison;
 };
 
 struct TrajectoryProvenance {

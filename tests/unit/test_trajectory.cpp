@@ -176,6 +176,22 @@ void expect_identical(const Trajectory& a, const Trajectory& b) {
   EXPECT_SAME_DOUBLE(a.seconds_elastic, b.seconds_elastic);
   EXPECT_SAME_DOUBLE(a.seconds_rigid, b.seconds_rigid);
   EXPECT_SAME_DOUBLE(a.seconds_total, b.seconds_total);
+  EXPECT_EQ(a.coarsening.level, b.coarsening.level);
+  EXPECT_EQ(a.coarsening.material, b.coarsening.material);
+  EXPECT_EQ(a.coarsening.database, b.coarsening.database);
+  EXPECT_EQ(a.coarsening.element, b.coarsening.element);
+  EXPECT_EQ(a.coarsening.fallback, b.coarsening.fallback);
+  EXPECT_EQ(a.coarsening.fallback_blocks, b.coarsening.fallback_blocks);
+  EXPECT_EQ(a.coarsening.fine_elements, b.coarsening.fine_elements);
+  EXPECT_SAME_DOUBLE(a.coarsening.seconds, b.coarsening.seconds);
+  EXPECT_EQ(a.comparison.reference, b.comparison.reference);
+  EXPECT_SAME_DOUBLE(a.comparison.error_at_release, b.comparison.error_at_release);
+  EXPECT_SAME_DOUBLE(a.comparison.error_max, b.comparison.error_max);
+  EXPECT_SAME_DOUBLE(a.comparison.error_mean, b.comparison.error_mean);
+  EXPECT_SAME_DOUBLE(a.comparison.error_final, b.comparison.error_final);
+  EXPECT_SAME_DOUBLE(a.comparison.max_center_of_mass_distance, b.comparison.max_center_of_mass_distance);
+  EXPECT_SAME_DOUBLE(a.comparison.fine_seconds_per_step, b.comparison.fine_seconds_per_step);
+  EXPECT_SAME_DOUBLE(a.comparison.seconds_per_step, b.comparison.seconds_per_step);
 }
 
 template <class F>
@@ -229,6 +245,23 @@ TEST_F(TrajectoryArtifact, RoundTripIsBitwiseExact) {
   EXPECT_EQ(total[1], t.samples[1].total());
   const MatX conn_vtk = in.file().read_matrix<double>("/mesh/elements_vtk", 8);
   EXPECT_EQ(conn_vtk(1, 1), t.elements[1][kToolkitNodeAtVtkCorner[1]]);
+}
+
+TEST_F(TrajectoryArtifact, CoarseningAndComparisonRoundTrip) {
+  Trajectory t = synthetic_trajectory();
+  t.coarsening = {1, "ddfem", "db/palette3.coarse_db.h5", "trilinear", "naive", 3, 12800, 0.0123};
+  t.comparison = {"fine.h5", 1.5e-3, 2.25e-2, 1.0e-2, 2.0e-2, 1.7e-3, 3.5, 0.18};
+  const std::string path = file("coarse.h5");
+  write_trajectory_artifact(path, t, {});
+  expect_identical(t, read_trajectory_artifact(path));
+  const ArtifactReader in(path, "msfab.trajectory", 1);
+  EXPECT_NE(in.file().read_string_attribute("/comparison", "error_definition").find("2.5.2"), std::string::npos);
+  // A fine run without a reference stores neither group.
+  const std::string fine = file("fine.h5");
+  write_trajectory_artifact(fine, synthetic_trajectory(), {});
+  const ArtifactReader plain(fine, "msfab.trajectory", 1);
+  EXPECT_FALSE(plain.file().exists("/coarsening"));
+  EXPECT_FALSE(plain.file().exists("/comparison"));
 }
 
 TEST_F(TrajectoryArtifact, EmptyTrajectoryRoundTrips) {
