@@ -253,6 +253,8 @@ int main(int argc, char** argv) {
     record.config_text = ctx.config.resolved_text();
     record.command_line = ctx.command_line;
     record.seed = ctx.options.seed;
+    if (!coarsening.database.empty()) record.inputs.push_back(coarsening.database);
+    if (!reference.empty()) record.inputs.push_back(reference);
     if (coarsened) {
       record.coarsen_level = coarsening.level;
       record.coarse_material = coarsening.material;

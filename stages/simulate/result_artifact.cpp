@@ -10,7 +10,7 @@ namespace msfab {
 std::string write_result_artifact(const std::string& path, const SimulationRecord& r) {
   const HexMesh& mesh = r.mesh->mesh;
   const NewtonResult& nr = *r.newton;
-  ArtifactWriter writer(path, kResultSchema, kResultSchemaVersion, "msfab-simulate", r.config_text, {}, r.seed);
+  ArtifactWriter writer(path, kResultSchema, kResultSchemaVersion, "msfab-simulate", r.config_text, r.inputs, r.seed);
   H5File& f = writer.file();
   f.write_attribute("/", "command_line", r.command_line);
   f.write_attribute("/", "scene", r.scene->name);

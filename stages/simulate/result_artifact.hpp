@@ -2,6 +2,7 @@
 // The `msfab.result` artifact of msfab-simulate (docs/artifacts.md).
 #include <array>
 #include <string>
+#include <vector>
 
 #include "fem/voxel_grid.hpp"
 #include "scene/scene.hpp"
@@ -19,6 +20,8 @@ struct SimulationRecord {
   const NewtonResult* newton = nullptr;
   double setup_seconds = 0;
   std::string config_text;
+  // Artifacts the run read (database, fine reference): recorded with their hashes.
+  std::vector<std::string> inputs;
   std::string command_line;
   std::uint64_t seed = 0;
   // Coarsened runs (level > 0): the mesh is the coarse one.

@@ -1,0 +1,60 @@
+"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE"""
+
+import argparse
+import sys
+
+from .artifact import ArtifactError, open_artifact
+from .export import export_mesh
+
+
+def info(args):
+    with open_artifact(args.file) as a:
+        print(f"{a.path}: {a.schema} version {a.schema_version}")
+        print(f"  producer: {a.producer}\n  created:  {a.created}\n  seed:     {a.seed}")
+        for entry in a.inputs:
+            print(f"  input:    {entry.path} ({entry.sha256[:12]})")
+        for name in a.datasets():
+            d = a.h5[name]
+            print(f"  {name}  {d.shape} {d.dtype}")
+
+
+def inputs(args):
+    with open_artifact(args.file) as a:
+        states = a.check_inputs(args.base)
+        for s in states:
+            print(f"{s.state:9s} {s.path}")
+        return 1 if any(s.state != "unchanged" for s in states) else 0
+
+
+def export(args):
+    with open_artifact(args.file) as a:
+        m = export_mesh(a, args.out, frame=args.frame)
+        print(f"{args.out}: {len(m.points)} nodes, {len(m.cells[0].data)} hexahedra, "
+              f"point fields {sorted(m.point_data)}, cell fields {sorted(m.cell_data)}")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python3 -m msfab", description="Read and export msfab artifacts.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("info", help="provenance and datasets of an artifact")
+    p.add_argument("file")
+    p.set_defaults(run=info)
+    p = sub.add_parser("inputs", help="each recorded input: unchanged, changed or missing (exit 1 unless all unchanged)")
+    p.add_argument("file")
+    p.add_argument("--base", default=".", help="folder the relative input paths are taken from")
+    p.set_defaults(run=inputs)
+    p = sub.add_parser("export", help="the mesh and its fields to a file meshio writes (.vtu, .vtk, .xdmf, ...)")
+    p.add_argument("file")
+    p.add_argument("out")
+    p.add_argument("--frame", type=int, help="trajectory frame index (negative from the end)")
+    p.set_defaults(run=export)
+    args = parser.parse_args(argv)
+    try:
+        return args.run(args) or 0
+    except (ArtifactError, KeyError, OSError) as e:
+        print(f"python3 -m msfab: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
