@@ -8,7 +8,7 @@
 #include "core/errors.hpp"
 #include "gamut/material_space.hpp"
 #include "gamut/structure_ops.hpp"
-#include "homog/batch_homogenization.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapper.hpp"

@@ -24,6 +24,7 @@
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "default_scene.hpp"
+#include "ddfem/coarsening_options.hpp"
 #include "dynamics/coarse_dynamics.hpp"
 #include "dynamics/dynamics_run.hpp"
 #include "dynamics/dynamics_scene.hpp"
@@ -143,17 +144,7 @@ int main(int argc, char** argv) {
       ->expected(3);
   app.cli().add_option("--marker-csv", marker_csv, "write the tracked node's position at every step as CSV (t,x,y,z)");
   CoarseningRequest coarsening;
-  app.cli()
-      .add_option("--coarsen", coarsening.level, "coarsening levels: 0 (fine), 1 (2x2x2 blocks), 2 (4x4x4)")
-      ->check(CLI::Range(0, 2));
-  app.cli()
-      .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged, homogenized or galerkin")
-      ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized", "galerkin"}));
-  app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build (trilinear element)");
-  app.cli()
-      .add_option("--coarse-fallback", coarsening.fallback,
-                  "ddfem: blocks the database holds no fit for are coarsened naive (default) or galerkin")
-      ->check(CLI::IsMember({"naive", "galerkin"}));
+  add_coarsening_options(app.cli(), coarsening, false);
   std::string reference;
   app.cli().add_option("--reference", reference,
                        "a msfab.trajectory of the same scene run fine (same time step and frames): report this "

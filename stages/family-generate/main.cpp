@@ -29,7 +29,7 @@
 #include "families/family_selection.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "gamut/structure_ops.hpp"
-#include "homog/batch_homogenization.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 
 using namespace msfab;

@@ -11,7 +11,7 @@
 #include "gamut/particle_scoring.hpp"
 #include "gamut/structure_evolution.hpp"
 #include "gamut/structure_ops.hpp"
-#include "homog/batch_homogenization.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 #include "parallel/fan_out.hpp"

@@ -21,7 +21,7 @@
 #include <cstdio>
 #include <optional>
 
-#include "homog/batch_homogenization.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "cell_input.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"

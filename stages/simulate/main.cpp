@@ -26,6 +26,7 @@
 #include "core/timing.hpp"
 #include "cli/stage_app.hpp"
 #include "coarse_model.hpp"
+#include "ddfem/coarsening_options.hpp"
 #include "core/errors.hpp"
 #include "adaptive_model.hpp"
 #include "ddfem/coarsening_error.hpp"
@@ -98,23 +99,7 @@ int main(int argc, char** argv) {
   app.set_default_config(kDefaultSimulateScene);
   CoarseningRequest coarsening;
   bool compare_fine = false;
-  app.cli()
-      .add_option("--coarsen", coarsening.level, "coarsening levels: 0 (fine), 1 (2x2x2 blocks), 2 (4x4x4)")
-      ->check(CLI::Range(0, 2));
-  app.cli()
-      .add_option("--coarse-material", coarsening.material, "ddfem (needs --database), naive, averaged, homogenized or galerkin")
-      ->check(CLI::IsMember({"ddfem", "naive", "averaged", "homogenized", "galerkin"}));
-  app.cli().add_option("--database", coarsening.database, "coarse_db artifact from msfab-ddfem-build");
-  app.cli()
-      .add_option("--coarse-fallback", coarsening.fallback,
-                  "ddfem: blocks the database holds no fit for (e.g. with void children) are coarsened naive "
-                  "(default) or galerkin (each fine voxel integrated over the coarse field, void empty)")
-      ->check(CLI::IsMember({"naive", "galerkin"}));
-  app.cli()
-      .add_option("--coarse-element", coarsening.element,
-                  "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking); "
-                  "default: the database's element for ddfem, trilinear otherwise")
-      ->check(CLI::IsMember({"trilinear", "enhanced"}));
+  add_coarsening_options(app.cli(), coarsening, true);
   app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
   double target_error = 0;
   auto* target_option = app.cli().add_option(

@@ -1,4 +1,4 @@
-#include "homog/batch_homogenization.hpp"
+#include "gamut/batch_homogenization.hpp"
 
 #include <omp.h>
 
