@@ -9,6 +9,7 @@
 #   tools/bench_ddfem_dynamics.sh build/bin out/bench/ddfem_dynamics \
 #     L1:isolated=out/ddfem/palette3.coarse_db.h5 L2:isolated=out/ddfem/palette3.level2.k400.coarse_db.h5 ...
 #   REUSE_FINE=1 tools/bench_ddfem_dynamics.sh ...   # keep fine.h5 of an earlier run (same binary and scene)
+#   SCENE=path.yaml SCENE_SET="key=value;key=value" tools/bench_ddfem_dynamics.sh ...   # another scene or layout
 set -euo pipefail
 START=$PWD
 BIN=$(cd "${1:-build/bin}" && pwd)
@@ -17,7 +18,12 @@ mkdir -p "${2:-out/bench/ddfem_dynamics}"
 cd "${2:-out/bench/ddfem_dynamics}"
 shift 2 || true
 export OMP_NUM_THREADS=${THREADS:-2} OPENBLAS_NUM_THREADS=1
-SCENE=$SRC/configs/dynamics/fiber_bar.yaml
+SCENE=${SCENE:-$SRC/configs/dynamics/fiber_bar.yaml}
+SETS=()
+if [ -n "${SCENE_SET:-}" ]; then
+  IFS=';' read -ra assignments <<< "$SCENE_SET"
+  for kv in "${assignments[@]}"; do SETS+=(--set "$kv"); done
+fi
 
 per_step() { sed -n 's/.*(\([0-9.]*\) Newton iterations, \([0-9.]*\) ms each).*/\2/p' "$1"; }
 its() { sed -n 's/.*(\([0-9.]*\) Newton iterations, \([0-9.]*\) ms each).*/\1/p' "$1"; }
@@ -27,9 +33,9 @@ field() {  # field LOG WORD: the number after WORD on the "vs fine" line
 }
 
 if [ "${REUSE_FINE:-0}" != 1 ] || [ ! -s fine.h5 ] || [ ! -s fine.txt ]; then
-  "$BIN/msfab-dynamics" --config "$SCENE" --quiet --out fine.h5 > fine.txt
+  "$BIN/msfab-dynamics" --config "$SCENE" "${SETS[@]}" --quiet --out fine.h5 > fine.txt
 fi
-echo "Fibre bar (configs/dynamics/fiber_bar.yaml, 16 x 50 x 16 voxels of 2 mm), $OMP_NUM_THREADS threads, revision $(git -C "$SRC" rev-parse --short HEAD)."
+echo "Scene ${SCENE#$SRC/}${SCENE_SET:+ with $SCENE_SET}, $OMP_NUM_THREADS threads, revision $(git -C "$SRC" rev-parse --short HEAD)."
 echo
 echo "| model | level | DOFs | error at release | max error | error at the end | centre of mass apart (mm) | ms per step | Newton its per step | speedup |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
@@ -38,7 +44,8 @@ run() {  # run LABEL LEVEL ARGS...
   local label=$1 level=$2 file=run_${1// /_}_$2
   local log=$file.txt
   shift 2
-  "$BIN/msfab-dynamics" --config "$SCENE" --quiet --coarsen "$level" "$@" --reference fine.h5 --out "$file.h5" > "$log"
+  "$BIN/msfab-dynamics" --config "$SCENE" "${SETS[@]}" --quiet --coarsen "$level" "$@" --reference fine.h5 \
+    --out "$file.h5" > "$log"
   local com speed
   com=$(awk '/centre of mass apart by up to/ { for (i = 1; i <= NF; ++i) if ($i == "to") printf "%.2f", 1e3 * $(i + 1) }' "$log")
   speed=$(sed -n 's/.*: \([0-9.]*\)x faster.*/\1/p' "$log")
