@@ -44,8 +44,11 @@ run() {  # run LABEL LEVEL ARGS...
   local label=$1 level=$2 file=run_${1// /_}_$2
   local log=$file.txt
   shift 2
-  "$BIN/msfab-dynamics" --config "$SCENE" "${SETS[@]}" --quiet --coarsen "$level" "$@" --reference fine.h5 \
-    --out "$file.h5" > "$log"
+  if ! "$BIN/msfab-dynamics" --config "$SCENE" "${SETS[@]}" --quiet --coarsen "$level" "$@" --reference fine.h5 \
+    --out "$file.h5" > "$log" 2> "$file.err"; then
+    echo "| $label | $level | $(dofs "$log") | failed: $(sed -n 's/^msfab-dynamics: error: //p' "$file.err" | head -1) |||||||"
+    return
+  fi
   local com speed
   com=$(awk '/centre of mass apart by up to/ { for (i = 1; i <= NF; ++i) if ($i == "to") printf "%.2f", 1e3 * $(i + 1) }' "$log")
   speed=$(sed -n 's/.*: \([0-9.]*\)x faster.*/\1/p' "$log")

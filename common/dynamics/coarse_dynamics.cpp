@@ -38,6 +38,31 @@ VoxelMesh fine_voxel_mesh(const VoxelGrid& grid, const std::vector<SceneMaterial
 
 }  // namespace
 
+std::shared_ptr<DynamicsCoarsening> coarsen_dynamics_design(const VoxelGrid& grid,
+                                                            const std::vector<SceneMaterial>& materials,
+                                                            const std::vector<MaterialPtr>& palette,
+                                                            const CoarseningRequest& request, DynamicsModel& model) {
+  if (request.element == "enhanced")
+    throw InputError("--coarse-element enhanced: dynamics runs trilinear coarse elements only");
+  auto state = std::make_shared<DynamicsCoarsening>();
+  state->request = request;
+  state->coarse = coarsen_voxels(grid, palette, request);
+  if (state->coarse.element != "trilinear")
+    throw InputError(request.database + ": fitted for the " + state->coarse.element +
+                     " element; dynamics runs trilinear coarse elements only");
+  state->fine = build_voxel_mesh(grid, palette);
+  state->to_fine = coarse_to_fine_interpolation(grid, state->fine, state->coarse.grid, state->coarse.mesh);
+  const CoarseElementInertia inertia = coarse_element_inertia(grid, state->coarse, materials);
+  model.mesh = state->coarse.mesh.mesh;
+  model.density = inertia.density;
+  model.damping_a = inertia.damping_a;
+  model.damping_b = inertia.damping_b;
+  model.mesh.element_tag = inertia.material_id;
+  model.element_material_name.clear();
+  for (int id : inertia.material_id) model.element_material_name.push_back(materials[id - 1].name);
+  return state;
+}
+
 void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
                           const std::string& fine_path) {
   const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);

@@ -11,10 +11,12 @@
 // A run is then compared with the fine run of the same scene frame by frame
 // with §2.5.2's error: coarse displacements interpolated trilinearly to the
 // fine nodes, mean distance over the longest side of the rest box.
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "ddfem/voxel_coarsening.hpp"
+#include "dynamics/dynamics_model.hpp"
 #include "dynamics/trajectory.hpp"
 
 namespace msfab {
@@ -43,6 +45,16 @@ struct DynamicsCoarsening {
   VecX fine_initial_positions;  // 3 per fine node
   SpMat to_fine;                // P: (fine nodes) x (coarse nodes)
 };
+
+// The design `grid` (voxel id i: materials[i - 1], palette[i]) coarsened as
+// `request` says: sets model.mesh (element_tag: the material id of the
+// largest share), density, damping and material names. The fine positions
+// are left for the caller, who knows the placement. InputError for a bad
+// request or an enhanced element.
+std::shared_ptr<DynamicsCoarsening> coarsen_dynamics_design(const VoxelGrid& grid,
+                                                            const std::vector<SceneMaterial>& materials,
+                                                            const std::vector<MaterialPtr>& palette,
+                                                            const CoarseningRequest& request, DynamicsModel& model);
 
 struct TrajectoryDifference {
   std::vector<double> time, error;  // per output frame: §2.5.2's error of the model against the fine run

@@ -234,7 +234,7 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
   std::vector<MaterialPtr> palette{nullptr};
   for (const SceneMaterial& m : s.materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
   DynamicsModel& model = s.model;
-  std::shared_ptr<DynamicsCoarsening> coarse_state;
+  std::shared_ptr<DynamicsCoarsening> coarse_state;  // filled further once the placement is known
   if (coarsening.level > 0) {
     // Coarse elements span several voxels: of one body, at the reference
     // geometry, on the element the static fits were verified on.
@@ -244,24 +244,7 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
     if (!morph.is_identity())
       throw InputError("--coarsen: the scene's parameters move its geometry; coarse fits hold for the reference "
                        "geometry only (coarsen a scene without geometry parameters)");
-    if (coarsening.element == "enhanced")
-      throw InputError("--coarse-element enhanced: dynamics runs trilinear coarse elements only");
-    coarse_state = std::make_shared<DynamicsCoarsening>();
-    DynamicsCoarsening* state = coarse_state.get();
-    state->request = coarsening;
-    state->coarse = coarsen_voxels(s.grid, palette, coarsening);
-    state->fine = build_voxel_mesh(s.grid, palette);
-    state->to_fine = coarse_to_fine_interpolation(s.grid, state->fine, state->coarse.grid, state->coarse.mesh);
-    if (state->coarse.element != "trilinear")
-      throw InputError(coarsening.database + ": fitted for the " + state->coarse.element +
-                       " element; dynamics runs trilinear coarse elements only");
-    const CoarseElementInertia inertia = coarse_element_inertia(s.grid, state->coarse, s.materials);
-    model.mesh = state->coarse.mesh.mesh;
-    model.density = inertia.density;
-    model.damping_a = inertia.damping_a;
-    model.damping_b = inertia.damping_b;
-    model.mesh.element_tag = inertia.material_id;
-    for (int id : inertia.material_id) model.element_material_name.push_back(s.materials[id - 1].name);
+    coarse_state = coarsen_dynamics_design(s.grid, s.materials, palette, coarsening, model);
     s.element_body.assign(model.mesh.num_elements(), 0);
     s.coarsening = coarse_state;
   } else {
