@@ -64,7 +64,7 @@ std::shared_ptr<DynamicsCoarsening> coarsen_dynamics_design(const VoxelGrid& gri
 }
 
 void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
-                          const std::string& fine_path) {
+                          const std::string& fine_path, double time_step) {
   const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
   const int nf = fine_mesh.mesh.num_nodes();
   if (fine.rest_nodes.rows() != nf)
@@ -75,6 +75,12 @@ void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial
     throw InputError(fine_path + ": dataset '/mesh/nodes' differs from this scene's fine mesh (not a fine run of "
                      "this scene, or one with other scene parameters)");
   if (fine.frames.empty()) throw InputError(fine_path + ": holds no output frame");
+  if (std::abs(fine.time_step - time_step) > 1e-9 * time_step) {
+    std::ostringstream msg;
+    msg << fine_path << ": run with time step " << fine.time_step << " s, this scene's is " << time_step
+        << " s (the frames must fall at the same times)";
+    throw InputError(msg.str());
+  }
 }
 
 CoarseElementInertia coarse_element_inertia(const VoxelGrid& fine, const CoarsenedVoxels& coarse,
@@ -119,7 +125,7 @@ CoarseElementInertia coarse_element_inertia(const VoxelGrid& fine, const Coarsen
 TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
                                        const DynamicsCoarsening* coarsening, const Trajectory& model,
                                        const Trajectory& fine, const std::string& fine_path) {
-  check_fine_reference(grid, materials, fine, fine_path);
+  check_fine_reference(grid, materials, fine, fine_path, model.time_step);
   const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
   const int nf = fine_mesh.mesh.num_nodes();
   if (model.frames.empty()) throw InputError("this run: holds no output frame");
@@ -170,6 +176,33 @@ TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<
   seconds_per_elastic_step(fine, d.fine_seconds_per_step, d.fine_steps);
   seconds_per_elastic_step(model, d.model_seconds_per_step, d.model_steps);
   return d;
+}
+
+TrajectoryCoarsening coarsening_record(const DynamicsCoarsening& coarsening) {
+  const CoarsenedVoxels& c = coarsening.coarse;
+  TrajectoryCoarsening r;
+  r.level = coarsening.request.level;
+  r.material = coarsening.request.material;
+  r.database = coarsening.request.database;
+  r.element = c.element;
+  r.fallback = r.material == "ddfem" ? c.fallback : std::string();
+  r.fallback_blocks = c.fallback_blocks;
+  r.fine_elements = coarsening.fine.mesh.num_elements();
+  r.seconds = c.seconds;
+  return r;
+}
+
+TrajectoryComparison comparison_record(const TrajectoryDifference& d, const std::string& fine_path) {
+  TrajectoryComparison r;
+  r.reference = fine_path;
+  r.error_at_release = d.error.empty() ? 0.0 : d.error.front();
+  r.error_max = d.max_error;
+  r.error_mean = d.mean_error;
+  r.error_final = d.final_error;
+  r.max_center_of_mass_distance = d.max_center_of_mass_distance;
+  r.fine_seconds_per_step = d.fine_seconds_per_step;
+  r.seconds_per_step = d.model_seconds_per_step;
+  return r;
 }
 
 }  // namespace msfab

@@ -67,10 +67,10 @@ struct TrajectoryDifference {
 };
 
 // InputError naming `fine_path` unless `fine` is a run of `grid` on its fine
-// voxel mesh (rest nodes equal) with at least one output frame; cheap, so a
-// stage checks before it runs.
+// voxel mesh (rest nodes equal) with at least one output frame and the time
+// step `time_step`; cheap, so a stage checks before it runs.
 void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
-                          const std::string& fine_path);
+                          const std::string& fine_path, double time_step);
 
 // `model` is the run of `grid` (coarsened by `coarsening`, or fine when it is
 // null); `fine` the run of the same scene on the fine voxel mesh, read from
@@ -79,5 +79,9 @@ void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial
 TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
                                        const DynamicsCoarsening* coarsening, const Trajectory& model,
                                        const Trajectory& fine, const std::string& fine_path);
+
+// What the trajectory artifact records of a coarsening and of a comparison.
+TrajectoryCoarsening coarsening_record(const DynamicsCoarsening& coarsening);
+TrajectoryComparison comparison_record(const TrajectoryDifference& difference, const std::string& fine_path);
 
 }  // namespace msfab

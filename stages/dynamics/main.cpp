@@ -124,8 +124,8 @@ void print_difference(const TrajectoryDifference& d) {
   std::printf("  vs fine (%s): error at release %.3e, max %.3e, mean %.3e, at the end %.3e over %zu frames\n"
               "    (mean fine-vertex distance of this run's displacements interpolated to the fine nodes, over the\n"
               "     longest side of the rest box; thesis 2.5.2); centre of mass apart by up to %.3e m\n",
-              d.model_nodes == d.fine_nodes ? "same mesh" : "interpolated", d.error.front(), d.max_error, d.mean_error, d.final_error,
-              d.error.size(), d.max_center_of_mass_distance);
+              d.model_nodes == d.fine_nodes ? "same mesh" : "interpolated", d.error.front(), d.max_error,
+              d.mean_error, d.final_error, d.error.size(), d.max_center_of_mass_distance);
   std::printf("  Newmark step: fine %.3f ms, this run %.3f ms (%d and %d elastic steps): %.1fx faster\n",
               1e3 * d.fine_seconds_per_step, 1e3 * d.model_seconds_per_step, d.fine_steps, d.model_steps,
               d.model_seconds_per_step > 0 ? d.fine_seconds_per_step / d.model_seconds_per_step : 0.0);
@@ -159,7 +159,8 @@ int main(int argc, char** argv) {
     const DynamicsScene scene = read_dynamics_scene(ctx.config, coarsening);
     ctx.finish_config();
     const Trajectory fine = reference.empty() ? Trajectory{} : read_trajectory_artifact(reference);
-    if (!reference.empty()) check_fine_reference(scene.grid, scene.materials, fine, reference);
+    if (!reference.empty())
+      check_fine_reference(scene.grid, scene.materials, fine, reference, scene.newmark.time_step);
     ctx.check_out_folder();
     ctx.check_memory(dynamics_peak_bytes(scene),
                      fmt::format("a run of {} elements over {} s with a frame every {} steps",
@@ -191,32 +192,13 @@ int main(int argc, char** argv) {
     };
     Trajectory trajectory = run_dynamics_scene(scene, callbacks);
     progress.done();
-    if (scene.coarsening) {
-      const CoarsenedVoxels& c = scene.coarsening->coarse;
-      TrajectoryCoarsening& record = trajectory.coarsening;
-      record.level = coarsening.level;
-      record.material = coarsening.material;
-      record.database = coarsening.database;
-      record.element = c.element;
-      record.fallback = coarsening.material == "ddfem" ? c.fallback : std::string();
-      record.fallback_blocks = c.fallback_blocks;
-      record.fine_elements = scene.coarsening->fine.mesh.num_elements();
-      record.seconds = c.seconds;
-    }
+    if (trace.node >= 0) write_marker_csv(marker_csv, trace);
+    if (scene.coarsening) trajectory.coarsening = coarsening_record(*scene.coarsening);
     TrajectoryDifference difference;
     if (!reference.empty()) {
       difference = compare_with_fine(scene.grid, scene.materials, scene.coarsening.get(), trajectory, fine, reference);
-      TrajectoryComparison& record = trajectory.comparison;
-      record.reference = reference;
-      record.error_at_release = difference.error.front();
-      record.error_max = difference.max_error;
-      record.error_mean = difference.mean_error;
-      record.error_final = difference.final_error;
-      record.max_center_of_mass_distance = difference.max_center_of_mass_distance;
-      record.fine_seconds_per_step = difference.fine_seconds_per_step;
-      record.seconds_per_step = difference.model_seconds_per_step;
+      trajectory.comparison = comparison_record(difference, reference);
     }
-    if (trace.node >= 0) write_marker_csv(marker_csv, trace);
 
     // 5. Artifact and plots.
     TrajectoryProvenance provenance;

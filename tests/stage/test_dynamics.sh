@@ -138,6 +138,9 @@ check "... and runs fewer DOFs" -- grep -q "msfab-dynamics: scene 'fiber-bar', 2
 check "the fine run against itself: no difference" -- grep -q "vs fine (same mesh): error at release 0.000e+00, max 0.000e+00" "$WORK/fiber_again.txt"
 expect_exit 2 "fiber_fine.h5: the reference has .* rest nodes" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \
   --reference "$WORK/fiber_fine.h5"
+expect_exit 2 "fiber_fine.h5: run with time step 0.001 s, this scene's is 0.002 s" -- "$BIN/msfab-dynamics" \
+  "${FIBER[@]}" --set simulation.time_step=0.002 --coarsen 1 --coarse-material naive --reference "$WORK/fiber_fine.h5" \
+  --out "$WORK/x.h5"
 expect_exit 2 "tiny.coarse_db.h5.*palette" -- "$BIN/msfab-dynamics" --config $S/fiber_bar.yaml --set geometry.voxel_size=0.004 \
   --coarsen 1 --database "$WORK/tiny.coarse_db.h5" --out "$WORK/x.h5"
 expect_exit 2 "--coarsen: the scene has 2 bodies" -- "$BIN/msfab-dynamics" --config $S/catapult.yaml --coarsen 1 \

@@ -149,7 +149,7 @@ TEST(CoarseDynamics, RefusesAReferenceOfAnotherSceneAndSeveralBodies) {
   Trajectory t;
   t.rest_nodes = other.model.mesh.nodes;
   try {
-    check_fine_reference(fine.grid, fine.materials, t, "other.h5");
+    check_fine_reference(fine.grid, fine.materials, t, "other.h5", fine.newmark.time_step);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("other.h5"), std::string::npos) << e.what();
