@@ -31,19 +31,19 @@ double mean_vertex_error(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh,
   if (fine_displacement.size() != fine_mesh.mesh.num_dofs())
     throw InputError("fine displacement has " + std::to_string(fine_displacement.size()) + " entries, the fine mesh " +
                      std::to_string(fine_mesh.mesh.num_dofs()) + " DOFs");
-  return mean_vertex_error(fine_mesh, fine_displacement,
+  return mean_vertex_error(fine_mesh.mesh, fine_displacement,
                            interpolate_to_fine(fine_grid, fine_mesh, coarse, coarse_mesh, coarse_displacement));
 }
 
-double mean_vertex_error(const VoxelMesh& fine_mesh, const VecX& fine_displacement, const VecX& interpolated) {
-  const int n = fine_mesh.mesh.num_nodes();
+double mean_vertex_error(const HexMesh& fine_mesh, const VecX& fine_displacement, const VecX& interpolated) {
+  const int n = fine_mesh.num_nodes();
   if (fine_displacement.size() != 3 * n || interpolated.size() != 3 * n)
     throw InputError("mean vertex error: displacements of " + std::to_string(fine_displacement.size()) + " and " +
                      std::to_string(interpolated.size()) + " entries for a fine mesh of " + std::to_string(3 * n) +
                      " DOFs");
   double sum = 0;
   for (int i = 0; i < n; ++i) sum += (fine_displacement.segment<3>(3 * i) - interpolated.segment<3>(3 * i)).norm();
-  const double longest = (fine_mesh.mesh.bbox_max() - fine_mesh.mesh.bbox_min()).maxCoeff();
+  const double longest = (fine_mesh.bbox_max() - fine_mesh.bbox_min()).maxCoeff();
   return sum / n / longest;
 }
 

@@ -19,7 +19,7 @@ double mean_vertex_error(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh,
                          const CoarseGrid& coarse, const VoxelMesh& coarse_mesh, const VecX& coarse_displacement);
 
 // The same error for displacements already interpolated to the fine nodes.
-double mean_vertex_error(const VoxelMesh& fine_mesh, const VecX& fine_displacement, const VecX& interpolated);
+double mean_vertex_error(const HexMesh& fine_mesh, const VecX& fine_displacement, const VecX& interpolated);
 
 // The smallest error any model on the coarse mesh can have: the error is a
 // function of the coarse nodal displacements alone, so whatever the coarse

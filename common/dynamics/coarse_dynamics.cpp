@@ -6,8 +6,6 @@
 
 #include "core/errors.hpp"
 #include "ddfem/coarsening_error.hpp"
-#include "dynamics/dynamics_scene.hpp"
-#include "material/neo_hookean.hpp"
 
 namespace msfab {
 
@@ -29,11 +27,10 @@ void seconds_per_elastic_step(const Trajectory& t, double& seconds, int& steps) 
   seconds = steps ? total / steps : 0.0;
 }
 
-// Only the fine mesh's nodes matter here, not its materials.
-VoxelMesh fine_voxel_mesh(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials) {
-  std::vector<MaterialPtr> palette{nullptr};
-  for (const SceneMaterial& m : materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
-  return build_voxel_mesh(grid, palette);
+// The mesh a fine run of the scene has: the voxel mesh a coarsening stands
+// for, or the scene's own.
+const HexMesh& fine_mesh_of(const DynamicsScene& scene) {
+  return scene.coarsening ? scene.coarsening->fine.mesh : scene.model.mesh;
 }
 
 }  // namespace
@@ -63,18 +60,18 @@ std::shared_ptr<DynamicsCoarsening> coarsen_dynamics_design(const VoxelGrid& gri
   return state;
 }
 
-void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
-                          const std::string& fine_path, double time_step) {
-  const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
-  const int nf = fine_mesh.mesh.num_nodes();
+void check_fine_reference(const DynamicsScene& scene, const Trajectory& fine, const std::string& fine_path) {
+  const HexMesh& fine_mesh = fine_mesh_of(scene);
+  const int nf = fine_mesh.num_nodes();
   if (fine.rest_nodes.rows() != nf)
     throw InputError(fine_path + ": the reference has " + std::to_string(fine.rest_nodes.rows()) +
                      " rest nodes; the fine mesh of this scene has " + std::to_string(nf) +
                      " (not a fine run of this scene)");
-  if ((fine.rest_nodes - fine_mesh.mesh.nodes).cwiseAbs().maxCoeff() > 1e-9 * grid.voxel_size)
+  if ((fine.rest_nodes - fine_mesh.nodes).cwiseAbs().maxCoeff() > 1e-9 * scene.grid.voxel_size)
     throw InputError(fine_path + ": dataset '/mesh/nodes' differs from this scene's fine mesh (not a fine run of "
                      "this scene, or one with other scene parameters)");
   if (fine.frames.empty()) throw InputError(fine_path + ": holds no output frame");
+  const double time_step = scene.newmark.time_step;
   if (std::abs(fine.time_step - time_step) > 1e-9 * time_step) {
     std::ostringstream msg;
     msg << fine_path << ": run with time step " << fine.time_step << " s, this scene's is " << time_step
@@ -122,12 +119,11 @@ CoarseElementInertia coarse_element_inertia(const VoxelGrid& fine, const Coarsen
   return out;
 }
 
-TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
-                                       const DynamicsCoarsening* coarsening, const Trajectory& model,
-                                       const Trajectory& fine, const std::string& fine_path) {
-  check_fine_reference(grid, materials, fine, fine_path, model.time_step);
-  const VoxelMesh fine_mesh = fine_voxel_mesh(grid, materials);
-  const int nf = fine_mesh.mesh.num_nodes();
+TrajectoryDifference compare_with_fine(const DynamicsScene& scene, const Trajectory& model, const Trajectory& fine,
+                                       const std::string& fine_path) {
+  check_fine_reference(scene, fine, fine_path);
+  const HexMesh& fine_mesh = fine_mesh_of(scene);
+  const int nf = fine_mesh.num_nodes();
   if (model.frames.empty()) throw InputError("this run: holds no output frame");
   if (fine.frames.size() != model.frames.size())
     throw InputError(fine_path + ": the reference has " + std::to_string(fine.frames.size()) + " frames, this run " +
@@ -142,14 +138,8 @@ TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<
       throw InputError(msg.str());
     }
 
-  SpMat P;
-  if (coarsening) {
-    P = coarsening->to_fine;
-  } else {
-    P.resize(nf, nf);
-    P.setIdentity();
-  }
-  if (P.cols() != model.rest_nodes.rows())
+  const SpMat* P = scene.coarsening ? &scene.coarsening->to_fine : nullptr;
+  if ((P ? P->cols() : nf) != model.rest_nodes.rows())
     throw std::logic_error("compare_with_fine: the run's mesh is not the model it was compared as");
 
   TrajectoryDifference d;
@@ -158,8 +148,11 @@ TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<
   for (size_t i = 0; i < fine.frames.size(); ++i) {
     const VecX uf = displacement_from_rest(fine.frames[i].positions, fine.rest_nodes);
     const VecX um = displacement_from_rest(model.frames[i].positions, model.rest_nodes);
-    VecX interpolated(3 * nf);
-    Eigen::Map<NodeRowsMap>(interpolated.data(), nf, 3) = P * Eigen::Map<const NodeRowsMap>(um.data(), d.model_nodes, 3);
+    VecX interpolated = um;
+    if (P) {
+      interpolated.resize(3 * nf);
+      Eigen::Map<NodeRowsMap>(interpolated.data(), nf, 3) = *P * Eigen::Map<const NodeRowsMap>(um.data(), d.model_nodes, 3);
+    }
     const double e = mean_vertex_error(fine_mesh, uf, interpolated);
     d.time.push_back(fine.frames[i].time);
     d.error.push_back(e);

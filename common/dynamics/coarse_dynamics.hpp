@@ -17,11 +17,10 @@
 
 #include "ddfem/voxel_coarsening.hpp"
 #include "dynamics/dynamics_model.hpp"
+#include "dynamics/dynamics_scene.hpp"
 #include "dynamics/trajectory.hpp"
 
 namespace msfab {
-
-struct SceneMaterial;
 
 struct CoarseElementInertia {
   std::vector<double> density, damping_a, damping_b;
@@ -66,19 +65,18 @@ struct TrajectoryDifference {
   int fine_nodes = 0, model_nodes = 0;
 };
 
-// InputError naming `fine_path` unless `fine` is a run of `grid` on its fine
-// voxel mesh (rest nodes equal) with at least one output frame and the time
-// step `time_step`; cheap, so a stage checks before it runs.
-void check_fine_reference(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials, const Trajectory& fine,
-                          const std::string& fine_path, double time_step);
+// InputError naming `fine_path` unless `fine` is a run of `scene` on its fine
+// mesh (rest nodes equal: the voxel mesh the coarsening stands for, or the
+// scene's own mesh) with at least one output frame and the scene's time
+// step; cheap, so a stage checks before it runs.
+void check_fine_reference(const DynamicsScene& scene, const Trajectory& fine, const std::string& fine_path);
 
-// `model` is the run of `grid` (coarsened by `coarsening`, or fine when it is
-// null); `fine` the run of the same scene on the fine voxel mesh, read from
-// `fine_path`. InputError naming `fine_path` when it is not that: other rest
-// nodes, other frame times, a run without frames.
-TrajectoryDifference compare_with_fine(const VoxelGrid& grid, const std::vector<SceneMaterial>& materials,
-                                       const DynamicsCoarsening* coarsening, const Trajectory& model,
-                                       const Trajectory& fine, const std::string& fine_path);
+// `model` is the run of `scene` (coarsened or not); `fine` the run of the
+// same scene on the fine mesh, read from `fine_path`. InputError naming
+// `fine_path` when it is not that: other rest nodes, time step or frame
+// times, a run without frames.
+TrajectoryDifference compare_with_fine(const DynamicsScene& scene, const Trajectory& model, const Trajectory& fine,
+                                       const std::string& fine_path);
 
 // What the trajectory artifact records of a coarsening and of a comparison.
 TrajectoryCoarsening coarsening_record(const DynamicsCoarsening& coarsening);

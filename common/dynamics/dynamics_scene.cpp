@@ -140,10 +140,8 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
     // The layout of a static scene (fibres, layers, a random field, ...)
     // repaints the materials inside the boxes; it never adds solid, and void
     // it paints becomes a hole. Ids are 1-based indices into `materials`.
-    std::vector<MaterialPtr> palette{nullptr};
-    for (const SceneMaterial& m : materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
     VoxelGrid painted = grid;
-    paint_layout(g, painted, palette);
+    paint_layout(g, painted, scene_palette(materials));
     for (size_t v = 0; v < grid.ids.size(); ++v)
       if (grid.ids[v]) grid.ids[v] = painted.ids[v];
   }
@@ -200,6 +198,12 @@ RegionLoad read_region_load(const Config& c) {
 
 }  // namespace
 
+std::vector<MaterialPtr> scene_palette(const std::vector<SceneMaterial>& materials) {
+  std::vector<MaterialPtr> palette{nullptr};
+  for (const SceneMaterial& m : materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
+  return palette;
+}
+
 VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::string& what) {
   // A coarsened design is loaded where the fine one is: on the fine nodes,
   // restricted to the coarse ones by P^T.
@@ -231,8 +235,7 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
   VoxelGrid body_grid;
   s.grid = paint_geometry(c.child("geometry"), s.materials, body_grid, s.body_names);
 
-  std::vector<MaterialPtr> palette{nullptr};
-  for (const SceneMaterial& m : s.materials) palette.push_back(std::make_shared<NeoHookean>(m.E, m.nu));
+  const std::vector<MaterialPtr> palette = scene_palette(s.materials);
   DynamicsModel& model = s.model;
   std::shared_ptr<DynamicsCoarsening> coarse_state;  // filled further once the placement is known
   if (coarsening.level > 0) {

@@ -75,6 +75,9 @@ struct DynamicsScene {
   std::shared_ptr<const DynamicsCoarsening> coarsening;
 };
 
+// The constitutive models of a scene's materials by voxel id ([0] = void).
+std::vector<MaterialPtr> scene_palette(const std::vector<SceneMaterial>& materials);
+
 // Reads and validates everything (InputError naming file, key and problem);
 // the caller runs check_no_unknown_keys() afterwards. A request of level 1
 // or 2 simulates the design on coarse elements (one body, no geometry

@@ -159,8 +159,7 @@ int main(int argc, char** argv) {
     const DynamicsScene scene = read_dynamics_scene(ctx.config, coarsening);
     ctx.finish_config();
     const Trajectory fine = reference.empty() ? Trajectory{} : read_trajectory_artifact(reference);
-    if (!reference.empty())
-      check_fine_reference(scene.grid, scene.materials, fine, reference, scene.newmark.time_step);
+    if (!reference.empty()) check_fine_reference(scene, fine, reference);
     ctx.check_out_folder();
     ctx.check_memory(dynamics_peak_bytes(scene),
                      fmt::format("a run of {} elements over {} s with a frame every {} steps",
@@ -196,7 +195,7 @@ int main(int argc, char** argv) {
     if (scene.coarsening) trajectory.coarsening = coarsening_record(*scene.coarsening);
     TrajectoryDifference difference;
     if (!reference.empty()) {
-      difference = compare_with_fine(scene.grid, scene.materials, scene.coarsening.get(), trajectory, fine, reference);
+      difference = compare_with_fine(scene, trajectory, fine, reference);
       trajectory.comparison = comparison_record(difference, reference);
     }
 

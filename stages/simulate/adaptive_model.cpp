@@ -99,7 +99,7 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   AdaptiveModel m;
 
   // The estimate: the two uniform solutions' difference, energies of the finer one.
-  m.level_difference = mean_vertex_error(fine, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
+  m.level_difference = mean_vertex_error(fine.mesh, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
   m.level_errors = level_errors_from_difference(m.level_difference);
   const std::vector<CellErrorModel> cells = cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh,
                                                               element_energies(level1.mesh.mesh, x1));

@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
       }
       record.compared = true;
       record.error_vs_fine =
-          adaptive ? mean_vertex_error(fine, uf, adaptive_displacement_on_fine(scene, fine, adapted, assembler, result.x))
+          adaptive ? mean_vertex_error(fine.mesh, uf, adaptive_displacement_on_fine(scene, fine, adapted, assembler, result.x))
                    : mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, result.x - assembler.rest_positions());
       if (!adaptive) {
         const CoarseErrorFloor floor = coarse_error_floor(scene.grid, fine, uf, coarse.grid, vm);

@@ -210,7 +210,7 @@ TEST(AdaptiveMixedMesh, UniformLevelsSolveTheUniformCoarseModel) {
       VecX interpolated(fine.mesh.num_dofs());
       Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
           W * Eigen::Map<const Rows3>(um.data(), m.num_unknown_nodes(), 3);
-      EXPECT_LT(mean_vertex_error(fine, uc, interpolated), 1e-8 * uc.cwiseAbs().maxCoeff());
+      EXPECT_LT(mean_vertex_error(fine.mesh, uc, interpolated), 1e-8 * uc.cwiseAbs().maxCoeff());
       EXPECT_GT(uc.cwiseAbs().maxCoeff(), 0);
     }
 }
@@ -245,7 +245,7 @@ TEST(AdaptiveMixedMesh, AllFineLevelsSolveTheFineModel) {
   Eigen::Map<Rows3>(interpolated.data(), fine.mesh.num_nodes(), 3) =
       W * Eigen::Map<const Rows3>(um.data(), m.num_unknown_nodes(), 3);
   const VecX uf = rf.x - af.rest_positions();
-  EXPECT_LT(mean_vertex_error(fine, uf, interpolated), 1e-8 * uf.cwiseAbs().maxCoeff());
+  EXPECT_LT(mean_vertex_error(fine.mesh, uf, interpolated), 1e-8 * uf.cwiseAbs().maxCoeff());
 }
 
 // Loads restricted to the unknowns keep their total; the interpolation to the

@@ -103,12 +103,10 @@ TEST(CoarseDynamics, ErrorAgainstTheFineRunGrowsWithTheLevel) {
   const DynamicsScene level1 = scene_of(kCantilever, 1);
   const DynamicsScene level2 = scene_of(kCantilever, 2);
   const Trajectory tf = run_dynamics_scene(fine), t1 = run_dynamics_scene(level1), t2 = run_dynamics_scene(level2);
-  const TrajectoryDifference same = compare_with_fine(fine.grid, fine.materials, nullptr, tf, tf, "fine.h5");
+  const TrajectoryDifference same = compare_with_fine(fine, tf, tf, "fine.h5");
   EXPECT_EQ(same.max_error, 0.0);
-  const TrajectoryDifference d1 =
-      compare_with_fine(level1.grid, level1.materials, level1.coarsening.get(), t1, tf, "fine.h5");
-  const TrajectoryDifference d2 =
-      compare_with_fine(level2.grid, level2.materials, level2.coarsening.get(), t2, tf, "fine.h5");
+  const TrajectoryDifference d1 = compare_with_fine(level1, t1, tf, "fine.h5");
+  const TrajectoryDifference d2 = compare_with_fine(level2, t2, tf, "fine.h5");
   ASSERT_EQ(d1.error.size(), tf.frames.size());
   EXPECT_EQ(d1.model_nodes, level1.model.mesh.num_nodes());
   // The swing is a few millimetres on an 8 cm bar: coarse models are close,
@@ -149,7 +147,7 @@ TEST(CoarseDynamics, RefusesAReferenceOfAnotherSceneAndSeveralBodies) {
   Trajectory t;
   t.rest_nodes = other.model.mesh.nodes;
   try {
-    check_fine_reference(fine.grid, fine.materials, t, "other.h5", fine.newmark.time_step);
+    check_fine_reference(fine, t, "other.h5");
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("other.h5"), std::string::npos) << e.what();
