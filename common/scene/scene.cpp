@@ -7,9 +7,13 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <spdlog/spdlog.h>
 
 #include "core/errors.hpp"
+#include "fem/surface_voxelizer.hpp"
 #include "fem/voxel_shapes.hpp"
+#include "io/surface_mesh_io.hpp"
+#include "io/voxel_array_io.hpp"
 #include "material/linear_anisotropic.hpp"
 #include "material/linear_isotropic.hpp"
 #include "material/neo_hookean.hpp"
@@ -72,6 +76,54 @@ Region read_region(const Config& parent, const VoxelGrid& grid) {
   }
   (void)grid;
   return r;
+}
+
+// `voxels: {file: F.npy}` or `{file: F.raw, dtype: uint8}`: every voxel's id
+// from the file (docs/scenes.md, "Your own object").
+void paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
+  const std::string path = c.get_path("file");
+  const std::vector<int> ids = read_voxel_ids(path, grid.nx, grid.ny, grid.nz, c.get_or<std::string>("dtype", ""));
+  std::map<int, long long> unknown;
+  for (int id : ids)
+    if (id >= static_cast<int>(material_by_id.size()) || (id > 0 && !material_by_id[id])) ++unknown[id];
+  if (!unknown.empty())
+    c.fail("file", path + " uses material id " + std::to_string(unknown.begin()->first) + " (" +
+                       std::to_string(unknown.begin()->second) + " voxels), which is not in the palette (0 = void)");
+  grid.ids = ids;
+}
+
+// `mesh: {file: F.stl, scale: s, offset: [x, y, z]}, id: n`: the voxels whose
+// centre lies inside the closed surface take id n; a file vertex p lies at
+// s p + offset in the scene (metres).
+void paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
+  const Config c = item.child("mesh");
+  const std::string path = c.get_path("file");
+  TriangleSurface surface = merge_equal_vertices(read_surface_mesh(path));
+  const SurfaceClosure closure = check_closure(surface);
+  if (!closure.closed()) {
+    const Vec3 a = surface.vertices[closure.example_edge[0]], b = surface.vertices[closure.example_edge[1]];
+    std::ostringstream o;
+    o << path << ": the surface does not enclose a volume: " << closure.unmatched_edges
+      << " triangle edges have no partner running the other way (a hole, a crack between parts that do not share "
+         "vertices, or triangles of opposite orientation), e.g. the edge from ("
+      << a.transpose() << ") to (" << b.transpose() << ")";
+    c.fail("file", o.str());
+  }
+  const double scale = c.get_or<double>("scale", 1.0);
+  if (!(scale > 0) || !std::isfinite(scale)) c.fail("scale", "must be a positive finite number");
+  const Vec3 offset = c.has("offset") ? read_vec3(c, "offset") : Vec3::Zero();
+  for (Vec3& p : surface.vertices) p = scale * p + offset;
+  const auto [lo, hi] = bounding_box(surface);
+  const Vec3 grid_hi = grid.origin + grid.extent();
+  const long long painted = paint_surface(grid, surface, id);
+  std::ostringstream box;
+  box << "its bounding box after scale and offset is [" << lo.transpose() << "] - [" << hi.transpose()
+      << "], the grid's [" << grid.origin.transpose() << "] - [" << grid_hi.transpose() << "]";
+  if (painted == 0)
+    c.fail("file", path + " contains no voxel centre: " + box.str() + " (check scale, offset and grid)");
+  if ((lo.array() < grid.origin.array()).any() || (hi.array() > grid_hi.array()).any())
+    spdlog::warn("{}: the surface reaches beyond the grid and is cut off there; {}", path, box.str());
+  spdlog::debug("{}: {} triangles, {} voxels painted with id {}", path, surface.triangles.size(), painted, id);
 }
 
 }  // namespace
@@ -143,8 +195,13 @@ void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<Mater
       const std::vector<int> ids = id_list_of(c);
       if (ids.empty()) c.fail("ids", "a random field needs at least one id");
       paint_random_field(grid, ids, c.get<std::uint64_t>("seed"));
+    } else if (item.has("voxels")) {
+      paint_voxel_file(item.child("voxels"), grid, material_by_id);
+    } else if (item.has("mesh")) {
+      paint_mesh_file(item, grid, id_of("id"));
     } else {
-      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field");
+      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field, "
+                    "voxels, mesh");
     }
   }
 }

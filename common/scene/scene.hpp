@@ -67,7 +67,8 @@ Scene read_scene(const Config& config);
 // ([0] = void = nullptr); InputError naming the key on bad input.
 std::vector<PaletteEntry> read_materials(const Config& config, std::vector<MaterialPtr>* material_by_id);
 // Paints the `layout` list (fill, box, layers, cylinder, helical_fibers,
-// checker, random_field) onto the grid, in physical coordinates.
+// checker, random_field, voxels from a .npy or raw file, a closed surface
+// mesh from an STL or OBJ file) onto the grid, in physical coordinates.
 void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id);
 
 // Boundary conditions and external forces on the mesh of a scene. Throws

@@ -1,4 +1,4 @@
-// Every static scene shipped in configs/scenes/ reads without error or
+// Every static scene shipped in configs/scenes/ (and user/) reads without error or
 // unknown keys, meshes, and has conditions that hold it (no free rigid
 // motion, no load on void). The DDFEM mixed-block scenes also use the
 // benchmark palette, coarsen without padding and mix materials inside their
@@ -23,7 +23,7 @@ const fs::path kFolder = fs::path(MSFAB_SOURCE_DIR) / "configs" / "scenes";
 
 TEST(SceneConfigs, EveryShippedSceneReadsMeshesAndIsHeld) {
   int checked = 0;
-  for (const auto& entry : fs::directory_iterator(kFolder)) {
+  for (const auto& entry : fs::recursive_directory_iterator(kFolder)) {  // user/: parts from files
     if (entry.path().extension() != ".yaml") continue;
     SCOPED_TRACE(entry.path().string());
     const Config config = Config::load_file(entry.path().string());
@@ -37,7 +37,7 @@ TEST(SceneConfigs, EveryShippedSceneReadsMeshesAndIsHeld) {
     EXPECT_GT(sc.dirichlet.count_fixed(), 0);
     ++checked;
   }
-  EXPECT_GE(checked, 13);  // Table 2.2, bridges, demo bar and the five mixed-block scenes
+  EXPECT_GE(checked, 15);  // Table 2.2, bridges, demo bar, the mixed-block scenes, the user bracket twice
 }
 
 // Fraction of the all-solid 2 x 2 x 2 blocks that hold more than one material.

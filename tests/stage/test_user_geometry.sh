@@ -1,0 +1,130 @@
+#!/bin/bash
+# A user's own object: an L-shaped bracket given as a binary STL, as an OBJ
+# and as a numpy array gives the same scene, and so bit for bit the same
+# displacements, as the same bracket built of layout boxes; a cell from a
+# numpy array homogenizes like its layout; bad files exit 2 naming the file.
+BIN=$1 SRC=$2
+source "$SRC/tests/stage/lib.sh"
+PY=/usr/bin/python3
+SIM="$BIN/msfab-simulate"
+
+# The bracket: a 6 x 12 x 2 mm plate with a 6 x 4 x 4 mm upright at its far
+# end, written in millimetres (the scenes scale it by 1e-3).
+"$PY" - "$WORK" <<'PY'
+import struct, sys
+import numpy as np
+work = sys.argv[1]
+profile = [(0, 0), (12, 0), (12, 6), (8, 6), (8, 2), (0, 2)]  # (y, z), counter-clockwise
+n = len(profile)
+verts = [(x, y, z) for x in (0.0, 6.0) for (y, z) in profile]
+tris = []
+for i in range(n):  # the sides, outward
+    j = (i + 1) % n
+    tris += [(i, j, n + j), (i, n + j, n + i)]
+fan = [(4, 5, 0), (4, 0, 1), (4, 1, 2), (4, 2, 3)]  # from the reflex corner (8, 2), counter-clockwise
+tris += [(n + a, n + b, n + c) for a, b, c in fan]  # the x = 6 cap faces +x
+tris += [(a, c, b) for a, b, c in fan]              # the x = 0 cap faces -x
+with open(f"{work}/bracket.stl", "wb") as f:
+    f.write(b"bracket".ljust(80, b" "))
+    f.write(struct.pack("<I", len(tris)))
+    for t in tris:
+        f.write(struct.pack("<3f", 0, 0, 0))
+        for v in t:
+            f.write(struct.pack("<3f", *verts[v]))
+        f.write(b"\0\0")
+with open(f"{work}/bracket.obj", "w") as f:
+    f.write("# the bracket\n")
+    for v in verts:
+        f.write("v %g %g %g\n" % v)
+    for t in tris:
+        f.write("f %d %d %d\n" % tuple(v + 1 for v in t))
+# The same object as voxel ids, a[i, j, k] = voxel (i, j, k) at 1 mm.
+c = np.arange(16) + 0.5
+X, Y, Z = np.meshgrid(c[:6], c[:12], c[:6], indexing="ij")
+ids = (((Z < 2) | ((Y > 8) & (Z < 6))) & (X < 6)).astype(np.uint8)
+np.save(f"{work}/bracket.npy", ids)
+np.save(f"{work}/wrong_shape.npy", ids[:, :, :5])
+# A cell: two crossing stiff bars in a soft matrix, 8^3 voxels.
+cell = np.full((8, 8, 8), 2, dtype=np.int32)
+cell[:, 3:5, 3:5] = 1
+cell[3:5, :, 3:5] = 1
+np.save(f"{work}/cell.npy", cell)
+PY
+
+scene() {  # scene NAME LAYOUT...
+  cat > "$WORK/$1.yaml" <<Y
+name: bracket
+grid: {size: [6, 12, 6], voxel_size: 0.001}
+materials:
+  - {id: 1, name: resin, model: neo-hookean, E: 1.0e6, nu: 0.4, density: 1100}
+layout:
+$2
+boundary:
+  - {region: {face: ymin}, fix: [x, y, z]}
+loads:
+  - {region: {face: zmax}, force: [0.0, -0.01, -0.02]}
+Y
+}
+scene boxes "  - {box: {min: [0, 0, 0], max: [0.006, 0.012, 0.002]}, id: 1}
+  - {box: {min: [0, 0.008, 0], max: [0.006, 0.012, 0.006]}, id: 1}"
+scene stl "  - {mesh: {file: bracket.stl, scale: 0.001}, id: 1}"
+scene obj "  - {mesh: {file: bracket.obj, scale: 0.001}, id: 1}"
+scene npy "  - {voxels: {file: bracket.npy}}"
+for s in boxes stl obj npy; do
+  expect_exit 0 "converged in" -- "$SIM" --config "$WORK/$s.yaml" --out "$WORK/$s.h5" --threads 1
+done
+for s in stl obj npy; do
+  check "$s scene gives the box scene's displacements bit for bit" -- \
+    h5diff "$WORK/boxes.h5" "$WORK/$s.h5" /displacement /displacement
+done
+
+# The shipped example (configs/scenes/user, docs/walkthrough.md): the same
+# bracket as an ASCII STL and as a .npy, then read back in Python.
+for s in bracket bracket_voxels; do
+  expect_exit 0 "ParaView: .*$s.xmf" -- "$SIM" --config "$SRC/configs/scenes/user/$s.yaml" --out "$WORK/$s.h5" --threads 1
+  check "shipped $s.yaml gives the box scene's displacements" -- h5diff "$WORK/boxes.h5" "$WORK/$s.h5" /displacement /displacement
+done
+expect_exit 0 "bracket.vtu: 413 nodes, 240 hexahedra" -- env PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1 \
+  "$PY" -m msfab export "$WORK/bracket.h5" "$WORK/bracket.vtu"
+check "exported mesh has the bracket's 240 voxels" -- env PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1 \
+  "$PY" -c "import meshio, sys; m = meshio.read(sys.argv[1]); sys.exit(0 if len(m.cells[0].data) == 240 else 1)" "$WORK/bracket.vtu"
+
+# A cell from a numpy array against the same cell painted from boxes.
+cell() {  # cell NAME LAYOUT...
+  cat > "$WORK/$1.yaml" <<Y
+materials:
+  - {id: 1, name: stiff, model: linear, E: 1.0e6, nu: 0.3}
+  - {id: 2, name: soft, model: linear, E: 1.0e4, nu: 0.3}
+cell: {size: [8, 8, 8]}
+layout:
+$2
+Y
+}
+cell cell_boxes "  - {fill: 2}
+  - {box: {min: [0, 0.375, 0.375], max: [1, 0.625, 0.625]}, id: 1}
+  - {box: {min: [0.375, 0, 0.375], max: [0.625, 1, 0.625]}, id: 1}"
+cell cell_npy "  - {voxels: {file: cell.npy}}"
+for c in cell_boxes cell_npy; do
+  "$BIN/msfab-homogenize" --config "$WORK/$c.yaml" --out "$WORK/$c.h5" > "$WORK/$c.txt" 2>&1 || echo "FAIL: homogenize $c"
+done
+check "numpy cell homogenizes like its layout" -- h5diff "$WORK/cell_boxes.h5" "$WORK/cell_npy.h5" /C /C
+
+# Bad files: exit 2, naming the file.
+"$PY" - "$WORK" <<'PY'
+import sys
+work = sys.argv[1]
+data = open(f"{work}/bracket.stl", "rb").read()
+n = int.from_bytes(data[80:84], "little")
+open(f"{work}/open.stl", "wb").write(data[:80] + (n - 1).to_bytes(4, "little") + data[84:84 + 50 * (n - 1)])
+PY
+scene open "  - {mesh: {file: open.stl, scale: 0.001}, id: 1}"
+expect_exit 2 "open.stl: the surface does not enclose a volume" -- "$SIM" --config "$WORK/open.yaml" --out "$WORK/x.h5"
+scene shape "  - {voxels: {file: wrong_shape.npy}}"
+expect_exit 2 "wrong_shape.npy: array of shape \(6, 12, 5\) for a grid of 6 x 12 x 6" -- \
+  "$SIM" --config "$WORK/shape.yaml" --out "$WORK/x.h5"
+scene far "  - {mesh: {file: bracket.stl, scale: 0.001, offset: [1, 0, 0]}, id: 1}"
+expect_exit 2 "bracket.stl contains no voxel centre" -- "$SIM" --config "$WORK/far.yaml" --out "$WORK/x.h5"
+scene missing "  - {mesh: {file: nowhere.stl}, id: 1}"
+expect_exit 2 "nowhere.stl: no such file" -- "$SIM" --config "$WORK/missing.yaml" --out "$WORK/x.h5"
+check "nothing written for refused scenes" -- test ! -e "$WORK/x.h5"
+finish
