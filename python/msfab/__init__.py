@@ -8,10 +8,22 @@ export meshes with their fields for ParaView and meshio.
         msfab.export_mesh(a, "bar.vtu")
 
 Command line: ``python3 -m msfab info FILE`` and ``python3 -m msfab export FILE OUT.vtu``.
+
+With the compiled bindings built (pybind11-dev): ``msfab.homogenize(ids,
+materials)`` and ``msfab.simulate(scene)`` run the stages' own code
+(native.py).
 """
 
 from .artifact import Artifact, ArtifactError, Input, InputState, Mesh, open_artifact, sha256_of, to_vtk_order
 from .export import export_mesh, frame_groups, to_meshio
+from .native import homogenize, simulate
 
 __all__ = ["Artifact", "ArtifactError", "Input", "InputState", "Mesh", "open_artifact", "sha256_of", "to_vtk_order",
-           "export_mesh", "frame_groups", "to_meshio"]
+           "export_mesh", "frame_groups", "to_meshio", "homogenize", "simulate"]
+
+
+def __getattr__(name):  # the bindings' error types, loaded on first use
+    if name in ("InputError", "NumericalError"):
+        from . import native
+        return getattr(native._bindings(), name)
+    raise AttributeError(name)

@@ -28,6 +28,7 @@
 #include "homog/periodic_homogenization.hpp"
 #include "finite_strain_check.hpp"
 #include "homogenized_artifact.hpp"
+#include "homogenization_options.hpp"
 
 using namespace msfab;
 
@@ -56,24 +57,10 @@ refine: 1
 use_symmetry: true
 )";
 
-HomogenizationOptions read_solver_options(const Config& config) {
-  HomogenizationOptions options;
-  options.void_stiffness = config.get_or<double>("void_stiffness", options.void_stiffness);
-  if (!(options.void_stiffness > 0 && options.void_stiffness < 1e-2)) config.fail("void_stiffness", "must be in (0, 0.01)");
-  if (config.has("solver")) options.solver = config.one_of("solver", {"auto", "direct", "multigrid"});
-  options.multigrid_tolerance = config.get_or<double>("multigrid_tolerance", options.multigrid_tolerance);
-  if (!(options.multigrid_tolerance > 0 && options.multigrid_tolerance < 1))
-    config.fail("multigrid_tolerance", "must be in (0, 1)");
-  // Both exact reductions (two strain cases for a cubic cell, one octant
-  // for a mirror-symmetric one); false solves six cases on the whole cell.
-  options.use_symmetry = options.use_mirror_symmetry = config.get_or<bool>("use_symmetry", true);
-  return options;
-}
-
 void run_batch(StageContext& ctx, const std::string& structures) {
   const std::string& out = ctx.require_out();
   BatchOptions options;
-  options.homogenization = read_solver_options(ctx.config);
+  options.homogenization = read_homogenization_options(ctx.config);
   options.homogenization.threads = ctx.options.threads;
   options.threads = ctx.options.threads;
   options.refine = ctx.config.get_or<int>("refine", 1);
@@ -127,7 +114,7 @@ int main(int argc, char** argv) {
     if (!structures.empty()) return run_batch(ctx, structures);
     const std::string& out = ctx.require_out();
     // 1. Materials and cell.
-    HomogenizationOptions options = read_solver_options(ctx.config);
+    HomogenizationOptions options = read_homogenization_options(ctx.config);
     const CellInput in = read_cell_input(ctx.config, [&](int nx, int ny, int nz) {
       ctx.check_memory(homogenization_peak_bytes(nx, ny, nz, options.solver),
                        "a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
