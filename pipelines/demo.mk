@@ -10,3 +10,8 @@ $(OUT)/demo/bar.ddfem.result.h5: configs/scenes/demo_bar.yaml $(OUT)/ddfem/tiny.
 	@mkdir -p $(@D)
 	$(BIN)/msfab-simulate --config $< --coarsen 1 --database $(word 2,$^) --reference $(word 3,$^) \
 	  --out $@ --threads $(THREADS)
+
+# The demo's pictures: speed against error and Newton convergence of the two
+# runs above (python/msfab/report.py; `make report` draws every artifact).
+$(OUT)/demo/report.html: $(OUT)/demo/bar.result.h5 $(OUT)/demo/bar.ddfem.result.h5 $(wildcard python/msfab/*.py)
+	PYTHONPATH=$(CURDIR)/python $(PYTHON) -m msfab report --title "msfab demo" $@ $(filter %.h5,$^)

@@ -1,4 +1,4 @@
-"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE"""
+"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE | report OUT.html PATH..."""
 
 import argparse
 import sys
@@ -33,6 +33,12 @@ def export(args):
               f"point fields {sorted(m.point_data)}, cell fields {sorted(m.cell_data)}")
 
 
+def report(args):
+    from .report import build_report
+    data = build_report(args.paths, args.out, title=args.title)
+    print(f"{args.out}: {len(data)} pictures")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m msfab", description="Read and export msfab artifacts.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -48,6 +54,11 @@ def main(argv=None):
     p.add_argument("out")
     p.add_argument("--frame", type=int, help="trajectory frame index (negative from the end)")
     p.set_defaults(run=export)
+    p = sub.add_parser("report", help="an HTML page with matplotlib pictures of the artifacts under PATH...")
+    p.add_argument("out", help="the page to write, e.g. out/report.html (pictures in out/report_files/)")
+    p.add_argument("paths", nargs="+", help="artifacts, or folders searched for *.h5")
+    p.add_argument("--title", default="msfab report")
+    p.set_defaults(run=report)
     args = parser.parse_args(argv)
     try:
         return args.run(args) or 0

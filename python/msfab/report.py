@@ -1,0 +1,342 @@
+"""An HTML report of msfab artifacts: speed against error, solver
+convergence, dynamics traces, designs and gamuts, drawn with matplotlib.
+
+    python3 -m msfab report out/report.html out/        # every artifact below out/
+    python3 -m msfab report demo.html a.h5 b.h5
+
+Writes the page, its pictures in ``<stem>_files/`` and the numbers each
+picture shows in ``<stem>_files/data.json`` (for scripts and tests).
+Artifacts it does not draw are listed with their producer.
+"""
+
+import html
+import json
+import os
+
+import numpy as np
+
+from .artifact import ArtifactError, open_artifact
+
+ERROR_DEFINITION = ("error: mean distance between the fine model's vertices and the coarse model's displacement "
+                    "interpolated to them, over the longest side of the body (thesis §2.5.2); 1e-2 is 1% of the body")
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _find_artifacts(paths):
+    found = []
+    for p in paths:
+        if os.path.isdir(p):
+            for root, dirs, files in os.walk(p):
+                dirs.sort()
+                found += [os.path.join(root, f) for f in sorted(files) if f.endswith(".h5")]
+        elif os.path.isfile(p):
+            found.append(p)
+        else:
+            raise ArtifactError(f"{p}: no such file or folder")
+    return found
+
+
+def _label(path):
+    return os.path.basename(path)[:-3] if path.endswith(".h5") else os.path.basename(path)
+
+
+class _Page:
+    def __init__(self, out_html):
+        self.out_html = out_html
+        stem = os.path.splitext(os.path.basename(out_html))[0]
+        self.files_name = stem + "_files"
+        self.files = os.path.join(os.path.dirname(os.path.abspath(out_html)), self.files_name)
+        os.makedirs(self.files, exist_ok=True)
+        self.parts = []
+        self.data = {}
+        self.figures = 0
+
+    def heading(self, text):
+        self.parts.append(f"<h2>{html.escape(text)}</h2>")
+
+    def paragraph(self, text):
+        self.parts.append(f"<p>{html.escape(text)}</p>")
+
+    def table(self, header, rows):
+        head = "".join(f"<th>{html.escape(str(h))}</th>" for h in header)
+        body = "".join("<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows)
+        self.parts.append(f"<table><tr>{head}</tr>{body}</table>")
+
+    def figure(self, fig, name, caption, data):
+        self.figures += 1
+        file_name = f"{self.figures:02d}_{name}.png"
+        fig.savefig(os.path.join(self.files, file_name), dpi=110)
+        _pyplot().close(fig)
+        self.data[file_name] = data
+        self.parts.append(f'<figure><img src="{self.files_name}/{file_name}" alt="{html.escape(caption)}">'
+                          f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+    def write(self, title):
+        style = ("body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}"
+                 "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+                 "text-align:right}th{background:#eee}figure{margin:1.5em 0}img{max-width:100%}"
+                 "figcaption{font-size:90%;color:#555}")
+        text = (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
+                f"<style>{style}</style></head><body><h1>{html.escape(title)}</h1>\n" + "\n".join(self.parts) +
+                "\n</body></html>\n")
+        tmp = self.out_html + ".tmp"
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, self.out_html)
+        with open(os.path.join(self.files, "data.json"), "w") as f:
+            json.dump(self.data, f, indent=1, default=float)
+
+
+# -- speed against error -------------------------------------------------------
+
+def _coarse_point(a):
+    """(scene, label, speedup, error) of a coarsened run compared with its fine run, or None."""
+    if a.schema == "msfab.result" and "/coarsening" in a:
+        c = a.attrs("/coarsening")
+        if "error_vs_fine" not in c or "fine_newton_seconds" not in c:
+            return None
+        seconds = float(a.attrs("/timings")["newton_total"])
+        if c.get("adaptive", 0):
+            label = f"adaptive, target {float(c['target_error']):.3g}"
+        else:
+            label = f"level {int(c['level'])}, {c['material']}"
+            if c.get("element", "trilinear") != "trilinear":
+                label += f", {c['element']}"
+        return (a.attrs("/")["scene"], label, float(c["fine_newton_seconds"]) / seconds, float(c["error_vs_fine"]))
+    if a.schema == "msfab.trajectory" and "/comparison" in a:
+        c = a.attrs("/comparison")
+        k = a.attrs("/coarsening") if "/coarsening" in a else {}
+        label = f"level {int(k.get('level', 0))}, {k.get('material', '?')} (dynamics, max over frames)"
+        return (a.attrs("/")["scene"], label, float(c["fine_seconds_per_step"]) / float(c["seconds_per_step"]),
+                float(c["error_max"]))
+    return None
+
+
+def _speed_against_error(page, points):
+    if not points:
+        return
+    plt = _pyplot()
+    page.heading("Speed against error")
+    page.paragraph("Each coarse model against the fine solution of the same scene, solved in the same run or "
+                   "read as its reference. Speedup: the fine model's Newton time over the coarse model's "
+                   "(per time step for dynamics). " + ERROR_DEFINITION + ".")
+    for scene in sorted({p[0] for p in points}):
+        mine = sorted((p for p in points if p[0] == scene), key=lambda p: p[2])
+        fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
+        markers = "osD^v<>ph*"
+        for n, (_, label, speed, error) in enumerate(mine):
+            ax.loglog([speed], [max(error, 1e-16)], markers[n % len(markers)], ms=8, alpha=0.8, label=label)
+        # Decades around the points, so that a few close points are not
+        # stretched over the whole axis.
+        speeds = [p[2] for p in mine] + [1.0]
+        errors = [max(p[3], 1e-16) for p in mine]
+        ax.set_xlim(min(speeds) / 2, max(speeds) * 2)
+        ax.set_ylim(min(errors) / 3, max(errors) * 3)
+        ax.axvline(1.0, color="0.5", ls="--", lw=1, label="the fine model's speed")
+        ax.set_xlabel("speedup over the fine model (×)")
+        ax.set_ylabel("error (fraction of the body's longest side)")
+        ax.set_title(f"{scene}: speed against error")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, loc="best", framealpha=0.9)
+        page.figure(fig, f"speed_error_{scene}", f"{scene}: speedup and error of each coarse model",
+                    [{"label": l, "speedup": s, "error": e} for _, l, s, e in mine])
+        page.table(["model", "speedup (×)", "error"], [(l, f"{s:.2f}", f"{e:.3g}") for _, l, s, e in mine])
+
+
+# -- static solves -------------------------------------------------------------
+
+def _static_results(page, results):
+    if not results:
+        return
+    plt = _pyplot()
+    page.heading("Static solves (msfab-simulate)")
+    rows, fig_data = [], []
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
+    for path, a in results:
+        newton = a.attrs("/newton")
+        residual = np.asarray(a["/newton/residual"], dtype=float)
+        u = np.asarray(a["/displacement"])
+        root = a.attrs("/")
+        timings = a.attrs("/timings")
+        model = "fine"
+        if "/coarsening" in a:
+            c = a.attrs("/coarsening")
+            model = "adaptive" if c.get("adaptive", 0) else f"level {int(c['level'])} {c['material']}"
+        rows.append((_label(path), root["scene"], model, int(root["elements"]), int(root["dofs"]),
+                     int(newton["iterations"]), f"{float(timings['newton_total']):.3f}",
+                     f"{np.abs(u).max():.4g}"))
+        ax.semilogy(np.arange(1, len(residual) + 1), np.maximum(residual, 1e-300), ".-", label=_label(path))
+        fig_data.append({"artifact": _label(path), "residual": residual.tolist()})
+    ax.set_xlabel("Newton iteration (all load steps)")
+    ax.set_ylabel("free residual / force scale")
+    ax.set_title("Newton convergence")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    page.table(["artifact", "scene", "model", "elements", "DOFs", "Newton iterations", "Newton s", "max |u| (m)"],
+               rows)
+    page.figure(fig, "newton", "Newton convergence of each static solve (the residual drops at each converged "
+                "load step, then restarts with the next increment)", fig_data)
+
+
+# -- dynamics ------------------------------------------------------------------
+
+def _trajectory(page, path, a):
+    plt = _pyplot()
+    t = np.asarray(a["/samples/time"], dtype=float)
+    phase = np.asarray(a["/samples/phase"])
+    energies = {k: np.asarray(a[f"/samples/{k}"], dtype=float) for k in ("kinetic", "elastic", "gravity", "total")}
+    com = np.asarray(a["/samples/center_of_mass"], dtype=float)
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True, constrained_layout=True)
+    for name, e in energies.items():
+        top.plot(t, e, label=name, lw=1.6 if name == "total" else 1.0)
+    names = ["quasistatic", "elastic", "rigid"]
+    for p, colour in ((0, "#dde6f5"), (2, "#f5e6dd")):
+        inside = phase == p
+        if inside.any():
+            for ax in (top, bottom):
+                ax.fill_between(t, 0, 1, where=inside, color=colour, transform=ax.get_xaxis_transform(), lw=0,
+                                label=names[p] if ax is top else None)
+    top.set_ylabel("energy (J)")
+    top.legend(fontsize=8, ncol=3, loc="best")
+    top.grid(True, alpha=0.3)
+    bottom.plot(t, 1e3 * com[:, 2], color="k")
+    bottom.set_ylabel("centre of mass z (mm)")
+    bottom.set_xlabel("time (s)")
+    bottom.grid(True, alpha=0.3)
+    scene = a.attrs("/")["scene"]
+    top.set_title(f"{scene} ({_label(path)})")
+    page.figure(fig, f"trajectory_{_label(path)}", f"{_label(path)}: energies and centre-of-mass height over time; "
+                "shaded: quasistatic preload (blue) and rigid flight (orange)",
+                {"time": t[::max(1, len(t) // 200)].tolist(), "total": energies["total"][::max(1, len(t) // 200)].tolist()})
+
+
+# -- topology optimization -------------------------------------------------------
+
+def _design(page, path, a):
+    plt = _pyplot()
+    root = a.attrs("/")
+    grid = [int(g) for g in root["grid"]]
+    names = [n.strip() for n in str(root["property_names"]).split(",")]
+    raw = np.asarray(a["/cells/raw"], dtype=float)
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.0), gridspec_kw={"width_ratios": [1, 1.4]},
+                                      constrained_layout=True)
+    data = {}
+    if "/history/objective" in a:
+        objective = np.asarray(a["/history/objective"], dtype=float)
+        left.plot(np.arange(len(objective)), objective, "-")
+        if np.all(objective > 0):
+            left.set_yscale("log")
+        left.set_xlabel("optimizer iteration")
+        left.set_ylabel("objective")
+        left.grid(True, which="both", alpha=0.3)
+        data["objective"] = objective.tolist()
+    left.set_title("convergence")
+    if "rho" in names:
+        field, what = raw[:, names.index("rho")], "density ρ"
+    else:
+        field, what = raw[:, 0], names[0]
+    nx, ny, nz = grid
+    values = field.reshape(nz, ny, nx)
+    k = nz // 2
+    image = right.imshow(values[k], origin="lower", cmap="viridis", aspect="equal",
+                         extent=(0, nx, 0, ny), vmin=min(0.0, values.min()), vmax=max(values.max(), 1e-12))
+    right.set_xlabel("cell x")
+    right.set_ylabel("cell y")
+    right.set_title(what + (f", slice z = {k} of {nz}" if nz > 1 else ""))
+    fig.colorbar(image, ax=right, label=what)
+    data.update({"field": what, "min": float(values.min()), "max": float(values.max()), "grid": grid})
+    page.figure(fig, f"design_{_label(path)}", f"{_label(path)} ({root['space']}, {nx}×{ny}×{nz} cells): "
+                "objective over the iterations and the design", data)
+
+
+# -- gamuts ----------------------------------------------------------------------
+
+def _microstructures(page, path, a):
+    plt = _pyplot()
+    names = [n.strip() for n in str(a.attrs("/")["property_names"]).split(",")]
+    unit = np.asarray(a["/unit_properties"], dtype=float)
+    cycle = np.asarray(a["/cycle"]) if "/cycle" in a else np.zeros(len(unit))
+    d = unit.shape[1]
+    pairs = [(i, j) for i in range(d) for j in range(i + 1, d)][:3]
+    fig, axes = plt.subplots(1, len(pairs), figsize=(4.4 * len(pairs), 3.9), squeeze=False, constrained_layout=True)
+    for ax, (i, j) in zip(axes[0], pairs):
+        points = ax.scatter(unit[:, i], unit[:, j], c=cycle, s=6, cmap="plasma")
+        ax.set_xlabel(f"{names[i]} (normalized)")
+        ax.set_ylabel(f"{names[j]} (normalized)")
+        ax.set_xlim(-0.02, 1.02)
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(True, alpha=0.3)
+    fig.colorbar(points, ax=axes[0].tolist(), label="sampling cycle")
+    fig.suptitle(f"{_label(path)}: {len(unit)} structures")
+    page.figure(fig, f"gamut_{_label(path)}", f"{_label(path)}: the structures' properties in the normalized "
+                "material space, pairs of coordinates, coloured by the cycle that found them",
+                {"structures": len(unit), "names": names, "min": unit.min(axis=0).tolist(),
+                 "max": unit.max(axis=0).tolist()})
+
+
+def _homogenized(page, cells):
+    if not cells:
+        return
+    page.heading("Homogenized cells (msfab-homogenize)")
+    rows = []
+    for path, a in cells:
+        C = np.asarray(a["/C"], dtype=float)
+        rows.append((_label(path),) + tuple(f"{C[i, i]:.4g}" for i in range(6)) + (f"{C[0, 1]:.4g}",))
+    page.table(["artifact", "C11", "C22", "C33", "C44", "C55", "C66", "C12"], rows)
+    page.paragraph("C^H in Voigt order xx, yy, zz, yz, xz, xy with engineering shear strains, in the materials' "
+                   "units (Pa).")
+
+
+def build_report(paths, out_html, title="msfab report"):
+    """Writes the report of the artifacts under `paths` (files or folders) to
+    `out_html`; returns {picture file: numbers drawn}."""
+    page = _Page(out_html)
+    points, results, cells, others, drawn = [], [], [], [], []
+    opened = []
+    try:
+        for path in _find_artifacts(paths):
+            try:
+                a = open_artifact(path)
+            except ArtifactError as e:
+                others.append((path, f"not read: {e}"))
+                continue
+            opened.append(a)
+            p = _coarse_point(a)
+            if p:
+                points.append(p)
+            if a.schema == "msfab.result":
+                results.append((path, a))
+            elif a.schema == "msfab.homogenized":
+                cells.append((path, a))
+            elif a.schema in ("msfab.trajectory", "msfab.design", "msfab.microstructures"):
+                drawn.append((path, a))
+            else:
+                others.append((path, f"{a.schema} v{a.schema_version}, made by {a.producer}"))
+        _speed_against_error(page, points)
+        _static_results(page, results)
+        kinds = {"msfab.trajectory": ("Dynamics (msfab-dynamics)", _trajectory),
+                 "msfab.design": ("Designs (msfab-topopt)", _design),
+                 "msfab.microstructures": ("Gamuts (msfab-gamut-sample)", _microstructures)}
+        for schema, (heading, draw) in kinds.items():
+            mine = [(p, a) for p, a in drawn if a.schema == schema]
+            if mine:
+                page.heading(heading)
+                for p, a in mine:
+                    draw(page, p, a)
+        _homogenized(page, cells)
+        if others:
+            page.heading("Other artifacts")
+            page.table(["file", "kind"], [(p, what) for p, what in others])
+    finally:
+        for a in opened:
+            a.close()
+    if not page.parts:
+        page.paragraph("No artifacts found.")
+    page.write(title)
+    return page.data
