@@ -16,7 +16,7 @@
 # a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
 $(OUT)/families/two.microstructures.h5: configs/families/two_templates.yaml $(BIN)/msfab-family-generate
 	@mkdir -p $(@D)
-	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ $(QUIET)
 
 $(OUT)/families/two.families.h5: $(OUT)/families/two.microstructures.h5 $(BIN)/msfab-families
 	$(BIN)/msfab-families --structures $< --set 'selection.nu=[-1,0.5]' --set min_members=10 \

@@ -78,7 +78,7 @@ HAND_MADE_FAMILIES := graded_lattice graded_lattice_grid
 $(HAND_MADE_FAMILIES:%=$(OUT)/families/%.microstructures.h5): $(OUT)/families/%.microstructures.h5: \
     configs/families/%.yaml $(BIN)/msfab-family-generate
 	@mkdir -p $(@D)
-	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ $(QUIET)
 
 $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 	@test -s $@
@@ -86,7 +86,7 @@ $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.design.h5): $(TOPOPT_DIR)/%.design.h5: configs/topopt/%.yaml \
     $(TWO_SCALE_SPACE) $(BIN)/msfab-topopt
 	@mkdir -p $(@D)
-	$(BIN)/msfab-topopt --config $< $(TWO_SCALE_SPACE_ARGS) $(TOPOPT_ARGS) --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-topopt --config $< $(TWO_SCALE_SPACE_ARGS) $(TOPOPT_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
 # The gamut's structures, with FILL_TARGETS=1 plus structures generated at
 # the design's targets that the gamut does not cover (msfab-fill-targets). The targets fan out over MPI ranks with
@@ -117,7 +117,7 @@ MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.mapped.h5): $(TOPOPT_DIR)/%.mapped.h5: $(TOPOPT_DIR)/%.design.h5 \
     $(TOPOPT_DIR)/%.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
-	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ --quiet
+	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
 # The three checks of Table 3.1 per scene: S.verify.h5 (one hexahedron per
 # cell), S.h4.verify.h5 and S.solid.verify.h5, differing only in settings.
@@ -134,7 +134,7 @@ $(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
 $(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(BIN)/msfab-map
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
-	  $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ --quiet
+	  $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
 $(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(BIN)/msfab-verify-map
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \
@@ -170,7 +170,7 @@ HUGE_CONFIG := configs/topopt/bridge_family_huge.yaml
 HUGE_TOPOPT = $(BIN)/msfab-topopt --config $(HUGE_CONFIG) --set family=$(HUGE_FAMILY) --threads $(THREADS)
 $(HUGE_FAMILY): configs/families/graded_lattice_grid.yaml $(BIN)/msfab-family-generate
 	@mkdir -p $(@D)
-	$(BIN)/msfab-family-generate --config $< --set resolution=64 --threads $(THREADS) --out $@ --quiet
+	$(BIN)/msfab-family-generate --config $< --set resolution=64 --threads $(THREADS) --out $@ $(QUIET)
 $(HUGE_DIR)/bridge80.design.h5: $(HUGE_CONFIG) $(HUGE_FAMILY) $(BIN)/msfab-topopt
 	@mkdir -p $(@D)
 	$(HUGE_TOPOPT) --set grid="{size: [80, 40, 20], cell_size: 4.0}" --set optimizer.max_iterations=30 \

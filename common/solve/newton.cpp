@@ -114,6 +114,12 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
   };
   const double length_scale = (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm();
 
+  // Every iteration's record goes to the history and to the caller's hook.
+  auto add_record = [&](const NewtonIteration& rec) {
+    result.history.push_back(rec);
+    if (options.on_iteration) options.on_iteration(rec);
+  };
+
   // Runs Newton at one load factor from result.x; returns true on convergence.
   auto newton_at = [&](double s, int step, std::string& why) -> bool {
     const VecX fs = s * force;
@@ -155,7 +161,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       stagnant_steps = (round_off_step && residual > 0.5 * previous_residual) ? stagnant_steps + 1 : 0;
       previous_residual = residual;
       if (gap_closed && residual <= options.relative_tolerance) {
-        result.history.push_back(rec);
+        add_record(rec);
         return true;
       }
       // The gradient has a round-off floor too (positions are the unknowns,
@@ -164,14 +170,14 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       // not halve the residual mean the floor is reached; that is the
       // solution, and more iterations only redraw the noise.
       if (gap_closed && stagnant_steps >= 2) {
-        result.history.push_back(rec);
+        add_record(rec);
         spdlog::warn("Newton: the residual stagnates at {:.2e}, the round-off level of this problem, above the "
                      "tolerance {:.1e}; accepted as converged",
                      residual, options.relative_tolerance);
         return true;
       }
       if (it == options.max_iterations) {
-        result.history.push_back(rec);
+        add_record(rec);
         why = "no convergence in " + std::to_string(options.max_iterations) + " iterations";
         return false;
       }
@@ -206,7 +212,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       rec.shift = shift;
       rec.linear_iterations = solver->stats().iterations;
       if (!ok) {
-        result.history.push_back(rec);
+        add_record(rec);
         why = "the Newton system could not be solved even with regularization";
         return false;
       }
@@ -254,7 +260,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       }
       result.timings.line_search += seconds_since(t0);
       rec.step_length = accepted ? alpha : 0;
-      result.history.push_back(rec);
+      add_record(rec);
       spdlog::debug("newton load {:.4f} iter {:2d} residual {:.3e} energy {:.6e} alpha {:.3g} shift {:.2e}", s, it,
                     residual, potential, rec.step_length, shift);
       if (!accepted) {

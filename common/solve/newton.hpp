@@ -26,6 +26,8 @@ struct DirichletConditions {
   int count_fixed() const;
 };
 
+struct NewtonIteration;
+
 struct NewtonOptions {
   double relative_tolerance = 1e-6;  // on ||residual|| / force scale
   int max_iterations = 50;           // per load step
@@ -40,6 +42,9 @@ struct NewtonOptions {
   LinearSolverOptions linear;
   // Called after each converged load increment with the load factor reached.
   std::function<void(double load_factor)> on_load_step;
+  // Called with each Newton iteration's record as it is added to the
+  // history (progress within a load increment).
+  std::function<void(const NewtonIteration&)> on_iteration;
 };
 
 struct NewtonIteration {

@@ -302,3 +302,31 @@ TEST(NewtonHardCases, NonConvergenceIsReportedWithHistory) {
   EXPECT_NE(format_history(res.history).find("residual"), std::string::npos);
   EXPECT_TRUE(res.x.allFinite());
 }
+
+TEST(Newton, IterationHookSeesEveryHistoryRecordAsItIsAdded) {
+  // A compression in one load step, which must be halved: the hook
+  // gets exactly the records the history ends with, in order, converged,
+  // failed and halved increments alike.
+  VoxelGrid grid(2, 2, 2, 0.01, 1);
+  const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)});
+  ElasticAssembler asmb(vm.mesh);
+  auto DC = DirichletConditions::none(vm.mesh.num_dofs());
+  for (int n = 0; n < vm.mesh.num_nodes(); ++n) {
+    const double z = vm.mesh.nodes(n, 2);
+    if (z == 0 || z == 0.02) DC.fixed[3 * n] = DC.fixed[3 * n + 1] = DC.fixed[3 * n + 2] = 1;
+    if (z == 0.02) DC.displacement[3 * n + 2] = -0.008;
+  }
+  NewtonOptions opt;
+  opt.max_iterations = 3;  // too few for the whole load at once: increments are halved
+  std::vector<NewtonIteration> seen;
+  opt.on_iteration = [&](const NewtonIteration& it) { seen.push_back(it); };
+  const auto res = solve_static(asmb, DC, VecX::Zero(vm.mesh.num_dofs()), opt);
+  ASSERT_TRUE(res.converged) << res.failure;
+  ASSERT_EQ(seen.size(), res.history.size());
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    EXPECT_EQ(seen[k].load_factor, res.history[k].load_factor);
+    EXPECT_EQ(seen[k].iteration, res.history[k].iteration);
+    EXPECT_EQ(seen[k].residual, res.history[k].residual);
+  }
+  EXPECT_GT(res.load_steps, 1) << "the test should exercise a halved increment";
+}
