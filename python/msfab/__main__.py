@@ -5,6 +5,7 @@ import sys
 
 from .artifact import ArtifactError, open_artifact
 from .export import export_mesh
+from .image import IMAGE_SCHEMAS, export_image
 
 
 def info(args):
@@ -28,6 +29,13 @@ def inputs(args):
 
 def export(args):
     with open_artifact(args.file) as a:
+        if a.schema in IMAGE_SCHEMAS:
+            if args.frame is not None:
+                raise ArtifactError(f"{args.file}: --frame applies to trajectories only")
+            print(f"{args.out}: {export_image(a, args.out, structure=args.structure)}")
+            return 0
+        if args.structure is not None:
+            raise ArtifactError(f"{args.file}: --structure applies to microstructure sets only")
         m = export_mesh(a, args.out, frame=args.frame)
         print(f"{args.out}: {len(m.points)} nodes, {len(m.cells[0].data)} hexahedra, "
               f"point fields {sorted(m.point_data)}, cell fields {sorted(m.cell_data)}")
@@ -49,10 +57,12 @@ def main(argv=None):
     p.add_argument("file")
     p.add_argument("--base", default=".", help="folder the relative input paths are taken from")
     p.set_defaults(run=inputs)
-    p = sub.add_parser("export", help="the mesh and its fields to a file meshio writes (.vtu, .vtk, .xdmf, ...)")
+    p = sub.add_parser("export", help="the mesh and its fields to a file meshio writes (.vtu, .vtk, .xdmf, ...); "
+                       "voxel and cell-grid artifacts (microstructures, voxels, mapped, verify_map) to .vti")
     p.add_argument("file")
     p.add_argument("out")
     p.add_argument("--frame", type=int, help="trajectory frame index (negative from the end)")
+    p.add_argument("--structure", type=int, help="one structure of a microstructure set (default: all, side by side)")
     p.set_defaults(run=export)
     p = sub.add_parser("report", help="an HTML page with matplotlib pictures of the artifacts under PATH...")
     p.add_argument("out", help="the page to write, e.g. out/report.html (pictures in out/report_files/)")
