@@ -1,7 +1,9 @@
-"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE | report OUT.html PATH..."""
+"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE | report OUT.html PATH... | stack OUT.npy IMAGE..."""
 
 import argparse
 import sys
+
+import numpy as np
 
 from .artifact import ArtifactError, open_artifact
 from .export import export_mesh
@@ -47,6 +49,14 @@ def report(args):
     print(f"{args.out}: {len(data)} pictures")
 
 
+def stack(args):
+    from .stack import parse_map, stack_to_ids, write_ids
+    ids = stack_to_ids(args.images, parse_map(args.map) if args.map else None)
+    write_ids(args.out, ids)
+    counts = {int(v): int(c) for v, c in zip(*np.unique(ids, return_counts=True))}
+    print(f"{args.out}: {ids.shape[0]} x {ids.shape[1]} x {ids.shape[2]} voxels, voxels per id {counts}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m msfab", description="Read and export msfab artifacts.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -64,6 +74,12 @@ def main(argv=None):
     p.add_argument("--frame", type=int, help="trajectory frame index (negative from the end)")
     p.add_argument("--structure", type=int, help="one structure of a microstructure set (default: all, side by side)")
     p.set_defaults(run=export)
+    p = sub.add_parser("stack", help="an image stack (one image per z layer) to a voxel-id .npy for scenes and cells")
+    p.add_argument("out", help="the .npy to write")
+    p.add_argument("images", nargs="+", help="the layers, z = 0 first (PNG; TIFF with Pillow)")
+    p.add_argument("--map", nargs="+", metavar="GRAY:ID", help="gray level to material id, e.g. 0:0 255:1 128:2 "
+                   "(default: >= 128 is 1, else void)")
+    p.set_defaults(run=stack)
     p = sub.add_parser("report", help="an HTML page with matplotlib pictures of the artifacts under PATH...")
     p.add_argument("out", help="the page to write, e.g. out/report.html (pictures in out/report_files/)")
     p.add_argument("paths", nargs="+", help="artifacts, or folders searched for *.h5")

@@ -89,6 +89,32 @@ expect_exit 0 "bracket.vtu: 413 nodes, 240 hexahedra" -- env PYTHONPATH="$SRC/py
 check "exported mesh has the bracket's 240 voxels" -- env PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1 \
   "$PY" -c "import meshio, sys; m = meshio.read(sys.argv[1]); sys.exit(0 if len(m.cells[0].data) == 240 else 1)" "$WORK/bracket.vtu"
 
+# The bracket as an image stack: one PNG per z layer (white = material),
+# turned into a .npy by python3 -m msfab stack; a second stack with three
+# gray levels mapped to void and two materials.
+"$PY" - "$WORK" <<'PY'
+import sys
+import matplotlib.image
+import numpy as np
+work = sys.argv[1]
+ids = np.load(f"{work}/bracket.npy")
+for z in range(ids.shape[2]):  # rows run downwards in an image: y upwards
+    matplotlib.image.imsave(f"{work}/slice{z:02d}.png", 255 * ids[:, ::-1, z].T, cmap="gray", vmin=0, vmax=255)
+    level = np.where(ids[:, :, z] == 1, np.where(np.arange(12)[None, :] < 6, 255, 128), 0)
+    matplotlib.image.imsave(f"{work}/gray{z:02d}.png", level[:, ::-1].T, cmap="gray", vmin=0, vmax=255)
+PY
+expect_exit 0 "stack.npy: 6 x 12 x 6 voxels" -- env PYTHONPATH="$SRC/python" "$PY" -m msfab stack "$WORK/stack.npy" "$WORK"/slice*.png
+check "the image stack is the bracket's array" -- "$PY" -c \
+  "import numpy as np, sys; sys.exit(0 if np.array_equal(np.load('$WORK/stack.npy'), np.load('$WORK/bracket.npy')) else 1)"
+scene stack "  - {voxels: {file: stack.npy}}"
+expect_exit 0 "converged in" -- "$SIM" --config "$WORK/stack.yaml" --out "$WORK/stack.h5" --threads 1
+check "image stack scene gives the box scene's displacements" -- h5diff "$WORK/boxes.h5" "$WORK/stack.h5" /displacement /displacement
+expect_exit 0 "voxels per id \{0: 192, 1: 72, 2: 168\}" -- env PYTHONPATH="$SRC/python" "$PY" -m msfab stack \
+  "$WORK/two.npy" "$WORK"/gray*.png --map 0:0 255:1 128:2
+expect_exit 2 "gray00.png: pixel .* has gray level 128, which --map does not name" -- env PYTHONPATH="$SRC/python" \
+  "$PY" -m msfab stack "$WORK/bad.npy" "$WORK"/gray*.png --map 0:0 255:1
+check "nothing written for the refused stack" -- test ! -e "$WORK/bad.npy"
+
 # A cell from a numpy array against the same cell painted from boxes.
 cell() {  # cell NAME LAYOUT...
   cat > "$WORK/$1.yaml" <<Y
