@@ -14,6 +14,7 @@
 
 #include "core/errors.hpp"
 #include "core/version.hpp"
+#include "ddfem/coarse_db.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "homogenization_options.hpp"
@@ -146,6 +147,50 @@ py::dict simulate_scene(const std::string& config_path, const std::vector<std::s
   return out;
 }
 
+// A coarse material of a DDFEM database as numpy arrays (per coarse
+// quadrature point: mu, lambda, C, the spring directions v).
+py::dict fit_to_dict(const CoarseMaterialFit& fit) {
+  py::dict out;
+  const auto vector = [](const std::vector<double>& v) { return py::array_t<double>(v.size(), v.data()); };
+  out["ids"] = std::vector<int>(fit.material_ids.begin(), fit.material_ids.end());
+  out["mu"] = vector(fit.mu);
+  out["lambda"] = vector(fit.lambda);
+  out["C"] = vector(fit.C);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> v(fit.v.size(), 3);
+  for (std::size_t k = 0; k < fit.v.size(); ++k) v.row(static_cast<Eigen::Index>(k)) = fit.v[k].transpose();
+  out["v"] = to_numpy(v);
+  out["mu_centre"] = fit.mu_centre;
+  out["lambda_centre"] = fit.lambda_centre;
+  out["enhanced"] = fit.enhanced;
+  out["residual"] = fit.residual;
+  out["heldout_error"] = fit.heldout_error;
+  out["heldout_energy_error"] = fit.heldout_energy_error;
+  return out;
+}
+
+// Level-1 lookup, as msfab-simulate --coarsen 1 does it: the coarse
+// material of the 2 x 2 x 2 block with children `ids` (hex8 order, child
+// c = 4 i + 2 j + k at offset (i, j, k)), or None where the database has no
+// fit (naive coarsening online).
+py::object lookup_block(const CoarseDatabase& db, const std::vector<int>& ids) {
+  if (db.level != 1)
+    throw InputError("lookup: this is a level-" + std::to_string(db.level) +
+                     " database, whose rows are found from the level-1 entries of a cell's children; look blocks up "
+                     "in its level-1 database");
+  if (ids.size() != 8) throw InputError("lookup: expected the 8 child ids of a 2 x 2 x 2 block, got " +
+                                        std::to_string(ids.size()));
+  BlockMaterials block{};
+  for (int c = 0; c < 8; ++c) {
+    if (ids[c] < 0 || ids[c] > db.num_materials())
+      throw InputError("lookup: child " + std::to_string(c) + " has id " + std::to_string(ids[c]) +
+                       ", the database's palette has ids 1.." + std::to_string(db.num_materials()) + " (0 = void)");
+    block[c] = ids[c];
+  }
+  const CoarseMaterialFit* fit = db.find(block);
+  if (!fit || !fit->fitted) return py::none();
+  return fit_to_dict(*fit);
+}
+
 }  // namespace
 
 PYBIND11_MODULE(msfab_bindings, m) {
@@ -162,6 +207,28 @@ PYBIND11_MODULE(msfab_bindings, m) {
     }
   });
   m.def("version", [] { return std::string(version()); });
+  py::class_<CoarseDatabase, std::shared_ptr<CoarseDatabase>>(m, "CoarseDatabase")
+      .def(py::init([](const std::string& path) { return std::make_shared<CoarseDatabase>(read_coarse_db(path)); }),
+           py::arg("path"))
+      .def_property_readonly("level", [](const CoarseDatabase& db) { return db.level; })
+      .def_property_readonly("void_children", [](const CoarseDatabase& db) { return db.void_children; })
+      .def_property_readonly("compressed", [](const CoarseDatabase& db) { return db.compressed(); })
+      .def_property_readonly("entries", [](const CoarseDatabase& db) { return db.entries.size(); })
+      .def_property_readonly("materials",
+                             [](const CoarseDatabase& db) {
+                               py::list out;
+                               for (int i = 0; i < db.num_materials(); ++i) {
+                                 py::dict m;
+                                 m["id"] = i + 1;
+                                 m["name"] = db.materials[i].name;
+                                 m["E"] = db.materials[i].E;
+                                 m["nu"] = db.materials[i].nu;
+                                 m["density"] = db.materials[i].density;
+                                 out.append(m);
+                               }
+                               return out;
+                             })
+      .def("lookup", &lookup_block, py::arg("ids"));
   m.def("homogenize", &homogenize_array, py::arg("ids"), py::arg("config_text"), py::arg("threads") = 1);
   m.def("simulate", &simulate_scene, py::arg("config_path"), py::arg("overrides") = std::vector<std::string>{},
         py::arg("threads") = 1);

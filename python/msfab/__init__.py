@@ -17,10 +17,10 @@ materials)`` and ``msfab.simulate(scene)`` run the stages' own code
 from .artifact import Artifact, ArtifactError, Input, InputState, Mesh, open_artifact, sha256_of, to_vtk_order
 from .export import export_mesh, frame_groups, to_meshio
 from .image import export_image, read_vti, write_vti
-from .native import homogenize, simulate
+from .native import homogenize, open_database, simulate
 
 __all__ = ["Artifact", "ArtifactError", "Input", "InputState", "Mesh", "open_artifact", "sha256_of", "to_vtk_order",
-           "export_mesh", "frame_groups", "to_meshio", "homogenize", "simulate", "export_image", "read_vti", "write_vti"]
+           "export_mesh", "frame_groups", "to_meshio", "homogenize", "simulate", "open_database", "export_image", "read_vti", "write_vti"]
 
 
 def __getattr__(name):  # the bindings' error types, loaded on first use

@@ -62,6 +62,19 @@ def homogenize(ids, materials, *, voxel_size=None, void_stiffness=None, solver=N
     return _bindings().homogenize(ids, json.dumps(config, default=float), threads)
 
 
+def open_database(path):
+    """A DDFEM database (msfab.coarse_db) as msfab-simulate reads it:
+    ``.level``, ``.materials``, ``.entries``, and at level 1
+    ``.lookup(ids)``: the coarse material of a 2 x 2 x 2 block whose
+    children (hex8 order, child c = 4 i + 2 j + k at offset (i, j, k)) have
+    palette ids ``ids`` (0 = void), as a dict of numpy arrays (mu, lambda,
+    C per coarse quadrature point, v their spring directions, fit errors),
+    or None where the database has no fit. Raises msfab.InputError on a bad
+    file, naming the dataset.
+    """
+    return _bindings().CoarseDatabase(os.fspath(path))
+
+
 def simulate(config, *, set=(), threads=1):
     """A static scene (YAML file) solved as msfab-simulate solves it without
     coarsening; ``set`` takes --set assignments ("solver.tolerance=1e-8").

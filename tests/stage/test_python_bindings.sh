@@ -1,5 +1,6 @@
 #!/bin/bash
-# The Python bindings (python/bindings, msfab.homogenize / msfab.simulate)
+# The Python bindings (python/bindings, msfab.homogenize / msfab.simulate /
+# msfab.open_database)
 # run the stages' own code: their results equal the executables' artifacts
 # bit for bit at one thread, and bad input raises msfab.InputError naming
 # the key. Skipped (exit 77) when the build has no bindings (no pybind11).
@@ -63,6 +64,32 @@ print(f"bracket: displacement equal bit for bit: {same} ({run['newton_iterations
 sys.exit(0 if ok and same else 1)
 PY
 
+# A DDFEM database looked up as msfab-simulate looks it up: every
+# combination's coarse material equals the row the file assigns it.
+expect_exit 0 "" -- "$BIN/msfab-ddfem-build" --quiet --config "$SRC/configs/ddfem/tiny.yaml" --out "$WORK/tiny.coarse_db.h5"
+check "database lookup equals the file's rows" -- "$PY" - "$WORK" <<'PY'
+import sys
+import h5py
+import numpy as np
+import msfab
+work = sys.argv[1]
+db = msfab.open_database(f"{work}/tiny.coarse_db.h5")
+ok = db.level == 1 and [m["E"] for m in db.materials] == [1.0e5, 1.0e7]
+with h5py.File(f"{work}/tiny.coarse_db.h5") as f:
+    ids, entry, fitted = f["/combinations/ids"][()], f["/combinations/entry"][()], f["/fit/fitted"][()]
+    mu, C, v = f["/fit/mu"][()], f["/fit/C"][()], f["/fit/v"][()]
+    for code in range(len(ids)):
+        got = db.lookup([int(i) for i in ids[code]])
+        row = entry[code]
+        if row < 0 or not fitted[row]:
+            ok &= got is None
+            continue
+        ok &= got is not None and np.array_equal(got["mu"], mu[row]) and np.array_equal(got["C"], C[row]) \
+            and np.array_equal(got["v"].reshape(-1), v[row])
+print(f"{len(ids)} combinations looked up, all equal: {ok}")
+sys.exit(0 if ok else 1)
+PY
+
 check "bad input raises InputError naming the key" -- "$PY" - "$SRC" <<'PY'
 import sys
 import numpy as np
@@ -77,6 +104,7 @@ cases = [
     (lambda: msfab.homogenize(ids.astype(float), stiff), "expected an integer array"),
     (lambda: msfab.simulate(f"{src}/configs/scenes/user/bracket.yaml", set=["solver.tolerance=2"]), "solver.tolerance"),
     (lambda: msfab.simulate(f"{src}/configs/scenes/user/nowhere.yaml"), "no such file"),
+    (lambda: msfab.open_database(f"{src}/configs/scenes/user/bracket.npy"), "bracket.npy"),
 ]
 ok = True
 for call, expected in cases:
