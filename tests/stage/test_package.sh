@@ -15,5 +15,21 @@ check "a project outside the tree configures with find_package(msfab)" -- \
   > "$WORK/configure.log" 2>&1
 check "... builds against the installed libraries" -- cmake --build "$WORK/example" > "$WORK/example.log" 2>&1
 check "... and its laminate matches the exact stiffness" -- "$WORK/example/laminate"
+# The Python package from the prefix: artifacts read, and with the
+# bindings built, a cell homogenized by the installed module.
+PYPATH="$WORK/prefix/lib/msfab/python"
+check "... the Python package" -- test -s "$PYPATH/msfab/__init__.py"
+"$BIN/msfab-homogenize" --quiet --out "$WORK/cell.h5" > /dev/null
+check "the installed package reads an artifact" -- env PYTHONPATH="$PYPATH" PYTHONDONTWRITEBYTECODE=1 \
+  /usr/bin/python3 -m msfab info "$WORK/cell.h5" > /dev/null
+if ls "$BUILD/python"/msfab_bindings*.so > /dev/null 2>&1; then
+  check "the installed bindings homogenize a cell" -- env PYTHONPATH="$PYPATH" PYTHONDONTWRITEBYTECODE=1 \
+    MSFAB_BUILD=/nonexistent /usr/bin/python3 -c "
+import numpy as np, msfab, msfab_bindings, sys
+assert msfab_bindings.__file__.startswith('$PYPATH'), msfab_bindings.__file__
+ids = np.full((4, 4, 4), 1); ids[:, :, :2] = 2
+C = msfab.homogenize(ids, [{'id': 1, 'model': 'linear', 'E': 1e6, 'nu': 0.3}, {'id': 2, 'model': 'linear', 'E': 1e5, 'nu': 0.3}])['C']
+sys.exit(0 if C[0, 0] > C[2, 2] > 0 else 1)"
+fi
 [ -x "$WORK/example/laminate" ] || tail -20 "$WORK/configure.log" "$WORK/example.log"
 finish
