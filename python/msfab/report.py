@@ -280,6 +280,71 @@ def _microstructures(page, path, a):
                  "max": unit.max(axis=0).tolist()})
 
 
+def _verify_map(page, checks):
+    if not checks:
+        return
+    page.heading("Full-resolution checks (msfab-verify-map)")
+    page.paragraph("Each mapped design's homogenized model against its voxel model (thesis Table 3.1): the mean "
+                   "displacement difference and the energy difference relative to the voxel model, per load case.")
+    rows, data = [], []
+    for path, a in checks:
+        names = a.attrs("/cases").get("names", "")
+        names = names.split(",") if isinstance(names, str) else list(names)
+        displacement = np.atleast_1d(a["/cases/relative_displacement_difference"])
+        energy = np.atleast_1d(a["/cases/relative_energy_difference"])
+        for c in range(len(displacement)):
+            label = names[c] if c < len(names) and names[c] else f"case {c}"
+            rows.append((_label(path), label, f"{100 * displacement[c]:.1f}%", f"{100 * energy[c]:.1f}%"))
+            data.append({"artifact": _label(path), "case": label, "displacement": float(displacement[c]),
+                         "energy": float(energy[c])})
+    page.table(["check", "load case", "displacement difference", "energy difference"], rows)
+    page.data["verify_map"] = data
+
+
+def _mapped(page, path, a):
+    if "/cells/property_gap" not in a:
+        return
+    plt = _pyplot()
+    gap = np.asarray(a["/cells/property_gap"], dtype=float)
+    role = np.asarray(a["/cells/role"])
+    gap = gap[role == 0]
+    fig, ax = plt.subplots(figsize=(6.4, 3.8), constrained_layout=True)
+    ax.hist(gap, bins=30, color="#4477aa")
+    ax.set_xlabel("property gap |C(structure) - C(target)| / |C(target)|")
+    ax.set_ylabel("design cells")
+    ax.set_title(f"{_label(path)}: {len(gap)} design cells")
+    ax.grid(True, alpha=0.3)
+    page.figure(fig, f"mapped_{_label(path)}", f"{_label(path)}: how far each mapped structure's stiffness is from "
+                "the optimized cell's", {"cells": len(gap), "max": float(gap.max()) if len(gap) else 0.0,
+                                         "mean": float(gap.mean()) if len(gap) else 0.0})
+
+
+def _jump_design(page, path, a):
+    plt = _pyplot()
+    start = np.asarray(a["/evaluations/start"])
+    objective = np.asarray(a["/evaluations/objective"], dtype=float)
+    simulated = np.asarray(a["/evaluations/simulated"]).astype(bool)
+    fig, ax = plt.subplots(figsize=(6.4, 3.8), constrained_layout=True)
+    for s in np.unique(start):
+        index = np.nonzero(start == s)[0]
+        ok = simulated[index]
+        ax.plot(np.arange(1, len(index) + 1)[ok], objective[index][ok], "o-", ms=3, label=f"start {int(s)}")
+    if np.all(objective[simulated] > 0):
+        ax.set_yscale("log")
+    ax.set_xlabel("evaluation")
+    ax.set_ylabel("objective")
+    root = a.attrs("/")
+    ax.set_title(f"{_label(path)}: task {root['task']}")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    data = {"objective": objective.tolist(), "final": float(a.attrs("/final")["objective"])}
+    caption = f"{_label(path)}: the objective of every evaluation of each COBYLA start"
+    if "/robustness" in a:
+        data["success_fraction"] = float(a.attrs("/robustness")["success_fraction"])
+        caption += f"; print variation: {100 * data['success_fraction']:.0f}% of the samples meet the goal"
+    page.figure(fig, f"jump_{_label(path)}", caption, data)
+
+
 def _homogenized(page, cells):
     if not cells:
         return
@@ -297,7 +362,7 @@ def build_report(paths, out_html, title="msfab report"):
     """Writes the report of the artifacts under `paths` (files or folders) to
     `out_html`; returns {picture file: numbers drawn}."""
     page = _Page(out_html)
-    points, results, cells, others, drawn = [], [], [], [], []
+    points, results, cells, checks, others, drawn = [], [], [], [], [], []
     opened = []
     try:
         for path in _find_artifacts(paths):
@@ -314,7 +379,10 @@ def build_report(paths, out_html, title="msfab report"):
                 results.append((path, a))
             elif a.schema == "msfab.homogenized":
                 cells.append((path, a))
-            elif a.schema in ("msfab.trajectory", "msfab.design", "msfab.microstructures"):
+            elif a.schema == "msfab.verify_map":
+                checks.append((path, a))
+            elif a.schema in ("msfab.trajectory", "msfab.design", "msfab.microstructures", "msfab.mapped",
+                              "msfab.jump_design"):
                 drawn.append((path, a))
             else:
                 others.append((path, f"{a.schema} v{a.schema_version}, made by {a.producer}"))
@@ -322,13 +390,16 @@ def build_report(paths, out_html, title="msfab report"):
         _static_results(page, results)
         kinds = {"msfab.trajectory": ("Dynamics (msfab-dynamics)", _trajectory),
                  "msfab.design": ("Designs (msfab-topopt)", _design),
-                 "msfab.microstructures": ("Gamuts (msfab-gamut-sample)", _microstructures)}
+                 "msfab.microstructures": ("Gamuts (msfab-gamut-sample)", _microstructures),
+                 "msfab.mapped": ("Mapped designs (msfab-map)", _mapped),
+                 "msfab.jump_design": ("Design loops (msfab-jump-design)", _jump_design)}
         for schema, (heading, draw) in kinds.items():
             mine = [(p, a) for p, a in drawn if a.schema == schema]
             if mine:
                 page.heading(heading)
                 for p, a in mine:
                     draw(page, p, a)
+        _verify_map(page, checks)
         _homogenized(page, cells)
         if others:
             page.heading("Other artifacts")

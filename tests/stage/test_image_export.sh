@@ -89,6 +89,19 @@ with h5py.File("bar.verify.h5") as f:
     expect("full-resolution displacement", np.array_equal(chk[found[0]], full[0]))
 sys.exit(0 if ok else 1)
 PY
+# The report draws the mapping's property gaps and tables the check.
+check "the report draws the mapping and the check" -- "$PY" -c "
+import sys, h5py, numpy as np
+from msfab.report import build_report
+data = build_report(['bar.mapped.h5', 'bar.verify.h5'], 'report.html')
+f = h5py.File('bar.verify.h5')
+rows = data['verify_map']
+ok = [r['displacement'] for r in rows] == list(f['/cases/relative_displacement_difference'][()])
+mapped = [v for k, v in data.items() if 'mapped_bar' in k]
+g = h5py.File('bar.mapped.h5')
+gap = g['/cells/property_gap'][()][g['/cells/role'][()] == 0]
+ok = ok and len(mapped) == 1 and mapped[0]['cells'] == len(gap) and mapped[0]['max'] == gap.max()
+sys.exit(0 if ok else 1)"
 expect_exit 2 "exported as VTK image data \(.vti\)" -- "$PY" -m msfab export set.microstructures.h5 set.vtu
 expect_exit 2 "structure 99 asked for" -- "$PY" -m msfab export set.microstructures.h5 x.vti --structure 99
 finish

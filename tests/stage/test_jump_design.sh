@@ -69,6 +69,18 @@ samples_same() {
   done
 }
 check "1 and 2 ranks give the same samples" -- samples_same "$WORK/robust1.h5" "$WORK/robust2.h5"
+# The report draws the loop: every evaluation's objective, and the print
+# variation's success fraction as the artifact stores it.
+mkdir -p "$WORK/rep" && cp "$WORK/robust1.h5" "$WORK/rep/"
+check "the report draws the design loop" -- env PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -c "
+import json, sys, h5py, numpy as np
+from msfab.report import build_report
+data = build_report(['$WORK/rep'], '$WORK/rep/report.html')
+jump = [v for k, v in data.items() if k.endswith('jump_robust1.png')]
+f = h5py.File('$WORK/robust1.h5')
+ok = len(jump) == 1 and np.array_equal(jump[0]['objective'], f['/evaluations/objective'][()]) \
+    and jump[0]['success_fraction'] == f['/robustness'].attrs['success_fraction']
+sys.exit(0 if ok else 1)"
 # A given design checked without a search: meshed at voxel-aligned
 # reference values, morphed to the design.
 check "a given design on its reference mesh" -- "$DESIGN" --config "$WORK/design.yaml" \
