@@ -44,22 +44,22 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
         ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed \
         ddfem-table-dynamics
-ddfem-db-tiny: build $(OUT)/ddfem/tiny.coarse_db.h5
-ddfem-db-level1: build $(OUT)/ddfem/palette3.coarse_db.h5
-ddfem-db-level2: build $(OUT)/ddfem/palette3.level2.coarse_db.h5
+ddfem-db-tiny: stages $(OUT)/ddfem/tiny.coarse_db.h5
+ddfem-db-level1: stages $(OUT)/ddfem/palette3.coarse_db.h5
+ddfem-db-level2: stages $(OUT)/ddfem/palette3.level2.coarse_db.h5
 
-ddfem-table: build $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/palette3.level2.coarse_db.h5
+ddfem-table: stages $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/palette3.level2.coarse_db.h5
 	DATABASE2=$(OUT)/ddfem/palette3.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem docs/BENCHMARKS.md $(OUT)/ddfem/palette3.coarse_db.h5
 
 # In-situ sampling (docs/ddfem.md): both levels sampled periodically.
-ddfem-table-periodic: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+ddfem-table-periodic: stages $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
 	BENCH_SECTION=ddfem-periodic DATABASE2=$(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-periodic docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic.coarse_db.h5
 
 # The centre point (docs/ddfem.md, "Centre point") on periodic databases.
-ddfem-table-centre: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
+ddfem-table-centre: stages $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
                     $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
 	BENCH_SECTION=ddfem-centre DATABASE2=$(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-centre docs/BENCHMARKS.md \
@@ -68,14 +68,14 @@ ddfem-table-centre: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
 # What limits coarsening (docs/ddfem.md, "Error floor and the homogenized
 # reference"): every scene at both levels, naive, homogenized and DDFEM
 # against the floor no coarse model can beat.
-ddfem-table-floor: build $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
+ddfem-table-floor: stages $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 \
                    $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
 	bash tools/bench_ddfem_floor.sh $(BIN) $(OUT)/bench/ddfem-floor docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_centre.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_centre.level2.coarse_db.h5
 
 # The fit on the enhanced coarse element (docs/ddfem.md, "Fit on the
 # enhanced element"): level 1, the same columns as ddfem-table-floor.
-ddfem-table-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5
+ddfem-table-enhanced: stages $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5
 	LEVELS=1 BENCH_SECTION=ddfem-enhanced bash tools/bench_ddfem_floor.sh $(BIN) $(OUT)/bench/ddfem-enhanced \
 	  docs/BENCHMARKS.md $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5 -
 
@@ -83,14 +83,14 @@ ddfem-table-enhanced: build $(OUT)/ddfem/palette3_periodic_enhanced.coarse_db.h5
 # the enhanced element"): naive and Galerkin coarsening on both elements at both levels,
 # DDFEM of the enhanced databases fitted on affine samples (both levels),
 # its blocks without a fit naive or Galerkin.
-ddfem-table-mixed: build $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
+ddfem-table-mixed: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
                    $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 	bash tools/bench_ddfem_mixed.sh $(BIN) $(OUT)/bench/ddfem-mixed docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 
 # DDFEM in dynamics (docs/ddfem.md, "Coarsening in dynamics"): the fibre bar
 # fine and at both levels, naive and the isolated and periodic databases.
-ddfem-table-dynamics: build $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/palette3.level2.coarse_db.h5 \
+ddfem-table-dynamics: stages $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/palette3.level2.coarse_db.h5 \
                       $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
 	bash tools/bench_ddfem_dynamics.sh $(BIN) $(OUT)/bench/ddfem-dynamics \
 	  L1:isolated=$(OUT)/ddfem/palette3.coarse_db.h5 L1:periodic=$(OUT)/ddfem/palette3_periodic.coarse_db.h5 \
@@ -98,7 +98,7 @@ ddfem-table-dynamics: build $(OUT)/ddfem/palette3.coarse_db.h5 $(OUT)/ddfem/pale
 
 # Void in the palette (docs/ddfem.md, "Blocks with void"): blocks with void
 # children fitted, periodic sampling at both levels.
-ddfem-table-void: build $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
+ddfem-table-void: stages $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
                   $(OUT)/ddfem/palette3_periodic_void.level2.coarse_db.h5
 	BENCH_SECTION=ddfem-void DATABASE2=$(OUT)/ddfem/palette3_periodic_void.level2.coarse_db.h5 \
 	  bash tools/bench_ddfem.sh $(BIN) $(OUT)/bench/ddfem-void docs/BENCHMARKS.md \
@@ -106,7 +106,7 @@ ddfem-table-void: build $(OUT)/ddfem/palette3_periodic_void.coarse_db.h5 \
 
 # Adaptive coarsening (docs/ddfem.md, "Adaptive coarsening") over the
 # periodic level-2 database; TARGETS="..." picks the target errors.
-ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
+ddfem-table-adaptive: stages $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
 	DATABASE1=$(OUT)/ddfem/palette3_periodic.coarse_db.h5 \
 	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic.level2.coarse_db.h5
@@ -118,7 +118,7 @@ ddfem-table-adaptive: build $(OUT)/ddfem/palette3_periodic.coarse_db.h5 $(OUT)/d
 # void too (its level 2 takes hours; docs/BENCHMARKS.md).
 FALLBACK ?= galerkin
 ENHANCED_DB ?= palette3_periodic_enhanced_affine
-ddfem-table-adaptive-enhanced: build $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+ddfem-table-adaptive-enhanced: stages $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
 	DATABASE1=$(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 BENCH_SECTION=ddfem-adaptive-enhanced \
 	  COARSE_ARGS="--coarse-fallback $(FALLBACK)" \
 	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-$(ENHANCED_DB)-$(FALLBACK) docs/BENCHMARKS.md \
@@ -143,7 +143,7 @@ $(OUT)/ddfem/palette3.level2.%.coarse_db.h5: configs/ddfem/palette3_level2.yaml 
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3.$*.coarse_db.h5 --out $@ --resume
 .PHONY: ddfem-table-thesis-settings
-ddfem-table-thesis-settings: build $(foreach d,$(DDFEM_SETTINGS_L1),$(OUT)/ddfem/$(d).coarse_db.h5) \
+ddfem-table-thesis-settings: stages $(foreach d,$(DDFEM_SETTINGS_L1),$(OUT)/ddfem/$(d).coarse_db.h5) \
                              $(foreach k,$(DDFEM_K1_SWEEP),$(OUT)/ddfem/palette3.k$(k).coarse_db.h5) \
                              $(foreach b,$(DDFEM_L2_BASES),$(OUT)/ddfem/palette3.level2.$(b).coarse_db.h5)
 	BENCH_RUN_LIMIT=120 BENCH_SECTION=ddfem-thesis-settings bash tools/bench_ddfem_databases.sh $(BIN) \

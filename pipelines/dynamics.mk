@@ -60,16 +60,16 @@ $(OUT)/design/catapult.jump_design.h5: configs/dynamics/catapult_param.yaml
 
 .PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult dynamics-catapult \
     bench-dac-plant bench-dac-jumper
-dynamics-drops: build $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
+dynamics-drops: stages $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
-dac-cantilever: build $(DYN)/rig_dac.trajectory.h5
-dynamics-flipper: build $(DYN)/flipper.trajectory.h5
-dynamics-catapult: build $(DYN)/catapult.trajectory.h5
-design-flipper: build $(OUT)/design/flipper.jump_design.h5
-design-jump-onto: build $(OUT)/design/jump_onto.jump_design.h5
-design-jump-over: build $(OUT)/design/jump_over.jump_design.h5
-design-catapult: build $(OUT)/design/catapult.jump_design.h5
-bench-dac-plant: build
+dac-cantilever: stages $(DYN)/rig_dac.trajectory.h5
+dynamics-flipper: stages $(DYN)/flipper.trajectory.h5
+dynamics-catapult: stages $(DYN)/catapult.trajectory.h5
+design-flipper: stages $(OUT)/design/flipper.jump_design.h5
+design-jump-onto: stages $(OUT)/design/jump_onto.jump_design.h5
+design-jump-over: stages $(OUT)/design/jump_over.jump_design.h5
+design-catapult: stages $(OUT)/design/catapult.jump_design.h5
+bench-dac-plant: stages
 	bash tools/bench_dac_plant.sh $(BIN) $(OUT)/bench/dac_plant
-bench-dac-jumper: build
+bench-dac-jumper: stages
 	bash tools/bench_dac_jumper.sh $(BIN) $(OUT)/bench/dac_jumper

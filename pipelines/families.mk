@@ -44,13 +44,13 @@ $(OUT)/families/auxetic_directed_32.families.h5: configs/families/auxetic_direct
 	  --set min_members=3 --seed $(SEED) --threads $(THREADS) --out $@
 
 .PHONY: families-demo families-gamut families-auxetic families-auxetic-32 families-auxetic-check
-families-auxetic: build $(OUT)/families/auxetic_directed.families.h5
-families-auxetic-32: build $(OUT)/families/auxetic_directed_32.families.h5
-families-auxetic-check: build $(OUT)/families/auxetic_directed.families.h5
+families-auxetic: stages $(OUT)/families/auxetic_directed.families.h5
+families-auxetic-32: stages $(OUT)/families/auxetic_directed_32.families.h5
+families-auxetic-check: stages $(OUT)/families/auxetic_directed.families.h5
 	bash tools/bench_finite_strain.sh $(BIN) $(OUT)/gamut/cubic3d_auxetic.microstructures.h5 \
 	  $(OUT)/families/auxetic_directed.families.h5 0 $(OUT)/families/finite_strain
-families-demo: build $(OUT)/families/two.families.h5 $(OUT)/families/two.family1.microstructures.h5
-families-gamut: build $(OUT)/families/stiff_nu.families.h5
+families-demo: stages $(OUT)/families/two.families.h5 $(OUT)/families/two.family1.microstructures.h5
+families-gamut: stages $(OUT)/families/stiff_nu.families.h5
 	@# The auxetic selection of the same set (an input error when it holds none).
 	-$(BIN)/msfab-families --config configs/families/auxetic.yaml \
 	  --structures $(OUT)/gamut/cubic3d_families.microstructures.h5 --seed $(SEED) --threads $(THREADS) \

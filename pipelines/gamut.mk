@@ -39,22 +39,22 @@ $(OUT)/gamut/converged/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sampl
 	  --set stop='{coverage_growth: $(CONVERGE_GROWTH), window: $(CONVERGE_WINDOW)}'
 
 .PHONY: gamut-converge-2d gamut-converge-3d
-gamut-converge-2d: build $(addprefix $(OUT)/gamut/converged/,cubic2d.gamut.h5 orthotropic2d.gamut.h5 cubic2d_void.gamut.h5 \
+gamut-converge-2d: stages $(addprefix $(OUT)/gamut/converged/,cubic2d.gamut.h5 orthotropic2d.gamut.h5 cubic2d_void.gamut.h5 \
     orthotropic2d_void.gamut.h5 cubic2d_three.gamut.h5)
-gamut-converge-3d: build $(OUT)/gamut/converged/cubic3d_void.gamut.h5
+gamut-converge-3d: stages $(OUT)/gamut/converged/cubic3d_void.gamut.h5
 
 .PHONY: gamut-2d gamut-ortho gamut-2d-void gamut-2d-three gamut-auxetic-2d gamut-auxetic-2d-printable gamut-auxetic-3d gamut-auxetic-3d-32 gamut-auxetic-3d-64 gamut-3d gamut-bench
-gamut-2d: build $(OUT)/gamut/cubic2d.gamut.h5
-gamut-ortho: build $(OUT)/gamut/orthotropic2d.gamut.h5
-gamut-2d-void: build $(OUT)/gamut/cubic2d_void.gamut.h5 $(OUT)/gamut/orthotropic2d_void.gamut.h5
-gamut-2d-three: build $(OUT)/gamut/cubic2d_three.gamut.h5
-gamut-auxetic-2d: build $(OUT)/gamut/cubic2d_auxetic.gamut.h5
-gamut-auxetic-2d-printable: build $(OUT)/gamut/cubic2d_auxetic_printable.gamut.h5
-gamut-auxetic-3d: build $(OUT)/gamut/cubic3d_auxetic.gamut.h5
-gamut-auxetic-3d-32: build $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5
-gamut-auxetic-3d-64: build $(OUT)/gamut/cubic3d_auxetic_64.gamut.h5
+gamut-2d: stages $(OUT)/gamut/cubic2d.gamut.h5
+gamut-ortho: stages $(OUT)/gamut/orthotropic2d.gamut.h5
+gamut-2d-void: stages $(OUT)/gamut/cubic2d_void.gamut.h5 $(OUT)/gamut/orthotropic2d_void.gamut.h5
+gamut-2d-three: stages $(OUT)/gamut/cubic2d_three.gamut.h5
+gamut-auxetic-2d: stages $(OUT)/gamut/cubic2d_auxetic.gamut.h5
+gamut-auxetic-2d-printable: stages $(OUT)/gamut/cubic2d_auxetic_printable.gamut.h5
+gamut-auxetic-3d: stages $(OUT)/gamut/cubic3d_auxetic.gamut.h5
+gamut-auxetic-3d-32: stages $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5
+gamut-auxetic-3d-64: stages $(OUT)/gamut/cubic3d_auxetic_64.gamut.h5
 $(OUT)/gamut/cubic3d_auxetic_64.gamut.h5: $(OUT)/gamut/cubic3d_auxetic.gamut.h5
-gamut-3d: build $(OUT)/gamut/cubic3d_void.gamut.h5
+gamut-3d: stages $(OUT)/gamut/cubic3d_void.gamut.h5
 
-gamut-bench: build
+gamut-bench: stages
 	bash tools/bench_gamut.sh $(BIN) $(OUT)/bench/gamut docs/BENCHMARKS.md

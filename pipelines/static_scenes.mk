@@ -8,4 +8,4 @@ $(OUT)/scenes/%.result.h5: configs/scenes/%.yaml $(BIN)/msfab-simulate
 	$(BIN)/msfab-simulate --config $< --out $@ --threads $(THREADS)
 
 .PHONY: static-scenes
-static-scenes: build $(STATIC_SCENES:%=$(OUT)/scenes/%.result.h5)
+static-scenes: stages $(STATIC_SCENES:%=$(OUT)/scenes/%.result.h5)

@@ -204,19 +204,19 @@ endef
 $(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)))))
 
 .PHONY: topopt-thesis-2d
-topopt-thesis-2d: build $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
+topopt-thesis-2d: stages $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
 
 .PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check topopt-checks topopt-cubes \
     topopt-bridge-large topopt-bridge-huge
-topopt-bar-check: build $(TOPOPT_DIR)/bar.verify.h5 $(TOPOPT_DIR)/bar.h4.verify.h5 $(TOPOPT_DIR)/bar.solid.verify.h5 \
+topopt-bar-check: stages $(TOPOPT_DIR)/bar.verify.h5 $(TOPOPT_DIR)/bar.h4.verify.h5 $(TOPOPT_DIR)/bar.solid.verify.h5 \
     $(TOPOPT_DIR)/bar.t2.verify.h5
-topopt-cubes: build $(OUT)/topopt/cubes.md
-topopt-gripper-check: build $(TOPOPT_DIR)/gripper3d.verify.h5 $(TOPOPT_DIR)/gripper3d.h4.verify.h5 \
+topopt-cubes: stages $(OUT)/topopt/cubes.md
+topopt-gripper-check: stages $(TOPOPT_DIR)/gripper3d.verify.h5 $(TOPOPT_DIR)/gripper3d.h4.verify.h5 \
     $(TOPOPT_DIR)/gripper3d.solid.verify.h5
-topopt-bridge-check: build $(TOPOPT_DIR)/bridge_cubic.verify.h5 $(TOPOPT_DIR)/bridge_cubic.h4.verify.h5 \
+topopt-bridge-check: stages $(TOPOPT_DIR)/bridge_cubic.verify.h5 $(TOPOPT_DIR)/bridge_cubic.h4.verify.h5 \
     $(TOPOPT_DIR)/bridge_cubic.solid.verify.h5
-topopt-cantilever-check: build $(TOPOPT_DIR)/cantilever_cubic.verify.h5 $(TOPOPT_DIR)/cantilever_cubic.h4.verify.h5 \
+topopt-cantilever-check: stages $(TOPOPT_DIR)/cantilever_cubic.verify.h5 $(TOPOPT_DIR)/cantilever_cubic.h4.verify.h5 \
     $(TOPOPT_DIR)/cantilever_cubic.solid.verify.h5
 topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check
-topopt-bridge-large: build $(OUT)/topopt/bridge_cubic_large.design.h5
-topopt-bridge-huge: build $(HUGE_DIR)/bridge320.mapped.h5
+topopt-bridge-large: stages $(OUT)/topopt/bridge_cubic_large.design.h5
+topopt-bridge-huge: stages $(HUGE_DIR)/bridge320.mapped.h5
