@@ -294,6 +294,7 @@ Scene read_scene(const Config& config) {
     o.linear_solver = c.get_or<std::string>("linear_solver", o.linear_solver);
     o.linear.pcg_tolerance = c.get_or<double>("pcg_tolerance", o.linear.pcg_tolerance);
     o.linear.pcg_max_iterations = c.get_or<int>("pcg_max_iterations", o.linear.pcg_max_iterations);
+    o.linear.pcg_max_iterations_key = c.key_path("pcg_max_iterations");
     o.linear.pcg_preconditioner = c.get_or<std::string>("pcg_preconditioner", o.linear.pcg_preconditioner);
     auto names = linear_solver_names();
     names.insert(names.begin(), "auto");

@@ -90,7 +90,8 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
       fail(settings.label + " did not converge: relative residual " +
            format_number(r_norm / b_norm) + " after " + std::to_string(iteration) +
            " iterations (tolerance " + format_number(settings.tolerance) +
-           ", pcg_max_iterations " + std::to_string(max_iterations) +
+           ", iteration limit " + std::to_string(max_iterations) +
+           (settings.max_iterations_key.empty() ? std::string() : " set by " + settings.max_iterations_key) +
            "); relative residual every " + std::to_string(history_stride) +
            " iterations: " + history);
     }

@@ -37,6 +37,9 @@ struct CgPreconditioner {
 struct CgSettings {
   double tolerance = 1e-8;  // stop when ||b - (A + shift I) x|| <= tolerance ||b||
   int max_iterations = 10000;
+  // The config key that sets max_iterations, named when it is reached
+  // (empty: an internal limit, no key to raise).
+  std::string max_iterations_key;
   int threads = 0;  // as in LinearSolverOptions::threads
   // Names the method in messages: "<label> did not converge: ...".
   std::string label;

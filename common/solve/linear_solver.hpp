@@ -13,6 +13,9 @@ struct LinearSolverOptions {
   // PCG stops when ||b - (A + shift I) x|| <= pcg_tolerance * ||b||.
   double pcg_tolerance = 1e-8;
   int pcg_max_iterations = 10000;
+  // The config key pcg_max_iterations was read from, for messages (empty:
+  // not configurable where this solver runs).
+  std::string pcg_max_iterations_key;
   // "jacobi" (diagonal) or "block-jacobi3" (3x3 diagonal blocks, one per
   // mesh node with 3 displacement unknowns; needs n divisible by 3).
   std::string pcg_preconditioner = "jacobi";

@@ -209,6 +209,7 @@ VecX MultigridSolver::solve(const VecX& b) {
   CgSettings settings;
   settings.tolerance = options_.pcg_tolerance;
   settings.max_iterations = options_.pcg_max_iterations;
+  settings.max_iterations_key = options_.pcg_max_iterations_key;
   settings.threads = threads;
   settings.label = "pcg-mg";
   settings.curvature_label = "pcg-mg";

@@ -189,6 +189,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       constrain_matrix(K, fixed, diag);
       double shift = 0;
       bool ok = false;
+      std::string last_linear_error;
       for (int attempt = 0; attempt < 12 && !ok; ++attempt) {
         if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
         if (!solver->factorize(K, shift)) continue;
@@ -198,6 +199,7 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
         } catch (const NumericalError& e) {
           // An iterative solver meets indefiniteness only while solving.
           spdlog::debug("linear solve failed with shift {:.2e}: {}", shift, e.what());
+          last_linear_error = e.what();
           continue;
         }
         if (!dx.allFinite()) continue;
@@ -214,6 +216,9 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       if (!ok) {
         add_record(rec);
         why = "the Newton system could not be solved even with regularization";
+        // A shift does not help an iterative solver that ran out of
+        // iterations: say what it reported (e.g. the key of its limit).
+        if (!last_linear_error.empty()) why += "; the linear solver reported: " + last_linear_error;
         return false;
       }
 

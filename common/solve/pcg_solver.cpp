@@ -147,6 +147,7 @@ VecX PcgSolver::solve(const VecX& b) {
   CgSettings settings;
   settings.tolerance = options_.pcg_tolerance;
   settings.max_iterations = options_.pcg_max_iterations;
+  settings.max_iterations_key = options_.pcg_max_iterations_key;
   settings.threads = threads;
   settings.label = "PCG (" + options_.pcg_preconditioner + ")";
   settings.curvature_label = "PCG";

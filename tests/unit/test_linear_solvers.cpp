@@ -301,9 +301,25 @@ TEST(LinearSolverPcg, ThrowsWhenMaxIterationsTooSmall) {
     const std::string message = error.what();
     EXPECT_NE(message.find("5 iterations"), std::string::npos) << message;
     EXPECT_NE(message.find("relative residual"), std::string::npos) << message;
+    // No config key set this limit: none is named.
+    EXPECT_NE(message.find("iteration limit 5)"), std::string::npos) << message;
+    EXPECT_EQ(message.find("pcg_max_iterations"), std::string::npos) << message;
   }
   EXPECT_EQ(solver->stats().iterations, 5);
   EXPECT_GT(solver->stats().relative_residual, 1e-8);
+  // Read from a config: the message names the key to raise.
+  options.pcg_max_iterations_key = "scene.yaml: solver.pcg_max_iterations";
+  auto keyed = make_linear_solver("pcg", options);
+  keyed->analyze(A);
+  ASSERT_TRUE(keyed->factorize(A));
+  try {
+    keyed->solve(b);
+    FAIL() << "PCG converged in 5 iterations";
+  } catch (const NumericalError& error) {
+    EXPECT_NE(std::string(error.what()).find("iteration limit 5 set by scene.yaml: solver.pcg_max_iterations"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 TEST(LinearSolver, EmptySystemSolvesToEmptyVector) {
