@@ -68,6 +68,24 @@ void run_patch_test(const MaterialPtr& mat, double amplitude) {
   EXPECT_LT((uc - (A * Xc + b)).norm(), 1e-10 * (A * Xc + b).norm()) << "interior node off the linear field";
 }
 
+// A 2 cm Neo-Hookean cube of 2 x 2 x 2 hexahedra held between two plates,
+// the upper one pressed down by `press` metres.
+struct CubeBetweenPlates {
+  VoxelMesh mesh;
+  ElasticAssembler assembler;
+  DirichletConditions dirichlet;
+  explicit CubeBetweenPlates(double press)
+      : mesh(build_voxel_mesh(VoxelGrid(2, 2, 2, 0.01, 1), {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)})),
+        assembler(mesh.mesh),
+        dirichlet(DirichletConditions::none(mesh.mesh.num_dofs())) {
+    for (int n = 0; n < mesh.mesh.num_nodes(); ++n) {
+      const double z = mesh.mesh.nodes(n, 2);
+      if (z == 0 || z == 0.02) dirichlet.fixed[3 * n] = dirichlet.fixed[3 * n + 1] = dirichlet.fixed[3 * n + 2] = 1;
+      if (z == 0.02) dirichlet.displacement[3 * n + 2] = -press;
+    }
+  }
+};
+
 }  // namespace
 
 TEST(Newton, PatchTestLinearMaterialIrregularMesh) {
@@ -282,15 +300,10 @@ TEST(NewtonHardCases, NeoHookeanCubeCompressedFiftyPercent) {
 TEST(NewtonHardCases, NonConvergenceIsReportedWithHistory) {
   // Two Newton iterations cannot reach 1e-12 on a 50% compression: the
   // solver must stop cleanly with a reason and a finite history.
-  VoxelGrid grid(2, 2, 2, 0.01, 1);
-  const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)});
-  ElasticAssembler asmb(vm.mesh);
-  auto DC = DirichletConditions::none(vm.mesh.num_dofs());
-  for (int n = 0; n < vm.mesh.num_nodes(); ++n) {
-    const double z = vm.mesh.nodes(n, 2);
-    if (z == 0 || z == 0.02) DC.fixed[3 * n] = DC.fixed[3 * n + 1] = DC.fixed[3 * n + 2] = 1;
-    if (z == 0.02) DC.displacement[3 * n + 2] = -0.01;
-  }
+  const CubeBetweenPlates cube(0.01);
+  const ElasticAssembler& asmb = cube.assembler;
+  const DirichletConditions& DC = cube.dirichlet;
+  const VoxelMesh& vm = cube.mesh;
   NewtonOptions opt;
   opt.max_iterations = 2;
   opt.max_step_halvings = 1;
@@ -307,15 +320,10 @@ TEST(Newton, IterationHookSeesEveryHistoryRecordAsItIsAdded) {
   // A compression in one load step, which must be halved: the hook
   // gets exactly the records the history ends with, in order, converged,
   // failed and halved increments alike.
-  VoxelGrid grid(2, 2, 2, 0.01, 1);
-  const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.45)});
-  ElasticAssembler asmb(vm.mesh);
-  auto DC = DirichletConditions::none(vm.mesh.num_dofs());
-  for (int n = 0; n < vm.mesh.num_nodes(); ++n) {
-    const double z = vm.mesh.nodes(n, 2);
-    if (z == 0 || z == 0.02) DC.fixed[3 * n] = DC.fixed[3 * n + 1] = DC.fixed[3 * n + 2] = 1;
-    if (z == 0.02) DC.displacement[3 * n + 2] = -0.008;
-  }
+  const CubeBetweenPlates cube(0.008);
+  const ElasticAssembler& asmb = cube.assembler;
+  const DirichletConditions& DC = cube.dirichlet;
+  const VoxelMesh& vm = cube.mesh;
   NewtonOptions opt;
   opt.max_iterations = 3;  // too few for the whole load at once: increments are halved
   std::vector<NewtonIteration> seen;
