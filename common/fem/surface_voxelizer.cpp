@@ -57,12 +57,11 @@ TriangleSurface merge_equal_vertices(const TriangleSurface& surface) {
 }
 
 SurfaceClosure check_closure(const TriangleSurface& surface) {
-  const TriangleSurface merged = merge_equal_vertices(surface);
   SurfaceClosure result;
   // Net count of each undirected edge's traversals: +1 for (a, b) with a < b,
   // -1 for (b, a). A closed, consistently oriented surface nets zero on each.
   std::map<std::pair<int, int>, int> net;
-  for (const auto& t : merged.triangles) {
+  for (const auto& t : surface.triangles) {
     if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
       ++result.degenerate_triangles;
       continue;

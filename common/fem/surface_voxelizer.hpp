@@ -35,7 +35,8 @@ TriangleSurface merge_equal_vertices(const TriangleSurface& surface);
 // How far a surface is from bounding a volume. Every directed edge (a, b)
 // of a triangle must be matched by a reverse edge (b, a) of another: then
 // the surface is a closed, consistently oriented 2-cycle and the winding
-// number is the same along any ray. Counted after merge_equal_vertices.
+// number is the same along any ray. Edges are compared by vertex index, so
+// a surface read from STL needs merge_equal_vertices first.
 struct SurfaceClosure {
   long long unmatched_edges = 0;      // directed edges without a reverse partner
   long long degenerate_triangles = 0; // triangles with a repeated vertex (ignored)

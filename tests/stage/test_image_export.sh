@@ -8,7 +8,7 @@
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 PY=/usr/bin/python3
-export PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1
+export PYTHONPATH="$SRC/python:$SRC/tests/stage" PYTHONDONTWRITEBYTECODE=1
 tiny_cubic3d_set 1
 cat > "$WORK/bar.yaml" <<Y
 grid: {size: [4, 2, 2], cell_size: 0.002}
@@ -37,12 +37,7 @@ import h5py
 import numpy as np
 import msfab
 from msfab.image import unpack_voxels
-ok = True
-def expect(what, condition):
-    global ok
-    if not condition:
-        print("FAIL:", what)
-        ok = False
+from expectations import expect, finish
 with h5py.File("set.microstructures.h5") as f:
     size = tuple(int(v) for v in f["/size"])
     names = f.attrs["property_names"]
@@ -87,7 +82,7 @@ with h5py.File("bar.verify.h5") as f:
     found = [name for name in chk if name.startswith("displacement_full_")]
     expect("one field per load case", len(found) == full.shape[0])
     expect("full-resolution displacement", np.array_equal(chk[found[0]], full[0]))
-sys.exit(0 if ok else 1)
+finish()
 PY
 # The report draws the mapping's property gaps and tables the check.
 check "the report draws the mapping and the check" -- "$PY" -c "

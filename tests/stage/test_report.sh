@@ -7,7 +7,7 @@
 BIN=$1 SRC=$2
 source "$SRC/tests/stage/lib.sh"
 PY=/usr/bin/python3
-export PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1
+export PYTHONPATH="$SRC/python:$SRC/tests/stage" PYTHONDONTWRITEBYTECODE=1
 cd "$WORK"
 mkdir art
 "$BIN/msfab-simulate" --quiet --out art/fine.h5 > /dev/null
@@ -30,12 +30,7 @@ import h5py
 import matplotlib.image
 import numpy as np
 data = json.load(open("report_files/data.json"))
-ok = True
-def expect(what, condition):
-    global ok
-    if not condition:
-        print("FAIL:", what)
-        ok = False
+from expectations import expect, finish
 for name in data:
     image = matplotlib.image.imread("report_files/" + name)
     expect(f"{name} is a picture", image.ndim == 3 and image.shape[0] > 200 and image.shape[1] > 300)
@@ -62,7 +57,7 @@ with h5py.File("art/design.h5") as f:
 gamut = data[next(n for n in data if "gamut" in n)]
 with h5py.File("art/tiny.microstructures.h5") as f:
     expect("every structure drawn", gamut["structures"] == len(f["/unit_properties"]))
-sys.exit(0 if ok else 1)
+finish()
 PY
 expect_exit 2 "error" -- "$PY" -m msfab report report.html nowhere
 finish
