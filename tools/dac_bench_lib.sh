@@ -39,6 +39,21 @@ frequency_errors() {
     END { printf "%-28s mean %.1f%%, max %.1f%% over %d modes\n", l, 100 * se / n, 100 * me, n }'
 }
 
+# convergence SCENE MATERIAL LEVELS [MODES]: modes of SCENE at its voxel
+# size and LEVELS halvings of it (msfab-dac-calibrate's search), the
+# converged frequencies of the first MODES (default 4) modes by Richardson
+# extrapolation, each level's error against them, and the accurate mesh
+# (thesis Fig. 4-11: within 5% of the converged values). Sets ACCURATE to
+# its voxel size (empty when no level is accurate).
+convergence() {
+  printf 'scene: %s\nmaterial: %s\ntarget: {frequency: 100.0, decay: 0.0}\nmodes: %s\nsearch_levels: %s\n' \
+    "$1" "$2" "${4:-4}" "$3" > convergence.yaml
+  "$BIN/msfab-dac-calibrate" --config convergence.yaml --out convergence.h5 > convergence.txt 2> convergence.log
+  grep -o "level [0-9]*: .*" convergence.log || true
+  grep -E "converged frequencies|accurate mesh" convergence.txt
+  ACCURATE=$(awk '/accurate mesh: level/ { for (i = 1; i <= NF; ++i) if ($i == "voxel") print $(i + 1) }' convergence.txt)
+}
+
 # timed_run NAME SCENE ARGS...: msfab-dynamics with peak memory; prints
 # time per elastic step, total time and memory.
 timed_run() {

@@ -120,6 +120,126 @@ QuadratureMaterials fit_materials(const CoarseMaterialFit& fit) {
   return q;
 }
 
+// Sample weights: kind weight / samples of that kind in the same split,
+// normalized per split, so the data term is a weighted mean squared
+// relative error.
+std::vector<double> sample_weights(const std::vector<ForceKind>& kind, const std::vector<char>& held,
+                                   const std::array<double, 5>& kind_weight, bool balance_kinds) {
+  const int ns = static_cast<int>(kind.size());
+  std::vector<double> weight(ns, 0.0);
+  for (int split = 0; split < 2; ++split) {
+    std::array<int, 5> count{};
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split) ++count[int(kind[s])];
+    double total = 0;
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split) {
+        weight[s] = kind_weight[int(kind[s])] / (balance_kinds ? count[int(kind[s])] : 1);
+        total += weight[s];
+      }
+    for (int s = 0; s < ns; ++s)
+      if (held[s] == split && total > 0) weight[s] /= total;
+  }
+  return weight;
+}
+
+// The fitted model's energies against the samples': the weighted RMS
+// relative error of the training and the held-out samples, and the
+// held-out energy error (sum of |differences| over sum of energies).
+void record_fit_errors(const std::vector<CoarseEnergyBasis>& basis, const std::vector<double>& V0,
+                       const std::vector<char>& held, const std::vector<double>& weight, CoarseMaterialFit& fit) {
+  const int ns = static_cast<int>(V0.size());
+  const int points = static_cast<int>(fit.mu.size());
+  std::vector<double> rel_train, rel_held, w_train, w_held;
+  double abs_held = 0, sum_held = 0;
+  for (int s = 0; s < ns; ++s) {
+    double V1 = fit.mu_centre * basis[s].a_centre + fit.lambda_centre * basis[s].b_centre;
+    for (int k = 0; k < points; ++k)
+      V1 += fit.mu[k] * basis[s].a[k] + fit.lambda[k] * basis[s].b[k] + fit.C[k] * basis[s].s[k];
+    (held[s] ? rel_held : rel_train).push_back((V1 - V0[s]) / V0[s]);
+    (held[s] ? w_held : w_train).push_back(weight[s]);
+    if (held[s]) {
+      abs_held += std::abs(V1 - V0[s]);
+      sum_held += V0[s];
+    }
+  }
+  fit.residual = weighted_rms(rel_train, w_train);
+  fit.heldout_error = weighted_rms(rel_held, w_held);
+  fit.heldout_energy_error = sum_held > 0 ? abs_held / sum_held : 0.0;
+}
+
+// The samples the coarse element can represent (not inverted, positive
+// energy), with their energy bases at zero bubble amplitudes.
+struct FitSamples {
+  std::vector<CoarseEnergyBasis> basis;
+  std::vector<double> V0;             // fine energies
+  std::vector<ForceKind> kind;
+  std::vector<const Vec24*> corners;  // coarse corner displacements, in `set`
+};
+FitSamples usable_samples(const ForceSampleSet& set, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
+                          CoarseMaterialFit& fit) {
+  FitSamples out;
+  for (const ForceSample& s : set.samples) {
+    CoarseEnergyBasis e;
+    if (!coarse_energy_basis(coarse, X, s.corner_displacement, fit.v, e) || !(s.energy > 0.0)) {
+      ++fit.samples_coarse_inverted;
+      continue;
+    }
+    out.basis.push_back(e);
+    out.V0.push_back(s.energy);
+    out.kind.push_back(set.patterns[s.pattern].kind);
+    out.corners.push_back(&s.corner_displacement);
+  }
+  return out;
+}
+
+// The NNLS unknowns: mu, lambda (and C) per point, then the centre
+// point's mu and lambda if fitted; each column's scale and the scaled
+// regularization target p^0 / scale.
+struct ParameterColumns {
+  int per_point = 2, centre = 0, count = 0;  // centre: mu_c's column, then lambda_c's
+  VecX scale, target;
+};
+ParameterColumns parameter_columns(const CoarseMaterialFit& fit, const CoarseFitOptions& options) {
+  const int points = static_cast<int>(fit.mu0.size());
+  ParameterColumns c;
+  c.per_point = options.anisotropic ? 3 : 2;
+  c.centre = points * c.per_point;
+  c.count = c.centre + (options.centre_point ? 2 : 0);
+  const int per_point = c.per_point, centre = c.centre, np = c.count;
+  // Unknowns per point: mu, lambda (and C). Columns are scaled by the
+  // block's volume-averaged fine parameters (mean mu for mu and C, mean
+  // lambda for lambda), so scaled unknowns are O(1) and the regularizer of
+  // Eq. 2.9 measures every deviation in the same units. A per-point scale
+  // would forbid a soft point from stiffening, yet in a layered block the
+  // soft children's points must carry the stiff layer's in-plane stiffness.
+  double mu_mean = 0, lambda_mean = 0;
+  for (int k = 0; k < points; ++k) mu_mean += fit.mu0[k] / points, lambda_mean += fit.lambda0[k] / points;
+  if (!(lambda_mean > 1e-6 * mu_mean)) lambda_mean = mu_mean;
+  VecX& scale = c.scale;
+  VecX& target = c.target;
+  scale.resize(np);
+  target.resize(np);
+  for (int k = 0; k < points; ++k) {
+    scale[per_point * k] = mu_mean;
+    target[per_point * k] = fit.mu0[k] / mu_mean;
+    scale[per_point * k + 1] = lambda_mean;
+    target[per_point * k + 1] = fit.lambda0[k] / lambda_mean;
+    if (options.anisotropic) {
+      scale[per_point * k + 2] = mu_mean;
+      target[per_point * k + 2] = 0.0;
+    }
+  }
+  // The centre starts from nothing: the fine block's material is at the
+  // Gauss points (p^0), and the data move stiffness to the centre where
+  // bending samples ask for it.
+  if (options.centre_point) {
+    scale[centre] = mu_mean, target[centre] = 0.0;
+    scale[centre + 1] = lambda_mean, target[centre + 1] = 0.0;
+  }
+  return c;
+}
+
 }  // namespace
 
 double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
@@ -182,21 +302,11 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   const hex8::NodeMatrix X = block.coarse_rest_positions();
   const hex8::ElementGeometry coarse = coarse_fit_geometry(X, points, options.enhanced_element);
   fit.enhanced = options.enhanced_element;
-  std::vector<CoarseEnergyBasis> basis;
-  std::vector<double> V0;
-  std::vector<ForceKind> kind;
-  std::vector<const Vec24*> corners;
-  for (const ForceSample& s : set.samples) {
-    CoarseEnergyBasis e;
-    if (!coarse_energy_basis(coarse, X, s.corner_displacement, fit.v, e) || !(s.energy > 0.0)) {
-      ++fit.samples_coarse_inverted;
-      continue;
-    }
-    basis.push_back(e);
-    V0.push_back(s.energy);
-    kind.push_back(set.patterns[s.pattern].kind);
-    corners.push_back(&s.corner_displacement);
-  }
+  FitSamples samples = usable_samples(set, coarse, X, fit);
+  std::vector<CoarseEnergyBasis>& basis = samples.basis;
+  const std::vector<double>& V0 = samples.V0;
+  const std::vector<ForceKind>& kind = samples.kind;
+  const std::vector<const Vec24*>& corners = samples.corners;
   // Enhanced element: the basis at the bubble amplitudes that the current
   // parameters choose, sample by sample (a sample whose condensed state
   // cannot be evaluated keeps its previous amplitudes).
@@ -224,36 +334,10 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     return fit;
   }
 
-  // Unknowns per point: mu, lambda (and C). Columns are scaled by the
-  // block's volume-averaged fine parameters (mean mu for mu and C, mean
-  // lambda for lambda), so scaled unknowns are O(1) and the regularizer of
-  // Eq. 2.9 measures every deviation in the same units. A per-point scale
-  // would forbid a soft point from stiffening, yet in a layered block the
-  // soft children's points must carry the stiff layer's in-plane stiffness.
-  const int per_point = options.anisotropic ? 3 : 2;
-  const int centre = points * per_point;  // mu_c's column, then lambda_c's, if fitted
-  const int np = centre + (options.centre_point ? 2 : 0);
-  double mu_mean = 0, lambda_mean = 0;
-  for (int k = 0; k < points; ++k) mu_mean += fit.mu0[k] / points, lambda_mean += fit.lambda0[k] / points;
-  if (!(lambda_mean > 1e-6 * mu_mean)) lambda_mean = mu_mean;
-  VecX scale(np), target(np);
-  for (int k = 0; k < points; ++k) {
-    scale[per_point * k] = mu_mean;
-    target[per_point * k] = fit.mu0[k] / mu_mean;
-    scale[per_point * k + 1] = lambda_mean;
-    target[per_point * k + 1] = fit.lambda0[k] / lambda_mean;
-    if (options.anisotropic) {
-      scale[per_point * k + 2] = mu_mean;
-      target[per_point * k + 2] = 0.0;
-    }
-  }
-  // The centre starts from nothing: the fine block's material is at the
-  // Gauss points (p^0), and the data move stiffness to the centre where
-  // bending samples ask for it.
-  if (options.centre_point) {
-    scale[centre] = mu_mean, target[centre] = 0.0;
-    scale[centre + 1] = lambda_mean, target[centre + 1] = 0.0;
-  }
+  const ParameterColumns columns = parameter_columns(fit, options);
+  const int per_point = columns.per_point, centre = columns.centre, np = columns.count;
+  const VecX& scale = columns.scale;
+  const VecX& target = columns.target;
   // Sample weights: kind weight / samples of that kind in the same split,
   // normalized per split, so the data term is a weighted mean squared
   // relative error.
@@ -264,20 +348,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
                                    [&](int id) { return id != 0 && id == block.material_ids[0]; });
   if (options.mixed_blocks_affine_only && !uniform)
     for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) kind_weight[int(k)] = 0.0;
-  std::vector<double> weight(ns, 0.0);
-  for (int split = 0; split < 2; ++split) {
-    std::array<int, 5> count{};
-    for (int s = 0; s < ns; ++s)
-      if (held[s] == split) ++count[int(kind[s])];
-    double total = 0;
-    for (int s = 0; s < ns; ++s)
-      if (held[s] == split) {
-        weight[s] = kind_weight[int(kind[s])] / (options.balance_kinds ? count[int(kind[s])] : 1);
-        total += weight[s];
-      }
-    for (int s = 0; s < ns; ++s)
-      if (held[s] == split && total > 0) weight[s] /= total;
-  }
+  const std::vector<double> weight = sample_weights(kind, held, kind_weight, options.balance_kinds);
 
   // Rows: each training sample's residual relative to its own energy (or to
   // the block's RMS training energy for the absolute residual), times
@@ -381,22 +452,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     return fit;
   }
 
-  std::vector<double> rel_train, rel_held, w_train, w_held;
-  double abs_held = 0, sum_held = 0;
-  for (int s = 0; s < ns; ++s) {
-    double V1 = fit.mu_centre * basis[s].a_centre + fit.lambda_centre * basis[s].b_centre;
-    for (int k = 0; k < points; ++k)
-      V1 += fit.mu[k] * basis[s].a[k] + fit.lambda[k] * basis[s].b[k] + fit.C[k] * basis[s].s[k];
-    (held[s] ? rel_held : rel_train).push_back((V1 - V0[s]) / V0[s]);
-    (held[s] ? w_held : w_train).push_back(weight[s]);
-    if (held[s]) {
-      abs_held += std::abs(V1 - V0[s]);
-      sum_held += V0[s];
-    }
-  }
-  fit.residual = weighted_rms(rel_train, w_train);
-  fit.heldout_error = weighted_rms(rel_held, w_held);
-  fit.heldout_energy_error = sum_held > 0 ? abs_held / sum_held : 0.0;
+  record_fit_errors(basis, V0, held, weight, fit);
   fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return fit;
 }

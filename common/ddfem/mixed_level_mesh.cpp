@@ -35,12 +35,9 @@ struct ElementBox {
   int size;
 };
 
-}  // namespace
-
-MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
-                                      const CoarseGrid& level1, const CoarseGrid& level2,
-                                      const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
-                                      const CoarseMaterialLookup& level2_materials, bool enhanced_modes) {
+void check_mixed_level_inputs(const VoxelGrid& fine, const CoarseGrid& level1, const CoarseGrid& level2,
+                              const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
+                              const CoarseMaterialLookup& level2_materials) {
   if (level1.level != 1 || level2.level != 2 || level1.fine_nx != fine.nx || level1.fine_ny != fine.ny ||
       level1.fine_nz != fine.nz || level2.fine_nx != fine.nx || level2.fine_ny != fine.ny || level2.fine_nz != fine.nz)
     throw InputError("mixed-level mesh: the level-1 and level-2 grids were not built from this voxel grid");
@@ -51,25 +48,23 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
     if (l < 0 || l > 2) throw InputError("mixed-level mesh: a cell level must be 0, 1 or 2, got " + std::to_string(l));
   if (!level1_materials || !level2_materials) throw InputError("mixed-level mesh: a material lookup is missing");
 
-  MixedLevelMesh m;
-  HexMesh& mesh = m.mesh;
-  m.lattice = {kCellSize * level2.nx + 1, kCellSize * level2.ny + 1, kCellSize * level2.nz + 1};
-  const LatticeIndex lattice{m.lattice};
-  std::vector<int> lattice_node(size_t(m.lattice[0]) * m.lattice[1] * m.lattice[2], -1);
-  std::vector<ElementBox> boxes;
-  m.voxel_element.assign(fine.size(), -1);
+}
 
-  // Geometries per (level, rule), told apart by an element's number of
-  // materials as in build_coarse_mesh: the Gauss rule (or one material for
-  // all points), the Gauss rule and the centre, or 8 points per fine voxel
-  // (the Galerkin element). Coarse elements carry the bubble modes when
-  // asked; fine voxels are always trilinear (they are the reference model).
-  enum Rule { kGauss, kGaussCentre, kComposite };
-  const double h = fine.voxel_size;
-  std::map<std::pair<int, Rule>, int> geometry_slot;
-  auto geometry = [&](int level, Rule rule) {
-    auto it = geometry_slot.find({level, rule});
-    if (it != geometry_slot.end()) return it->second;
+// Geometries per (level, rule), told apart by an element's number of
+// materials as in build_coarse_mesh: the Gauss rule (or one material for
+// all points), the Gauss rule and the centre, or 8 points per fine voxel
+// (the Galerkin element). Coarse elements carry the bubble modes when
+// asked; fine voxels are always trilinear (they are the reference model).
+enum Rule { kGauss, kGaussCentre, kComposite };
+struct GeometrySlots {
+  double h;
+  bool enhanced_modes;
+  HexMesh& mesh;
+  std::map<std::pair<int, Rule>, int> slot = {};
+  // The mesh's geometry index for (level, rule), added on first use.
+  int operator()(int level, Rule rule) {
+    auto it = slot.find({level, rule});
+    if (it != slot.end()) return it->second;
     const int size = 1 << level;
     hex8::NodeMatrix cube;
     for (int c = 0; c < 8; ++c) cube.row(c) = size * h * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
@@ -79,10 +74,98 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
                                                             : hex8::element_geometry(cube, quadrature);
     if (rule == kGaussCentre) geo = hex8::with_centre_point(geo, cube);
     mesh.geometries.push_back(std::move(geo));
-    const int slot = static_cast<int>(mesh.geometries.size()) - 1;
-    geometry_slot.emplace(std::make_pair(level, rule), slot);
-    return slot;
+    const int index = static_cast<int>(mesh.geometries.size()) - 1;
+    slot.emplace(std::make_pair(level, rule), index);
+    return index;
+  }
+};
+
+// Hanging nodes: mesh nodes on the boundary of a larger element other than
+// its corners, each interpolated in the largest such element (the first in
+// element order among equals; elements sharing the face or edge agree).
+// Fills m's unknown nodes and hanging-node count and returns the map from
+// the unknowns to every mesh node.
+std::shared_ptr<NodeConstraints> hanging_node_constraints(const std::vector<ElementBox>& boxes,
+                                                          const std::vector<int>& lattice_node,
+                                                          const LatticeIndex& lattice, MixedLevelMesh& m) {
+  const HexMesh& mesh = m.mesh;
+  const int num_nodes = mesh.num_nodes();
+  std::vector<int> master(num_nodes, -1);
+  for (int e = 0; e < mesh.num_elements(); ++e) {
+    const ElementBox& b = boxes[e];
+    if (b.size == 1) continue;
+    for (int dk = 0; dk <= b.size; ++dk)
+      for (int dj = 0; dj <= b.size; ++dj)
+        for (int di = 0; di <= b.size; ++di) {
+          const bool on_boundary = di == 0 || dj == 0 || dk == 0 || di == b.size || dj == b.size || dk == b.size;
+          const bool corner = (di % b.size == 0) && (dj % b.size == 0) && (dk % b.size == 0);
+          if (!on_boundary || corner) continue;
+          const int node = lattice_node[lattice(b.corner[0] + di, b.corner[1] + dj, b.corner[2] + dk)];
+          if (node < 0) continue;
+          if (master[node] < 0 || boxes[master[node]].size < b.size) master[node] = e;
+        }
+  }
+  // Unknown nodes in mesh-node order; hanging nodes expanded recursively
+  // (corners of a larger element can only hang on a still larger one).
+  std::vector<int> unknown_of(num_nodes, -1);
+  for (int n = 0; n < num_nodes; ++n)
+    if (master[n] < 0) {
+      unknown_of[n] = static_cast<int>(m.unknown_node.size());
+      m.unknown_node.push_back(n);
+    }
+  m.hanging_nodes = num_nodes - m.num_unknown_nodes();
+  std::vector<std::vector<std::pair<int, double>>> expansion(num_nodes);
+  std::vector<char> expanded(num_nodes, 0);
+  std::function<const std::vector<std::pair<int, double>>&(int)> expand = [&](int n) -> const auto& {
+    if (expanded[n]) return expansion[n];
+    std::map<int, double> acc;
+    if (master[n] < 0) {
+      acc[unknown_of[n]] = 1.0;
+    } else {
+      const ElementBox& b = boxes[master[n]];
+      const auto a = lattice.coords(m.node_lattice[n]);
+      const double t[3] = {double(a[0] - b.corner[0]) / b.size, double(a[1] - b.corner[1]) / b.size,
+                           double(a[2] - b.corner[2]) / b.size};
+      for (int c = 0; c < 8; ++c) {
+        const double w = corner_weight(c, t);
+        if (w == 0) continue;
+        for (const auto& [u, wu] : expand(mesh.elements[master[n]][c])) acc[u] += w * wu;
+      }
+    }
+    expansion[n].assign(acc.begin(), acc.end());
+    expanded[n] = 1;
+    return expansion[n];
   };
+  std::vector<Triplet> trip;
+  trip.reserve(size_t(num_nodes) + 8 * size_t(m.hanging_nodes));
+  for (int n = 0; n < num_nodes; ++n)
+    for (const auto& [u, w] : expand(n)) trip.emplace_back(n, u, w);
+  auto constraints = std::make_shared<NodeConstraints>();
+  constraints->node_map.resize(num_nodes, m.num_unknown_nodes());
+  constraints->node_map.setFromTriplets(trip.begin(), trip.end());
+  constraints->node_map.makeCompressed();
+  constraints->unknown_rest.resize(m.num_unknown_nodes(), 3);
+  for (int u = 0; u < m.num_unknown_nodes(); ++u) constraints->unknown_rest.row(u) = mesh.nodes.row(m.unknown_node[u]);
+  return constraints;
+}
+
+}  // namespace
+
+MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
+                                      const CoarseGrid& level1, const CoarseGrid& level2,
+                                      const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
+                                      const CoarseMaterialLookup& level2_materials, bool enhanced_modes) {
+  check_mixed_level_inputs(fine, level1, level2, cell_level, level1_materials, level2_materials);
+  MixedLevelMesh m;
+  HexMesh& mesh = m.mesh;
+  m.lattice = {kCellSize * level2.nx + 1, kCellSize * level2.ny + 1, kCellSize * level2.nz + 1};
+  const LatticeIndex lattice{m.lattice};
+  std::vector<int> lattice_node(size_t(m.lattice[0]) * m.lattice[1] * m.lattice[2], -1);
+  std::vector<ElementBox> boxes;
+  m.voxel_element.assign(fine.size(), -1);
+
+  GeometrySlots geometry{fine.voxel_size, enhanced_modes, mesh};
+  const double h = fine.voxel_size;
   std::map<std::pair<int, int>, int> material_slot;  // (level, id or combination) -> materials index
   auto material = [&](int level, int key, const auto& make) {
     auto it = material_slot.find({level, key});
@@ -178,66 +261,7 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
   }
   mesh.colors = greedy_element_coloring(mesh);
 
-  // Hanging nodes: mesh nodes on the boundary of a larger element other than
-  // its corners. Each is interpolated in the largest such element (the first
-  // in element order among equals; elements sharing the face or edge agree).
-  std::vector<int> master(num_nodes, -1);
-  for (int e = 0; e < mesh.num_elements(); ++e) {
-    const ElementBox& b = boxes[e];
-    if (b.size == 1) continue;
-    for (int dk = 0; dk <= b.size; ++dk)
-      for (int dj = 0; dj <= b.size; ++dj)
-        for (int di = 0; di <= b.size; ++di) {
-          const bool on_boundary = di == 0 || dj == 0 || dk == 0 || di == b.size || dj == b.size || dk == b.size;
-          const bool corner = (di % b.size == 0) && (dj % b.size == 0) && (dk % b.size == 0);
-          if (!on_boundary || corner) continue;
-          const int node = lattice_node[lattice(b.corner[0] + di, b.corner[1] + dj, b.corner[2] + dk)];
-          if (node < 0) continue;
-          if (master[node] < 0 || boxes[master[node]].size < b.size) master[node] = e;
-        }
-  }
-  // Unknown nodes in mesh-node order; hanging nodes expanded recursively
-  // (corners of a larger element can only hang on a still larger one).
-  std::vector<int> unknown_of(num_nodes, -1);
-  for (int n = 0; n < num_nodes; ++n)
-    if (master[n] < 0) {
-      unknown_of[n] = static_cast<int>(m.unknown_node.size());
-      m.unknown_node.push_back(n);
-    }
-  m.hanging_nodes = num_nodes - m.num_unknown_nodes();
-  std::vector<std::vector<std::pair<int, double>>> expansion(num_nodes);
-  std::vector<char> expanded(num_nodes, 0);
-  std::function<const std::vector<std::pair<int, double>>&(int)> expand = [&](int n) -> const auto& {
-    if (expanded[n]) return expansion[n];
-    std::map<int, double> acc;
-    if (master[n] < 0) {
-      acc[unknown_of[n]] = 1.0;
-    } else {
-      const ElementBox& b = boxes[master[n]];
-      const auto a = lattice.coords(m.node_lattice[n]);
-      const double t[3] = {double(a[0] - b.corner[0]) / b.size, double(a[1] - b.corner[1]) / b.size,
-                           double(a[2] - b.corner[2]) / b.size};
-      for (int c = 0; c < 8; ++c) {
-        const double w = corner_weight(c, t);
-        if (w == 0) continue;
-        for (const auto& [u, wu] : expand(mesh.elements[master[n]][c])) acc[u] += w * wu;
-      }
-    }
-    expansion[n].assign(acc.begin(), acc.end());
-    expanded[n] = 1;
-    return expansion[n];
-  };
-  std::vector<Triplet> trip;
-  trip.reserve(size_t(num_nodes) + 8 * size_t(m.hanging_nodes));
-  for (int n = 0; n < num_nodes; ++n)
-    for (const auto& [u, w] : expand(n)) trip.emplace_back(n, u, w);
-  auto constraints = std::make_shared<NodeConstraints>();
-  constraints->node_map.resize(num_nodes, m.num_unknown_nodes());
-  constraints->node_map.setFromTriplets(trip.begin(), trip.end());
-  constraints->node_map.makeCompressed();
-  constraints->unknown_rest.resize(m.num_unknown_nodes(), 3);
-  for (int u = 0; u < m.num_unknown_nodes(); ++u) constraints->unknown_rest.row(u) = mesh.nodes.row(m.unknown_node[u]);
-  m.constraints = std::move(constraints);
+  m.constraints = hanging_node_constraints(boxes, lattice_node, lattice, m);
   return m;
 }
 

@@ -5,6 +5,7 @@
 // convergent mesh's mode shapes to a relative Hausdorff tolerance. The
 // frequencies of that coarse mesh are too high (numerical stiffening);
 // dynamics/dac_calibration.hpp (Eq. 4.16-4.18) rescales its Young's modulus.
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -21,9 +22,25 @@ struct DacLevel {
   HexMesh mesh;
   std::vector<double> density;  // per element, kg/m^3
   std::vector<char> fixed;      // per DOF (1 = clamped), or empty for a free body
-  double element_size = 0.0;    // reported only
+  double element_size = 0.0;    // sizes that decrease with the level allow the frequency extrapolation
 };
 using DacLevelBuilder = std::function<DacLevel(int level)>;
+
+// Richardson extrapolation of one mode's frequency over three meshes,
+// coarse to fine, element sizes h[0] > h[1] > h[2]: f(h) ~ f0 + c h^p with
+// the order p observed from the three values (the fixed-point form for
+// unequal refinement ratios of Celik et al., J. Fluids Eng. 130, 2008). It
+// holds only where the sequence is in its asymptotic range, which shows as
+// monotone convergence: both changes of one sign, the finer one smaller.
+// Elsewhere (oscillating or growing changes) no limit can be claimed and
+// the finest value is returned with `monotone` false. InputError unless
+// the sizes decrease and every value is finite.
+struct FrequencyLimit {
+  double limit = 0.0;   // estimated converged frequency
+  double order = 0.0;   // observed order p; 0 when not monotone
+  bool monotone = false;
+};
+FrequencyLimit extrapolate_frequency(const std::array<double, 3>& f, const std::array<double, 3>& h);
 
 struct DacOptions {
   int first_level = 0;
@@ -32,6 +49,9 @@ struct DacOptions {
   double convergence_tolerance = 0.01;  // max relative frequency change between levels
   double shape_tolerance = 0.05;        // max relative Hausdorff distance per mode
   int match_window = 2;                 // see match_modes; extra modes are computed for it
+  // The thesis's "accurate" mesh (§4.3.2, Fig. 4-11): frequencies of the
+  // first num_modes modes within this fraction of their converged values.
+  double accuracy_tolerance = 0.05;
   // Modal solver settings; num_modes is overridden, and rigid modes are
   // always skipped (a mesh without enough clamped DOFs has them).
   ModalOptions modal;
@@ -48,6 +68,10 @@ struct DacLevelReport {
   std::vector<ModeMatch> matches; // mode i -> convergent mode and its relative Hausdorff distance
   double max_distance = 0.0;
   bool within_tolerance = false;  // every distance <= shape_tolerance
+  // Relative distance of the first num_modes frequencies from their
+  // estimated converged values (DacResult::limits): largest and mean.
+  double limit_error = 0.0, mean_limit_error = 0.0;
+  bool accurate = false;  // limit_error <= accuracy_tolerance
 };
 
 struct DacResult {
@@ -56,6 +80,17 @@ struct DacResult {
   int convergent_level = -1;
   int chosen_level = -1;   // coarsest level within the shape tolerance
   size_t chosen_index = 0; // its position in `levels`
+  // Converged frequency of each of the first num_modes modes (of the
+  // reference level, tracked through coarser levels by shape): Richardson
+  // extrapolation over the three finest levels where the mode converges
+  // monotonically there, else the reference level's own frequency. A
+  // convergent level still moves by up to convergence_tolerance, and one
+  // stopped at max_level by more: the extrapolation says by how much.
+  std::vector<FrequencyLimit> limits;
+  // Coarsest level with `accurate`; -1 when none is (the reference level
+  // itself may lie further than accuracy_tolerance from the limits).
+  int accurate_level = -1;
+  size_t accurate_index = 0;  // its position in `levels` (when accurate_level >= 0)
   ModalResult chosen_modes, convergent_modes;
 };
 

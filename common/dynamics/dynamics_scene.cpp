@@ -225,6 +225,106 @@ VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::str
   return coarse;
 }
 
+namespace {
+
+// The `simulation` block: time step and duration, output, contact and
+// impact switches, the Newton tolerance and rigid flight. Friction is on by
+// default where the scene has a friction table.
+void read_simulation_settings(const Config& sim, bool has_friction_table, DynamicsScene& s) {
+  DynamicsModel& model = s.model;
+  s.newmark.time_step = sim.get<double>("time_step");
+  if (!(s.newmark.time_step > 0) || !std::isfinite(s.newmark.time_step))
+    sim.fail("time_step", "must be positive (got " + std::to_string(s.newmark.time_step) + ")");
+  s.duration = sim.require_positive<double>("duration", "simulated time (s)");
+  // A step longer than the run takes no step at all, and a tiny one takes
+  // more steps than any run can finish: both are typos, refused up front.
+  if (s.newmark.time_step > s.duration) {
+    std::ostringstream msg;
+    msg << "is longer than duration (" << s.duration << " s): no step would be taken";
+    sim.fail("time_step", msg.str());
+  }
+  constexpr double kMaxTimeSteps = 1e8;
+  if (s.duration / s.newmark.time_step > kMaxTimeSteps) {
+    std::ostringstream msg;
+    msg << "gives " << s.duration / s.newmark.time_step << " steps over duration " << s.duration
+        << " s; at most " << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
+    sim.fail("time_step", msg.str());
+  }
+  s.output_every = sim.get_or<int>("output_every", 10);
+  if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
+  model.body_contact = sim.get_or<bool>("body_contact", s.body_names.size() > 1);
+  model.contact = sim.get_or<bool>("contact", !model.obstacles.empty() || model.body_contact);
+  model.friction = sim.get_or<bool>("friction", has_friction_table);
+  if (model.contact && model.obstacles.empty() && !model.body_contact)
+    sim.fail("contact", "is on but the scene has no obstacles and body_contact is off");
+  if (model.body_contact && !model.contact) sim.fail("body_contact", "needs contact on");
+  s.newmark.edge_contact = sim.get_or<bool>("edge_contact", s.newmark.edge_contact);
+  model.impact = parse_impact_model(sim.get_or("impact", "bbi"), sim.key_path("impact"));
+  s.newmark.newton_tolerance = sim.get_or<double>("newton_tolerance", s.newmark.newton_tolerance);
+  if (sim.has("rigid_flight")) {
+    const Config r = sim.child("rigid_flight");
+    s.rigid.enabled = r.get_or<bool>("enabled", true);
+    s.rigid.elastic_fraction = r.get_or<double>("elastic_fraction", s.rigid.elastic_fraction);
+    s.rigid.lookahead_steps = r.get_or<int>("lookahead_steps", s.rigid.lookahead_steps);
+    if (!(s.rigid.elastic_fraction > 0)) r.fail("elastic_fraction", "must be positive");
+    if (s.rigid.lookahead_steps < 1) r.fail("lookahead_steps", "must be >= 1");
+    if (s.rigid.enabled && s.body_names.size() > 1)
+      r.fail("enabled", "rigid flight projects the whole mesh to one rigid body; the scene has " +
+                            std::to_string(s.body_names.size()) + " bodies");
+  }
+
+}
+
+// The preload: a static pluck or a press (quasistatic or dynamic).
+void read_preload(const Config& c, DynamicsScene& s) {
+  const DynamicsModel& model = s.model;
+  if (c.has("pluck") && c.has("press")) c.fail("press", "a scene has either a pluck or a press preload, not both");
+  if (c.has("pluck")) {
+    s.preload = Preload::kStaticPluck;
+    s.load = read_region_load(c.child("pluck"));
+    s.preload_steps = c.child("pluck").get_or<int>("steps", s.preload_steps);
+    if (model.fixed.empty()) c.fail("pluck", "needs a clamp (a free body has no static equilibrium)");
+  } else if (c.has("press")) {
+    const Config press = c.child("press");
+    const bool dynamic = press.has("mode") && press.one_of("mode", {"quasistatic", "dynamic"}) == "dynamic";
+    s.preload = dynamic ? Preload::kDynamicPress : Preload::kQuasistaticPress;
+    s.load = read_region_load(press);
+    s.preload_steps = press.get_or<int>("steps", s.preload_steps);
+    s.stop_at_touch = press.get_or<bool>("stop_at_touch", false);
+    s.press_self_contact = press.get_or<bool>("self_contact", false);
+    if (s.press_self_contact && s.stop_at_touch)
+      press.fail("self_contact", "and stop_at_touch exclude each other (with self-contact the press carries the load "
+                                 "on through the parts that touch)");
+    if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
+    if (dynamic) {
+      s.press_ramp_time = press.require_positive<double>("ramp_time", "seconds from zero to the full load");
+      if (s.stop_at_touch) press.fail("stop_at_touch", "belongs to the quasistatic press (mode: quasistatic)");
+      if (s.press_self_contact)
+        press.fail("self_contact", "belongs to the quasistatic press (a dynamic press uses simulation.body_contact)");
+      if (s.rigid.enabled) c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
+    } else if (press.has("ramp_time")) {
+      press.fail("ramp_time", "belongs to mode: dynamic (the quasistatic press steps its load with press.steps)");
+    }
+    if (s.body_names.size() > 1)
+      c.fail("press", "the quasistatic press handles one body; a scene with several bodies preloads with a pluck");
+  }
+}
+
+// Bodies must not start inside an obstacle.
+void check_start_clear_of_obstacles(const Config& c, const DynamicsScene& s) {
+  const int nn = s.model.mesh.num_nodes();
+  const double tolerance = 1e-6 * s.grid.voxel_size;
+  for (int i = 0; i < nn; ++i)
+    for (const Obstacle& o : s.model.obstacles)
+      if (signed_distance(o, s.initial_positions.segment<3>(3 * i), nullptr) < -tolerance)
+        c.fail("placement", "the body starts inside obstacle '" + o.name + "' (node at " +
+                                std::to_string(s.initial_positions(3 * i)) + ", " +
+                                std::to_string(s.initial_positions(3 * i + 1)) + ", " +
+                                std::to_string(s.initial_positions(3 * i + 2)) + ")");
+}
+
+}  // namespace
+
 DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coarsening) {
   DynamicsScene s;
   // Named parameters: expressions become numbers, the mesh is built at the
@@ -311,92 +411,12 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
   model.obstacles = read_obstacles(c);
   model.friction_table = read_friction(c, s.materials);
 
-  const Config sim = c.child("simulation");
-  s.newmark.time_step = sim.get<double>("time_step");
-  if (!(s.newmark.time_step > 0) || !std::isfinite(s.newmark.time_step))
-    sim.fail("time_step", "must be positive (got " + std::to_string(s.newmark.time_step) + ")");
-  s.duration = sim.require_positive<double>("duration", "simulated time (s)");
-  // A step longer than the run takes no step at all, and a tiny one takes
-  // more steps than any run can finish: both are typos, refused up front.
-  if (s.newmark.time_step > s.duration) {
-    std::ostringstream msg;
-    msg << "is longer than duration (" << s.duration << " s): no step would be taken";
-    sim.fail("time_step", msg.str());
-  }
-  constexpr double kMaxTimeSteps = 1e8;
-  if (s.duration / s.newmark.time_step > kMaxTimeSteps) {
-    std::ostringstream msg;
-    msg << "gives " << s.duration / s.newmark.time_step << " steps over duration " << s.duration
-        << " s; at most " << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
-    sim.fail("time_step", msg.str());
-  }
-  s.output_every = sim.get_or<int>("output_every", 10);
-  if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
-  model.body_contact = sim.get_or<bool>("body_contact", s.body_names.size() > 1);
-  model.contact = sim.get_or<bool>("contact", !model.obstacles.empty() || model.body_contact);
-  model.friction = sim.get_or<bool>("friction", c.has("friction"));
-  if (model.contact && model.obstacles.empty() && !model.body_contact)
-    sim.fail("contact", "is on but the scene has no obstacles and body_contact is off");
-  if (model.body_contact && !model.contact) sim.fail("body_contact", "needs contact on");
-  s.newmark.edge_contact = sim.get_or<bool>("edge_contact", s.newmark.edge_contact);
-  model.impact = parse_impact_model(sim.get_or("impact", "bbi"), sim.key_path("impact"));
-  s.newmark.newton_tolerance = sim.get_or<double>("newton_tolerance", s.newmark.newton_tolerance);
-  if (sim.has("rigid_flight")) {
-    const Config r = sim.child("rigid_flight");
-    s.rigid.enabled = r.get_or<bool>("enabled", true);
-    s.rigid.elastic_fraction = r.get_or<double>("elastic_fraction", s.rigid.elastic_fraction);
-    s.rigid.lookahead_steps = r.get_or<int>("lookahead_steps", s.rigid.lookahead_steps);
-    if (!(s.rigid.elastic_fraction > 0)) r.fail("elastic_fraction", "must be positive");
-    if (s.rigid.lookahead_steps < 1) r.fail("lookahead_steps", "must be >= 1");
-    if (s.rigid.enabled && s.body_names.size() > 1)
-      r.fail("enabled", "rigid flight projects the whole mesh to one rigid body; the scene has " +
-                            std::to_string(s.body_names.size()) + " bodies");
-  }
-
-  if (c.has("pluck") && c.has("press")) c.fail("press", "a scene has either a pluck or a press preload, not both");
-  if (c.has("pluck")) {
-    s.preload = Preload::kStaticPluck;
-    s.load = read_region_load(c.child("pluck"));
-    s.preload_steps = c.child("pluck").get_or<int>("steps", s.preload_steps);
-    if (model.fixed.empty()) c.fail("pluck", "needs a clamp (a free body has no static equilibrium)");
-  } else if (c.has("press")) {
-    const Config press = c.child("press");
-    const bool dynamic = press.has("mode") && press.one_of("mode", {"quasistatic", "dynamic"}) == "dynamic";
-    s.preload = dynamic ? Preload::kDynamicPress : Preload::kQuasistaticPress;
-    s.load = read_region_load(press);
-    s.preload_steps = press.get_or<int>("steps", s.preload_steps);
-    s.stop_at_touch = press.get_or<bool>("stop_at_touch", false);
-    s.press_self_contact = press.get_or<bool>("self_contact", false);
-    if (s.press_self_contact && s.stop_at_touch)
-      press.fail("self_contact", "and stop_at_touch exclude each other (with self-contact the press carries the load "
-                                 "on through the parts that touch)");
-    if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
-    if (dynamic) {
-      s.press_ramp_time = press.require_positive<double>("ramp_time", "seconds from zero to the full load");
-      if (s.stop_at_touch) press.fail("stop_at_touch", "belongs to the quasistatic press (mode: quasistatic)");
-      if (s.press_self_contact)
-        press.fail("self_contact", "belongs to the quasistatic press (a dynamic press uses simulation.body_contact)");
-      if (s.rigid.enabled) c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
-    } else if (press.has("ramp_time")) {
-      press.fail("ramp_time", "belongs to mode: dynamic (the quasistatic press steps its load with press.steps)");
-    }
-    if (s.body_names.size() > 1)
-      c.fail("press", "the quasistatic press handles one body; a scene with several bodies preloads with a pluck");
-  }
+  read_simulation_settings(c.child("simulation"), c.has("friction"), s);
+  read_preload(c, s);
   if (s.preload_steps < 1) c.fail(s.preload == Preload::kStaticPluck ? "pluck.steps" : "press.steps", "must be >= 1");
   validate_dynamics_model(model);
 
-  // Bodies must not start inside an obstacle.
-  if (model.contact) {
-    const double tolerance = 1e-6 * s.grid.voxel_size;
-    for (int i = 0; i < nn; ++i)
-      for (const Obstacle& o : model.obstacles)
-        if (signed_distance(o, s.initial_positions.segment<3>(3 * i), nullptr) < -tolerance)
-          c.fail("placement", "the body starts inside obstacle '" + o.name + "' (node at " +
-                                  std::to_string(s.initial_positions(3 * i)) + ", " +
-                                  std::to_string(s.initial_positions(3 * i + 1)) + ", " +
-                                  std::to_string(s.initial_positions(3 * i + 2)) + ")");
-  }
+  if (model.contact) check_start_clear_of_obstacles(c, s);
   return s;
 }
 

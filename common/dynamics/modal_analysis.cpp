@@ -169,11 +169,7 @@ void check_options(const ModalOptions& o) {
     bad("repeated_tolerance must be in [0, 1)");
 }
 
-}  // namespace
-
-ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<char>& fixed,
-                           const ModalOptions& options, const NodeArray* rest_positions) {
-  check_options(options);
+void check_system(const SpMat& K, const SpMat& M, const std::vector<char>& fixed, const NodeArray* rest_positions) {
   const Eigen::Index n = K.rows();
   if (K.cols() != n || M.rows() != n || M.cols() != n)
     throw InputError("modal analysis: K is " + std::to_string(K.rows()) + "x" + std::to_string(K.cols()) +
@@ -186,6 +182,174 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   if (!fixed.empty() && static_cast<Eigen::Index>(fixed.size()) != n)
     throw InputError("modal analysis: " + std::to_string(fixed.size()) + " fixed-DOF flags for " +
                      std::to_string(n) + " DOFs");
+}
+
+// Factorizes A = K - sigma M into `solver` and returns sigma: the given
+// shift, or an automatic one below zero moved down tenfold until A is
+// positive definite. The solver checks its solves against A, so the caller
+// keeps A alive as long as the solver.
+double factorize_shifted(const SpMat& Kf, const SpMat& Mf, const ModalOptions& options, double scale, SpMat& A,
+                         CholmodSolver& solver) {
+  const bool automatic = std::isnan(options.shift);
+  double sigma = automatic ? -options.shift_fraction * scale : options.shift;
+  A = Kf - sigma * Mf;
+  solver.analyze(A);
+  for (int attempt = 0;; ++attempt) {
+    if (solver.factorize(A)) return sigma;
+    if (!automatic || attempt == 6) {
+      std::ostringstream msg;
+      msg << "modal analysis: K - sigma M is not positive definite for sigma = " << sigma
+          << (automatic ? " (after lowering the automatic shift 6 times)" : "")
+          << "; the shift must lie below the lowest eigenvalue";
+      throw NumericalError(msg.str());
+    }
+    sigma *= 10.0;
+    A = Kf - sigma * Mf;  // same pattern: only values change
+  }
+}
+
+// Ritz pairs of the pencil: values, vectors X and their products K X, M X.
+struct RitzPairs {
+  VecX values;
+  MatX vectors, K, M;
+};
+
+// One cycle of the block Krylov method: the M-orthonormal basis of X and
+// (K - sigma M)^-1 M applied to it up to krylov_blocks deep, then
+// Rayleigh-Ritz on the pencil (V^T K V, V^T M V); the lowest p pairs.
+RitzPairs krylov_ritz_pairs(const SpMat& Kf, const SpMat& Mf, CholmodSolver& solver, const MatX& X, int p,
+                            int krylov_blocks, int cycle, Eigen::Index& basis_size, int& operator_applications) {
+  const Eigen::Index nf = Kf.rows();
+  MBasis basis(Mf, nf, std::min<Eigen::Index>(nf, Eigen::Index(p) * krylov_blocks));
+  Eigen::Index block_begin = 0;
+  for (Eigen::Index c = 0; c < X.cols(); ++c) basis.add(X.col(c));
+  for (int depth = 1; depth < krylov_blocks && basis.size() < basis.capacity(); ++depth) {
+    const Eigen::Index block_end = basis.size();
+    if (block_end == block_begin) break;  // the Krylov space is exhausted
+    for (Eigen::Index c = block_begin; c < block_end; ++c) {
+      VecX y = solver.solve(basis.MV().col(c));
+      ++operator_applications;
+      basis.add(std::move(y));
+    }
+    block_begin = block_end;
+  }
+
+  const Eigen::Index m = basis.size();
+  basis_size = m;
+  const MatX KV = Kf * basis.V();
+  MatX Kr = basis.V().transpose() * KV;
+  MatX Mr = basis.V().transpose() * basis.MV();
+  Kr = 0.5 * (Kr + Kr.transpose()).eval();
+  Mr = 0.5 * (Mr + Mr.transpose()).eval();
+  Eigen::GeneralizedSelfAdjointEigenSolver<MatX> dense(Kr, Mr);
+  if (dense.info() != Eigen::Success)
+    throw NumericalError("modal analysis: the projected eigenproblem failed in cycle " + std::to_string(cycle));
+  const Eigen::Index keep = std::min<Eigen::Index>(m, p);
+  const MatX Y = dense.eigenvectors().leftCols(keep);
+  RitzPairs ritz;
+  ritz.values = dense.eigenvalues().head(keep);
+  ritz.vectors = basis.V() * Y;
+  ritz.K = KV * Y;
+  ritz.M = basis.MV() * Y;
+  return ritz;
+}
+
+// Relative residuals of the reported Ritz pairs and of those just past the
+// last one with nearly the same eigenvalue: they may join its repeated
+// group in the canonical rotation, so they must converge as well.
+VecX checked_residuals(const RitzPairs& ritz, const std::vector<int>& reported, double rigid_below, double scale) {
+  std::vector<int> checked = reported;
+  const double last = ritz.values(reported.back());
+  for (Eigen::Index i = reported.back() + 1; i < ritz.values.size(); ++i) {
+    const bool rigid_pair = last < rigid_below && ritz.values(i) < rigid_below;
+    if (!rigid_pair && !(std::abs(ritz.values(i) - last) <= 1e-3 * std::abs(last))) break;
+    checked.push_back(static_cast<int>(i));
+  }
+  VecX residuals(static_cast<Eigen::Index>(checked.size()));
+  for (size_t r = 0; r < checked.size(); ++r) {
+    const int i = checked[r];
+    residuals(static_cast<Eigen::Index>(r)) =
+        relative_residual(ritz.K.col(i), ritz.M.col(i), ritz.values(i), ritz.values(i) < rigid_below, scale);
+  }
+  return residuals;
+}
+
+// The reported Ritz pairs as the result's modes on all n DOFs (fixed ones
+// zero), each with the sign rule below, and their frequencies and residuals.
+void store_modes(const RitzPairs& ritz, const std::vector<int>& reported, const std::vector<int>& free_dofs,
+                 Eigen::Index n, double rigid_below, double scale, ModalResult& result) {
+  const int k = static_cast<int>(reported.size());
+  const int nf = static_cast<int>(free_dofs.size());
+  result.eigenvalues.resize(k);
+  result.frequencies.resize(k);
+  result.residuals.resize(k);
+  result.modes = MatX::Zero(n, k);
+  for (int r = 0; r < k; ++r) {
+    const int i = reported[static_cast<size_t>(r)];
+    VecX x = ritz.vectors.col(i);
+    // Sign: the first entry within round-off of the largest magnitude is
+    // positive (ties are common on symmetric meshes).
+    const double largest = x.cwiseAbs().maxCoeff();
+    for (int j = 0; j < nf; ++j)
+      if (std::abs(x(j)) >= (1.0 - 1e-8) * largest) {
+        if (x(j) < 0) x = -x;
+        break;
+      }
+    const double lambda = ritz.values(i);
+    result.eigenvalues(r) = lambda;
+    result.frequencies(r) = std::sqrt(std::max(lambda, 0.0)) / kTwoPi;
+    result.residuals(r) = relative_residual(ritz.K.col(i), ritz.M.col(i), lambda, lambda < rigid_below, scale);
+    for (int j = 0; j < nf; ++j) result.modes(free_dofs[static_cast<size_t>(j)], r) = x(j);
+  }
+}
+
+// Canonical bases of repeated eigenvalues. A group may run past the last
+// reported mode, so the Ritz pairs that follow are taken in while their
+// eigenvalues still agree.
+void canonicalize_repeated(const SpMat& Kf, const SpMat& Mf, const std::vector<int>& reported,
+                           const std::vector<int>& free_dofs, const NodeArray* rest_positions,
+                           double repeated_tolerance, double rigid_below, RitzPairs& ritz) {
+  const Eigen::Index available = ritz.values.size();
+  const Eigen::Index nf = ritz.vectors.rows();
+  auto same = [&](int a, int b) {
+    const double la = ritz.values(a), lb = ritz.values(b);
+    if (la < rigid_below || lb < rigid_below) return la < rigid_below && lb < rigid_below;
+    return std::abs(la - lb) <= repeated_tolerance * std::max(std::abs(la), std::abs(lb));
+  };
+  std::vector<int> extended = reported;
+  while (static_cast<Eigen::Index>(extended.back()) + 1 < available && same(extended.back(), extended.back() + 1))
+    extended.push_back(extended.back() + 1);
+  const std::vector<VecX> weights = canonical_weights(free_dofs, rest_positions);
+  for (size_t g = 0; g < extended.size();) {
+    size_t h = g + 1;
+    while (h < extended.size() && same(extended[h - 1], extended[h])) ++h;
+    const Eigen::Index size = static_cast<Eigen::Index>(h - g);
+    if (size > 1) {
+      MatX Xg(nf, size), MXg(nf, size);
+      for (Eigen::Index c = 0; c < size; ++c) {
+        Xg.col(c) = ritz.vectors.col(extended[g + c]);
+        MXg.col(c) = ritz.M.col(extended[g + c]);
+      }
+      const MatX XR = Xg * canonical_rotation(Xg, MXg, weights, 0);
+      for (Eigen::Index c = 0; c < size; ++c) {
+        const int i = extended[g + c];
+        ritz.vectors.col(i) = XR.col(c);
+        ritz.K.col(i) = Kf * ritz.vectors.col(i);
+        ritz.M.col(i) = Mf * ritz.vectors.col(i);
+        ritz.values(i) = ritz.vectors.col(i).dot(ritz.K.col(i)) / ritz.vectors.col(i).dot(ritz.M.col(i));
+      }
+    }
+    g = h;
+  }
+}
+
+}  // namespace
+
+ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<char>& fixed,
+                           const ModalOptions& options, const NodeArray* rest_positions) {
+  check_options(options);
+  check_system(K, M, fixed, rest_positions);
+  const Eigen::Index n = K.rows();
 
   std::vector<int> map(static_cast<size_t>(n), -1), free_dofs;
   for (Eigen::Index i = 0; i < n; ++i)
@@ -213,23 +377,9 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   // Factorize K - sigma M, moving an automatic shift down until it is SPD.
   LinearSolverOptions solver_options;
   solver_options.threads = options.threads;
+  SpMat shifted;  // K - sigma M, referred to by the solver
   CholmodSolver solver(solver_options);
-  const bool automatic = std::isnan(options.shift);
-  double sigma = automatic ? -options.shift_fraction * scale : options.shift;
-  SpMat A = Kf - sigma * Mf;
-  solver.analyze(A);
-  for (int attempt = 0;; ++attempt) {
-    if (solver.factorize(A)) break;
-    if (!automatic || attempt == 6) {
-      std::ostringstream msg;
-      msg << "modal analysis: K - sigma M is not positive definite for sigma = " << sigma
-          << (automatic ? " (after lowering the automatic shift 6 times)" : "")
-          << "; the shift must lie below the lowest eigenvalue";
-      throw NumericalError(msg.str());
-    }
-    sigma *= 10.0;
-    A = Kf - sigma * Mf;  // same pattern: only values change
-  }
+  const double sigma = factorize_shifted(Kf, Mf, options, scale, shifted, solver);
   result.shift = sigma;
 
   const int wanted = std::min(nf, k + (options.skip_rigid ? 6 : 0));
@@ -237,8 +387,7 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   p = std::min(std::max(p, wanted), nf);
 
   MatX X = start_block(nf, p, 1);
-  VecX ritz_values;
-  MatX ritz_vectors, ritz_K, ritz_M;  // X, K X, M X of the Ritz pairs
+  RitzPairs ritz;
   std::vector<int> reported;
   VecX residuals;
   std::vector<std::string> history;
@@ -246,42 +395,15 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   bool converged = false;
   for (int cycle = 1; cycle <= options.max_cycles && !converged; ++cycle) {
     result.cycles = cycle;
-    MBasis basis(Mf, nf, std::min<Eigen::Index>(nf, Eigen::Index(p) * options.krylov_blocks));
-    Eigen::Index block_begin = 0;
-    for (Eigen::Index c = 0; c < X.cols(); ++c) basis.add(X.col(c));
-    for (int depth = 1; depth < options.krylov_blocks && basis.size() < basis.capacity(); ++depth) {
-      const Eigen::Index block_end = basis.size();
-      if (block_end == block_begin) break;  // the Krylov space is exhausted
-      for (Eigen::Index c = block_begin; c < block_end; ++c) {
-        VecX y = solver.solve(basis.MV().col(c));
-        ++result.operator_applications;
-        basis.add(std::move(y));
-      }
-      block_begin = block_end;
-    }
-
-    // Rayleigh-Ritz on the pencil (V^T K V, V^T M V).
-    const Eigen::Index m = basis.size();
-    const MatX KV = Kf * basis.V();
-    MatX Kr = basis.V().transpose() * KV;
-    MatX Mr = basis.V().transpose() * basis.MV();
-    Kr = 0.5 * (Kr + Kr.transpose()).eval();
-    Mr = 0.5 * (Mr + Mr.transpose()).eval();
-    Eigen::GeneralizedSelfAdjointEigenSolver<MatX> dense(Kr, Mr);
-    if (dense.info() != Eigen::Success)
-      throw NumericalError("modal analysis: the projected eigenproblem failed in cycle " + std::to_string(cycle));
-    const Eigen::Index keep = std::min<Eigen::Index>(m, p);
-    const MatX Y = dense.eigenvectors().leftCols(keep);
-    ritz_values = dense.eigenvalues().head(keep);
-    ritz_vectors = basis.V() * Y;
-    ritz_K = KV * Y;
-    ritz_M = basis.MV() * Y;
+    Eigen::Index m = 0;  // the basis' size
+    ritz = krylov_ritz_pairs(Kf, Mf, solver, X, p, options.krylov_blocks, cycle, m, result.operator_applications);
+    const Eigen::Index keep = ritz.values.size();
 
     // The first k Ritz pairs above the rigid threshold (or simply the first k).
     reported.clear();
     int rigid = 0;
     for (Eigen::Index i = 0; i < keep && static_cast<int>(reported.size()) < k; ++i) {
-      if (options.skip_rigid && ritz_values(i) < rigid_below) {
+      if (options.skip_rigid && ritz.values(i) < rigid_below) {
         ++rigid;
         continue;
       }
@@ -296,7 +418,7 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
                              " non-rigid modes exist among the " + std::to_string(nf) + " free DOFs");
       const int wider = std::min(nf, p + rigid + k);
       MatX Xw(nf, wider);
-      Xw.leftCols(keep) = ritz_vectors;
+      Xw.leftCols(keep) = ritz.vectors;
       Xw.rightCols(wider - keep) = start_block(nf, wider - keep, 2 + cycle);
       X = std::move(Xw);
       p = wider;
@@ -304,22 +426,7 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
       continue;
     }
 
-    // Ritz pairs just past the last reported one with nearly the same
-    // eigenvalue may join its repeated group in the canonical rotation
-    // below, so they must converge as well.
-    std::vector<int> checked = reported;
-    const double last = ritz_values(reported.back());
-    for (Eigen::Index i = reported.back() + 1; i < keep; ++i) {
-      const bool rigid_pair = last < rigid_below && ritz_values(i) < rigid_below;
-      if (!rigid_pair && !(std::abs(ritz_values(i) - last) <= 1e-3 * std::abs(last))) break;
-      checked.push_back(static_cast<int>(i));
-    }
-    residuals.resize(static_cast<Eigen::Index>(checked.size()));
-    for (size_t r = 0; r < checked.size(); ++r) {
-      const int i = checked[r];
-      residuals(static_cast<Eigen::Index>(r)) = relative_residual(
-          ritz_K.col(i), ritz_M.col(i), ritz_values(i), ritz_values(i) < rigid_below, scale);
-    }
+    residuals = checked_residuals(ritz, reported, rigid_below, scale);
     std::ostringstream line;
     line << "cycle " << cycle << ": max residual " << residuals.maxCoeff();
     history.push_back(line.str());
@@ -331,7 +438,7 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
     const bool stalled = c > 20 && max_residuals[c - 1] <= 100 * options.tolerance &&
                          max_residuals[c - 1] > 0.99 * max_residuals[c - 21];
     converged = residuals.maxCoeff() <= options.tolerance || m == nf || stalled;
-    X = ritz_vectors;
+    X = ritz.vectors;
   }
   if (!converged) {
     std::ostringstream msg;
@@ -342,67 +449,10 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
     throw NumericalError(msg.str());
   }
 
-  // Canonical bases of repeated eigenvalues. A group may run past the last
-  // reported mode, so the Ritz pairs that follow are taken in while their
-  // eigenvalues still agree.
-  const Eigen::Index available = ritz_values.size();
-  std::vector<int> order = reported;
-  if (options.repeated_tolerance > 0) {
-    auto same = [&](int a, int b) {
-      const double la = ritz_values(a), lb = ritz_values(b);
-      if (la < rigid_below || lb < rigid_below) return la < rigid_below && lb < rigid_below;
-      return std::abs(la - lb) <= options.repeated_tolerance * std::max(std::abs(la), std::abs(lb));
-    };
-    std::vector<int> extended = reported;
-    while (static_cast<Eigen::Index>(extended.back()) + 1 < available &&
-           same(extended.back(), extended.back() + 1))
-      extended.push_back(extended.back() + 1);
-    const std::vector<VecX> weights = canonical_weights(free_dofs, rest_positions);
-    for (size_t g = 0; g < extended.size();) {
-      size_t h = g + 1;
-      while (h < extended.size() && same(extended[h - 1], extended[h])) ++h;
-      const Eigen::Index size = static_cast<Eigen::Index>(h - g);
-      if (size > 1) {
-        MatX Xg(nf, size), MXg(nf, size);
-        for (Eigen::Index c = 0; c < size; ++c) {
-          Xg.col(c) = ritz_vectors.col(extended[g + c]);
-          MXg.col(c) = ritz_M.col(extended[g + c]);
-        }
-        const MatX XR = Xg * canonical_rotation(Xg, MXg, weights, 0);
-        for (Eigen::Index c = 0; c < size; ++c) {
-          const int i = extended[g + c];
-          ritz_vectors.col(i) = XR.col(c);
-          ritz_K.col(i) = Kf * ritz_vectors.col(i);
-          ritz_M.col(i) = Mf * ritz_vectors.col(i);
-          ritz_values(i) = ritz_vectors.col(i).dot(ritz_K.col(i)) / ritz_vectors.col(i).dot(ritz_M.col(i));
-        }
-      }
-      g = h;
-    }
-  }
+  if (options.repeated_tolerance > 0)
+    canonicalize_repeated(Kf, Mf, reported, free_dofs, rest_positions, options.repeated_tolerance, rigid_below, ritz);
 
-  result.eigenvalues.resize(k);
-  result.frequencies.resize(k);
-  result.residuals.resize(k);
-  result.modes = MatX::Zero(n, k);
-  for (int r = 0; r < k; ++r) {
-    const int i = order[static_cast<size_t>(r)];
-    VecX x = ritz_vectors.col(i);
-    // Sign: the first entry within round-off of the largest magnitude is
-    // positive (ties are common on symmetric meshes).
-    const double largest = x.cwiseAbs().maxCoeff();
-    for (int j = 0; j < nf; ++j)
-      if (std::abs(x(j)) >= (1.0 - 1e-8) * largest) {
-        if (x(j) < 0) x = -x;
-        break;
-      }
-    const double lambda = ritz_values(i);
-    result.eigenvalues(r) = lambda;
-    result.frequencies(r) = std::sqrt(std::max(lambda, 0.0)) / kTwoPi;
-    result.residuals(r) =
-        relative_residual(ritz_K.col(i), ritz_M.col(i), lambda, lambda < rigid_below, scale);
-    for (int j = 0; j < nf; ++j) result.modes(free_dofs[static_cast<size_t>(j)], r) = x(j);
-  }
+  store_modes(ritz, reported, free_dofs, n, rigid_below, scale, result);
   return result;
 }
 

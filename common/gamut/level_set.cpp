@@ -21,6 +21,176 @@ void decode(long long flat, int cells, std::vector<int>& index) {
   for (std::size_t a = 0; a < index.size(); ++a) index[a] = static_cast<int>(flat % cells), flat /= cells;
 }
 
+// A grid of cells^d nodes at lo + (i + 1/2) h per axis, axis 0 fastest.
+struct NodeGrid {
+  int d, cells;
+  double lo, h;
+  double extent;  // (1 + 2 margin): the grid's edge length
+  std::vector<long long> stride;
+  long long nodes;
+};
+
+// 1. The Zhu-Bridson implicit function at every node, |x - xbar(x)| - r,
+// from buckets of edge 2r; kUnknown where no sample lies within 2r.
+std::vector<double> implicit_function(const std::vector<VecX>& points, const NodeGrid& g, double r) {
+  const int d = g.d;
+  const double h = g.h, reach = 2 * r;
+  const long long buckets_per_axis = static_cast<long long>(std::ceil(g.extent / reach)) + 2;
+  auto bucket_key = [&](const std::vector<long long>& b) {
+    long long key = 0;
+    for (int a = d - 1; a >= 0; --a) key = key * buckets_per_axis + b[a];
+    return key;
+  };
+  std::unordered_map<long long, std::vector<int>> buckets;
+  std::vector<long long> b(d);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int a = 0; a < d; ++a) b[a] = static_cast<long long>(std::floor((points[i][a] - g.lo) / reach)) + 1;
+    buckets[bucket_key(b)].push_back(static_cast<int>(i));
+  }
+  long long neighbourhood = 1;
+  for (int a = 0; a < d; ++a) neighbourhood *= 3;
+  std::vector<double> phi0(g.nodes);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (long long v = 0; v < g.nodes; ++v) {
+    std::vector<int> index(d);
+    std::vector<long long> home(d), nb(d);
+    decode(v, g.cells, index);
+    VecX x(d);
+    for (int a = 0; a < d; ++a) {
+      x[a] = g.lo + (index[a] + 0.5) * h;
+      home[a] = static_cast<long long>(std::floor((x[a] - g.lo) / reach)) + 1;
+    }
+    VecX mean = VecX::Zero(d);
+    double weight = 0;
+    for (long long c = 0; c < neighbourhood; ++c) {
+      long long rest = c;
+      for (int a = 0; a < d; ++a) nb[a] = home[a] + rest % 3 - 1, rest /= 3;
+      const auto it = buckets.find(bucket_key(nb));
+      if (it == buckets.end()) continue;
+      for (int i : it->second) {
+        const double s2 = (points[i] - x).squaredNorm() / (reach * reach);
+        if (s2 >= 1) continue;
+        const double w = (1 - s2) * (1 - s2) * (1 - s2);
+        mean += w * points[i];
+        weight += w;
+      }
+    }
+    phi0[v] = weight > 0 ? (x - mean / weight).norm() - r : kUnknown;
+  }
+  return phi0;
+}
+
+using DistanceHeap =
+    std::priority_queue<std::pair<double, long long>, std::vector<std::pair<double, long long>>, std::greater<>>;
+
+// 2. Nodes next to a sign change of phi0, with their distance estimated
+// along the crossing axis (unknown nodes are outside): into u and the heap.
+DistanceHeap seed_crossing_nodes(const std::vector<double>& phi0, const NodeGrid& g, std::vector<double>& u) {
+  const int d = g.d;
+  DistanceHeap heap;
+  std::vector<int> index(d);
+  for (long long v = 0; v < g.nodes; ++v) {
+    decode(v, g.cells, index);
+    const bool inside = phi0[v] < 0;
+    double best = kUnknown;
+    for (int a = 0; a < d; ++a)
+      for (int step : {-1, 1}) {
+        const int j = index[a] + step;
+        if (j < 0 || j >= g.cells) continue;
+        const long long w = v + step * g.stride[a];
+        if ((phi0[w] < 0) == inside) continue;
+        double dist;
+        if (std::isfinite(phi0[v]) && std::isfinite(phi0[w]))
+          dist = g.h * phi0[v] / (phi0[v] - phi0[w]);
+        else
+          dist = std::isfinite(phi0[v]) ? std::min(std::abs(phi0[v]), g.h) : g.h;
+        best = std::min(best, std::abs(dist));
+      }
+    if (best < kUnknown) {
+      u[v] = best;
+      heap.push({best, v});
+    }
+  }
+  return heap;
+}
+
+// 3. Fast marching of the unsigned distance u from the seeded nodes
+// (first-order upwind Eikonal).
+void fast_march(const NodeGrid& g, DistanceHeap& heap, std::vector<double>& u) {
+  const int d = g.d;
+  std::vector<char> accepted(static_cast<std::size_t>(g.nodes), 0);
+  std::vector<int> index(d);
+  std::vector<double> m;
+  while (!heap.empty()) {
+    const auto [value, v] = heap.top();
+    heap.pop();
+    if (accepted[v] || value > u[v]) continue;
+    accepted[v] = 1;
+    decode(v, g.cells, index);
+    for (int a = 0; a < d; ++a)
+      for (int step : {-1, 1}) {
+        const int j = index[a] + step;
+        if (j < 0 || j >= g.cells) continue;
+        const long long w = v + step * g.stride[a];
+        if (accepted[w]) continue;
+        // Update w from its accepted neighbours, axis by axis.
+        std::vector<int> wi(d);
+        decode(w, g.cells, wi);
+        m.clear();
+        for (int b2 = 0; b2 < d; ++b2) {
+          double best = kUnknown;
+          for (int s2 : {-1, 1}) {
+            const int k = wi[b2] + s2;
+            if (k < 0 || k >= g.cells) continue;
+            const long long q = w + s2 * g.stride[b2];
+            if (accepted[q]) best = std::min(best, u[q]);
+          }
+          if (best < kUnknown) m.push_back(best);
+        }
+        std::sort(m.begin(), m.end());
+        double sum = 0, sum2 = 0, solution = kUnknown;
+        for (std::size_t k = 0; k < m.size(); ++k) {
+          sum += m[k];
+          sum2 += m[k] * m[k];
+          const double kk = double(k + 1), disc = sum * sum - kk * (sum2 - g.h * g.h);
+          if (disc < 0) break;
+          const double candidate = (sum + std::sqrt(disc)) / kk;
+          if (k + 1 < m.size() && candidate > m[k + 1]) {
+            solution = candidate;
+            continue;
+          }
+          solution = candidate;
+          break;
+        }
+        if (solution < u[w]) {
+          u[w] = solution;
+          heap.push({solution, w});
+        }
+      }
+  }
+}
+
+// 4. One explicit step of dPhi/dt = Laplacian(Phi), mirrored at the grid
+// boundary, dt = h^2 / (4 d).
+void smooth_once(const NodeGrid& g, std::vector<double>& phi) {
+  const int d = g.d;
+  const double dt = g.h * g.h / (4 * d);
+  std::vector<double> next(g.nodes);
+#pragma omp parallel for schedule(static)
+  for (long long v = 0; v < g.nodes; ++v) {
+    std::vector<int> index(d);
+    decode(v, g.cells, index);
+    double lap = 0;
+    for (int a = 0; a < d; ++a) {
+      const double lo = index[a] > 0 ? phi[v - g.stride[a]] : phi[v];
+      const double hi = index[a] + 1 < g.cells ? phi[v + g.stride[a]] : phi[v];
+      lap += (lo - 2 * phi[v] + hi) / (g.h * g.h);
+    }
+    next[v] = phi[v] + dt * lap;
+  }
+  phi.swap(next);
+}
+
 }  // namespace
 
 double GamutLevelSet::node(const std::vector<int>& index) const {
@@ -89,159 +259,22 @@ GamutLevelSet GamutLevelSet::from_points(const std::vector<VecX>& points, const 
   ls.stride_.assign(d, 1);
   for (int a = 1; a < d; ++a) ls.stride_[a] = ls.stride_[a - 1] * o.cells;
   const long long n = ls.stride_[d - 1] * o.cells;
-  const double h = ls.h_, r = o.radius > 0 ? o.radius : 1.5 * h, reach = 2 * r;
+  const double h = ls.h_, r = o.radius > 0 ? o.radius : 1.5 * h;
   ls.padding_ = r;
 
-  // 1. Zhu-Bridson implicit function, from buckets of edge 2r.
-  const long long buckets_per_axis = static_cast<long long>(std::ceil((1 + 2 * o.margin) / reach)) + 2;
-  auto bucket_key = [&](const std::vector<long long>& b) {
-    long long key = 0;
-    for (int a = d - 1; a >= 0; --a) key = key * buckets_per_axis + b[a];
-    return key;
-  };
-  std::unordered_map<long long, std::vector<int>> buckets;
-  std::vector<long long> b(d);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (int a = 0; a < d; ++a) b[a] = static_cast<long long>(std::floor((points[i][a] - ls.lo_) / reach)) + 1;
-    buckets[bucket_key(b)].push_back(static_cast<int>(i));
-  }
-  long long neighbourhood = 1;
-  for (int a = 0; a < d; ++a) neighbourhood *= 3;
-  std::vector<double> phi0(n);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (long long v = 0; v < n; ++v) {
-    std::vector<int> index(d);
-    std::vector<long long> home(d), nb(d);
-    decode(v, o.cells, index);
-    VecX x(d);
-    for (int a = 0; a < d; ++a) {
-      x[a] = ls.lo_ + (index[a] + 0.5) * h;
-      home[a] = static_cast<long long>(std::floor((x[a] - ls.lo_) / reach)) + 1;
-    }
-    VecX mean = VecX::Zero(d);
-    double weight = 0;
-    for (long long c = 0; c < neighbourhood; ++c) {
-      long long rest = c;
-      for (int a = 0; a < d; ++a) nb[a] = home[a] + rest % 3 - 1, rest /= 3;
-      const auto it = buckets.find(bucket_key(nb));
-      if (it == buckets.end()) continue;
-      for (int i : it->second) {
-        const double s2 = (points[i] - x).squaredNorm() / (reach * reach);
-        if (s2 >= 1) continue;
-        const double w = (1 - s2) * (1 - s2) * (1 - s2);
-        mean += w * points[i];
-        weight += w;
-      }
-    }
-    phi0[v] = weight > 0 ? (x - mean / weight).norm() - r : kUnknown;
-  }
-
-  // 2. Nodes next to a sign change, with their distance estimated along the
-  // crossing axis (unknown nodes are outside).
+  const NodeGrid grid{d, o.cells, ls.lo_, h, 1 + 2 * o.margin, ls.stride_, n};
+  // 1-3. The implicit function, the nodes next to its zero crossing, and
+  // fast marching from them to a signed distance everywhere.
+  const std::vector<double> phi0 = implicit_function(points, grid, r);
   std::vector<double> u(n, kUnknown);
-  std::vector<char> accepted(n, 0);
-  using Item = std::pair<double, long long>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
-  {
-    std::vector<int> index(d);
-    for (long long v = 0; v < n; ++v) {
-      decode(v, o.cells, index);
-      const bool inside = phi0[v] < 0;
-      double best = kUnknown;
-      for (int a = 0; a < d; ++a)
-        for (int step : {-1, 1}) {
-          const int j = index[a] + step;
-          if (j < 0 || j >= o.cells) continue;
-          const long long w = v + step * ls.stride_[a];
-          if ((phi0[w] < 0) == inside) continue;
-          double dist;
-          if (std::isfinite(phi0[v]) && std::isfinite(phi0[w]))
-            dist = h * phi0[v] / (phi0[v] - phi0[w]);
-          else
-            dist = std::isfinite(phi0[v]) ? std::min(std::abs(phi0[v]), h) : h;
-          best = std::min(best, std::abs(dist));
-        }
-      if (best < kUnknown) {
-        u[v] = best;
-        heap.push({best, v});
-      }
-    }
-  }
+  DistanceHeap heap = seed_crossing_nodes(phi0, grid, u);
   if (heap.empty()) throw InputError("gamut level set: the samples leave no boundary on the grid (all inside or none)");
-
-  // 3. Fast marching of the unsigned distance (first-order upwind Eikonal).
-  {
-    std::vector<int> index(d);
-    std::vector<double> m;
-    while (!heap.empty()) {
-      const auto [value, v] = heap.top();
-      heap.pop();
-      if (accepted[v] || value > u[v]) continue;
-      accepted[v] = 1;
-      decode(v, o.cells, index);
-      for (int a = 0; a < d; ++a)
-        for (int step : {-1, 1}) {
-          const int j = index[a] + step;
-          if (j < 0 || j >= o.cells) continue;
-          const long long w = v + step * ls.stride_[a];
-          if (accepted[w]) continue;
-          // Update w from its accepted neighbours, axis by axis.
-          std::vector<int> wi(d);
-          decode(w, o.cells, wi);
-          m.clear();
-          for (int b2 = 0; b2 < d; ++b2) {
-            double best = kUnknown;
-            for (int s2 : {-1, 1}) {
-              const int k = wi[b2] + s2;
-              if (k < 0 || k >= o.cells) continue;
-              const long long q = w + s2 * ls.stride_[b2];
-              if (accepted[q]) best = std::min(best, u[q]);
-            }
-            if (best < kUnknown) m.push_back(best);
-          }
-          std::sort(m.begin(), m.end());
-          double sum = 0, sum2 = 0, solution = kUnknown;
-          for (std::size_t k = 0; k < m.size(); ++k) {
-            sum += m[k];
-            sum2 += m[k] * m[k];
-            const double kk = double(k + 1), disc = sum * sum - kk * (sum2 - h * h);
-            if (disc < 0) break;
-            const double candidate = (sum + std::sqrt(disc)) / kk;
-            if (k + 1 < m.size() && candidate > m[k + 1]) {
-              solution = candidate;
-              continue;
-            }
-            solution = candidate;
-            break;
-          }
-          if (solution < u[w]) {
-            u[w] = solution;
-            heap.push({solution, w});
-          }
-        }
-    }
-  }
+  fast_march(grid, heap, u);
   ls.phi_.resize(n);
   for (long long v = 0; v < n; ++v) ls.phi_[v] = phi0[v] < 0 ? -u[v] : u[v];
 
-  // 4. Smoothing, dPhi/dt = Laplacian(Phi), mirrored at the grid boundary.
-  const double dt = h * h / (4 * d);
-  for (int step = 0; step < o.smoothing_steps; ++step) {
-    std::vector<double> next(n);
-#pragma omp parallel for schedule(static)
-    for (long long v = 0; v < n; ++v) {
-      std::vector<int> index(d);
-      decode(v, o.cells, index);
-      double lap = 0;
-      for (int a = 0; a < d; ++a) {
-        const double lo = index[a] > 0 ? ls.phi_[v - ls.stride_[a]] : ls.phi_[v];
-        const double hi = index[a] + 1 < o.cells ? ls.phi_[v + ls.stride_[a]] : ls.phi_[v];
-        lap += (lo - 2 * ls.phi_[v] + hi) / (h * h);
-      }
-      next[v] = ls.phi_[v] + dt * lap;
-    }
-    ls.phi_.swap(next);
-  }
+  // 4. Smoothing.
+  for (int step = 0; step < o.smoothing_steps; ++step) smooth_once(grid, ls.phi_);
   return ls;
 }
 

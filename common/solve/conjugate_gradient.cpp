@@ -18,6 +18,34 @@ std::string format_number(double value) {
   return text;
 }
 
+// One pass over the vectors: x += alpha p, r -= alpha q, and the sums r.r
+// and, where the preconditioner works chunk by chunk, z = M^-1 r with r.z
+// (else r.z is 0 and z untouched).
+Eigen::Vector2d step_and_residual(double alpha, const VecX& p, const VecX& q, const CgPreconditioner& M, int threads,
+                                  VecX& x, VecX& r, VecX& z) {
+  const Eigen::Index n = x.size();
+  if (M.apply_chunk)
+    return chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
+      double rr = 0.0;
+      for (Eigen::Index i = begin; i < end; ++i) {
+        x[i] += alpha * p[i];
+        r[i] -= alpha * q[i];
+        rr += r[i] * r[i];
+      }
+      return Eigen::Vector2d(rr, M.apply_chunk(r.data(), z.data(), begin, end));
+    });
+  const double rr = chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
+    double sum = 0.0;
+    for (Eigen::Index i = begin; i < end; ++i) {
+      x[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+      sum += r[i] * r[i];
+    }
+    return sum;
+  });
+  return Eigen::Vector2d(rr, 0.0);
+}
+
 }  // namespace
 
 VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b,
@@ -100,33 +128,9 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
       not_definite("non-positive curvature p'(A + shift I)p", curvature);
     }
     const double alpha = rz / curvature;
-    double rz_next = 0.0;
-    if (M.apply_chunk) {
-      // One pass: update x and r, precondition r, and sum r.r and r.z.
-      const Eigen::Vector2d sums =
-          chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-            double rr = 0.0;
-            for (Eigen::Index i = begin; i < end; ++i) {
-              x[i] += alpha * p[i];
-              r[i] -= alpha * q[i];
-              rr += r[i] * r[i];
-            }
-            return Eigen::Vector2d(rr, M.apply_chunk(r.data(), z.data(), begin, end));
-          });
-      r_norm = std::sqrt(sums[0]);
-      rz_next = sums[1];
-    } else {
-      const double rr = chunked_reduce(n, threads, [&](Eigen::Index begin, Eigen::Index end) {
-        double sum = 0.0;
-        for (Eigen::Index i = begin; i < end; ++i) {
-          x[i] += alpha * p[i];
-          r[i] -= alpha * q[i];
-          sum += r[i] * r[i];
-        }
-        return sum;
-      });
-      r_norm = std::sqrt(rr);
-    }
+    const Eigen::Vector2d sums = step_and_residual(alpha, p, q, M, threads, x, r, z);
+    r_norm = std::sqrt(sums[0]);
+    double rz_next = sums[1];
     ++iteration;
     if (iteration % history_stride == 0) history += ", " + format_number(r_norm / b_norm);
     if (settings.progress && iteration % std::max(1, settings.progress_stride) == 0)

@@ -62,6 +62,122 @@ std::vector<std::int64_t> select_nodes(const Config& item, const CellGrid& g) {
   return nodes;
 }
 
+// Design domain: design everywhere, then the items in order.
+void read_design_domain(const Config& config, const CellGrid& g, std::vector<CellRole>& roles) {
+  const int dim = g.dimension();
+  roles.assign(g.cells(), CellRole::design);
+  if (config.has("domain")) {
+    for (const Config& item : config.children("domain")) {
+      const std::string role = item.one_of("role", {"design", "empty", "solid"});
+      const CellRole r = role == "design" ? CellRole::design : role == "empty" ? CellRole::empty : CellRole::solid;
+      int hits = 0;
+      if (item.has("box")) {
+        const Box box = read_box(item, "box", dim);
+        for (std::int64_t c = 0; c < g.cells(); ++c)
+          if (box.contains(g.cell_center(c), 1e-9 * g.h())) roles[c] = r, ++hits;
+      } else if (item.has("cylinder")) {
+        // A cylinder along z (3D) or a disk (2D).
+        const Config cyl = item.child("cylinder");
+        const auto centre = cyl.get<std::vector<double>>("center");
+        if (centre.size() != 2) cyl.fail("center", "needs 2 coordinates (x, y)");
+        const double radius = cyl.require_positive("radius");
+        for (std::int64_t c = 0; c < g.cells(); ++c) {
+          const Vec3 x = g.cell_center(c);
+          if (std::hypot(x[0] - centre[0], x[1] - centre[1]) <= radius) roles[c] = r, ++hits;
+        }
+      } else {
+        item.fail("", "a domain item needs a box or a cylinder");
+      }
+      if (hits == 0) item.fail("", "selects no cell of the grid");
+    }
+  }
+}
+
+// One load case: forces on carried nodes, prescribed displacements on
+// supported unknowns, and for a target objective its target displacements.
+LoadCase read_load_case(const Config& lc, const CellGrid& g, const std::vector<char>& fixed,
+                        const std::vector<char>& carried, const VecX& support_values, bool any_value, size_t index) {
+  const int dim = g.dimension();
+  const std::int64_t n = g.unknowns();
+  LoadCase l;
+  l.name = lc.get_or<std::string>("name", "load" + std::to_string(index));
+  l.weight = lc.get_or<double>("weight", 1.0);
+  if (!(l.weight > 0)) lc.fail("weight", "must be > 0");
+  const std::string objective = lc.one_of("objective", {"compliance", "target"});
+  l.objective = objective == "compliance" ? ElasticObjective::compliance : ElasticObjective::target;
+  l.force = VecX::Zero(n);
+  if (lc.has("forces")) {
+    for (const Config& f : lc.children("forces")) {
+      const std::vector<std::int64_t> nodes = select_nodes(f, g);
+      const Vec3 force = read_vector(f, "force", dim);
+      // `total`: the force is shared by the selected nodes; `per_node`: each gets it.
+      const std::string spread = f.get_or("distribute", "per_node");
+      if (spread != "per_node" && spread != "total") f.fail("distribute", "is per_node or total");
+      const double share = spread == "total" ? 1.0 / double(nodes.size()) : 1.0;
+      for (std::int64_t node : nodes) {
+        if (!carried[node]) f.fail("", "loads a node that only empty cells touch (a load on void)");
+        for (int a = 0; a < dim; ++a) l.force[node * dim + a] += share * force[a];
+      }
+    }
+  }
+  l.prescribed = support_values;
+  bool case_value = any_value;
+  if (lc.has("prescribed")) {
+    for (const Config& pr : lc.children("prescribed")) {
+      const Vec3 value = read_vector(pr, "displacement", dim);
+      for (std::int64_t node : select_nodes(pr, g))
+        for (int a = 0; a < dim; ++a) {
+          if (!fixed[node * dim + a])
+            pr.fail("displacement", "prescribes a value on an unknown no support fixes");
+          l.prescribed[node * dim + a] = value[a];
+          case_value = case_value || value[a] != 0;
+        }
+    }
+  }
+  if (!case_value) l.prescribed.resize(0);
+  if (l.objective == ElasticObjective::target) {
+    l.target = VecX::Zero(n);
+    l.target_weight = VecX::Zero(n);
+    if (!lc.has("targets")) lc.fail("targets", "is missing: a target objective needs target displacements");
+    for (const Config& t : lc.children("targets")) {
+      const Vec3 value = read_vector(t, "displacement", dim);
+      const double w = t.get_or<double>("weight", 1.0);
+      if (!(w > 0)) t.fail("weight", "must be > 0");
+      for (std::int64_t node : select_nodes(t, g))
+        for (int a = 0; a < dim; ++a) l.target[node * dim + a] = value[a], l.target_weight[node * dim + a] = w;
+    }
+  } else if (lc.has("targets")) {
+    lc.fail("targets", "only a target objective takes targets");
+  }
+  if (l.force.squaredNorm() == 0 && l.prescribed.size() == 0)
+    lc.fail("", "has neither a force nor a nonzero prescribed displacement");
+  return l;
+}
+
+// Mass: a volume fraction or a weighted target, and local density targets.
+void read_mass_terms(const Config& config, const CellGrid& g, TopoptScene& scene) {
+  const int dim = g.dimension();
+  if (config.has("mass")) {
+    const Config m = config.child("mass");
+    scene.volume_fraction = m.get_or<double>("volume_fraction", 0.0);
+    if (!(scene.volume_fraction >= 0 && scene.volume_fraction <= 1)) m.fail("volume_fraction", "must be in [0, 1]");
+    scene.setup.mass.total_weight = m.get_or<double>("weight", 0.0);
+    if (!(scene.setup.mass.total_weight >= 0)) m.fail("weight", "must be >= 0");
+    if (scene.setup.mass.total_weight > 0) scene.setup.mass.total_target = m.require_positive("target", "target mass");
+  }
+  if (config.has("local_density")) {
+    scene.setup.mass.local_target = VecX::Zero(g.cells());
+    for (const Config& item : config.children("local_density")) {
+      const Box box = read_box(item, "box", dim);
+      const double rho = item.require_range<double>("rho", 0.0, 1.0);
+      const double w = item.require_positive("weight");
+      scene.setup.mass.local_weight = std::max(scene.setup.mass.local_weight, w);
+      for (std::int64_t c = 0; c < g.cells(); ++c)
+        if (box.contains(g.cell_center(c), 1e-9 * g.h())) scene.setup.mass.local_target[c] = rho;
+    }
+  }
+}
+
 }  // namespace
 
 TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double gamut_decades) {
@@ -116,33 +232,7 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
   s.solid_C = isotropic_voigt(dim, scene.E0, scene.nu);
   s.empty_C = void_ratio * s.solid_C;
 
-  // Design domain: design everywhere, then the items in order.
-  s.roles.assign(g.cells(), CellRole::design);
-  if (config.has("domain")) {
-    for (const Config& item : config.children("domain")) {
-      const std::string role = item.one_of("role", {"design", "empty", "solid"});
-      const CellRole r = role == "design" ? CellRole::design : role == "empty" ? CellRole::empty : CellRole::solid;
-      int hits = 0;
-      if (item.has("box")) {
-        const Box box = read_box(item, "box", dim);
-        for (std::int64_t c = 0; c < g.cells(); ++c)
-          if (box.contains(g.cell_center(c), 1e-9 * h)) s.roles[c] = r, ++hits;
-      } else if (item.has("cylinder")) {
-        // A cylinder along z (3D) or a disk (2D).
-        const Config cyl = item.child("cylinder");
-        const auto centre = cyl.get<std::vector<double>>("center");
-        if (centre.size() != 2) cyl.fail("center", "needs 2 coordinates (x, y)");
-        const double radius = cyl.require_positive("radius");
-        for (std::int64_t c = 0; c < g.cells(); ++c) {
-          const Vec3 x = g.cell_center(c);
-          if (std::hypot(x[0] - centre[0], x[1] - centre[1]) <= radius) s.roles[c] = r, ++hits;
-        }
-      } else {
-        item.fail("", "a domain item needs a box or a cylinder");
-      }
-      if (hits == 0) item.fail("", "selects no cell of the grid");
-    }
-  }
+  read_design_domain(config, g, s.roles);
 
   // Supports.
   const std::int64_t n = g.unknowns();
@@ -178,83 +268,11 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
       for (int a = 0; a < g.corners(); ++a) carried[g.cell_nodes(c)[a]] = 1;
 
   // Load cases.
-  for (const Config& lc : config.children("loads")) {
-    LoadCase l;
-    l.name = lc.get_or<std::string>("name", "load" + std::to_string(s.loads.size()));
-    l.weight = lc.get_or<double>("weight", 1.0);
-    if (!(l.weight > 0)) lc.fail("weight", "must be > 0");
-    const std::string objective = lc.one_of("objective", {"compliance", "target"});
-    l.objective = objective == "compliance" ? ElasticObjective::compliance : ElasticObjective::target;
-    l.force = VecX::Zero(n);
-    if (lc.has("forces")) {
-      for (const Config& f : lc.children("forces")) {
-        const std::vector<std::int64_t> nodes = select_nodes(f, g);
-        const Vec3 force = read_vector(f, "force", dim);
-        // `total`: the force is shared by the selected nodes; `per_node`: each gets it.
-        const std::string spread = f.get_or("distribute", "per_node");
-        if (spread != "per_node" && spread != "total") f.fail("distribute", "is per_node or total");
-        const double share = spread == "total" ? 1.0 / double(nodes.size()) : 1.0;
-        for (std::int64_t node : nodes) {
-          if (!carried[node]) f.fail("", "loads a node that only empty cells touch (a load on void)");
-          for (int a = 0; a < dim; ++a) l.force[node * dim + a] += share * force[a];
-        }
-      }
-    }
-    l.prescribed = support_values;
-    bool case_value = any_value;
-    if (lc.has("prescribed")) {
-      for (const Config& pr : lc.children("prescribed")) {
-        const Vec3 value = read_vector(pr, "displacement", dim);
-        for (std::int64_t node : select_nodes(pr, g))
-          for (int a = 0; a < dim; ++a) {
-            if (!s.fixed[node * dim + a])
-              pr.fail("displacement", "prescribes a value on an unknown no support fixes");
-            l.prescribed[node * dim + a] = value[a];
-            case_value = case_value || value[a] != 0;
-          }
-      }
-    }
-    if (!case_value) l.prescribed.resize(0);
-    if (l.objective == ElasticObjective::target) {
-      l.target = VecX::Zero(n);
-      l.target_weight = VecX::Zero(n);
-      if (!lc.has("targets")) lc.fail("targets", "is missing: a target objective needs target displacements");
-      for (const Config& t : lc.children("targets")) {
-        const Vec3 value = read_vector(t, "displacement", dim);
-        const double w = t.get_or<double>("weight", 1.0);
-        if (!(w > 0)) t.fail("weight", "must be > 0");
-        for (std::int64_t node : select_nodes(t, g))
-          for (int a = 0; a < dim; ++a) l.target[node * dim + a] = value[a], l.target_weight[node * dim + a] = w;
-      }
-    } else if (lc.has("targets")) {
-      lc.fail("targets", "only a target objective takes targets");
-    }
-    if (l.force.squaredNorm() == 0 && l.prescribed.size() == 0)
-      lc.fail("", "has neither a force nor a nonzero prescribed displacement");
-    s.loads.push_back(std::move(l));
-  }
+  for (const Config& lc : config.children("loads"))
+    s.loads.push_back(read_load_case(lc, g, s.fixed, carried, support_values, any_value, s.loads.size()));
   if (s.loads.empty()) config.fail("loads", "needs at least one load case");
 
-  // Mass.
-  if (config.has("mass")) {
-    const Config m = config.child("mass");
-    scene.volume_fraction = m.get_or<double>("volume_fraction", 0.0);
-    if (!(scene.volume_fraction >= 0 && scene.volume_fraction <= 1)) m.fail("volume_fraction", "must be in [0, 1]");
-    s.mass.total_weight = m.get_or<double>("weight", 0.0);
-    if (!(s.mass.total_weight >= 0)) m.fail("weight", "must be >= 0");
-    if (s.mass.total_weight > 0) s.mass.total_target = m.require_positive("target", "target mass");
-  }
-  if (config.has("local_density")) {
-    s.mass.local_target = VecX::Zero(g.cells());
-    for (const Config& item : config.children("local_density")) {
-      const Box box = read_box(item, "box", dim);
-      const double rho = item.require_range<double>("rho", 0.0, 1.0);
-      const double w = item.require_positive("weight");
-      s.mass.local_weight = std::max(s.mass.local_weight, w);
-      for (std::int64_t c = 0; c < g.cells(); ++c)
-        if (box.contains(g.cell_center(c), 1e-9 * h)) s.mass.local_target[c] = rho;
-    }
-  }
+  read_mass_terms(config, g, scene);
   s.filter_radius = config.get_or<double>("filter.radius", 0.0);
   if (!(s.filter_radius >= 0)) config.fail("filter.radius", "must be >= 0");
   s.solver = config.has("solver") ? config.one_of("solver", {"auto", "cholmod", "pcg-mg", "matrix-free"}) : "auto";

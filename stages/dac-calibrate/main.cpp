@@ -41,6 +41,10 @@ scene: configs/dynamics/cantilever_pluck.yaml
 material: rigur
 target: {frequency: 340.0, decay: 20.0}   # a stand-in for a measured rig
 modes: 4
+# search_levels: 2          # also mesh the rig at 1..2 halvings of its voxel: calibrate the coarsest
+#                           # whose first modes' shapes match the finest's (§4.3.1), and report the
+#                           # converged frequencies and the accurate mesh
+# accuracy_tolerance: 0.05  # accurate mesh: first modes within this fraction of the converged values
 )yaml";
 
 DynamicsScene scene_at_voxel_size(const std::string& path, double voxel_size) {
@@ -71,6 +75,33 @@ double undamped_if_unresolved(const std::string& track_path, double decay, doubl
                    std::to_string(uncertainty) + " 1/s): not the free decay of a rig, cannot calibrate on it");
 }
 
+// The search's levels, the converged frequencies and the accurate mesh
+// (thesis Fig. 4-11: frequencies within the tolerance of their converged
+// values), which is what a coarse DAC mesh is timed against.
+void report_search(const DacResult& search, double voxel_size, int num_modes) {
+  for (const DacLevelReport& l : search.levels)
+    spdlog::info("level {}: {} elements, f1 {:.4f} Hz, frequency change {:.2f}%, shape distance {:.4f}, "
+                 "frequency error against the converged values: largest {:.2f}%, mean {:.2f}%",
+                 l.level, l.elements, l.frequencies.size() ? l.frequencies[0] : 0.0, 100 * l.frequency_change,
+                 l.max_distance, 100 * l.limit_error, 100 * l.mean_limit_error);
+  std::string limits;
+  for (const FrequencyLimit& f : search.limits)
+    limits += f.monotone ? fmt::format(" {:.6g} (p {:.2f})", f.limit, f.order) : fmt::format(" {:.6g} (finest)", f.limit);
+  std::printf("  converged frequencies of the first %d modes (Hz; Richardson extrapolation over the three finest "
+              "levels, observed order p):%s\n",
+              num_modes, limits.c_str());
+  if (search.accurate_level < 0) {
+    std::printf("  accurate mesh: none of the levels searched (finest: largest error %.2f%%)\n",
+                100 * search.levels.back().limit_error);
+    return;
+  }
+  const DacLevelReport& a = search.levels[search.accurate_index];
+  std::printf("  accurate mesh: level %d, voxel %.4g m, %d elements (first %d frequencies within %.2f%% of the "
+              "converged values, mean %.2f%%)\n",
+              a.level, voxel_size / std::pow(2.0, a.level), a.elements, num_modes, 100 * a.limit_error,
+              100 * a.mean_limit_error);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,6 +119,8 @@ int main(int argc, char** argv) {
     if (num_modes < 1 || num_modes > 50) c.fail("modes", "must be in 1..50");
     const int search_levels = c.get_or<int>("search_levels", 0);
     if (search_levels < 0 || search_levels > 5) c.fail("search_levels", "must be in 0..5");
+    const double accuracy_tolerance = c.get_or<double>("accuracy_tolerance", 0.05);
+    if (!(accuracy_tolerance > 0 && accuracy_tolerance < 1)) c.fail("accuracy_tolerance", "must be in (0, 1)");
     const bool from_marker = c.has("marker_csv");
     if (from_marker == c.has("target")) c.fail("target", "give either target {frequency, decay} or marker_csv");
     double f_t = 0, d_t = 0;
@@ -131,6 +164,7 @@ int main(int argc, char** argv) {
       DacOptions options;
       options.num_modes = num_modes;
       options.max_level = search_levels;
+      options.accuracy_tolerance = accuracy_tolerance;
       search = dac_geometric_coarsening(
           [&](int level) {
             const DynamicsScene s = scene_at_voxel_size(scene_path, rig.grid.voxel_size / std::pow(2.0, level));
@@ -139,9 +173,7 @@ int main(int argc, char** argv) {
           options);
       voxel_size = rig.grid.voxel_size / std::pow(2.0, search.chosen_level);
       modes = search.chosen_modes;
-      for (const DacLevelReport& l : search.levels)
-        spdlog::info("level {}: {} elements, f1 {:.4f} Hz, frequency change {:.2f}%, shape distance {:.4f}", l.level,
-                     l.elements, l.frequencies.size() ? l.frequencies[0] : 0.0, 100 * l.frequency_change, l.max_distance);
+      report_search(search, rig.grid.voxel_size, num_modes);
     } else {
       ModalOptions options;
       options.num_modes = num_modes;
