@@ -90,6 +90,11 @@ void report_search(const DacResult& search, double voxel_size, int num_modes) {
   std::printf("  converged frequencies of the first %d modes (Hz; Richardson extrapolation over the three finest "
               "levels, observed order p):%s\n",
               num_modes, limits.c_str());
+  const bool all_extrapolated = std::all_of(search.limits.begin(), search.limits.end(),
+                                           [](const FrequencyLimit& f) { return f.monotone; });
+  if (!search.converged && !all_extrapolated)
+    std::printf("  note: the levels neither converged (frequency change < 1%%) nor gave every mode a limit (three "
+                "levels converging monotonically): the accurate mesh below is judged against the finest level\n");
   if (search.accurate_level < 0) {
     std::printf("  accurate mesh: none of the levels searched (finest: largest error %.2f%%)\n",
                 100 * search.levels.back().limit_error);

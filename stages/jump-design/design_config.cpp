@@ -58,6 +58,8 @@ void read_optimizer(const Config& c, DesignProblem& p) {
   if (p.starts < 1 || p.starts > 1000) o.fail("starts", "must be in [1, 1000]");
   p.spread = o.get_or<double>("spread", p.spread);
   if (!(p.spread >= 0)) o.fail("spread", "must be >= 0 (initial steps)");
+  if (o.has("start_points"))
+    p.space_filling_starts = o.one_of("start_points", {"around_initial", "space_filling"}) == "space_filling";
   p.xtol = o.get_or<double>("xtol", p.xtol);
   if (!(p.xtol > 0) || !(p.xtol < 1)) o.fail("xtol", "must be in (0, 1) (normalized parameters)");
   p.stop_below = o.get_or<double>("stop_below", p.stop_below);

@@ -55,8 +55,12 @@ struct DesignProblem {
   double settle = 0.01;      // s: simulated after the landing before the run is stopped
   // Optimizer.
   int max_evaluations = 20;  // per start
-  int starts = 1;            // the initial design and starts - 1 perturbations of it
-  double spread = 1.0;       // perturbation size in initial steps
+  int starts = 1;            // the initial design and starts - 1 more (see start_point)
+  double spread = 1.0;       // perturbation size in initial steps (starts around the initial design)
+  // Where starts 1.. begin: `around_initial` (corners at `spread` steps) or
+  // `space_filling` (a Halton sequence over the whole box, independent of
+  // the initial design: a global stage).
+  bool space_filling_starts = false;
   double xtol = 0.01;        // stop when a step changes no normalized parameter by more
   double stop_below = 0;     // stop a start once its objective is below this (0: never)
   double length_scale = 0.01;  // m: constraints and distances are divided by it for COBYLA

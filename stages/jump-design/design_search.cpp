@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <nlopt.hpp>
 #include <string>
 
@@ -12,14 +13,32 @@
 
 namespace msfab {
 
+namespace {
+
+// The radical inverse of k in base b: the k-th Halton coordinate.
+double radical_inverse(int k, int base) {
+  double inverse = 0, digit = 1.0 / base;
+  for (; k > 0; k /= base, digit /= base) inverse += digit * (k % base);
+  return inverse;
+}
+
+}  // namespace
+
 std::vector<double> start_point(const DesignProblem& p, int start) {
   std::vector<double> x;
   const int n = static_cast<int>(p.parameters.size());
   const int corners = n < 20 ? 1 << n : 1 << 20;
+  static constexpr int kPrimes[] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53, 59, 61, 67, 71};
+  if (p.space_filling_starts && n > static_cast<int>(std::size(kPrimes)))
+    throw InputError("design loop: space-filling starts take at most 20 parameters");
   for (int i = 0; i < n; ++i) {
     const DesignParameter& q = p.parameters[i];
     double value = q.initial;
-    if (start > 0) {
+    if (start > 0 && p.space_filling_starts) {
+      // Halton point `start` (point 0 is the box's corner, so the sequence
+      // begins at 1): low discrepancy for every number of starts.
+      value = q.lower + radical_inverse(start, kPrimes[i]) * (q.upper - q.lower);
+    } else if (start > 0) {
       // Corners first at `spread` steps, then again further out, so no two
       // starts coincide before clamping.
       const int k = start - 1;

@@ -13,9 +13,11 @@
 
 namespace msfab {
 
-// Start 0 is the initial design; start k > 0 moves every normalized
+// Start 0 is the initial design. Start k > 0 moves every normalized
 // parameter by `spread` initial steps, the signs running through the
-// corners of the box (k - 1 in binary), clamped to the bounds.
+// corners of the box (k - 1 in binary), clamped to the bounds; or, with
+// space-filling starts, is the k-th point of the Halton sequence over the
+// box (bases 2, 3, 5, ... per parameter).
 std::vector<double> start_point(const DesignProblem& problem, int start);
 
 // One COBYLA run of at most max_evaluations simulations; every evaluation

@@ -46,6 +46,24 @@ echo "tip frequency: fine rig $f_fine Hz, calibrated coarse rig $f_coarse Hz"
 check "calibrated coarse rig reproduces the fine f1 within 1%" -- \
   awk -v a="$f_fine" -v b="$f_coarse" 'BEGIN { d = (b - a) / a; if (d < 0) d = -d; exit !(a > 0 && d < 0.01) }'
 
+# The accurate mesh (Fig. 4-11): the rig at 3, 1.5 and 0.75 mm; every
+# mode's converged frequency extrapolated (the meshes soften towards it, so
+# it lies below the finest mesh's), and the coarsest mesh within 5% named.
+printf 'scene: %s\nmaterial: rigur\ntarget: {frequency: 340.0, decay: 0.0}\nmodes: 4\nsearch_levels: 2\n' \
+  "$SRC/$S/cantilever_pluck.yaml" > "$WORK/search.yaml"
+check "mesh search with converged frequencies" -- bash -c "'$BIN/msfab-dac-calibrate' --config '$WORK/search.yaml' \
+  --out '$WORK/search.h5' > '$WORK/search.txt' 2> '$WORK/search.log'"
+grep -E "converged frequencies|accurate mesh|level [0-9]:" "$WORK/search.txt" "$WORK/search.log"
+check "every mode extrapolated" -- bash -c "grep 'converged frequencies' '$WORK/search.txt' | grep -o '(p ' | wc -l | grep -qx 4"
+f_limit=$(awk '/converged frequencies/ { for (i = 1; i <= NF; ++i) if ($i == "(p") { print $(i - 1); exit } }' "$WORK/search.txt")
+f_finest=$(grep -o "level 2: .* f1 [0-9.]*" "$WORK/search.log" | awk '{ print $NF }')
+echo "f1: finest mesh $f_finest Hz, extrapolated $f_limit Hz"
+check "the limit lies below the finest mesh, within 5%" -- \
+  awk -v l="$f_limit" -v f="$f_finest" 'BEGIN { exit !(l > 0 && l < f && f < 1.05 * l) }'
+check "the accurate mesh is named" -- grep -q "accurate mesh: level [0-2], voxel" "$WORK/search.txt"
+expect_exit 2 "accuracy_tolerance.*must be in \(0, 1\)" -- "$BIN/msfab-dac-calibrate" --config "$WORK/search.yaml" \
+  --set accuracy_tolerance=0 --out "$WORK/x.h5"
+
 # Catapult: the cube lying in the basket is carried into the loaded basket,
 # then thrown upward by the released arm through body contact.
 OMP_NUM_THREADS=1 "$BIN/msfab-dynamics" --quiet --config $S/catapult.yaml --set simulation.duration=0.02 \

@@ -52,6 +52,17 @@ same() {
 }
 check "1 and 2 ranks give identical evaluations and designs" -- same "$WORK/one.h5" "$WORK/two.h5"
 
+# Space-filling starts (the global stage): start k > 0 begins at the k-th
+# Halton point of the box, bases 2 and 3: (1/2, 1/3), then (1/4, 2/3).
+check "space-filling starts" -- "$DESIGN" --config "$WORK/design.yaml" --set optimizer.start_points=space_filling \
+  --set optimizer.starts=3 --set optimizer.max_evaluations=1 --threads 2 --out "$WORK/halton.h5" --quiet
+check "starts at the Halton points" -- bash -c "h5dump -d /evaluations/parameters '$WORK/halton.h5' | awk '
+  /\\(0,0\\)/ { ok += (\$2 + 0 == 0.01 && \$3 + 0 == 0.5) }
+  /\\(1,0\\)/ { ok += (\$2 - 0.011 < 1e-12 && 0.011 - \$2 < 1e-12 && \$3 - 0.5 < 1e-12 && 0.5 - \$3 < 1e-12) }
+  /\\(2,0\\)/ { ok += (\$2 - 0.0095 < 1e-12 && 0.0095 - \$2 < 1e-12 && \$3 - 0.7 < 1e-12 && 0.7 - \$3 < 1e-12) }
+  END { exit ok != 3 }'"
+expect_exit 2 "start_points" -- "$DESIGN" --config "$WORK/design.yaml" --set optimizer.start_points=random --out "$WORK/bad.h5"
+
 # Print variation of the final design: the samples are recorded, do not
 # depend on the rank count, and a throw that hits within 2 mm still hits
 # within 1 cm with E +-20% and the length +-0.2 mm.

@@ -318,14 +318,19 @@ TEST(ModeShapeDistance, IdenticalZeroAndCoarseBeamModesClose) {
   }
 }
 
+namespace {
+// DAC level l: the cantilever with l voxels through the thickness.
+DacLevel cantilever_levels(int level) {
+  Body b = cantilever(level);
+  return DacLevel{std::move(b.mesh), std::move(b.density), std::move(b.fixed), kWidth / level};
+}
+}  // namespace
+
 TEST(DacCoarsening, PicksCoarsestLevelWithinShapeTolerance) {
   // Level l: cantilever with l voxels through the thickness. The frequency
   // tolerance is 5% instead of the thesis' 1% (which needs ~10 voxels
   // through the thickness of this locking-prone beam) to keep the test fast.
-  DacLevelBuilder build = [](int level) {
-    Body b = cantilever(level);
-    return DacLevel{std::move(b.mesh), std::move(b.density), std::move(b.fixed), kWidth / level};
-  };
+  const DacLevelBuilder build = cantilever_levels;
   DacOptions opt;
   opt.first_level = 1;
   opt.max_level = 5;
@@ -391,10 +396,7 @@ TEST(DacCoarsening, ExtrapolatedLimitMeetsBeamTheoryAndNamesTheAccurateLevel) {
   // convergence asked for: the first frequency extrapolated from the three
   // lies within 1% of Euler-Bernoulli (shear and rotary inertia, about
   // -0.5% at L/w = 10), the finest mesh itself 2-3% above it.
-  DacLevelBuilder build = [](int level) {
-    Body b = cantilever(level);
-    return DacLevel{std::move(b.mesh), std::move(b.density), std::move(b.fixed), kWidth / level};
-  };
+  const DacLevelBuilder build = cantilever_levels;
   DacOptions opt;
   opt.first_level = 1;
   opt.max_level = 3;
