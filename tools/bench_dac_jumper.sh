@@ -21,13 +21,7 @@ source "$(dirname "$0")/dac_bench_lib.sh"
 bench_folders "${1:-build/bin}" "${2:-out/bench/dac_jumper}"
 SCENE=$SRC/configs/dynamics/flipper_jumper.yaml
 
-echo "mesh convergence (2 mm and ${LEVELS:-3} halvings):"
-convergence "$SCENE" rigur "${LEVELS:-3}"
-REF=${REFERENCE:-$ACCURATE}
-[ -n "$REF" ] || { echo "no accurate mesh among the levels: give REFERENCE" >&2; exit 1; }
-echo "reference: the flipper at $REF m (accurate mesh: ${ACCURATE:-none})"
-sed "s/voxel_size: 0.002/voxel_size: $REF/" "$SCENE" > flipper_ref.yaml
-sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > flipper_1mm.yaml
+reference_meshes "$SCENE" rigur flipper
 
 modes "$OUT/flipper_ref.yaml" rigur modes_ref.h5 > f_ref.txt
 modes "$OUT/flipper_1mm.yaml" rigur modes_1mm.h5 > f_1mm.txt

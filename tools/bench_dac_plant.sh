@@ -19,13 +19,7 @@ source "$(dirname "$0")/dac_bench_lib.sh"
 bench_folders "${1:-build/bin}" "${2:-out/bench/dac_plant}"
 SCENE=$SRC/configs/dynamics/plant.yaml
 
-echo "mesh convergence (2 mm and ${LEVELS:-3} halvings):"
-convergence "$SCENE" dm4825 "${LEVELS:-3}"
-REF=${REFERENCE:-$ACCURATE}
-[ -n "$REF" ] || { echo "no accurate mesh among the levels: give REFERENCE" >&2; exit 1; }
-echo "reference: the plant at $REF m"
-sed "s/voxel_size: 0.002/voxel_size: $REF/" "$SCENE" > plant_ref.yaml
-sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$SCENE" > plant_1mm.yaml
+reference_meshes "$SCENE" dm4825 plant
 
 modes "$OUT/plant_ref.yaml" dm4825 modes_ref.h5 > f_ref.txt
 modes "$OUT/plant_1mm.yaml" dm4825 modes_1mm.h5 > f_1mm.txt

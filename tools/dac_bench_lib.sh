@@ -54,6 +54,20 @@ convergence() {
   ACCURATE=$(awk '/accurate mesh: level/ { for (i = 1; i <= NF; ++i) if ($i == "voxel") print $(i + 1) }' convergence.txt)
 }
 
+# reference_meshes SCENE MATERIAL NAME: the convergence table of SCENE (a
+# 2 mm scene) over LEVELS halvings (default 3), then NAME_ref.yaml at
+# REFERENCE (a voxel size; default the accurate mesh) and NAME_1mm.yaml.
+# Sets REF to the reference's voxel size.
+reference_meshes() {
+  echo "mesh convergence (2 mm and ${LEVELS:-3} halvings):"
+  convergence "$1" "$2" "${LEVELS:-3}"
+  REF=${REFERENCE:-$ACCURATE}
+  [ -n "$REF" ] || { echo "no accurate mesh among the levels: give REFERENCE" >&2; exit 1; }
+  echo "reference: the $3 at $REF m (accurate mesh: ${ACCURATE:-none})"
+  sed "s/voxel_size: 0.002/voxel_size: $REF/" "$1" > "$3_ref.yaml"
+  sed "s/voxel_size: 0.002/voxel_size: 0.001/" "$1" > "$3_1mm.yaml"
+}
+
 # timed_run NAME SCENE ARGS...: msfab-dynamics with peak memory; prints
 # time per elastic step, total time and memory.
 timed_run() {

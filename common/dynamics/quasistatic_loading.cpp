@@ -14,6 +14,10 @@
 namespace msfab {
 namespace {
 
+// Total iterations of one load increment, in units of max_iterations (see
+// the iteration limit in newton_at).
+constexpr int kActiveSetRounds = 10;
+
 constexpr int kFree = -1;
 
 // Contact state per node: the obstacle holding it (kFree if none) and the
@@ -215,7 +219,14 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
     const VecX fs = s * force;
     int activated = 0;  // free vertices made active after the previous step
     std::vector<double> recent;  // residuals since the active set last changed
-    for (int it = 0; it <= opt.max_iterations; ++it) {
+    // The iteration limit counts Newton iterations at a settled active set:
+    // a contact front that peels or spreads moves by a row of vertices per
+    // iteration, so on a fine mesh the active set alone can take more than
+    // max_iterations updates (the 0.5 mm flipper lifting its base: 60). A
+    // hard cap of kActiveSetRounds times the limit stops a cycling set.
+    int last_change = 0;
+    const int hard_cap = kActiveSetRounds * opt.max_iterations;
+    for (int it = 0;; ++it) {
       const double E = assembler.evaluate(q, &g, &K);
       if (!std::isfinite(E)) {
         why = "the configuration is inverted (an element has det F <= 0)";
@@ -286,10 +297,15 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
         result.history.push_back(rec);
         return true;
       }
-      if (released || activated) recent.clear();
-      if (it == opt.max_iterations) {
+      if (released || activated) {
+        recent.clear();
+        last_change = it;
+      }
+      if (it - last_change == opt.max_iterations || it == hard_cap) {
         result.history.push_back(rec);
-        why = "no convergence in " + std::to_string(opt.max_iterations) + " iterations";
+        why = "no convergence in " + std::to_string(it) + " iterations (" + std::to_string(it - last_change) +
+              " since the active set last changed; limits " + std::to_string(opt.max_iterations) + " and " +
+              std::to_string(hard_cap) + ")";
         return false;
       }
 

@@ -28,7 +28,7 @@ struct QuasistaticOptions {
   // Convergence: ||free residual|| <= relative_tolerance * force scale (the
   // applied load and the contact reactions), with an unchanged active set.
   double relative_tolerance = 1e-9;
-  int max_iterations = 60;     // per load increment
+  int max_iterations = 60;     // per load increment, counted from the last change of the active set
   int load_steps = 4;          // initial number of equal load increments
   int max_step_halvings = 6;   // adaptive cuts of a failing increment
   double armijo = 1e-4;
