@@ -78,7 +78,8 @@ double undamped_if_unresolved(const std::string& track_path, double decay, doubl
 // The search's levels, the converged frequencies and the accurate mesh
 // (thesis Fig. 4-11: frequencies within the tolerance of their converged
 // values), which is what a coarse DAC mesh is timed against.
-void report_search(const DacResult& search, double voxel_size, int num_modes) {
+void report_search(const DacResult& search, const DacOptions& options, double voxel_size) {
+  const int num_modes = options.num_modes;
   for (const DacLevelReport& l : search.levels)
     spdlog::info("level {}: {} elements, f1 {:.4f} Hz, frequency change {:.2f}%, shape distance {:.4f}, "
                  "frequency error against the converged values: largest {:.2f}%, mean {:.2f}%",
@@ -93,8 +94,9 @@ void report_search(const DacResult& search, double voxel_size, int num_modes) {
   const bool all_extrapolated = std::all_of(search.limits.begin(), search.limits.end(),
                                            [](const FrequencyLimit& f) { return f.monotone; });
   if (!search.converged && !all_extrapolated)
-    std::printf("  note: the levels neither converged (frequency change < 1%%) nor gave every mode a limit (three "
-                "levels converging monotonically): the accurate mesh below is judged against the finest level\n");
+    std::printf("  note: the levels neither converged (frequency change < %g%%) nor gave every mode a limit (three "
+                "levels converging monotonically): the accurate mesh below is judged against the finest level\n",
+                100 * options.convergence_tolerance);
   if (search.accurate_level < 0) {
     std::printf("  accurate mesh: none of the levels searched (finest: largest error %.2f%%)\n",
                 100 * search.levels.back().limit_error);
@@ -178,7 +180,7 @@ int main(int argc, char** argv) {
           options);
       voxel_size = rig.grid.voxel_size / std::pow(2.0, search.chosen_level);
       modes = search.chosen_modes;
-      report_search(search, rig.grid.voxel_size, num_modes);
+      report_search(search, options, rig.grid.voxel_size);
     } else {
       ModalOptions options;
       options.num_modes = num_modes;
