@@ -14,6 +14,10 @@
 #                                                    lattice family at 64^3, coarse to fine, mapped (1.07e12 voxels; about an hour)
 #   make -f Makefile.pipeline topopt-thesis-2d       the thesis's 2D scenes: the S-beam (Fig. 3-18), the four
 #                                                    grippers (Fig. 3-20) and the orthotropic lattice (Fig. 3-25)
+#   make -f Makefile.pipeline topopt-fig316          Fig. 3-16 on the 2D cantilever: SIMP p = 1 / p = 3, the cubic and
+#                                                    orthotropic gamuts of one material + void run to convergence (the
+#                                                    orthotropic one seeded with the cubic structures), Ipopt and cell
+#                                                    MMA: out/topopt/fig316.md (about 40 minutes, most of it Ipopt)
 #   make -f Makefile.pipeline topopt-cubes           Table 3.1's cubes and the tiling study (Fig. 3-23) in
 #                                                    configs/gamut/cubic3d_bar_dense.yaml: out/topopt/cubes.md
 #                                                    (tools/bench_cubes.sh, about 15 minutes)
@@ -202,6 +206,25 @@ $(OUT)/topopt/$(1).design.h5: configs/topopt/$(1).yaml $(OUT)/gamut/$(2).gamut.h
 	$(BIN)/msfab-topopt --config $$< --set gamut=$(OUT)/gamut/$(2).gamut.h5 --threads $(THREADS) --out $$@
 endef
 $(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)))))
+
+# The orthotropic gamut of Fig. 3-16 starts from the cubic gamut's
+# structures (every cubic material is orthotropic), then runs to convergence.
+FIG316_CUBIC := $(OUT)/gamut/converged/cubic2d_void
+FIG316_ORTHO := $(OUT)/gamut/converged/orthotropic2d_void_seeded
+$(FIG316_ORTHO).gamut.h5: configs/gamut/orthotropic2d_void.yaml $(FIG316_CUBIC).gamut.h5 $(BIN)/msfab-gamut-sample
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume \
+	  --set cycles=$(CONVERGE_CYCLES) --set plot_every_cycle=false \
+	  --set stop='{coverage_growth: $(CONVERGE_GROWTH), window: $(CONVERGE_WINDOW)}' \
+	  --set initial_set='{path: $(abspath $(FIG316_CUBIC)).microstructures.h5}'
+$(OUT)/topopt/fig316.md: $(FIG316_CUBIC).gamut.h5 $(FIG316_ORTHO).gamut.h5 tools/bench_topopt.sh $(BIN)/msfab-topopt
+	@mkdir -p $(@D)
+	CANTILEVER_ONLY=1 CUBIC2D=$(FIG316_CUBIC).gamut.h5 ORTHO2D=$(FIG316_ORTHO).gamut.h5 \
+	  bash tools/bench_topopt.sh $(BUILD) > $@.tmp
+	mv $@.tmp $@
+
+.PHONY: topopt-fig316
+topopt-fig316: stages $(OUT)/topopt/fig316.md
 
 .PHONY: topopt-thesis-2d
 topopt-thesis-2d: stages $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)

@@ -143,6 +143,49 @@ class OrthotropicModel : public CellMaterialModel {
   const GamutLevelSet* ls_;
 };
 
+// Square-symmetric cells inside an orthotropic gamut: the gamut's slice
+// Ex = Ey. Its feasible set is a subset of the orthotropic space's in the
+// same level set by construction, so the two spaces can be compared on one
+// gamut (Fig. 3-16), and its optimum is a feasible start for the
+// orthotropic run. The design records the orthotropic point, so it maps
+// with the orthotropic gamut's structures.
+class CubicSliceModel : public CubicModel {
+ public:
+  CubicSliceModel(UnitScale scale, const GamutLevelSet* ls) : CubicModel(2, scale, ls) {}
+  std::string space() const override { return "cubic2d_slice"; }
+  double constraint(const VecX& p, VecX* g) const override {
+    VecX go;
+    const double value = ls_->smooth_value(orthotropic_point(p), g ? &go : nullptr);
+    if (g) {
+      g->resize(4);
+      (*g) << go[0] + go[1], go[2], go[3], go[4];
+    }
+    return value;
+  }
+  std::string design_space() const override { return "orthotropic2d"; }
+  std::vector<std::string> design_names() const override { return {"Ex", "Ey", "nu_xy", "G", "rho"}; }
+  void design_row(const VecX& p, VecX& unit, VecX& raw_row) const override {
+    unit = orthotropic_point(p);
+    const VecX r = raw(p);
+    raw_row.resize(5);
+    raw_row << r[0], r[0], r[1], r[2], r[3];
+  }
+  // An orthotropic point's nearest slice point (Ex and Ey are log-scaled:
+  // their mean is the geometric mean of the moduli).
+  VecX parameters_of_design_unit(const VecX& unit) const override {
+    VecX p(4);
+    p << 0.5 * (unit[0] + unit[1]), unit[2], unit[3], unit[4];
+    return p;
+  }
+
+ private:
+  static VecX orthotropic_point(const VecX& p) {
+    VecX q(5);
+    q << p[0], p[0], p[1], p[2], p[3];
+    return q;
+  }
+};
+
 // Isotropic cells inside a cubic gamut: G tied to E and nu.
 class IsotropicModel : public CubicModel {
  public:
@@ -296,7 +339,7 @@ double CellMaterialModel::density(const VecX& p, VecX* gradient) const {
 }
 
 std::vector<std::string> cell_material_spaces() {
-  return {"cubic3d", "cubic2d", "orthotropic2d", "isotropic2d", "isotropic3d",
+  return {"cubic3d", "cubic2d", "orthotropic2d", "cubic2d_slice", "isotropic2d", "isotropic3d",
           "analytic2d", "analytic3d", "simp2d", "simp3d", "family3d"};
 }
 
@@ -305,6 +348,7 @@ bool needs_family_grid(const std::string& space) { return space == "family3d"; }
 std::string required_gamut_space(const std::string& space) {
   if (space == "cubic3d" || space == "cubic2d" || space == "orthotropic2d") return space;
   if (space == "isotropic2d") return "cubic2d";
+  if (space == "cubic2d_slice") return "orthotropic2d";
   if (space == "isotropic3d") return "cubic3d";
   return "";
 }
@@ -331,6 +375,7 @@ std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSe
   if (sp == "cubic3d") return std::make_unique<CubicModel>(3, scale, s.level_set);
   if (sp == "cubic2d") return std::make_unique<CubicModel>(2, scale, s.level_set);
   if (sp == "orthotropic2d") return std::make_unique<OrthotropicModel>(scale, s.level_set);
+  if (sp == "cubic2d_slice") return std::make_unique<CubicSliceModel>(scale, s.level_set);
   if (sp == "isotropic3d") return std::make_unique<IsotropicModel>(3, scale, s.level_set);
   if (sp == "isotropic2d") return std::make_unique<IsotropicModel>(2, scale, s.level_set);
   const double nu_hi = sp.back() == 'd' && sp[sp.size() - 2] == '3' ? 0.5 : 1.0;

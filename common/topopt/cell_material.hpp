@@ -14,6 +14,7 @@
 //   cubic3d/2d     E, nu, G, rho       cubic compliance             gamut level set
 //   orthotropic2d  Ex, Ey, nu_xy, G, rho orthotropic compliance     gamut level set
 //   isotropic2d/3d E, nu, rho          G = E / (2 (1 + nu))         the cubic gamut at that G
+//   cubic2d_slice  E, nu, G, rho       cubic compliance             an orthotropic gamut at Ex = Ey
 //   analytic2d/3d  E, rho              isotropic, nu fixed          E / E0 - rho^3 <= 0 (§3.6.2)
 //   simp2d/3d      rho                 E = Emin + rho^p (E0 - Emin) none (a volume constraint instead)
 //   family3d       the family's own, rho  interpolated between members rho >= the members' (family_material.hpp)
@@ -69,6 +70,10 @@ class CellMaterialModel {
   virtual std::string design_space() const { return space(); }
   virtual std::vector<std::string> design_names() const { return names(); }
   virtual void design_row(const VecX& p, VecX& unit, VecX& raw_row) const { unit = p, raw_row = raw(p); }
+  // The parameters of a design row's unit values (design_names() order), to
+  // start from a stored design: the inverse of design_row where one exists,
+  // else the nearest parameters. By default the row itself.
+  virtual VecX parameters_of_design_unit(const VecX& unit) const { return unit; }
   // A family space's own parameters (the first parameters of every cell;
   // raw() gives their values); empty elsewhere.
   virtual std::vector<std::string> family_names() const { return {}; }
@@ -116,7 +121,8 @@ std::vector<std::string> cell_material_spaces();
 bool needs_family_grid(const std::string& space);
 
 // The gamut space whose artifact a design space needs ("" for none):
-// isotropic2d -> cubic2d, isotropic3d -> cubic3d, a gamut space -> itself.
+// isotropic2d -> cubic2d, isotropic3d -> cubic3d, cubic2d_slice ->
+// orthotropic2d, a gamut space -> itself.
 std::string required_gamut_space(const std::string& space);
 
 // Isotropic Voigt stiffness (in-plane constants in 2D) of a solid cell.

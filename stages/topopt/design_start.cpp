@@ -33,7 +33,7 @@ DesignStart read_design_start(const Config& config, const CellMaterialModel& mod
       const int ck = std::min(coarse.nz - 1, int((k + 0.5) * coarse.nz / grid.nz()));
       const std::int64_t cc = ci + std::int64_t(coarse.nx) * (cj + std::int64_t(coarse.ny) * ck);
       if (family.empty()) {
-        start.per_cell.row(c) = coarse.unit.row(cc);
+        start.per_cell.row(c) = model.parameters_of_design_unit(coarse.unit.row(cc).transpose()).transpose();
       } else {  // the family's parameters, then rho
         const Eigen::Index k = Eigen::Index(family.size());
         start.per_cell.row(c).head(k) = coarse.family_unit.row(cc);

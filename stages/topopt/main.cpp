@@ -66,7 +66,6 @@ loads:
 mass: {volume_fraction: 0.5}
 filter: {radius: 1.5}
 optimizer: {name: auto, max_iterations: 500}
-initial: {rho: 0.5}
 )";
 }  // namespace
 

@@ -106,7 +106,7 @@ TEST(TopoptMaterial, StiffnessDerivativesAndConstraintGradientsMatchFiniteDiffer
     CellMaterialSettings s;
     s.space = space;
     s.E_stiff = 1e6;
-    s.level_set = space == "orthotropic2d" ? &ortho : &cubic;
+    s.level_set = required_gamut_space(space) == "orthotropic2d" ? &ortho : &cubic;
     const auto model = make_cell_material_model(s);
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> U(0.25, 0.75);
@@ -142,6 +142,38 @@ TEST(TopoptMaterial, InitialPointsLieInsideTheGamut) {
     const auto model = make_cell_material_model(s);
     for (double rho : {0.3, 0.5, 0.9}) EXPECT_LE(model->constraint(model->initial_point(rho), nullptr), 0) << space;
   }
+}
+
+// Fig. 3-16 compares the cubic and orthotropic spaces; on one orthotropic
+// gamut the cubic cells are its slice Ex = Ey, so every cubic cell is an
+// orthotropic one with the same stiffness and the same constraint value.
+TEST(TopoptMaterial, CubicSliceIsTheOrthotropicSpaceAtEqualModuli) {
+  const GamutLevelSet ortho = synthetic_gamut(5, 6);
+  CellMaterialSettings s;
+  s.E_stiff = 1e6;
+  s.level_set = &ortho;
+  s.space = "orthotropic2d";
+  const auto full = make_cell_material_model(s);
+  s.space = "cubic2d_slice";
+  const auto slice = make_cell_material_model(s);
+  EXPECT_EQ(slice->design_space(), "orthotropic2d");
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(0.25, 0.75);
+  for (int trial = 0; trial < 5; ++trial) {
+    VecX p(4);
+    for (int k = 0; k < 4; ++k) p[k] = U(rng);
+    VecX unit, raw;
+    slice->design_row(p, unit, raw);
+    ASSERT_EQ(unit.size(), 5);
+    EXPECT_EQ(unit[0], unit[1]);
+    MatX Cs, Co;
+    slice->tensor(p, Cs), full->tensor(unit, Co);
+    EXPECT_LT((Cs - Co).norm(), 1e-12 * Co.norm());
+    EXPECT_NEAR(slice->constraint(p, nullptr), full->constraint(unit, nullptr), 1e-14);
+    EXPECT_LT((raw - full->raw(unit)).norm(), 1e-9 * raw.norm());
+    EXPECT_LT((slice->parameters_of_design_unit(unit) - p).norm(), 1e-15);
+  }
+  for (double rho : {0.3, 0.5, 0.9}) EXPECT_LE(slice->constraint(slice->initial_point(rho), nullptr), 0);
 }
 
 TEST(TopoptMaterial, MissingOrWrongGamutIsAnInputError) {
