@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -421,6 +422,16 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     return Gp;
   };
 
+  // The contact unknowns go last in the factorization, so that the
+  // Delassus matrix comes from the factor's trailing block (one dense solve
+  // on them) instead of one sparse solve per contact column; a resting
+  // plate has hundreds of contacts (solve/cholmod_solver.hpp).
+  const std::vector<int> contact_dofs = contact_unknowns(contacts);
+  if (contact_dofs != solver_->last_unknowns()) {
+    if (contact_dofs.empty()) solver_->analyze(jacobian_);
+    else solver_->analyze_with_last(jacobian_, contact_dofs);
+  }
+
   for (int it = 1; it <= options_.max_newton_iterations; ++it) {
     const VecX x = q_ + delta;
     assembler_.evaluate(x, &grad, &K);
@@ -448,24 +459,14 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     const VecX delta_free = delta - solver_->solve(f);
     VecX candidate = delta_free;
     if (m > 0) {
-      MatX G = MatX::Zero(n, 3 * m);
-      for (int k = 0; k < m; ++k)
-        for (int c = 0; c < 3; ++c) {
-          VecX column = VecX::Zero(n);
-          contacts[k].scatter(contacts[k].frame.col(c), column);
-          apply_fixed(column);
-          G.col(3 * k + c) = column;
-        }
-      HinvG_ = solver_->solve_columns(G);
       ContactProblem problem;
       problem.h = h;
-      problem.W.resize(3 * m, 3 * m);
+      problem.W = delassus_matrix(contacts, contact_dofs);
       problem.u_free.resize(3 * m);
       problem.tangential_velocity_start.resize(2 * m);
       for (int k = 0; k < m; ++k) {
         const Contact& ct = contacts[k];
         const Mat3& F = ct.frame;
-        problem.W.middleRows<3>(3 * k) = F.transpose() * ct.relative_rows(HinvG_);
         problem.u_free.segment<3>(3 * k) = F.transpose() * ct.relative(delta_free);
         problem.gap0.push_back(ct.gap0);
         problem.mu.push_back(ct.mu);
@@ -483,7 +484,7 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
                              std::to_string(m) + " contacts, last relative change " + std::to_string(solved.max_change) + ")");
       impulses = solved.p;
       delassus_ = std::move(problem.W);
-      candidate += HinvG_ * impulses;
+      candidate += solver_->solve(contact_force(impulses));
     }
     // Backtracking on the step's incremental potential (Armijo) when the
     // direction descends it, which the frictionless contact step from an
@@ -513,6 +514,42 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
   throw NumericalError(msg.str());
 }
 
+std::vector<int> NewmarkIntegrator::contact_unknowns(const std::vector<Contact>& contacts) const {
+  std::vector<int> dofs;
+  for (const Contact& ct : contacts)
+    for (int i = 0; i < ct.count; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const int dof = 3 * ct.nodes[i] + a;
+        if (model_.fixed.empty() || !model_.fixed[dof]) dofs.push_back(dof);
+      }
+  std::sort(dofs.begin(), dofs.end());
+  dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
+  return dofs;
+}
+
+MatX NewmarkIntegrator::delassus_matrix(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const {
+  // G restricted to the contact unknowns, then W = (L_ll^{-1} G)^T (L_ll^{-1} G).
+  const int m = static_cast<int>(contacts.size());
+  std::unordered_map<int, int> row;
+  row.reserve(dofs.size());
+  for (std::size_t r = 0; r < dofs.size(); ++r) row.emplace(dofs[r], static_cast<int>(r));
+  MatX G = MatX::Zero(static_cast<Eigen::Index>(dofs.size()), 3 * m);
+  for (int k = 0; k < m; ++k) {
+    const Contact& ct = contacts[k];
+    for (int i = 0; i < ct.count; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const auto r = row.find(3 * ct.nodes[i] + a);
+        if (r == row.end()) continue;  // a fixed unknown
+        for (int c = 0; c < 3; ++c) G(r->second, 3 * k + c) += ct.coefficient[i] * ct.frame(a, c);
+      }
+  }
+  if (dofs.empty()) return MatX::Zero(3 * m, 3 * m);
+  const MatX X = solver_->trailing_factor().triangularView<Eigen::Lower>().solve(G);
+  MatX W = MatX::Zero(3 * m, 3 * m);
+  W.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
+  return W.selfadjointView<Eigen::Lower>();
+}
+
 VecX NewmarkIntegrator::impact_velocity(const VecX& delta, const std::vector<Contact>& contacts, const VecX& impulses) {
   const double h = options_.time_step;
   const VecX c = 2.0 * delta - h * v_;
@@ -522,19 +559,18 @@ VecX NewmarkIntegrator::impact_velocity(const VecX& delta, const std::vector<Con
     if (impulses(3 * k) > 0) active.push_back(static_cast<int>(k));
   if (active.empty()) return c / h;
   const int a = static_cast<int>(active.size());
-  // Y = A^{-1} N_a with A = H (BBI, reusing the last Newton factorization's
-  // columns) or A = M (DKE).
-  MatX Y(c.size(), a);
+  // Y = A^{-1} N_a with A = H (BBI, with the last Newton iterate's
+  // factorization and Delassus matrix) or A = M (DKE).
+  MatX Y;
   MatX S(a, a);
   if (model_.impact == ImpactModel::kBbi) {
-    for (int j = 0; j < a; ++j) Y.col(j) = HinvG_.col(3 * active[j]);
     for (int i = 0; i < a; ++i)
       for (int j = 0; j < a; ++j) S(i, j) = delassus_(3 * active[i], 3 * active[j]);
   } else {
     // DKE: the L2 projection with the lumped (row-sum) mass, which is
     // nodewise: each force-carrying node loses its normal velocity and
     // nothing else changes.
-    Y.setZero();
+    Y = MatX::Zero(c.size(), a);
     S.setZero();
     for (int j = 0; j < a; ++j) {
       const Contact& ct = contacts[active[j]];
@@ -557,7 +593,15 @@ VecX NewmarkIntegrator::impact_velocity(const VecX& delta, const std::vector<Con
   // Zero normal velocity at every force-carrying contact, nearest to c in
   // the chosen metric: d = c + Y mu with N_a^T d = 0.
   const VecX mu = S.ldlt().solve(-normal_c);
-  VecX d = c + Y * mu;
+  VecX d = c;
+  if (model_.impact == ImpactModel::kBbi) {  // H^{-1} N_a mu, one solve
+    VecX N_mu = VecX::Zero(c.size());
+    for (int j = 0; j < a; ++j) contacts[active[j]].scatter(mu(j) * contacts[active[j]].frame.col(0), N_mu);
+    apply_fixed(N_mu);
+    d += solver_->solve(N_mu);
+  } else {
+    d += Y * mu;
+  }
   apply_fixed(d);
   return d / h;
 }

@@ -130,6 +130,11 @@ class NewmarkIntegrator {
   // whose gradient is the residual of (B.6) with D held at q^t.
   double step_potential(const VecX& delta) const;
   void apply_fixed(VecX& x) const;
+  // The unknowns the contacts touch (fixed ones left out), sorted.
+  std::vector<int> contact_unknowns(const std::vector<Contact>& contacts) const;
+  // W = G^T H^{-1} G from the current factorization, analyzed with `dofs`
+  // (contact_unknowns) last.
+  MatX delassus_matrix(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const;
   VecX impact_velocity(const VecX& delta, const std::vector<Contact>& contacts, const VecX& impulses);
 
   const DynamicsModel& model_;
@@ -156,8 +161,8 @@ class NewmarkIntegrator {
   double time_ = 0;
   VecX step_rhs_;          // b^t of the current step
   double force_scale_ = 1; // what the current step's residual is relative to
-  // Last Newton iterate's H^{-1} G and Delassus matrix, reused by BBI.
-  MatX HinvG_;
+  // The last Newton iterate's Delassus matrix, reused by BBI with the
+  // factorization it came from.
   MatX delassus_;
 };
 

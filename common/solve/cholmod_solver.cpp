@@ -46,6 +46,14 @@ class CholmodThreadScope {
   SingleThreadedBlas blas_;  // OpenBLAS on one thread for the scope too
 };
 
+// METIS keeps its random-number state in globals: two threads ordering at
+// once disturb each other's orderings, and with them the round-off of every
+// solve. One ordering at a time keeps results reproducible.
+std::mutex& metis_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 // A CHOLMOD view of Eigen's arrays (no copy). stype = -1 tells CHOLMOD to
 // read only the lower triangle of the full symmetric matrix.
 cholmod_sparse lower_triangle_view(const SpMat& A) {
@@ -160,15 +168,12 @@ void CholmodSolver::analyze(const SpMat& A) {
   c.free_factor();
   factorized_ = nullptr;
   c.n = -1;
+  last_.clear();
   stats_ = LinearSolveStats{};
 
   if (A.rows() > 0) {
     cholmod_sparse view = lower_triangle_view(A);
-    // METIS keeps its random-number state in globals: two threads ordering
-    // at once disturb each other's orderings, and with them the round-off
-    // of every solve. One analysis at a time keeps results reproducible.
-    static std::mutex analysis_mutex;
-    std::lock_guard<std::mutex> lock(analysis_mutex);
+    std::lock_guard<std::mutex> lock(metis_mutex());
     c.use_ordering(CHOLMOD_METIS);
     c.factor = cholmod_analyze(&view, &c.common);
     if (c.factor == nullptr || c.common.status < CHOLMOD_OK) {
@@ -196,6 +201,112 @@ void CholmodSolver::analyze(const SpMat& A) {
   c.n = A.rows();
   c.pattern = pattern_fingerprint(A);
   stats_.analyze_seconds = seconds_since(start);
+}
+
+void CholmodSolver::analyze_with_last(const SpMat& A, const std::vector<int>& last) {
+  const auto start = std::chrono::steady_clock::now();
+  require_square(A, "CholmodSolver");
+  const int n = static_cast<int>(A.rows());
+  std::vector<char> is_last(std::size_t(n), 0);
+  for (int i : last) {
+    if (i < 0 || i >= n) throw InputError("CholmodSolver: unknown " + std::to_string(i) + " out of range");
+    if (is_last[std::size_t(i)]) throw InputError("CholmodSolver: unknown " + std::to_string(i) + " listed twice");
+    is_last[std::size_t(i)] = 1;
+  }
+  Cholmod& c = *cholmod_;
+  c.free_factor();
+  factorized_ = nullptr;
+  c.n = -1;
+  last_.clear();
+  stats_ = LinearSolveStats{};
+
+  // The others' ordering, on their own submatrix.
+  std::vector<int> others;
+  others.reserve(std::size_t(n) - last.size());
+  for (int i = 0; i < n; ++i)
+    if (!is_last[std::size_t(i)]) others.push_back(i);
+  std::vector<int> perm;
+  perm.reserve(std::size_t(n));
+  std::lock_guard<std::mutex> lock(metis_mutex());
+  if (!others.empty()) {
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> to_front(n);
+    {
+      std::vector<int> order = others;
+      order.insert(order.end(), last.begin(), last.end());
+      for (int k = 0; k < n; ++k) to_front.indices()[order[std::size_t(k)]] = k;
+    }
+    const int m = static_cast<int>(others.size());
+    SpMat permuted;
+    permuted = A.selfadjointView<Eigen::Lower>().twistedBy(to_front);
+    const SpMat interior = permuted.topLeftCorner(m, m);
+    cholmod_sparse view = lower_triangle_view(interior);
+    std::vector<int> interior_perm(static_cast<std::size_t>(m));
+    int ok = cholmod_metis(&view, nullptr, 0, 1, interior_perm.data(), &c.common);
+    if (!ok) ok = cholmod_amd(&view, nullptr, 0, interior_perm.data(), &c.common);
+    if (!ok) throw NumericalError("CHOLMOD ordering of a " + std::to_string(m) + "-unknown block failed: " +
+                                  status_text(c.common.status));
+    for (int k : interior_perm) perm.push_back(others[std::size_t(k)]);
+  }
+  perm.insert(perm.end(), last.begin(), last.end());
+
+  if (n > 0) {
+    cholmod_sparse view = lower_triangle_view(A);
+    c.common.nmethods = 1;
+    c.common.method[0].ordering = CHOLMOD_GIVEN;
+    c.common.postorder = 0;  // a postorder could move the last unknowns
+    c.factor = cholmod_analyze_p(&view, perm.data(), nullptr, 0, &c.common);
+    if (c.factor == nullptr || c.common.status < CHOLMOD_OK) {
+      const int status = c.common.status;
+      c.free_factor();
+      throw NumericalError("CHOLMOD symbolic analysis with given ordering failed: " + status_text(status));
+    }
+    const int* P = static_cast<const int*>(c.factor->Perm);
+    for (std::size_t k = 0; k < last.size(); ++k)
+      if (P[std::size_t(n) - last.size() + k] != last[k])
+        throw NumericalError("CHOLMOD did not keep the given unknowns last");
+    c.factor_nonzeros = c.common.lnz;
+  }
+  ordering_ = "metis, given unknowns last";
+  last_ = last;
+  c.n = A.rows();
+  c.pattern = pattern_fingerprint(A);
+  stats_.analyze_seconds = seconds_since(start);
+}
+
+MatX CholmodSolver::trailing_factor() const {
+  const Cholmod& c = *cholmod_;
+  if (!c.factor_ready) throw NumericalError("CHOLMOD trailing factor without a valid factorization");
+  const int k = static_cast<int>(last_.size());
+  MatX T = MatX::Zero(k, k);
+  if (k == 0) return T;
+  const cholmod_factor* L = c.factor;
+  const int n = static_cast<int>(L->n), first = n - k;
+  const double* x = static_cast<const double*>(L->x);
+  if (L->is_super) {
+    const int* super = static_cast<const int*>(L->super);
+    const int* pi = static_cast<const int*>(L->pi);
+    const int* px = static_cast<const int*>(L->px);
+    const int* rows = static_cast<const int*>(L->s);
+    for (std::size_t s = 0; s < L->nsuper; ++s) {
+      const int k1 = super[s], k2 = super[s + 1];
+      if (k2 <= first) continue;
+      const int nrows = pi[s + 1] - pi[s];
+      for (int j = std::max(k1, first); j < k2; ++j)
+        for (int r = j - k1; r < nrows; ++r) {
+          const int row = rows[pi[s] + r];
+          if (row >= first) T(row - first, j - first) = x[px[s] + std::ptrdiff_t(j - k1) * nrows + r];
+        }
+    }
+  } else {
+    if (!L->is_ll) throw NumericalError("CHOLMOD trailing factor: expected an LL^T factor");
+    const int* p = static_cast<const int*>(L->p);
+    const int* i = static_cast<const int*>(L->i);
+    const int* nz = static_cast<const int*>(L->nz);
+    for (int j = first; j < n; ++j)
+      for (int q = p[j]; q < p[j] + nz[j]; ++q)
+        if (i[q] >= first) T(i[q] - first, j - first) = x[q];
+  }
+  return T;
 }
 
 bool CholmodSolver::factorize(const SpMat& A, double shift) {

@@ -141,6 +141,36 @@ TEST(LinearSolverCholmod, GridStiffnessMatchesSimplicialLdltWithMetis) {
   EXPECT_LT(eigen_residual(A, x, b), 1e-12);
 }
 
+// The contact solve's shortcut: with the given unknowns ordered last, the
+// inverse's block on them comes from the factor's trailing block alone.
+TEST(LinearSolverCholmod, TrailingFactorGivesTheInverseBlockOfTheLastUnknowns) {
+  for (const SpMat& A : {random_spd(300, 12), grid_stiffness(6)}) {
+    const int n = static_cast<int>(A.rows());
+    const std::vector<int> last = {n - 1, 7, 3, n / 2, 11, n / 3};  // unsorted on purpose
+    CholmodSolver solver;
+    solver.analyze_with_last(A, last);
+    EXPECT_EQ(solver.last_unknowns(), last);
+    ASSERT_TRUE(solver.factorize(A));
+    const MatX L = solver.trailing_factor();
+    const MatX from_factor = (L * L.transpose()).inverse();
+    const MatX inverse = MatX(A).inverse();
+    MatX block(last.size(), last.size());
+    for (std::size_t i = 0; i < last.size(); ++i)
+      for (std::size_t j = 0; j < last.size(); ++j) block(i, j) = inverse(last[i], last[j]);
+    EXPECT_LT((from_factor - block).norm(), 1e-10 * block.norm());
+    // Solves stay those of A under the constrained ordering.
+    const VecX b = VecX::LinSpaced(n, -1, 2);
+    EXPECT_LT((A * solver.solve(b) - b).norm(), 1e-10 * b.norm());
+    // analyze() gives the free ordering back.
+    solver.analyze(A);
+    EXPECT_TRUE(solver.last_unknowns().empty());
+  }
+  CholmodSolver solver;
+  const SpMat A = random_spd(20, 1);
+  EXPECT_THROW(solver.analyze_with_last(A, {3, 3}), InputError);
+  EXPECT_THROW(solver.analyze_with_last(A, {20}), InputError);
+}
+
 TEST(LinearSolverPcg, RandomSpdResidualBelowTolerance) {
   const SpMat A = random_spd(300, 4);
   const VecX b = random_vector(A.rows(), 5);
