@@ -67,6 +67,31 @@ check "coarse-to-fine continuation" -- "$T" --config "$WORK/cubic.yaml" --set 'g
   --set "initial.design=$WORK/cubic.design.h5" --set 'loads=[{objective: compliance, forces: [{node: [24, 0], force: [0, -1]}]}]' \
   --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]' --set optimizer.max_iterations=20 --out "$WORK/fine.design.h5" --quiet
 
+# Fig. 3-16 on one gamut: the cubic slice of a tiny orthotropic gamut, its
+# design mapped with that gamut's structures and starting an orthotropic
+# run (the default initial.rho gives way to initial.design).
+sed -e 's/space: cubic2d/space: orthotropic2d/' "$WORK/set.yaml" > "$WORK/ortho_set.yaml"
+check "a tiny orthotropic gamut" -- "$BIN/msfab-gamut-sample" --config "$WORK/ortho_set.yaml" --seed 3 \
+  --out "$WORK/ortho.gamut.h5" --quiet
+cantilever=(--set 'grid.size=[12,6]' --set 'supports=[{box: {min: [0, 0], max: [0, 6]}}]'
+  --set 'loads=[{objective: compliance, forces: [{node: [12, 0], force: [0, -1]}]}]' --set optimizer.name=cell-mma
+  --set optimizer.max_iterations=40 --set gamut="$WORK/ortho.gamut.h5" --quiet)
+check "cubic2d_slice: a design in the orthotropic gamut" -- "$T" "${cantilever[@]}" --set space=cubic2d_slice \
+  --out "$WORK/slice.design.h5"
+check "cubic2d_slice: recorded as an orthotropic design with Ex = Ey" -- /usr/bin/python3 -c "
+import h5py, numpy as np, sys
+f = h5py.File('$WORK/slice.design.h5', 'r')
+u = f['cells/unit'][...]
+sys.exit(0 if f.attrs['space'] in (b'orthotropic2d', 'orthotropic2d') and u.shape[1] == 5 and np.array_equal(u[:, 0], u[:, 1]) else 1)"
+check "cubic2d_slice: the design maps with the orthotropic structures" -- "$BIN/msfab-map" \
+  --design "$WORK/slice.design.h5" --structures "$WORK/ortho.microstructures.h5" --out "$WORK/slice.mapped.h5" --quiet
+check "orthotropic2d starts from the slice design" -- "$T" "${cantilever[@]}" --set space=orthotropic2d \
+  --set "initial.design=$WORK/slice.design.h5" --out "$WORK/ortho.design.h5"
+check "cubic2d_slice starts from an orthotropic design" -- "$T" "${cantilever[@]}" --set space=cubic2d_slice \
+  --set "initial.design=$WORK/ortho.design.h5" --out "$WORK/slice2.design.h5"
+expect_exit 2 "is a cubic2d gamut; space cubic2d_slice needs a orthotropic2d gamut" -- "$T" "${cantilever[@]}" \
+  --set space=cubic2d_slice --set gamut="$WORK/set.gamut.h5" --out "$WORK/bad_slice.design.h5"
+
 # The thesis's 2D scenes (configs/topopt/) read and run in a cubic2d gamut.
 for scene in s_beam gripper gripper_pull gripper_push gripper_stretch; do
   check "configs/topopt/$scene.yaml runs" -- "$T" --config "$SRC/configs/topopt/$scene.yaml" \
