@@ -161,15 +161,19 @@ CholmodSolver::~CholmodSolver() = default;
 
 double CholmodSolver::factor_nonzeros() const { return cholmod_->factor_nonzeros; }
 
+void CholmodSolver::reset_analysis() {
+  cholmod_->free_factor();
+  cholmod_->n = -1;
+  factorized_ = nullptr;
+  last_.clear();
+  stats_ = LinearSolveStats{};
+}
+
 void CholmodSolver::analyze(const SpMat& A) {
   const auto start = std::chrono::steady_clock::now();
   require_square(A, "CholmodSolver");
   Cholmod& c = *cholmod_;
-  c.free_factor();
-  factorized_ = nullptr;
-  c.n = -1;
-  last_.clear();
-  stats_ = LinearSolveStats{};
+  reset_analysis();
 
   if (A.rows() > 0) {
     cholmod_sparse view = lower_triangle_view(A);
@@ -214,11 +218,7 @@ void CholmodSolver::analyze_with_last(const SpMat& A, const std::vector<int>& la
     is_last[std::size_t(i)] = 1;
   }
   Cholmod& c = *cholmod_;
-  c.free_factor();
-  factorized_ = nullptr;
-  c.n = -1;
-  last_.clear();
-  stats_ = LinearSolveStats{};
+  reset_analysis();
 
   // The others' ordering, on their own submatrix.
   std::vector<int> others;

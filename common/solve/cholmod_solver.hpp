@@ -47,6 +47,7 @@ class CholmodSolver final : public LinearSolver {
   double factor_nonzeros() const;
 
  private:
+  void reset_analysis();  // frees the factor and forgets the analysis
   struct Cholmod;  // CHOLMOD workspace and factor; keeps cholmod.h out of this header
   std::unique_ptr<Cholmod> cholmod_;
   LinearSolverOptions options_;
