@@ -7,7 +7,7 @@
 # definition). The reference simulated is REFERENCE (a voxel size; default
 # the accurate mesh); where the accurate mesh is finer than the reference
 # (too large to run to the landing here), TIMING_STEPS of its take-off are
-# timed. The 1 mm flipper runs as one halving, the 2 mm flipper once with
+# timed (TIMING_STEPS=0 skips it). The 1 mm flipper runs as one halving, the 2 mm flipper once with
 # the material's own modulus and once with the DAC modulus and damping
 # fitted to the reference's first frequency and its Rayleigh decay
 # (Eq. 4.16-4.18). Prints the convergence table, the first-10-mode
@@ -46,7 +46,7 @@ run=(--threads 1 --quiet --set simulation.duration=0.16 --set simulation.time_st
 for m in fine:flipper_ref.yaml one_halving:flipper_1mm.yaml coarse:$SCENE dac:flipper_dac.yaml; do
   timed_run "${m%%:*}" "${m#*:}" "${run[@]}"
 done
-if [ -n "$ACCURATE" ] && [ "$ACCURATE" != "$REF" ]; then
+if [ -n "$ACCURATE" ] && [ "$ACCURATE" != "$REF" ] && [ "${TIMING_STEPS:-10}" -gt 0 ]; then
   # The accurate mesh's take-off, timed only: the first TIMING_STEPS steps.
   sed "s/voxel_size: 0.002/voxel_size: $ACCURATE/" "$SCENE" > flipper_accurate.yaml
   timed_run accurate flipper_accurate.yaml "${run[@]}" --set "simulation.duration=$(awk -v n="${TIMING_STEPS:-10}" 'BEGIN { print n * 1e-4 }')"
