@@ -266,7 +266,7 @@ void CholmodSolver::analyze_with_last(const SpMat& A, const std::vector<int>& la
         throw NumericalError("CHOLMOD did not keep the given unknowns last");
     c.factor_nonzeros = c.common.lnz;
   }
-  ordering_ = "metis, given unknowns last";
+  ordering_ = "given unknowns last";
   last_ = last;
   c.n = A.rows();
   c.pattern = pattern_fingerprint(A);

@@ -41,7 +41,8 @@ class CholmodSolver final : public LinearSolver {
   const LinearSolveStats& stats() const override { return stats_; }
   std::string name() const override { return "cholmod"; }
 
-  // Ordering used by the last analyze(): "metis" or "amd" (empty before).
+  // Ordering used by the last analysis: "metis" or "amd" (empty before), or
+  // "given unknowns last" after analyze_with_last().
   const std::string& ordering() const { return ordering_; }
   // Nonzeros of the factor L (0 before the first analyze()).
   double factor_nonzeros() const;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <limits>
 #include <string>
 
@@ -64,6 +65,8 @@ OptimizationResult optimize_cell_mma(TopologyObjective& objective, const MatX& x
                                      const CellFilter& gradient_smoothing) {
   const CellMaterialModel& model = objective.model();
   const int m = model.has_constraint() ? 1 + model.bound_conditions() : 0;
+  if (m > kCellMmaMaxConstraints || model.parameters() > kCellMmaMaxVariables)
+    throw std::logic_error("cell MMA: a cell has more conditions or parameters than the subproblem's fixed sizes");
   // A density filter makes every cell's physical parameters a mix of its
   // neighbours' variables: fine for the objective and the mass, whose MMA
   // approximations are separable in the variables whatever they depend on,

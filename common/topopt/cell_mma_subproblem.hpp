@@ -27,9 +27,9 @@
 namespace msfab {
 
 // Sizes: the gamut spaces have at most 5 parameters (orthotropic2d) and
-// 1 + 4 conditions per cell.
+// 1 + 9 conditions per cell (Phi and the orthotropic Voigt bound).
 constexpr int kCellMmaMaxVariables = 6;
-constexpr int kCellMmaMaxConstraints = 6;
+constexpr int kCellMmaMaxConstraints = 10;
 
 using CellMmaVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kCellMmaMaxVariables, 1>;
 using CellMmaConstraintVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kCellMmaMaxConstraints, 1>;

@@ -8,6 +8,11 @@ namespace msfab {
 
 namespace {
 
+// Directions of the orthotropic normal block: 8, 22.5 degrees apart, admit
+// a negative eigenvalue of at most tan^2(11.25 deg) = 4% of the positive one
+// (voigt_bound.hpp).
+constexpr int kOrthotropicDirections = 8;
+
 // Hydrostatic, deviatoric and shear unit modes of a Voigt vector.
 std::vector<VecX> cubic_modes(int m) {
   const int normals = m == 6 ? 3 : 2;
@@ -16,6 +21,19 @@ std::vector<VecX> cubic_modes(int m) {
   dev[0] = 1 / std::sqrt(2.0), dev[1] = -1 / std::sqrt(2.0);
   shear[normals] = 1;
   return {hydro, dev, shear};
+}
+
+// Orthotropic 2D: the shear mode, and the normal block's quadratic form in
+// kOrthotropicDirections directions evenly spread over 180 degrees.
+std::vector<VecX> orthotropic_modes() {
+  std::vector<VecX> modes(1, VecX::Unit(3, 2));
+  for (int k = 0; k < kOrthotropicDirections; ++k) {
+    const double t = M_PI * k / kOrthotropicDirections;
+    VecX v = VecX::Zero(3);
+    v[0] = std::cos(t), v[1] = std::sin(t);
+    modes.push_back(v);
+  }
+  return modes;
 }
 
 }  // namespace
@@ -33,18 +51,11 @@ VoigtBound::VoigtBound(MatX stiff, MatX soft, VoigtBoundModes modes)
   const Eigen::SelfAdjointEigenSolver<MatX> ed(0.5 * (stiff_ - soft_ + (stiff_ - soft_).transpose()));
   if (ed.eigenvalues().minCoeff() < -1e-12 * es.eigenvalues().maxCoeff())
     throw InputError("Voigt bound: the soft tensor is stiffer than the stiff one in some mode");
-  if (modes_ == VoigtBoundModes::cubic) {
-    mode_vectors_ = cubic_modes(int(m));
-    for (const VecX& v : mode_vectors_) mode_scale_.push_back(v.dot(stiff_ * v));
-  } else {
-    mode_scale_ = {stiff_(2, 2), stiff_(0, 0), stiff_(1, 1), stiff_(0, 0) * stiff_(1, 1)};
-  }
+  mode_vectors_ = modes_ == VoigtBoundModes::cubic ? cubic_modes(int(m)) : orthotropic_modes();
+  for (const VecX& v : mode_vectors_) mode_scale_.push_back(v.dot(stiff_ * v));
 }
 
-int VoigtBound::count() const {
-  if (!active()) return 0;
-  return modes_ == VoigtBoundModes::cubic ? 3 : 4;
-}
+int VoigtBound::count() const { return active() ? int(mode_vectors_.size()) : 0; }
 
 VecX VoigtBound::evaluate(const MatX& C, double rho, const std::vector<MatX>* dC, int rho_index,
                           MatX* jacobian) const {
@@ -65,25 +76,10 @@ VecX VoigtBound::evaluate(const MatX& C, double rho, const std::vector<MatX>* dC
     if (k == rho_index) d += dB_drho;
     return d;
   };
-  if (modes_ == VoigtBoundModes::cubic) {
-    for (int i = 0; i < n; ++i) g[i] = -mode_vectors_[i].dot(B * mode_vectors_[i]) / mode_scale_[i];
-    for (int k = 0; jacobian && k < params; ++k) {
-      const MatX D = dB(k);
-      for (int i = 0; i < n; ++i) (*jacobian)(i, k) = -mode_vectors_[i].dot(D * mode_vectors_[i]) / mode_scale_[i];
-    }
-    return g;
-  }
-  // Orthotropic 2D: shear, the two normal diagonals, the normal block's determinant.
-  const double a = B(0, 0), b = B(0, 1), d = B(1, 1);
-  g << -B(2, 2) / mode_scale_[0], -a / mode_scale_[1], -d / mode_scale_[2], -(a * d - b * b) / mode_scale_[3];
-  if (jacobian) {
-    for (int k = 0; k < params; ++k) {
-      const MatX D = dB(k);
-      (*jacobian)(0, k) = -D(2, 2) / mode_scale_[0];
-      (*jacobian)(1, k) = -D(0, 0) / mode_scale_[1];
-      (*jacobian)(2, k) = -D(1, 1) / mode_scale_[2];
-      (*jacobian)(3, k) = -(D(0, 0) * d + a * D(1, 1) - 2 * b * D(0, 1)) / mode_scale_[3];
-    }
+  for (int i = 0; i < n; ++i) g[i] = -mode_vectors_[i].dot(B * mode_vectors_[i]) / mode_scale_[i];
+  for (int k = 0; jacobian && k < params; ++k) {
+    const MatX D = dB(k);
+    for (int i = 0; i < n; ++i) (*jacobian)(i, k) = -mode_vectors_[i].dot(D * mode_vectors_[i]) / mode_scale_[i];
   }
   return g;
 }

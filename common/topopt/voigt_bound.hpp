@@ -19,8 +19,15 @@
 //   cubic (2D, 3D; also isotropic): C_s, C_w isotropic and C(p) cubic share
 //     the eigenvectors hydrostatic, deviatoric and shear, so B >= 0 is
 //     v^T B v >= 0 for those three modes: 3 conditions.
-//   orthotropic 2D: the shear mode, and the 2 x 2 normal block by its
-//     diagonal entries and determinant (>= 0 each): 4 conditions.
+//   orthotropic 2D: the shear mode, and the 2 x 2 normal block's form
+//     v^T B v >= 0 for 8 directions v 22.5 degrees apart: 9 conditions,
+//     linear in C. A negative eigenvalue of the normal block of at most
+//     tan^2(11.25 deg) = 4% of the positive one passes. The exact test
+//     (diagonal and determinant >= 0) has a determinant whose gradient
+//     vanishes where B's normal block does, at the solid corner (rho = 1,
+//     C = C_s), where many cells of a design sit; Ipopt's multipliers did
+//     not settle there and every orthotropic run ended at its iteration
+//     limit (docs/BENCHMARKS.md, "Fig. 3-16 on one gamut").
 #include <vector>
 
 #include "core/types.hpp"
