@@ -44,12 +44,6 @@ struct NewmarkIntegrator::Contact {
     for (int i = 0; i < count; ++i) r += coefficient[i] * x.segment<3>(3 * nodes[i]);
     return r;
   }
-  // Rows of the relative position of a block of columns (3 x cols).
-  MatX relative_rows(const MatX& X) const {
-    MatX r = coefficient[0] * X.middleRows<3>(3 * nodes[0]);
-    for (int i = 1; i < count; ++i) r += coefficient[i] * X.middleRows<3>(3 * nodes[i]);
-    return r;
-  }
   // out += G_k f, each node's share divided by scale(node).
   template <class Scale>
   void scatter(const Vec3& f, VecX& out, Scale scale) const {
