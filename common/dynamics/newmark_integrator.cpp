@@ -7,7 +7,6 @@
 #include <limits>
 #include <map>
 #include <sstream>
-#include <unordered_map>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -425,6 +424,7 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     if (contact_dofs.empty()) solver_->analyze(jacobian_);
     else solver_->analyze_with_last(jacobian_, contact_dofs);
   }
+  const MatX G_contact = contact_columns(contacts, contact_dofs);
 
   for (int it = 1; it <= options_.max_newton_iterations; ++it) {
     const VecX x = q_ + delta;
@@ -455,7 +455,7 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     if (m > 0) {
       ContactProblem problem;
       problem.h = h;
-      problem.W = delassus_matrix(contacts, contact_dofs);
+      problem.W = delassus_matrix(G_contact);
       problem.u_free.resize(3 * m);
       problem.tangential_velocity_start.resize(2 * m);
       for (int k = 0; k < m; ++k) {
@@ -521,25 +521,27 @@ std::vector<int> NewmarkIntegrator::contact_unknowns(const std::vector<Contact>&
   return dofs;
 }
 
-MatX NewmarkIntegrator::delassus_matrix(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const {
-  // G restricted to the contact unknowns, then W = (L_ll^{-1} G)^T (L_ll^{-1} G).
+MatX NewmarkIntegrator::contact_columns(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const {
   const int m = static_cast<int>(contacts.size());
-  std::unordered_map<int, int> row;
-  row.reserve(dofs.size());
-  for (std::size_t r = 0; r < dofs.size(); ++r) row.emplace(dofs[r], static_cast<int>(r));
   MatX G = MatX::Zero(static_cast<Eigen::Index>(dofs.size()), 3 * m);
   for (int k = 0; k < m; ++k) {
     const Contact& ct = contacts[k];
     for (int i = 0; i < ct.count; ++i)
       for (int a = 0; a < 3; ++a) {
-        const auto r = row.find(3 * ct.nodes[i] + a);
-        if (r == row.end()) continue;  // a fixed unknown
-        for (int c = 0; c < 3; ++c) G(r->second, 3 * k + c) += ct.coefficient[i] * ct.frame(a, c);
+        const auto r = std::lower_bound(dofs.begin(), dofs.end(), 3 * ct.nodes[i] + a);
+        if (r == dofs.end() || *r != 3 * ct.nodes[i] + a) continue;  // a fixed unknown
+        for (int c = 0; c < 3; ++c) G(r - dofs.begin(), 3 * k + c) += ct.coefficient[i] * ct.frame(a, c);
       }
   }
-  if (dofs.empty()) return MatX::Zero(3 * m, 3 * m);
-  const MatX X = solver_->trailing_factor().triangularView<Eigen::Lower>().solve(G);
-  MatX W = MatX::Zero(3 * m, 3 * m);
+  return G;
+}
+
+MatX NewmarkIntegrator::delassus_matrix(const MatX& G_contact) const {
+  // W = (L_ll^{-1} G_C)^T (L_ll^{-1} G_C).
+  const Eigen::Index cols = G_contact.cols();
+  if (G_contact.rows() == 0) return MatX::Zero(cols, cols);
+  const MatX X = solver_->trailing_factor().triangularView<Eigen::Lower>().solve(G_contact);
+  MatX W = MatX::Zero(cols, cols);
   W.selfadjointView<Eigen::Lower>().rankUpdate(X.transpose());
   return W.selfadjointView<Eigen::Lower>();
 }

@@ -132,9 +132,11 @@ class NewmarkIntegrator {
   void apply_fixed(VecX& x) const;
   // The unknowns the contacts touch (fixed ones left out), sorted.
   std::vector<int> contact_unknowns(const std::vector<Contact>& contacts) const;
-  // W = G^T H^{-1} G from the current factorization, analyzed with `dofs`
-  // (contact_unknowns) last.
-  MatX delassus_matrix(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const;
+  // G restricted to `dofs` (contact_unknowns, sorted): |dofs| x 3 contacts.
+  MatX contact_columns(const std::vector<Contact>& contacts, const std::vector<int>& dofs) const;
+  // W = G^T H^{-1} G from the current factorization, analyzed with the
+  // contact unknowns last, and G_contact = contact_columns().
+  MatX delassus_matrix(const MatX& G_contact) const;
   VecX impact_velocity(const VecX& delta, const std::vector<Contact>& contacts, const VecX& impulses);
 
   const DynamicsModel& model_;

@@ -101,11 +101,13 @@ VecX CubicModel::initial_point(double rho) const {
   return descend_into(p, [&](const VecX& q, VecX* g) { return constraint(q, g); });
 }
 
+const std::vector<std::string> kOrthotropicNames = {"Ex", "Ey", "nu_xy", "G", "rho"};
+
 class OrthotropicModel : public CellMaterialModel {
  public:
   OrthotropicModel(UnitScale scale, const GamutLevelSet* ls) : scale_(scale), ls_(ls) {}
   std::string space() const override { return "orthotropic2d"; }
-  std::vector<std::string> names() const override { return {"Ex", "Ey", "nu_xy", "G", "rho"}; }
+  std::vector<std::string> names() const override { return kOrthotropicNames; }
   VoigtBoundModes bound_modes() const override { return VoigtBoundModes::orthotropic2d; }
   int dimension() const override { return 2; }
   VecX raw(const VecX& p) const override {
@@ -163,7 +165,7 @@ class CubicSliceModel : public CubicModel {
     return value;
   }
   std::string design_space() const override { return "orthotropic2d"; }
-  std::vector<std::string> design_names() const override { return {"Ex", "Ey", "nu_xy", "G", "rho"}; }
+  std::vector<std::string> design_names() const override { return kOrthotropicNames; }
   void design_row(const VecX& p, VecX& unit, VecX& raw_row) const override {
     unit = orthotropic_point(p);
     const VecX r = raw(p);

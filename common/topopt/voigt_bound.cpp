@@ -39,11 +39,11 @@ std::vector<VecX> orthotropic_modes() {
 }  // namespace
 
 VoigtBound::VoigtBound(MatX stiff, MatX soft, VoigtBoundModes modes)
-    : stiff_(std::move(stiff)), soft_(std::move(soft)), modes_(modes) {
+    : stiff_(std::move(stiff)), soft_(std::move(soft)) {
   const Eigen::Index m = stiff_.rows();
   if ((m != 3 && m != 6) || stiff_.cols() != m || soft_.rows() != m || soft_.cols() != m)
     throw InputError("Voigt bound: the stiff and soft tensors must both be 3 x 3 (2D) or 6 x 6 (3D)");
-  if (modes_ == VoigtBoundModes::orthotropic2d && m != 3)
+  if (modes == VoigtBoundModes::orthotropic2d && m != 3)
     throw InputError("Voigt bound: the orthotropic modes are 2D (3 x 3 tensors)");
   if (!stiff_.allFinite() || !soft_.allFinite()) throw InputError("Voigt bound: a tensor entry is not finite");
   const Eigen::SelfAdjointEigenSolver<MatX> es(0.5 * (stiff_ + stiff_.transpose()));
@@ -51,7 +51,7 @@ VoigtBound::VoigtBound(MatX stiff, MatX soft, VoigtBoundModes modes)
   const Eigen::SelfAdjointEigenSolver<MatX> ed(0.5 * (stiff_ - soft_ + (stiff_ - soft_).transpose()));
   if (ed.eigenvalues().minCoeff() < -1e-12 * es.eigenvalues().maxCoeff())
     throw InputError("Voigt bound: the soft tensor is stiffer than the stiff one in some mode");
-  mode_vectors_ = modes_ == VoigtBoundModes::cubic ? cubic_modes(int(m)) : orthotropic_modes();
+  mode_vectors_ = modes == VoigtBoundModes::cubic ? cubic_modes(int(m)) : orthotropic_modes();
   for (const VecX& v : mode_vectors_) mode_scale_.push_back(v.dot(stiff_ * v));
 }
 

@@ -55,8 +55,7 @@ class VoigtBound {
 
  private:
   MatX stiff_, soft_;
-  VoigtBoundModes modes_ = VoigtBoundModes::cubic;
-  std::vector<VecX> mode_vectors_;  // cubic: the three eigenmodes
+  std::vector<VecX> mode_vectors_;  // cubic: the three eigenmodes; orthotropic: shear and 8 directions
   std::vector<double> mode_scale_;  // v^T C_s v per condition
 };
 
