@@ -459,6 +459,9 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 
 CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOptions& options) {
   const bool periodic = options.sampling.mode == ForceSamplingOptions::Mode::periodic;
+  if (block.voxels_per_edge != 2 && !periodic)
+    throw InputError("coarse fit: a block of " + std::to_string(block.voxels_per_edge) +
+                     "^3 voxels is sampled among periodic copies only (sampling.mode: periodic)");
   // Isolated and patch samples load the block's own nodes: a void child
   // leaves a coarse corner without a fine node there.
   if (!periodic && (!block.all_children_solid() || !block.has_all_corners())) {
@@ -468,11 +471,18 @@ CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOpt
     return fit;
   }
   const auto t0 = std::chrono::steady_clock::now();
+  // A block of more voxels costs more per sample: it is sampled in the
+  // kinds its fit weighs only (the level-1 blocks, as they were built, in all).
+  ForceSamplingOptions sampling = options.sampling;
+  if (block.voxels_per_edge != 2)
+    for (int k = 0; k < 5; ++k) sampling.kinds[k] = options.kind_weight[k] > 0;
   const ForceSampleSet samples =
-      periodic ? sample_periodic(block, options.sampling) : sample_force_space(block, options.sampling);
+      periodic ? sample_periodic(block, sampling) : sample_force_space(block, sampling);
   std::vector<Vec3> directions(block.coarse_points(), Vec3::UnitX());
   if (options.anisotropic) {
-    if (block.all_children_solid()) {
+    if (block.voxels_per_edge != 2) {
+      directions = periodic_point_directions(block, options.anisotropy);
+    } else if (block.all_children_solid()) {
       directions = estimate_anisotropy(block, options.anisotropy).direction;
     } else {
       const AnisotropyOptions& a = options.anisotropy;

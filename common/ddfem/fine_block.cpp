@@ -1,5 +1,6 @@
 #include "ddfem/fine_block.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -34,18 +35,19 @@ bool FineBlock::has_all_corners() const {
 bool FineBlock::all_children_solid() const { return is_all_solid(material_ids); }
 
 int FineBlock::child_of_element(int e) const {
-  const int n = 2 + 2 * context;
+  const int N = voxels_per_edge, n = N + 2 * context;
   const int v = voxels.element_voxel[e];  // x fastest
   const int i = v % n, j = (v / n) % n, k = v / (n * n);
-  // Periodic copy: voxel i of the patch is child (i - context) mod 2.
-  auto child = [&](int a) { return ((a - context) % 2 + 2) % 2; };
+  // Periodic copy: voxel i of the patch is voxel (i - context) mod N of the
+  // block, in its lower or upper half.
+  auto child = [&](int a) { return ((a - context) % N + N) % N / (N / 2); };
   return 4 * child(i) + 2 * child(j) + child(k);
 }
 
 hex8::NodeMatrix FineBlock::coarse_rest_positions() const {
   hex8::NodeMatrix X;
   for (int c = 0; c < 8; ++c)
-    X.row(c) = 2.0 * voxel_size * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
+    X.row(c) = edge() * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
   return X;
 }
 
@@ -64,7 +66,7 @@ int FineBlock::child_of_coarse_point(int q) {
 }
 
 int FineBlock::lattice_node(int i, int j, int k) const {
-  const size_t n = 3 + 2 * size_t(context);
+  const size_t n = voxels_per_edge + 1 + 2 * size_t(context);
   return voxels.lattice_node[size_t(i + context) + n * (size_t(j + context) + n * size_t(k + context))];
 }
 
@@ -128,6 +130,57 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
     const MaterialPtr& m = block.child_material[block.child_of_point(q)];
     block.point_mu0.push_back(m ? m->shear_modulus() : 0.0);
     block.point_lambda0.push_back(m ? m->lame_lambda() : 0.0);
+  }
+  return block;
+}
+
+FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<MaterialPtr>& palette,
+                           double voxel_size, const BlockMaterials& label) {
+  constexpr int N = 4;
+  if (voxel_ids.size() != size_t(N * N * N)) {
+    std::ostringstream os;
+    os << "voxel block: needs " << N * N * N << " voxel ids, got " << voxel_ids.size();
+    throw InputError(os.str());
+  }
+  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
+    std::ostringstream os;
+    os << "voxel block: voxel size must be positive and finite, got " << voxel_size;
+    throw InputError(os.str());
+  }
+  FineBlock block;
+  block.voxel_size = voxel_size;
+  block.voxels_per_edge = N;
+  block.coarse_points_per_axis = N;
+  block.material_ids = label;
+  block.child_material.assign(8, nullptr);
+  VoxelGrid grid(N, N, N, voxel_size, 0);
+  bool any_solid = false;
+  for (int v = 0; v < N * N * N; ++v) {
+    const int id = voxel_ids[v];
+    if (id < 0 || id >= static_cast<int>(palette.size()) || (id != 0 && !palette[id])) {
+      std::ostringstream os;
+      os << "voxel block: material id " << id << " of voxel " << v << " is not in the palette (size "
+         << palette.size() << ")";
+      throw InputError(os.str());
+    }
+    any_solid = any_solid || id != 0;
+    grid.at(v % N, (v / N) % N, v / (N * N)) = id;
+  }
+  if (!any_solid) throw InputError("voxel block: every voxel is void");
+  block.voxels = build_voxel_mesh(grid, palette);
+  block.core_element.assign(block.mesh().num_elements(), 1);
+  for (int c = 0; c < 8; ++c)
+    block.corner_nodes[c] = block.lattice_node(N * (c >> 2 & 1), N * (c >> 1 & 1), N * (c & 1));
+  // One Gauss point in each voxel: the 4-point rule's abscissae lie one in
+  // each quarter of [-1, 1].
+  const hex8::ElementGeometry coarse = block.coarse_geometry();
+  for (int q = 0; q < coarse.size(); ++q) {
+    const Vec3 chi = hex8::gauss_rule(N).points[q];
+    int voxel[3];
+    for (int a = 0; a < 3; ++a) voxel[a] = std::min(N - 1, static_cast<int>(std::floor((chi[a] + 1) * N / 2)));
+    const int id = voxel_ids[voxel[0] + N * (voxel[1] + N * voxel[2])];
+    block.point_mu0.push_back(id ? palette[id]->shear_modulus() : 0.0);
+    block.point_lambda0.push_back(id ? palette[id]->lame_lambda() : 0.0);
   }
   return block;
 }

@@ -19,7 +19,11 @@ bool is_all_solid(const BlockMaterials& ids);
 std::string block_name(const BlockMaterials& ids);
 
 struct FineBlock {
-  double voxel_size = 1.0;           // fine edge h; the coarse element has edge 2h
+  double voxel_size = 1.0;           // fine edge h; the coarse element has edge n h
+  // Voxels n along each edge of the block: 2 (one voxel per child, level 1)
+  // or 4 (a level-2 block sampled on its fine voxels: each child is then
+  // 2 x 2 x 2 voxels, see make_voxel_block).
+  int voxels_per_edge = 2;
   BlockMaterials material_ids{};     // palette ids per child, 0 = void
   std::vector<MaterialPtr> child_material;  // per child, null for void
   // Voxels of context around the block on every side (in-situ sampling,
@@ -49,7 +53,8 @@ struct FineBlock {
   // The child of the block whose copy element e is (the element's own child
   // inside the block).
   int child_of_element(int e) const;
-  // Rest positions of the coarse element's corners (edge 2h, origin at 0).
+  double edge() const { return voxels_per_edge * voxel_size; }
+  // Rest positions of the coarse element's corners (edge n h, origin at 0).
   hex8::NodeMatrix coarse_rest_positions() const;
   // The coarse element's Gauss geometry (its quadrature points k of
   // Eq. 2.6-2.7), and the child containing each point.
@@ -57,7 +62,7 @@ struct FineBlock {
   int coarse_points() const { return coarse_points_per_axis * coarse_points_per_axis * coarse_points_per_axis; }
   int child_of_point(int q) const;
   static int child_of_coarse_point(int q);  // the 2-point rule
-  // Mesh node at block lattice position (i, j, k), i, j, k in {0, 1, 2}
+  // Mesh node at block lattice position (i, j, k), i, j, k in {0, ..., n}
   // (offset by the context); -1 if absent.
   int lattice_node(int i, int j, int k) const;
 };
@@ -68,5 +73,15 @@ struct FineBlock {
 // child is void, or context is outside [0, 4].
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
                           double voxel_size, int coarse_points_per_axis = 2, int context = 0);
+
+// A level-2 block on its fine voxels (docs/ddfem.md, "Level 2"): 4 x 4 x 4
+// voxels, `voxel_ids[i + 4 (j + 4 k)]` the palette id of voxel (i, j, k)
+// (0 = void), coarsened into one element with the 4-point Gauss rule, one
+// point in each voxel (p^0 there: that voxel's material). `label` names the
+// block's eight children (e.g. their level-1 entries + 1, 0 for a void
+// child). Periodic sampling only (no context). Throws InputError as
+// make_fine_block, and on a wrong number of ids.
+FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<MaterialPtr>& palette,
+                           double voxel_size, const BlockMaterials& label);
 
 }  // namespace msfab

@@ -38,6 +38,8 @@ struct ForceSamplingOptions {
   //  periodic: among infinitely many periodic copies, corner displacements
   //            prescribed and the periodic fluctuation relaxed
   //            (periodic_samples.hpp).
+  // The kinds sampled, by ForceKind (periodic sampling; all by default).
+  std::array<bool, 5> kinds{true, true, true, true, true};
   enum class Mode { isolated, patch, periodic };
   Mode mode = Mode::isolated;
   int context = 1;  // patch mode: voxels of periodic copies on each side

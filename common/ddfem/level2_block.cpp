@@ -22,6 +22,19 @@ int level1_point_of(int q, int* child) {
   return k;
 }
 
+std::vector<int> level2_voxel_ids(const std::array<const CoarseMaterialFit*, 8>& children) {
+  std::vector<int> ids(64, 0);
+  for (int c = 0; c < 8; ++c) {
+    if (!children[c]) continue;
+    for (int v = 0; v < 8; ++v) {
+      // Child c and its voxel v both in hex8 bit order (x is bit 2).
+      const int i = 2 * (c >> 2 & 1) + (v >> 2 & 1), j = 2 * (c >> 1 & 1) + (v >> 1 & 1), k = 2 * (c & 1) + (v & 1);
+      ids[i + 4 * (j + 4 * k)] = children[c]->material_ids[v];
+    }
+  }
+  return ids;
+}
+
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
                                          const BlockMaterials& ids, double child_size, int context) {
   BlockMaterials shape{};  // 1 where a child has an element

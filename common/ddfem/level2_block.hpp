@@ -26,6 +26,11 @@ namespace msfab {
 FineBlock make_block_of_coarse_materials(const std::array<const CoarseMaterialFit*, 8>& children,
                                          const BlockMaterials& ids, double child_size, int context = 0);
 
+// The 4 x 4 x 4 palette ids (x fastest, as make_voxel_block takes them) of
+// a level-2 block whose child c is the level-1 block `children[c]` (its
+// material_ids are palette ids; null: a void child).
+std::vector<int> level2_voxel_ids(const std::array<const CoarseMaterialFit*, 8>& children);
+
 // Level-1 point of child `child` that lies in the same fine voxel as point
 // q of the 4-point rule (both in hex8 bit order).
 int level1_point_of(int q, int* child);

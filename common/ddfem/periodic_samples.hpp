@@ -12,6 +12,7 @@
 // block's faces, as in a body); for a homogeneous block it is then exactly
 // the coarse element's energy. Isolated, force-loaded sampling instead lets
 // a stiff fibre segment carry load only through the soft matrix around it.
+#include "ddfem/anisotropy.hpp"
 #include "ddfem/force_samples.hpp"
 
 namespace msfab {
@@ -27,8 +28,8 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
 
 // The relaxed fine energy min_w E(X + U + w) for corner displacements u1.
 // `w` carries the periodic fluctuation in (a warm start) and out, one Vec3
-// per periodic node class of the 3 x 3 x 3 lattice (8 classes, the corners'
-// class held at zero). Returns +inf if Newton does not converge.
+// per periodic node class of the (n + 1)^3 lattice (n^3 classes, the
+// corners' class held at zero). Returns +inf if Newton does not converge.
 class PeriodicBlockSolver {
  public:
   explicit PeriodicBlockSolver(const FineBlock& block, double newton_tolerance = 1e-9);
@@ -50,11 +51,12 @@ class PeriodicBlockSolver {
   const FineBlock& block_;
   ElasticAssembler assembler_;
   double tolerance_;
+  int free_ = 0;                        // 3 per periodic class with nodes, corners' class excepted
   double force_round_off_;              // mu h^2 of the stiffest fine material: nodal forces' scale at round-off
   VecX rest_;
-  std::vector<int> node_class_;        // mesh node -> periodic class 0..7 (0: corners)
+  std::vector<int> node_class_;        // mesh node -> its periodic class's unknown, -1 at the corners
   std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node
-  MatX reduce_;                         // DOFs x 21: sums nodal forces over each free periodic class
+  MatX reduce_;                         // DOFs x free_: sums nodal forces over each free periodic class
   std::vector<int> void_corners_;       // corners without a fine node
   MatX extrapolate_;                    // (3 void corners) x 21: their least-squares correction from w
 };
@@ -73,5 +75,18 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
 // direction for all points of the block.
 Vec3 stiffest_periodic_direction(const FineBlock& block, int directions, double strain, std::uint64_t seed,
                                  double newton_tolerance = 1e-9);
+
+// Per-point spring directions of a block of 4 x 4 x 4 voxels among its
+// periodic copies. Its coarse points lie one in each voxel, and an affine
+// coarse field tells them apart only through the fine field: for each of
+// `directions` seeded directions d the block is relaxed under the uniaxial
+// strain `strain` d (d . X), and the voxel under point q stores the energy
+// W_q(d). Displacement-controlled, a voxel is stiffest where it stores the
+// most, so the point's direction is the one where its compliance
+// 1 / sqrt(W_q(d)) is least: the smallest singular vector of the points
+// +-d / sqrt(W_q(d)), as estimate_anisotropy does with the stretches of
+// force-controlled samples. Points in void voxels take x. Throws
+// NumericalError if fewer than 3 directions relax.
+std::vector<Vec3> periodic_point_directions(const FineBlock& block, const AnisotropyOptions& options);
 
 }  // namespace msfab

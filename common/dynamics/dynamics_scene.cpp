@@ -86,9 +86,9 @@ int material_index(const Config& c, const std::string& key, const std::vector<Sc
 
 // The voxel materials, and in `body` each voxel's body (boxes with the same
 // `body:` name, default "body", form one body; numbered in order of first
-// appearance).
+// appearance). The files a layout read are appended to `files`.
 VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& materials, VoxelGrid& body,
-                         std::vector<std::string>& body_names) {
+                         std::vector<std::string>& body_names, std::vector<std::string>& files) {
   const double h = g.require_positive<double>("voxel_size", "voxel edge length (m)");
   struct Box {
     Vec3 lo, hi;
@@ -141,7 +141,7 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
     // repaints the materials inside the boxes; it never adds solid, and void
     // it paints becomes a hole. Ids are 1-based indices into `materials`.
     VoxelGrid painted = grid;
-    paint_layout(g, painted, scene_palette(materials));
+    files = paint_layout(g, painted, scene_palette(materials));
     for (size_t v = 0; v < grid.ids.size(); ++v)
       if (grid.ids[v]) grid.ids[v] = painted.ids[v];
   }
@@ -333,7 +333,7 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
   s.name = c.get_or("name", "dynamics");
   s.materials = read_materials(c);
   VoxelGrid body_grid;
-  s.grid = paint_geometry(c.child("geometry"), s.materials, body_grid, s.body_names);
+  s.grid = paint_geometry(c.child("geometry"), s.materials, body_grid, s.body_names, s.geometry_files);
 
   const std::vector<MaterialPtr> palette = scene_palette(s.materials);
   DynamicsModel& model = s.model;

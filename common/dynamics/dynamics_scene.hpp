@@ -52,6 +52,7 @@ struct DynamicsScene {
   // bodies share no node and meet only through contact.
   std::vector<std::string> body_names;
   std::vector<int> element_body;
+  std::vector<std::string> geometry_files;  // voxel arrays and surface meshes the layout read
   DynamicsModel model;
   VecX initial_positions, initial_velocities;
   NewmarkOptions newmark;

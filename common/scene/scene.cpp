@@ -80,7 +80,8 @@ Region read_region(const Config& parent, const VoxelGrid& grid) {
 
 // `voxels: {file: F.npy}` or `{file: F.raw, dtype: uint8}`: every voxel's id
 // from the file (docs/scenes.md, "Your own object").
-void paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
+// Returns the file's path.
+std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
   const std::string path = c.get_path("file");
   const std::vector<int> ids = read_voxel_ids(path, grid.nx, grid.ny, grid.nz, c.get_or<std::string>("dtype", ""));
   std::map<int, long long> unknown;
@@ -90,12 +91,13 @@ void paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<Materi
     c.fail("file", path + " uses material id " + std::to_string(unknown.begin()->first) + " (" +
                        std::to_string(unknown.begin()->second) + " voxels), which is not in the palette (0 = void)");
   grid.ids = ids;
+  return path;
 }
 
 // `mesh: {file: F.stl, scale: s, offset: [x, y, z]}, id: n`: the voxels whose
 // centre lies inside the closed surface take id n; a file vertex p lies at
-// s p + offset in the scene (metres).
-void paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
+// s p + offset in the scene (metres). Returns the file's path.
+std::string paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
   const Config c = item.child("mesh");
   const std::string path = c.get_path("file");
   TriangleSurface surface = merge_equal_vertices(read_surface_mesh(path));
@@ -124,6 +126,7 @@ void paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
   if ((lo.array() < grid.origin.array()).any() || (hi.array() > grid_hi.array()).any())
     spdlog::warn("{}: the surface reaches beyond the grid and is cut off there; {}", path, box.str());
   spdlog::debug("{}: {} triangles, {} voxels painted with id {}", path, surface.triangles.size(), painted, id);
+  return path;
 }
 
 }  // namespace
@@ -146,7 +149,9 @@ std::vector<PaletteEntry> read_materials(const Config& config, std::vector<Mater
   return palette;
 }
 
-void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
+std::vector<std::string> paint_layout(const Config& config, VoxelGrid& grid,
+                                      const std::vector<MaterialPtr>& material_by_id) {
+  std::vector<std::string> files;
   // The `ids` list of a pattern item: each a palette id or 0 (void).
   auto id_list_of = [&](const Config& c) {
     const std::vector<int> ids = c.get<std::vector<int>>("ids");
@@ -196,14 +201,15 @@ void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<Mater
       if (ids.empty()) c.fail("ids", "a random field needs at least one id");
       paint_random_field(grid, ids, c.get<std::uint64_t>("seed"));
     } else if (item.has("voxels")) {
-      paint_voxel_file(item.child("voxels"), grid, material_by_id);
+      files.push_back(paint_voxel_file(item.child("voxels"), grid, material_by_id));
     } else if (item.has("mesh")) {
-      paint_mesh_file(item, grid, id_of("id"));
+      files.push_back(paint_mesh_file(item, grid, id_of("id")));
     } else {
       item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field, "
                     "voxels, mesh");
     }
   }
+  return files;
 }
 
 
@@ -234,7 +240,7 @@ Scene read_scene(const Config& config) {
   s.nonlinear = false;
   for (const auto& p : s.palette) s.nonlinear |= p.model == "neo-hookean";
 
-  paint_layout(config, s.grid, s.material_by_id);
+  s.geometry_files = paint_layout(config, s.grid, s.material_by_id);
   if (s.grid.count_solid() == 0) config.fail("layout", "the layout leaves every voxel void (empty grid)");
 
   if (config.has("boundary")) {

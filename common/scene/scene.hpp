@@ -56,6 +56,7 @@ struct Scene {
   Vec3 gravity = Vec3::Zero();
   NewtonOptions newton;
   bool nonlinear = true;  // false when every material is linear
+  std::vector<std::string> geometry_files;  // voxel arrays and surface meshes the layout read
 };
 
 // Parses and validates a scene. Unknown keys are left for the caller's
@@ -69,7 +70,10 @@ std::vector<PaletteEntry> read_materials(const Config& config, std::vector<Mater
 // Paints the `layout` list (fill, box, layers, cylinder, helical_fibers,
 // checker, random_field, voxels from a .npy or raw file, a closed surface
 // mesh from an STL or OBJ file) onto the grid, in physical coordinates.
-void paint_layout(const Config& config, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id);
+// Returns the files it read (voxel arrays, surface meshes) in layout order:
+// inputs of the result artifact, hashed there.
+std::vector<std::string> paint_layout(const Config& config, VoxelGrid& grid,
+                                      const std::vector<MaterialPtr>& material_by_id);
 
 // Boundary conditions and external forces on the mesh of a scene. Throws
 // InputError for a region that selects no solid node (a load on void), for a

@@ -26,6 +26,11 @@ BuildOptions read_build_options(const Config& config) {
       h.strain = l.get_or<double>("strain", h.strain);
       if (!(h.strain > 0 && h.strain < 0.5)) l.fail("strain", "must be in (0, 0.5)");
       h.seed = l.get_or<std::uint64_t>("seed", h.seed);
+      const std::string samples = l.get_or<std::string>("samples", "level1");
+      if (samples != "level1" && samples != "voxels")
+        l.fail("samples", "must be level1 (2 x 2 x 2 level-1 elements) or voxels (4 x 4 x 4 fine voxels), got '" +
+                              samples + "'");
+      o.level2_voxel_samples = samples == "voxels";
       l.check_no_unknown_keys();
     }
   } else if (config.has("level2")) {
@@ -123,6 +128,9 @@ BuildOptions read_build_options(const Config& config) {
       config.fail("void_children", "needs sampling.mode: periodic (blocks with void children are sampled among "
                                    "their periodic copies)");
   }
+  if (o.level2_voxel_samples && o.fit.sampling.mode != ForceSamplingOptions::Mode::periodic)
+    config.child("level2").fail("samples", "voxels needs sampling.mode: periodic (a block of 4 x 4 x 4 voxels is "
+                                           "sampled among its periodic copies)");
   o.use_symmetry = config.get_or<bool>("symmetry", o.use_symmetry);
   o.orbits_per_round = config.get_or<int>("orbits_per_round", o.orbits_per_round);
   if (o.orbits_per_round < 1) config.fail("orbits_per_round", "must be >= 1");

@@ -17,6 +17,11 @@ struct BuildOptions {
   // coarse materials, is the palette; the hierarchy's options.
   std::string base_database;
   HierarchyOptions hierarchy;
+  // Level 2: sample each final block on its 4 x 4 x 4 fine voxels (the
+  // palette materials of its children's level-1 combinations) instead of on
+  // 2 x 2 x 2 level-1 elements with their fitted materials, so a level-1
+  // fit's error is not fitted into level 2 (`level2.samples: voxels`).
+  bool level2_voxel_samples = false;
   double voxel_size = 1e-3;           // of the sampled block; the fit is scale-invariant
   CoarseFitOptions fit;
   bool use_symmetry = true;           // fit one block per cube-symmetry orbit

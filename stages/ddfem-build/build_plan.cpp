@@ -118,8 +118,9 @@ BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memo
   for (int r = 0; r < plan.db.hierarchy.num_final(); ++r) plan.items.push_back(r);
   plan.points = 64;
   plan.fingerprint = "base_database " + file_fingerprint(options.base_database);
-  plan.block = [base, hierarchy = plan.db.hierarchy, h = options.voxel_size,
-                context = patch_context(options)](std::int64_t r) {
+  if (options.level2_voxel_samples) plan.fingerprint += " samples voxels";
+  plan.block = [base, palette = base->palette(), hierarchy = plan.db.hierarchy, h = options.voxel_size,
+                context = patch_context(options), voxels = options.level2_voxel_samples](std::int64_t r) {
     const Arrangement arr = hierarchy.arrangement(2, static_cast<int>(r));
     std::array<const CoarseMaterialFit*, 8> children;
     BlockMaterials ids;
@@ -128,6 +129,7 @@ BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memo
       children[c] = is_void ? nullptr : &base->entries[arr[c]];
       ids[c] = is_void ? 0 : arr[c] + 1;
     }
+    if (voxels) return make_voxel_block(level2_voxel_ids(children), palette, h, ids);
     return make_block_of_coarse_materials(children, ids, 2 * h, context);
   };
   plan.void_children = [hierarchy = plan.db.hierarchy](std::int64_t r) {

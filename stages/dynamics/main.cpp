@@ -203,6 +203,7 @@ int main(int argc, char** argv) {
     TrajectoryProvenance provenance;
     provenance.config_text = ctx.config.resolved_text();
     provenance.seed = ctx.options.seed;
+    provenance.inputs = scene.geometry_files;
     if (!coarsening.database.empty()) provenance.inputs.push_back(coarsening.database);
     if (!reference.empty()) provenance.inputs.push_back(reference);
     const std::string xmf = write_trajectory_artifact(out, trajectory, provenance);

@@ -95,7 +95,8 @@ CellInput read_cell_input(const Config& config, const std::function<void(int, in
   const bool has_voxels = c.has("voxels"), has_layout = config.has("layout");
   if (has_voxels == has_layout) config.fail("layout", "give either cell.voxels (a voxel file) or a layout, not both");
   if (has_voxels) {
-    in.cell = read_voxel_text(c.get_path("voxels"), 1.0);  // at most kMaxTextInputBytes of text
+    in.files.push_back(c.get_path("voxels"));
+    in.cell = read_voxel_text(in.files.back(), 1.0);  // at most kMaxTextInputBytes of text
     if (c.has("size")) c.fail("size", "comes from the voxel file; drop it");
     checked(in.cell.nx, in.cell.ny, in.cell.nz);
   } else {
@@ -109,7 +110,7 @@ CellInput read_cell_input(const Config& config, const std::function<void(int, in
   // The cell spans [0, 1] along x by default: C^H does not depend on the scale.
   in.cell.voxel_size = c.get_or<double>("voxel_size", 1.0 / in.cell.nx);
   if (!(in.cell.voxel_size > 0)) c.fail("voxel_size", "must be > 0");
-  if (has_layout) paint_layout(config, in.cell, in.material_by_id);
+  if (has_layout) in.files = paint_layout(config, in.cell, in.material_by_id);
   for (int id : in.cell.ids)
     if (id > 0 && (id >= static_cast<int>(in.material_by_id.size()) || !in.material_by_id[id]))
       config.fail("materials", "the cell uses material id " + std::to_string(id) + ", which is not defined");

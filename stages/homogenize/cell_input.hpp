@@ -19,6 +19,7 @@ struct CellInput {
   std::vector<PaletteEntry> palette;
   std::vector<MaterialPtr> material_by_id;  // [0] = void
   std::string source;  // the microstructures artifact the cell came from (an input of the result), or empty
+  std::vector<std::string> files;  // the voxel files the cell was read from (inputs of the result)
 };
 
 // InputError naming the key (or the voxel file and line) on bad input.

@@ -10,6 +10,7 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
                        const std::string& command_line, std::uint64_t seed) {
   std::vector<std::string> inputs;
   if (!in.source.empty()) inputs.push_back(in.source);
+  inputs.insert(inputs.end(), in.files.begin(), in.files.end());
   ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "command_line", command_line);

@@ -261,6 +261,7 @@ int main(int argc, char** argv) {
     record.config_text = ctx.config.resolved_text();
     record.command_line = ctx.command_line;
     record.seed = ctx.options.seed;
+    record.inputs = scene.geometry_files;
     if (!coarsening.database.empty()) record.inputs.push_back(coarsening.database);
     if (!reference.empty()) record.inputs.push_back(reference);
     if (coarsened) {

@@ -86,6 +86,17 @@ expect_exit 2 "takes its palette from base_database" -- "$BUILD" --config "$L2" 
 expect_exit 2 "level2.representatives" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
   --set 'level2.representatives=[4, 4]' --out "$WORK/bad.h5"
 expect_exit 2 "needs base_database" -- "$BUILD" --config "$TINY" --set 'level2.deformations=4' --out "$WORK/bad.h5"
+# Level 2 sampled on the blocks' fine voxels (periodic only), same for 1 and 2 ranks.
+expect_exit 0 "16 level-2 coarse materials over 256 level-1 materials" -- "$BUILD" --config "$L2" \
+  --set base_database="$WORK/one.h5" --set sampling.mode=periodic --set level2.samples=voxels --out "$WORK/l2vox.h5"
+check "two-rank voxel-sampled level-2 build" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 "$BUILD" --config "$L2" \
+  --set base_database="$WORK/one.h5" --set sampling.mode=periodic --set level2.samples=voxels --out "$WORK/l2vox2.h5" --quiet
+check "level 2 on voxels: 1 and 2 ranks give the same database" -- same_db2 "$WORK/l2vox.h5" "$WORK/l2vox2.h5"
+check "level 2 on voxels differs from level 2 on level-1 elements" -- bash -c "! h5diff -q '$WORK/l2vox.h5' '$WORK/l2one.h5' /fit/mu"
+expect_exit 2 "level2.samples.*needs sampling.mode: periodic" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
+  --set level2.samples=voxels --out "$WORK/bad.h5"
+expect_exit 2 "level2.samples.*level1 .* or voxels" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
+  --set sampling.mode=periodic --set level2.samples=fine --out "$WORK/bad.h5"
 # The pairing's memory is checked before the hierarchy is built (the thesis
 # paired all 6561 level-1 materials of its palette; a machine decides).
 expect_exit 2 "pairing 256 level-1 materials \(65536 candidates x [0-9]+ level2.deformations\) needs about .* MiB, more than the 4 MiB" -- \

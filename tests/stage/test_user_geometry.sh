@@ -77,6 +77,12 @@ for s in stl obj npy; do
   check "$s scene gives the box scene's displacements bit for bit" -- \
     h5diff "$WORK/boxes.h5" "$WORK/$s.h5" /displacement /displacement
 done
+# The files a layout reads are inputs of the result, with their hashes.
+lists_input() {  # lists_input ARTIFACT FILE
+  h5dump -a /inputs "$1" | grep -q "$(sha256sum "$2" | cut -d' ' -f1)  .*$(basename "$2")"
+}
+check "the STL scene's result lists bracket.stl with its hash" -- lists_input "$WORK/stl.h5" "$WORK/bracket.stl"
+check "the .npy scene's result lists bracket.npy with its hash" -- lists_input "$WORK/npy.h5" "$WORK/bracket.npy"
 
 # The shipped example (configs/scenes/user, docs/walkthrough.md): the same
 # bracket as an ASCII STL and as a .npy, then read back in Python.
@@ -134,6 +140,7 @@ for c in cell_boxes cell_npy; do
   "$BIN/msfab-homogenize" --config "$WORK/$c.yaml" --out "$WORK/$c.h5" > "$WORK/$c.txt" 2>&1 || echo "FAIL: homogenize $c"
 done
 check "numpy cell homogenizes like its layout" -- h5diff "$WORK/cell_boxes.h5" "$WORK/cell_npy.h5" /C /C
+check "the numpy cell's result lists cell.npy with its hash" -- lists_input "$WORK/cell_npy.h5" "$WORK/cell.npy"
 
 # Bad files: exit 2, naming the file.
 "$PY" - "$WORK" <<'PY'
