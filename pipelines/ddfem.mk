@@ -12,7 +12,7 @@
 #   make -f Makefile.pipeline ddfem-table-floor     error floor of the coarse meshes, homogenized reference, its own section
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
 #   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
-#   make -f Makefile.pipeline ddfem-table-level2-voxels  level 2 sampled on fine voxels against on level-1 elements
+#   make -f Makefile.pipeline ddfem-table-level2-variants  level 2 sampled on fine voxels, and with corner moves in the lookup
 #   make -f Makefile.pipeline ddfem-table-dynamics  DDFEM in dynamics: the fibre bar fine, level 1 and 2, trajectory error and speed
 #   make -f Makefile.pipeline ddfem-table-thesis-settings  the thesis's sampling and fit, and level 2 over 100/400/1024 materials
 #
@@ -43,7 +43,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-voxels \
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants \
         ddfem-table-dynamics
 ddfem-db-tiny: stages $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: stages $(OUT)/ddfem/palette3.coarse_db.h5
@@ -89,22 +89,34 @@ ddfem-table-mixed: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_
 	bash tools/bench_ddfem_mixed.sh $(BIN) $(OUT)/bench/ddfem-mixed docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5
 
-# Level 2 sampled on its fine voxels (docs/ddfem.md, "Level 2"): the same
-# level-1 base and hierarchy as the mixed table's level 2, each final block
-# sampled on its 4 x 4 x 4 voxels instead of its 2 x 2 x 2 level-1 elements;
-# both databases side by side, blocks without a fit by the Galerkin element.
+# Level-2 variants of the mixed table's database (docs/ddfem.md, "Level 2"),
+# blocks without a fit by the Galerkin element: each final block sampled on
+# its 4 x 4 x 4 voxels instead of its 2 x 2 x 2 level-1 elements; and the
+# lookup's features with the single-corner moves, at the level-1
+# compression (k$(K1)c) and at every pairing stage.
+.PRECIOUS: $(OUT)/ddfem/%.k$(K1)c.coarse_db.h5
+$(OUT)/ddfem/%.k$(K1)c.coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(BIN)/msfab-ddfem-compress
+	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$(K1) --set corner_moves=true --out $@
+$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5: \
+  configs/ddfem/palette3_periodic_enhanced_affine_corners_level2.yaml \
+  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(BIN)/msfab-ddfem-build
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
+	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --out $@ --resume
 $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5: \
   configs/ddfem/palette3_periodic_enhanced_affine_voxels_level2.yaml \
   $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 $(BIN)/msfab-ddfem-build
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --out $@ --resume
-ddfem-table-level2-voxels: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
-                           $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5
-	LEVEL=2 COARSE_ARGS="--coarse-fallback galerkin" BENCH_SECTION=ddfem-level2-voxels \
-	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-voxels docs/BENCHMARKS.md \
+ddfem-table-level2-variants: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
+                             $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
+                             $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5
+	LEVEL=2 COARSE_ARGS="--coarse-fallback galerkin" BENCH_SECTION=ddfem-level2-variants \
+	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-variants docs/BENCHMARKS.md \
 	  level1-elements=$(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
-	  fine-voxels=$(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5
+	  fine-voxels=$(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
+	  corner-lookup=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5
 
 # DDFEM in dynamics (docs/ddfem.md, "Coarsening in dynamics"): the fibre bar
 # fine and at both levels, naive and the isolated and periodic databases.

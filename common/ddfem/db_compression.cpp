@@ -35,6 +35,19 @@ std::vector<Vec24> common_deformations(const hex8::NodeMatrix& coarse_rest, int 
   return out;
 }
 
+std::vector<Vec24> corner_deformations(const hex8::NodeMatrix& coarse_rest, double strain) {
+  if (!(strain > 0 && strain < 0.5)) throw InputError("compression: deformation strain must be in (0, 0.5)");
+  const double edge = (coarse_rest.row(7) - coarse_rest.row(0)).maxCoeff();
+  std::vector<Vec24> out;
+  for (int c = 0; c < 8; ++c)
+    for (int a = 0; a < 3; ++a) {
+      Vec24 u = Vec24::Zero();
+      u[3 * c + a] = strain * edge;
+      out.push_back(u);
+    }
+  return out;
+}
+
 MatX energy_features(const std::vector<CoarseMaterialFit>& entries, const std::vector<Vec24>& deformations,
                      double voxel_size) {
   std::vector<MaterialPtr> one{nullptr};
@@ -95,11 +108,13 @@ FarthestPointSet farthest_point_sampling(const MatX& features, int k, const std:
 }
 
 CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
-                                 std::uint64_t seed, CompressionReport* report) {
+                                 std::uint64_t seed, CompressionReport* report, bool corner_moves) {
   if (full.compressed()) throw InputError("compression: the input database is already compressed");
   FineBlock unit;
   unit.voxel_size = 1e-3;
-  const auto defs = common_deformations(unit.coarse_rest_positions(), deformations, strain, seed);
+  auto defs = common_deformations(unit.coarse_rest_positions(), deformations, strain, seed);
+  if (corner_moves)
+    for (const Vec24& u : corner_deformations(unit.coarse_rest_positions(), strain)) defs.push_back(u);
   // Only fitted entries take part (a database with void children keeps the
   // blocks it could not fit, and the all-void one, as unfitted rows; online
   // they are coarsened naively, so they map to no representative).

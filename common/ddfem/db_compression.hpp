@@ -23,6 +23,13 @@ double uniform_pm1(std::mt19937_64& rng);
 // from the standardized mt19937_64 sequence of `seed`.
 std::vector<Vec24> common_deformations(const hex8::NodeMatrix& coarse_rest, int count, double strain,
                                        std::uint64_t seed);
+// The 24 single-corner moves: corner c displaced by `strain` times the edge
+// along one axis, every other corner at rest. Smooth deformations see a
+// block's stiffness as a whole; these see where in the block it sits (the
+// energy of a corner's move comes mostly from the points next to it), so a
+// checkerboard block is not taken for another block with as much stiff
+// material elsewhere (docs/ddfem.md, "Compression").
+std::vector<Vec24> corner_deformations(const hex8::NodeMatrix& coarse_rest, double strain);
 
 // Row e: log V_s of entry e at deformation s (Eq. 2.10's feature vector).
 // InputError if an entry's energy is not positive and finite at a deformation.
@@ -57,7 +64,8 @@ struct CompressionReport {
 // uncompressed), with entry_of mapping every combination to its
 // representative. The homogeneous combinations come first (if k allows),
 // then farthest-point sampling; `seed` draws the common deformations.
+// `corner_moves` appends corner_deformations to the common ones.
 CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
-                                 std::uint64_t seed, CompressionReport* report = nullptr);
+                                 std::uint64_t seed, CompressionReport* report = nullptr, bool corner_moves = false);
 
 }  // namespace msfab

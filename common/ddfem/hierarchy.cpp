@@ -171,7 +171,7 @@ Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& lev
     condensed_stiffness(probe, K1, &extent);
     Eigen::Matrix<double, 24, Eigen::Dynamic> U(24, D);
     for (int d = 0; d < D; ++d) U.col(d) = box_corner_displacements(defs[d], extent, child_size);
-    MatX features(candidates, D);
+    MatX features(candidates, options.features());
 #pragma omp parallel for schedule(static)
     for (std::int64_t ab = 0; ab < candidates; ++ab) {
       Arrangement arr = items[ab / inputs];
@@ -182,6 +182,10 @@ Level2Hierarchy build_level2_hierarchy(const std::vector<CoarseMaterialFit>& lev
       const VecX energy = 0.5 * (U.transpose() * S * U).diagonal();
       // A floor keeps log finite for a mode the candidate does not resist.
       for (int d = 0; d < D; ++d) features(ab, d) = std::log(std::max(energy[d], 1e-300));
+      // A corner moved alone by u stores S_ii u^2 / 2; the constant factor
+      // drops out of the distances.
+      if (options.corner_moves)
+        for (int i = 0; i < 24; ++i) features(ab, D + i) = std::log(std::max(S(i, i), 1e-300));
     }
 
     PairStage& stage = h.stages[s];

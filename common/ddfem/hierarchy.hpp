@@ -66,6 +66,11 @@ struct HierarchyOptions {
   int deformations = 32;    // common deformations of the level-2 cell
   double strain = 0.05;     // their strain magnitude
   std::uint64_t seed = 5;   // draws the deformations and each stage's first representative
+  // Add the 24 single-corner moves of the candidate's box to its features
+  // (the diagonal of its condensed stiffness): where in the cell its
+  // stiffness sits, as msfab-ddfem-compress's corner_moves.
+  bool corner_moves = false;
+  int features() const { return deformations + (corner_moves ? 24 : 0); }
 };
 
 // Common smooth deformations of the cube [0, L]^3: u(x) = L * strain *

@@ -26,6 +26,7 @@ BuildOptions read_build_options(const Config& config) {
       h.strain = l.get_or<double>("strain", h.strain);
       if (!(h.strain > 0 && h.strain < 0.5)) l.fail("strain", "must be in (0, 0.5)");
       h.seed = l.get_or<std::uint64_t>("seed", h.seed);
+      h.corner_moves = l.get_or<bool>("corner_moves", h.corner_moves);
       const std::string samples = l.get_or<std::string>("samples", "level1");
       if (samples != "level1" && samples != "voxels")
         l.fail("samples", "must be level1 (2 x 2 x 2 level-1 elements) or voxels (4 x 4 x 4 fine voxels), got '" +

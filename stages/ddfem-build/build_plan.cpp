@@ -86,7 +86,7 @@ BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memo
   const double pairs = std::pow(std::max<double>(k1 + 1, *std::max_element(options.hierarchy.representatives.begin(),
                                                                            options.hierarchy.representatives.end())),
                                 2.0);
-  check_memory(pairs * (8.0 * options.hierarchy.deformations + 12.0),
+  check_memory(pairs * (8.0 * options.hierarchy.features() + 12.0),
                "pairing " + std::to_string(k1) + " level-1 materials (" + std::to_string(std::int64_t(k1) * k1) +
                    " candidates x " + std::to_string(options.hierarchy.deformations) + " level2.deformations)",
                "compress the base first (msfab-ddfem-compress --set representatives=K)");

@@ -25,6 +25,7 @@ representatives: 64     # k
 deformations: 64        # common deformations in the feature vectors
 strain: 0.05            # their strain magnitude
 seed: 3                 # draws the deformations and the first representative
+corner_moves: false     # add the 24 single-corner moves to the features (where in a block its stiffness sits)
 )";
 }
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
     const int deformations = ctx.config.require_positive<int>("deformations", "number of common deformations");
     const double strain = ctx.config.require_range<double>("strain", 0.0, 0.5, Bounds::Open, "deformation strain");
     const auto seed = ctx.config.get_or<std::uint64_t>("seed", 3);
+    const bool corner_moves = ctx.config.get_or<bool>("corner_moves", false);
     ctx.finish_config();
     ctx.check_out_folder();
 
@@ -55,7 +57,7 @@ int main(int argc, char** argv) {
                          " coarse materials (deformations)",
                      "use fewer deformations");
     CompressionReport report;
-    const CoarseDatabase small = compress_database(full, k, deformations, strain, seed, &report);
+    const CoarseDatabase small = compress_database(full, k, deformations, strain, seed, &report, corner_moves);
     write_coarse_db(out, small, ctx.config.resolved_text(), ctx.command_line, seed, "msfab-ddfem-compress");
     std::printf("msfab-ddfem-compress: %zu -> %zu coarse materials\n", full.entries.size(), small.entries.size());
     std::printf("  distance to representative (Eq. 2.10): mean %.4f, max %.4f\n", report.mean_distance,

@@ -58,6 +58,8 @@ check "resumed build gives the same database" -- same_db "$WORK/one.h5" "$WORK/p
 COMPRESS="$BIN/msfab-ddfem-compress"
 expect_exit 0 "256 -> 16 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=16 --out "$WORK/k16.h5"
 check "compressed database holds 16 materials" -- bash -c "h5dump -H -d /fit/mu '$WORK/k16.h5' | grep -q '( 16, 8 )'"
+expect_exit 0 "256 -> 16 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=16 \
+  --set corner_moves=true --out "$WORK/k16c.h5"
 expect_exit 2 "exceeds the 256 coarse materials" -- "$COMPRESS" --database "$WORK/one.h5" --set representatives=300 --out "$WORK/bad.h5"
 expect_exit 2 "already compressed" -- "$COMPRESS" --database "$WORK/k16.h5" --set representatives=4 --out "$WORK/bad.h5"
 expect_exit 2 "tiny.yaml: not a valid HDF5" -- "$COMPRESS" --database "$SRC/configs/ddfem/tiny.yaml" --out "$WORK/bad.h5"
@@ -86,6 +88,9 @@ expect_exit 2 "takes its palette from base_database" -- "$BUILD" --config "$L2" 
 expect_exit 2 "level2.representatives" -- "$BUILD" --config "$L2" --set base_database="$WORK/one.h5" \
   --set 'level2.representatives=[4, 4]' --out "$WORK/bad.h5"
 expect_exit 2 "needs base_database" -- "$BUILD" --config "$TINY" --set 'level2.deformations=4' --out "$WORK/bad.h5"
+# Corner moves in the level-2 lookup, over the base compressed with them.
+expect_exit 0 "16 level-2 coarse materials over 16 level-1 materials" -- "$BUILD" --config "$L2" \
+  --set base_database="$WORK/k16c.h5" --set level2.corner_moves=true --out "$WORK/l2c.h5"
 # Level 2 sampled on the blocks' fine voxels (periodic only), same for 1 and 2 ranks.
 expect_exit 0 "16 level-2 coarse materials over 256 level-1 materials" -- "$BUILD" --config "$L2" \
   --set base_database="$WORK/one.h5" --set sampling.mode=periodic --set level2.samples=voxels --out "$WORK/l2vox.h5"

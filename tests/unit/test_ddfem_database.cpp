@@ -193,6 +193,28 @@ TEST(DdfemCompression, CompressedDatabaseLooksEveryCombinationUpToARepresentativ
   // Same seed, same result.
   const CoarseDatabase again = compress_database(db, 10, 16, 0.05, 3);
   EXPECT_EQ(again.entry_of, small.entry_of);
+  // With the corner moves: still every combination has a representative,
+  // each representative is its own, uniform blocks are exact.
+  const CoarseDatabase corners = compress_database(db, 10, 16, 0.05, 3, nullptr, true);
+  for (const CoarseMaterialFit& rep : corners.entries) EXPECT_EQ(corners.find(rep.material_ids), &rep);
+  for (int m = 1; m <= 2; ++m) {
+    const BlockMaterials uniform{m, m, m, m, m, m, m, m};
+    EXPECT_EQ(corners.find(uniform)->material_ids, uniform);
+  }
+  EXPECT_NE(corners.entry_of, small.entry_of);
+}
+
+// The single-corner moves: one corner moved by strain x edge along one axis.
+TEST(DdfemCompression, CornerMovesMoveOneCornerAlongOneAxis) {
+  FineBlock unit;
+  unit.voxel_size = 1e-3;
+  const std::vector<Vec24> moves = corner_deformations(unit.coarse_rest_positions(), 0.05);
+  ASSERT_EQ(moves.size(), 24u);
+  for (int i = 0; i < 24; ++i) {
+    EXPECT_DOUBLE_EQ(moves[i][i], 0.05 * 2e-3) << i;
+    EXPECT_DOUBLE_EQ(moves[i].norm(), 0.05 * 2e-3) << i;
+  }
+  EXPECT_THROW(corner_deformations(unit.coarse_rest_positions(), 0.0), InputError);
 }
 
 }  // namespace

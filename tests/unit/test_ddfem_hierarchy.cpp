@@ -167,6 +167,46 @@ TEST(DdfemHierarchy, UncompressedStagesLookEveryArrangementUpToItself) {
   }
 }
 
+// With the corner moves among the features every arrangement still finds
+// itself in uncompressed stages; and the moves tell apart two cells whose
+// stiff child sits at opposite corners, which the smooth deformations,
+// seeing the cell as a whole, nearly take for one another.
+TEST(DdfemHierarchy, CornerMovesSeeWhereTheStiffChildSits) {
+  std::vector<CoarseMaterialFit> level1(2, CoarseMaterialFit(8));
+  for (int m = 0; m < 2; ++m) {
+    level1[m].fitted = true;
+    level1[m].material_ids.fill(m + 1);
+    for (int k = 0; k < 8; ++k) level1[m].mu[k] = m ? 3.4e6 : 3.4e4, level1[m].lambda[k] = m ? 3.1e7 : 3.1e5;
+  }
+  HierarchyOptions o;
+  o.representatives = {4, 16, 256};
+  o.deformations = 8;
+  o.corner_moves = true;
+  EXPECT_EQ(o.features(), 32);
+  const Level2Hierarchy all = build_level2_hierarchy(level1, kChild, o);
+  for (int code = 0; code < 256; ++code) {
+    const Arrangement e = arrangement_of_code(code, 2);
+    ASSERT_EQ(all.arrangement(2, all.lookup(e)), e) << "arrangement " << code;
+  }
+  Arrangement at0, at7;
+  at0.fill(0), at7.fill(0);
+  at0[0] = 1, at7[7] = 1;
+  const std::vector<Mat24> K1 = level1_rest_stiffness(level1, kChild);
+  const Mat24 S0 = condensed_stiffness(at0, K1), S7 = condensed_stiffness(at7, K1);
+  // Moving corner 0 alone meets the stiff child in one cell, soft ones in the other.
+  EXPECT_GT(S0(0, 0), 2.5 * S7(0, 0));
+  EXPECT_GT(S7(21, 21), 2.5 * S0(21, 21));
+  // A smooth deformation of the whole cell stores nearly the same in both.
+  const auto defs = smooth_deformations(2 * kChild, 8, 0.05, 5);
+  Eigen::Vector3i extent;
+  condensed_stiffness(at0, K1, &extent);
+  for (const SmoothDeformation& d : defs) {
+    const Vec24 u = box_corner_displacements(d, extent, kChild);
+    const double e0 = u.dot(S0 * u), e7 = u.dot(S7 * u);
+    EXPECT_LT(std::abs(std::log(e0 / e7)), std::log(1.5));
+  }
+}
+
 TEST(DdfemHierarchy, CompressedLookupIsConsistentAndPicksANearRepresentative) {
   const int k1 = 3;
   const auto level1 = random_palette(k1, 6, false, {0, 2});
