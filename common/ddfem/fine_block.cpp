@@ -7,6 +7,16 @@
 #include "core/errors.hpp"
 
 namespace msfab {
+namespace {
+
+void check_voxel_size(const char* what, double voxel_size) {
+  if (voxel_size > 0.0 && std::isfinite(voxel_size)) return;
+  std::ostringstream os;
+  os << what << ": voxel size must be positive and finite, got " << voxel_size;
+  throw InputError(os.str());
+}
+
+}  // namespace
 
 bool is_all_void(const BlockMaterials& ids) {
   for (int id : ids)
@@ -79,11 +89,7 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
   }
   if (coarse_points_per_axis != 2 && coarse_points_per_axis != 4)
     throw InputError("fine block: the coarse element takes 2 or 4 Gauss points per axis");
-  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
-    std::ostringstream os;
-    os << "fine block: voxel size must be positive and finite, got " << voxel_size;
-    throw InputError(os.str());
-  }
+  check_voxel_size("fine block", voxel_size);
   FineBlock block;
   block.voxel_size = voxel_size;
   block.coarse_points_per_axis = coarse_points_per_axis;
@@ -142,11 +148,7 @@ FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<
     os << "voxel block: needs " << N * N * N << " voxel ids, got " << voxel_ids.size();
     throw InputError(os.str());
   }
-  if (!(voxel_size > 0.0) || !std::isfinite(voxel_size)) {
-    std::ostringstream os;
-    os << "voxel block: voxel size must be positive and finite, got " << voxel_size;
-    throw InputError(os.str());
-  }
+  check_voxel_size("voxel block", voxel_size);
   FineBlock block;
   block.voxel_size = voxel_size;
   block.voxels_per_edge = N;

@@ -133,17 +133,23 @@ TEST(DdfemHierarchy, CondensedStiffnessIsTheRelaxedEnergyOfTheBlock) {
   EXPECT_NE(smooth_deformations(2 * kChild, 5, 0.05, 10)[3].B, defs[3].B);
 }
 
-TEST(DdfemHierarchy, SoftHalfOfACellIsNotLookedUpToAStiffOne) {
-  // Two uniform level-1 materials 100x apart and the cells mixing them:
-  // a cell with a soft half along y must find a representative with the
-  // same halves, the case that imposing the deformation on every node got
-  // wrong (the stiff half's energy hid the soft half).
+// Two uniform level-1 materials 100x apart (ids 1 and 2).
+std::vector<CoarseMaterialFit> soft_and_stiff_level1() {
   std::vector<CoarseMaterialFit> level1(2, CoarseMaterialFit(8));
   for (int m = 0; m < 2; ++m) {
     level1[m].fitted = true;
     level1[m].material_ids.fill(m + 1);
     for (int k = 0; k < 8; ++k) level1[m].mu[k] = m ? 3.4e6 : 3.4e4, level1[m].lambda[k] = m ? 3.1e7 : 3.1e5;
   }
+  return level1;
+}
+
+TEST(DdfemHierarchy, SoftHalfOfACellIsNotLookedUpToAStiffOne) {
+  // Two uniform level-1 materials 100x apart and the cells mixing them:
+  // a cell with a soft half along y must find a representative with the
+  // same halves, the case that imposing the deformation on every node got
+  // wrong (the stiff half's energy hid the soft half).
+  const std::vector<CoarseMaterialFit> level1 = soft_and_stiff_level1();
   HierarchyOptions o;
   o.representatives = {4, 16, 24};
   o.deformations = 16;
@@ -172,12 +178,7 @@ TEST(DdfemHierarchy, UncompressedStagesLookEveryArrangementUpToItself) {
 // stiff child sits at opposite corners, which the smooth deformations,
 // seeing the cell as a whole, nearly take for one another.
 TEST(DdfemHierarchy, CornerMovesSeeWhereTheStiffChildSits) {
-  std::vector<CoarseMaterialFit> level1(2, CoarseMaterialFit(8));
-  for (int m = 0; m < 2; ++m) {
-    level1[m].fitted = true;
-    level1[m].material_ids.fill(m + 1);
-    for (int k = 0; k < 8; ++k) level1[m].mu[k] = m ? 3.4e6 : 3.4e4, level1[m].lambda[k] = m ? 3.1e7 : 3.1e5;
-  }
+  const std::vector<CoarseMaterialFit> level1 = soft_and_stiff_level1();
   HierarchyOptions o;
   o.representatives = {4, 16, 256};
   o.deformations = 8;
