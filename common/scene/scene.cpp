@@ -1,6 +1,9 @@
 #include "scene/scene.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -94,11 +97,9 @@ std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector
   return path;
 }
 
-// `mesh: {file: F.stl, scale: s, offset: [x, y, z]}, id: n`: the voxels whose
-// centre lies inside the closed surface take id n; a file vertex p lies at
-// s p + offset in the scene (metres). Returns the file's path.
-std::string paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
-  const Config c = item.child("mesh");
+// The layout's surface mesh `c` (a `mesh` item's mapping) in scene
+// coordinates, vertices merged; InputError naming the file if it is not closed.
+TriangleSurface placed_surface(const Config& c) {
   const std::string path = c.get_path("file");
   TriangleSurface surface = merge_equal_vertices(read_surface_mesh(path));
   const SurfaceClosure closure = check_closure(surface);
@@ -115,6 +116,48 @@ std::string paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
   if (!(scale > 0) || !std::isfinite(scale)) c.fail("scale", "must be a positive finite number");
   const Vec3 offset = c.has("offset") ? read_vec3(c, "offset") : Vec3::Zero();
   for (Vec3& p : surface.vertices) p = scale * p + offset;
+  return surface;
+}
+
+// `grid: {voxel_size: h, size_from_parts: true, margin: m}`: the grid that
+// covers the bounding box of the layout's surface meshes plus m voxels on
+// every side, its origin at the box's lower corner minus the margin.
+VoxelGrid grid_around_parts(const Config& config) {
+  const Config g = config.child("grid");
+  for (const char* key : {"size", "origin"})
+    if (g.has(key)) g.fail(key, "comes from the parts with size_from_parts; drop it");
+  const double h = g.require_positive("voxel_size", "voxel size");
+  const int margin = g.get_or<int>("margin", 0);
+  if (margin < 0) g.fail("margin", "must be >= 0 voxels");
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Config& item : config.children("layout"))
+    if (item.has("mesh")) {
+      const auto box = bounding_box(placed_surface(item.child("mesh")));
+      lo = lo.cwiseMin(box[0]), hi = hi.cwiseMax(box[1]);
+    }
+  if (!(lo.array() <= hi.array()).all())
+    g.fail("size_from_parts", "needs at least one `mesh` item in the layout");
+  std::array<int, 3> n{};
+  for (int a = 0; a < 3; ++a) {
+    // A part whose extent is a whole number of voxels up to round-off takes exactly that many.
+    const double voxels = (hi[a] - lo[a]) / h;
+    n[a] = std::max(1, static_cast<int>(std::ceil(voxels - 1e-9 * std::max(1.0, voxels)))) + 2 * margin;
+  }
+  if (double(n[0]) * n[1] * n[2] > 2e9) g.fail("voxel_size", "gives the parts more than 2e9 voxels");
+  VoxelGrid grid(n[0], n[1], n[2], h);
+  grid.origin = lo - Vec3::Constant(margin * h);
+  spdlog::info("grid from the parts: {} x {} x {} voxels from ({:.6g}, {:.6g}, {:.6g})", n[0], n[1], n[2],
+               grid.origin.x(), grid.origin.y(), grid.origin.z());
+  return grid;
+}
+
+// `mesh: {file: F.stl, scale: s, offset: [x, y, z]}, id: n`: the voxels whose
+// centre lies inside the closed surface take id n; a file vertex p lies at
+// s p + offset in the scene (metres). Returns the file's path.
+std::string paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
+  const Config c = item.child("mesh");
+  const std::string path = c.get_path("file");
+  const TriangleSurface surface = placed_surface(c);
   const auto [lo, hi] = bounding_box(surface);
   const Vec3 grid_hi = grid.origin + grid.extent();
   const long long painted = paint_surface(grid, surface, id);
@@ -228,13 +271,17 @@ Scene read_scene(const Config& config) {
   s.name = config.get_or<std::string>("name", "scene");
   {
     const Config g = config.child("grid");
-    const auto size = g.get<std::vector<int>>("size");
-    if (size.size() != 3) g.fail("size", "expected [nx, ny, nz]");
-    for (int n : size)
-      if (n <= 0) g.fail("size", "grid dimensions must be positive");
-    if (double(size[0]) * size[1] * size[2] > 2e9) g.fail("size", "grid has more than 2e9 voxels");
-    s.grid = VoxelGrid(size[0], size[1], size[2], g.require_positive("voxel_size", "voxel size"));
-    if (g.has("origin")) s.grid.origin = read_vec3(g, "origin");
+    if (g.get_or<bool>("size_from_parts", false)) {
+      s.grid = grid_around_parts(config);
+    } else {
+      const auto size = g.get<std::vector<int>>("size");
+      if (size.size() != 3) g.fail("size", "expected [nx, ny, nz]");
+      for (int n : size)
+        if (n <= 0) g.fail("size", "grid dimensions must be positive");
+      if (double(size[0]) * size[1] * size[2] > 2e9) g.fail("size", "grid has more than 2e9 voxels");
+      s.grid = VoxelGrid(size[0], size[1], size[2], g.require_positive("voxel_size", "voxel size"));
+      if (g.has("origin")) s.grid.origin = read_vec3(g, "origin");
+    }
   }
   s.palette = read_materials(config, &s.material_by_id);
   s.nonlinear = false;

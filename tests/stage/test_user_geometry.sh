@@ -159,5 +159,20 @@ scene far "  - {mesh: {file: bracket.stl, scale: 0.001, offset: [1, 0, 0]}, id: 
 expect_exit 2 "bracket.stl contains no voxel centre" -- "$SIM" --config "$WORK/far.yaml" --out "$WORK/x.h5"
 scene missing "  - {mesh: {file: nowhere.stl}, id: 1}"
 expect_exit 2 "nowhere.stl: no such file" -- "$SIM" --config "$WORK/missing.yaml" --out "$WORK/x.h5"
+# The grid sized from the part: the bracket's 6 x 12 x 6 mm box at 1 mm voxels
+# is the box scene's grid, so the displacements are the same bit for bit.
+sed 's/grid: {size: \[6, 12, 6\], voxel_size: 0.001}/grid: {voxel_size: 0.001, size_from_parts: true}/' "$WORK/stl.yaml" > "$WORK/parts.yaml"
+expect_exit 0 "grid from the parts: 6 x 12 x 6 voxels from \(0, 0, 0\)" -- "$SIM" --config "$WORK/parts.yaml" \
+  --out "$WORK/parts.h5" --threads 1
+check "grid sized from the STL gives the box scene's displacements bit for bit" -- \
+  h5diff "$WORK/boxes.h5" "$WORK/parts.h5" /displacement /displacement
+sed 's/size_from_parts: true}/size_from_parts: true, margin: 1}/' "$WORK/parts.yaml" > "$WORK/margin.yaml"
+# With a margin the grid's faces lie in void, so the face clamp selects nothing (refused).
+expect_exit 2 "grid from the parts: 8 x 14 x 8 voxels from \(-0.001, -0.001, -0.001\)" -- "$SIM" \
+  --config "$WORK/margin.yaml" --out "$WORK/x.h5" --threads 1
+sed 's/grid: {size: \[6, 12, 6\], voxel_size: 0.001}/grid: {voxel_size: 0.001, size_from_parts: true}/' "$WORK/npy.yaml" > "$WORK/noparts.yaml"
+expect_exit 2 "grid.size_from_parts.*needs at least one .mesh. item" -- "$SIM" --config "$WORK/noparts.yaml" --out "$WORK/x.h5"
+sed 's/size_from_parts: true}/size_from_parts: true, size: [6, 12, 6]}/' "$WORK/parts.yaml" > "$WORK/both.yaml"
+expect_exit 2 "grid.size.*comes from the parts" -- "$SIM" --config "$WORK/both.yaml" --out "$WORK/x.h5"
 check "nothing written for refused scenes" -- test ! -e "$WORK/x.h5"
 finish
