@@ -109,14 +109,22 @@ $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5: \
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --out $@ --resume
+$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners800.level2.coarse_db.h5: \
+  configs/ddfem/palette3_periodic_enhanced_affine_corners800_level2.yaml \
+  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(BIN)/msfab-ddfem-build
+	@mkdir -p $(@D)
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
+	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --out $@ --resume
 ddfem-table-level2-variants: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
                              $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
-                             $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5
+                             $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 \
+                             $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners800.level2.coarse_db.h5
 	LEVEL=2 COARSE_ARGS="--coarse-fallback galerkin" BENCH_SECTION=ddfem-level2-variants \
 	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-variants docs/BENCHMARKS.md \
 	  level1-elements=$(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
 	  fine-voxels=$(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
-	  corner-lookup=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5
+	  corner-lookup=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 \
+	  corner-lookup-800=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners800.level2.coarse_db.h5
 
 # DDFEM in dynamics (docs/ddfem.md, "Coarsening in dynamics"): the fibre bar
 # fine and at both levels, naive and the isolated and periodic databases.
