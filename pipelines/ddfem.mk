@@ -97,8 +97,9 @@ ddfem-table-mixed: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_
 .PRECIOUS: $(OUT)/ddfem/%.k$(K1)c.coarse_db.h5
 $(OUT)/ddfem/%.k$(K1)c.coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(BIN)/msfab-ddfem-compress
 	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$(K1) --set corner_moves=true --out $@
-$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5: \
-  configs/ddfem/palette3_periodic_enhanced_affine_corners_level2.yaml \
+AFFINE_CORNER_L2 := $(foreach v,corners corners800,$(OUT)/ddfem/palette3_periodic_enhanced_affine_$(v).level2.coarse_db.h5)
+$(AFFINE_CORNER_L2): $(OUT)/ddfem/palette3_periodic_enhanced_affine_%.level2.coarse_db.h5: \
+  configs/ddfem/palette3_periodic_enhanced_affine_%_level2.yaml \
   $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(BIN)/msfab-ddfem-build
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
@@ -109,12 +110,6 @@ $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5: \
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --out $@ --resume
-$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners800.level2.coarse_db.h5: \
-  configs/ddfem/palette3_periodic_enhanced_affine_corners800_level2.yaml \
-  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(BIN)/msfab-ddfem-build
-	@mkdir -p $(@D)
-	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
-	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --out $@ --resume
 ddfem-table-level2-variants: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
                              $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
                              $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 \

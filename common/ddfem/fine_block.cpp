@@ -70,6 +70,14 @@ int FineBlock::child_of_point(int q) const {
   return 4 * (chi.x() > 0) + 2 * (chi.y() > 0) + (chi.z() > 0);
 }
 
+int FineBlock::voxel_of_point(int q) const {
+  const int N = voxels_per_edge;
+  const Vec3 chi = hex8::gauss_rule(coarse_points_per_axis).points[q];
+  int voxel[3];
+  for (int a = 0; a < 3; ++a) voxel[a] = std::min(N - 1, static_cast<int>(std::floor((chi[a] + 1) * N / 2)));
+  return voxel[0] + N * (voxel[1] + N * voxel[2]);
+}
+
 int FineBlock::child_of_coarse_point(int q) {
   const Vec3 chi = hex8::gauss_rule(2).points[q];
   return 4 * (chi.x() > 0) + 2 * (chi.y() > 0) + (chi.z() > 0);
@@ -175,12 +183,8 @@ FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<
     block.corner_nodes[c] = block.lattice_node(N * (c >> 2 & 1), N * (c >> 1 & 1), N * (c & 1));
   // One Gauss point in each voxel: the 4-point rule's abscissae lie one in
   // each quarter of [-1, 1].
-  const hex8::ElementGeometry coarse = block.coarse_geometry();
-  for (int q = 0; q < coarse.size(); ++q) {
-    const Vec3 chi = hex8::gauss_rule(N).points[q];
-    int voxel[3];
-    for (int a = 0; a < 3; ++a) voxel[a] = std::min(N - 1, static_cast<int>(std::floor((chi[a] + 1) * N / 2)));
-    const int id = voxel_ids[voxel[0] + N * (voxel[1] + N * voxel[2])];
+  for (int q = 0; q < block.coarse_points(); ++q) {
+    const int id = voxel_ids[block.voxel_of_point(q)];
     block.point_mu0.push_back(id ? palette[id]->shear_modulus() : 0.0);
     block.point_lambda0.push_back(id ? palette[id]->lame_lambda() : 0.0);
   }

@@ -61,6 +61,8 @@ struct FineBlock {
   hex8::ElementGeometry coarse_geometry() const;
   int coarse_points() const { return coarse_points_per_axis * coarse_points_per_axis * coarse_points_per_axis; }
   int child_of_point(int q) const;
+  // The block voxel (i + n (j + n k), x fastest) coarse point q lies in.
+  int voxel_of_point(int q) const;
   static int child_of_coarse_point(int q);  // the 2-point rule
   // Mesh node at block lattice position (i, j, k), i, j, k in {0, ..., n}
   // (offset by the context); -1 if absent.

@@ -291,18 +291,12 @@ std::vector<Vec3> periodic_point_directions(const FineBlock& block, const Anisot
   if (!(options.strain > 0.0)) throw InputError("anisotropy: strain must be > 0");
   const PeriodicBlockSolver solver(block, options.newton_tolerance);
   const HexMesh& mesh = block.mesh();
-  const int N = block.voxels_per_edge;
   const hex8::ElementGeometry coarse = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
   const Vec3 center = Vec3::Constant(0.5 * block.edge());
   // The element under each coarse point (-1 in a void voxel).
   std::vector<int> element_of_point(coarse.size(), -1);
-  for (int q = 0; q < coarse.size(); ++q) {
-    const Vec3 chi = hex8::gauss_rule(block.coarse_points_per_axis).points[q];
-    int voxel[3];
-    for (int a = 0; a < 3; ++a) voxel[a] = std::min(N - 1, static_cast<int>(std::floor((chi[a] + 1) * N / 2)));
-    element_of_point[q] = block.voxels.voxel_element[voxel[0] + N * (voxel[1] + N * voxel[2])];
-  }
+  for (int q = 0; q < coarse.size(); ++q) element_of_point[q] = block.voxels.voxel_element[block.voxel_of_point(q)];
   std::vector<std::vector<Vec3>> cloud(coarse.size());
   int relaxed = 0;
   for (const Vec3& d : sampling_directions(false, options.directions, options.seed)) {
