@@ -13,6 +13,7 @@
 #   make -f Makefile.pipeline ddfem-table-enhanced  level 1 fitted for the enhanced coarse element, its own section
 #   make -f Makefile.pipeline ddfem-table-mixed     mixed blocks: naive, Galerkin and DDFEM on both elements, its own section
 #   make -f Makefile.pipeline ddfem-table-level2-variants  level 2 sampled on fine voxels, and with corner moves in the lookup
+#   make -f Makefile.pipeline ddfem-table-checked   matched coarsening, and DDFEM lookups checked against each block's own C^H
 #   make -f Makefile.pipeline ddfem-table-dynamics  DDFEM in dynamics: the fibre bar fine, level 1 and 2, trajectory error and speed
 #   make -f Makefile.pipeline ddfem-table-thesis-settings  the thesis's sampling and fit, and level 2 over 100/400/1024 materials
 #
@@ -43,7 +44,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants \
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants ddfem-table-checked \
         ddfem-table-dynamics
 ddfem-db-tiny: stages $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: stages $(OUT)/ddfem/palette3.coarse_db.h5
@@ -120,6 +121,33 @@ ddfem-table-level2-variants: stages $(OUT)/ddfem/palette3_periodic_enhanced_affi
 	  fine-voxels=$(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5 \
 	  corner-lookup=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 \
 	  corner-lookup-800=$(OUT)/ddfem/palette3_periodic_enhanced_affine_corners800.level2.coarse_db.h5
+
+# Matched coarsening and the checked lookup (docs/ddfem.md, "Matched
+# materials and the checked lookup"): both levels on the references of the
+# level-2 variants; CHECK is the --coarse-check tolerance.
+CHECK ?= 0.1
+ENHANCED_NAIVE := --coarse-material naive --coarse-element enhanced
+ddfem-table-checked: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 \
+                     $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 \
+                     $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 \
+                     $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 \
+                     $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5
+	LEVEL=2 BENCH_SECTION=ddfem-checked-level2 \
+	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-variants docs/BENCHMARKS.md \
+	  naive-enhanced="$(ENHANCED_NAIVE)" matched="--coarse-material matched --coarse-element enhanced" \
+	  ddfem="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 --coarse-fallback galerkin" \
+	  ddfem-checked="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.level2.coarse_db.h5 --coarse-fallback galerkin --coarse-check $(CHECK)" \
+	  corner-lookup="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 --coarse-fallback galerkin" \
+	  corner-lookup-checked="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine_corners.level2.coarse_db.h5 --coarse-fallback galerkin --coarse-check $(CHECK)"
+	LEVEL=1 BENCH_SECTION=ddfem-checked-level1 \
+	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-variants docs/BENCHMARKS.md \
+	  naive-enhanced="$(ENHANCED_NAIVE)" \
+	  full="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 --coarse-fallback galerkin" \
+	  full-checked="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_db.h5 --coarse-fallback galerkin --coarse-check $(CHECK)" \
+	  k$(K1)="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --coarse-fallback galerkin" \
+	  k$(K1)-checked="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --coarse-fallback galerkin --coarse-check $(CHECK)" \
+	  k$(K1)c="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --coarse-fallback galerkin" \
+	  k$(K1)c-checked="--database $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --coarse-fallback galerkin --coarse-check $(CHECK)"
 
 # DDFEM in dynamics (docs/ddfem.md, "Coarsening in dynamics"): the fibre bar
 # fine and at both levels, naive and the isolated and periodic databases.

@@ -7,6 +7,9 @@
 # and references (docs/ddfem.md, "The thesis's settings").
 #
 #   tools/bench_ddfem_databases.sh BIN OUTDIR BENCHMARKS.md LABEL=DATABASE [LABEL=DATABASE ...]
+# A column may instead give msfab-simulate's coarsening arguments itself,
+# LABEL="--coarse-material matched --coarse-element enhanced" (value starting
+# with --; COARSE_ARGS is not added to it).
 # Env: LEVEL (1), SCENES (the Table 2.2 and mixed-block scenes), BENCH_SECTION
 # (ddfem-databases), COARSE_ARGS (extra msfab-simulate arguments for the
 # coarse runs, e.g. "--coarse-fallback galerkin"), BENCH_TIMES (1; 0 leaves the
@@ -19,7 +22,7 @@ LABELS=() DBS=()
 for spec in "$@"; do
   label=${spec%%=*} db=${spec#*=}
   [ "$label" != "$spec" ] && [ -n "$label" ] || { echo "bench: '$spec' is not LABEL=DATABASE" >&2; exit 2; }
-  [ -f "$db" ] || { echo "bench: no database $db (for $label)" >&2; exit 2; }
+  [ "${db#--}" != "$db" ] || [ -f "$db" ] || { echo "bench: no database $db (for $label)" >&2; exit 2; }
   LABELS+=("$label") DBS+=("$db")
 done
 LEVEL=${LEVEL:-1}
@@ -48,7 +51,9 @@ for scene in "${SCENE_LIST[@]}"; do
     out="$OUTDIR/$scene-L$LEVEL-${LABELS[$i]}.h5"
     echo "bench: $scene level $LEVEL ${LABELS[$i]} ..." >&2
     e=failed t=""
-    run "$out" --config "$cfg" --coarsen "$LEVEL" --reference "$fine" --database "${DBS[$i]}" "${EXTRA[@]}" &&
+    if [ "${DBS[$i]#--}" != "${DBS[$i]}" ]; then read -r -a column_args <<< "${DBS[$i]}"
+    else column_args=(--database "${DBS[$i]}" "${EXTRA[@]}"); fi
+    run "$out" --config "$cfg" --coarsen "$LEVEL" --reference "$fine" "${column_args[@]}" &&
       e=$(attr "$out" /coarsening error_vs_fine) && t=$(attr "$out" /timings newton_total)
     row+=$(awk -v e="$e" -v n="$naive" 'BEGIN { if (e == "failed") printf " failed |"; else if (n == "failed") printf " %.2e |", e;
                                                  else printf " %.2e (%.2f) |", e, e / n }')
@@ -59,7 +64,10 @@ done
 
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores"
 legend=""
-for i in "${!LABELS[@]}"; do legend+="${LABELS[$i]}: $(basename "${DBS[$i]}"); "; done
+for i in "${!LABELS[@]}"; do
+  if [ "${DBS[$i]#--}" != "${DBS[$i]}" ]; then legend+="${LABELS[$i]}: ${DBS[$i]}; "
+  else legend+="${LABELS[$i]}: $(basename "${DBS[$i]}"); "; fi
+done
 table="Measured $(date -u +%Y-%m-%d) on $machine, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), level $LEVEL${COARSE_ARGS:+, coarse runs with $COARSE_ARGS}. Databases: ${legend%; }. Error against the fine run; in brackets, over trilinear naive coarsening's.
 
 $header

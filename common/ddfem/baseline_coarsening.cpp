@@ -16,7 +16,7 @@
 namespace msfab {
 namespace {
 
-const MaterialPtr& palette_material(const std::vector<MaterialPtr>& palette, int id) {
+const MaterialPtr& palette_material_checked(const std::vector<MaterialPtr>& palette, int id) {
   if (id <= 0 || id >= static_cast<int>(palette.size()) || !palette[id]) {
     std::ostringstream msg;
     msg << "coarsening baseline: fine material id " << id << " is not in the palette (ids 1.."
@@ -26,8 +26,8 @@ const MaterialPtr& palette_material(const std::vector<MaterialPtr>& palette, int
   return palette[id];
 }
 
-// Fine ids of a block laid out n x n x n, index (a * n + b) * n + c with a
-// along x (slowest), the point order of hex8::gauss_rule(n).
+}  // namespace
+
 std::vector<int> block_level1(const ChildIds& child) { return std::vector<int>(child.begin(), child.end()); }
 
 std::vector<int> block_level2(const ChildIds& child, const std::vector<ChildIds>& level1) {
@@ -56,7 +56,7 @@ QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const s
   };
   for (int p = 0; p < static_cast<int>(ids.size()); ++p) {
     if (ids[p] != 0) {
-      m.at_point[p] = palette_material(palette, ids[p]);
+      m.at_point[p] = palette_material_checked(palette, ids[p]);
       continue;
     }
     int cp[3];
@@ -68,18 +68,20 @@ QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const s
       coords(s, cs);
       const int dist = std::abs(cs[0] - cp[0]) + std::abs(cs[1] - cp[1]) + std::abs(cs[2] - cp[2]);
       const bool better = best < 0 || dist < best_dist ||
-                          (dist == best_dist && palette_material(palette, ids[s])->shear_modulus() <
-                                                    palette_material(palette, ids[best])->shear_modulus());
+                          (dist == best_dist && palette_material_checked(palette, ids[s])->shear_modulus() <
+                                                    palette_material_checked(palette, ids[best])->shear_modulus());
       if (better) {
         best = s;
         best_dist = dist;
       }
     }
     if (best < 0) throw InputError("coarsening baseline: every voxel of the block is void");
-    m.at_point[p] = palette_material(palette, ids[best]);
+    m.at_point[p] = palette_material_checked(palette, ids[best]);
   }
   return m;
 }
+
+namespace {
 
 QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
   double mu = 0, lambda = 0;
@@ -98,28 +100,37 @@ QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, cons
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;
   m.at_point.reserve(8 * ids.size());
-  for (int id : ids) m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material(palette, id));
+  for (int id : ids) m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material_checked(palette, id));
   return m;
 }
 
 QuadratureMaterials homogenized_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
   if (std::find(ids.begin(), ids.end(), 0) != ids.end()) return naive_block(palette, ids, n);
-  VoxelGrid cell(n, n, n, 1.0, 0);
-  for (int a = 0; a < n; ++a)
-    for (int b = 0; b < n; ++b)
-      for (int c = 0; c < n; ++c) cell.at(a, b, c) = ids[(a * n + b) * n + c];
-  for (int id : ids) palette_material(palette, id);  // a clear error for an unknown id
-  HomogenizationOptions options;
-  options.solver = "direct";
-  options.threads = 1;
-  return QuadratureMaterials{{homogenized_block_material(to_material_voigt_order(homogenize(cell, palette, options).C))}};
+  return QuadratureMaterials{{homogenized_block_material(block_homogenized_stiffness(palette, ids, n))}};
 }
 
 }  // namespace
 
+Mat6 block_homogenized_stiffness(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
+  VoxelGrid cell(n, n, n, 1.0, 0);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      for (int c = 0; c < n; ++c) cell.at(a, b, c) = ids.at((a * n + b) * n + c);
+  for (int id : ids)
+    if (id != 0) palette_material_checked(palette, id);  // a clear error for an unknown id
+  HomogenizationOptions options;
+  options.solver = "direct";
+  options.threads = 1;
+  return to_material_voigt_order(homogenize(cell, palette, options).C);
+}
+
 MaterialPtr homogenized_block_material(const Mat6& C) {
   double mu = 0, lambda = 0;
   isotropic_projection(C, &mu, &lambda);
+  // A strongly anisotropic C (a stiff direction beside soft ones) can
+  // project to lambda < 0, which no Neo-Hookean part may have; lambda = 0
+  // keeps the split exact (t below is then taken against that part).
+  lambda = std::max(lambda, 0.0);
   Mat6 iso = Mat6::Zero();
   iso.topLeftCorner<3, 3>().setConstant(lambda);
   iso.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
@@ -140,7 +151,7 @@ void average_lame(const std::vector<MaterialPtr>& palette, const std::vector<int
   double sm = 0, sl = 0;
   for (int id : fine_ids) {
     if (id == 0) continue;
-    const MaterialPtr& m = palette_material(palette, id);
+    const MaterialPtr& m = palette_material_checked(palette, id);
     sm += m->shear_modulus();
     sl += m->lame_lambda();
   }

@@ -66,6 +66,17 @@ CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette);
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 
+// Fine ids of a block laid out n x n x n, index (a * n + b) * n + c with a
+// along x (slowest), the point order of hex8::gauss_rule(n): level 1 (the
+// child ids) and level 2 (children are combinations of `level1`, index + 1,
+// 0 = void).
+std::vector<int> block_level1(const ChildIds& child);
+std::vector<int> block_level2(const ChildIds& child, const std::vector<ChildIds>& level1);
+// Naive materials of such a block on the n-point rule (one per voxel).
+QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n);
+// C^H of the block taken as a periodic cell (material Voigt order).
+Mat6 block_homogenized_stiffness(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n);
+
 // The material the homogenized coarsening gives a block of stiffness C^H
 // (Voigt order of material/voigt.hpp).
 MaterialPtr homogenized_block_material(const Mat6& C);

@@ -1,32 +1,72 @@
 #include "ddfem/voxel_coarsening.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <set>
 
 #include "core/errors.hpp"
 #include "ddfem/baseline_coarsening.hpp"
+#include "ddfem/matched_coarsening.hpp"
 
 namespace msfab {
 
+namespace {
+
+// The database's lookup, except where a solid mixed block's fit has a
+// response to uniform strains farther than `tolerance` from the block's own
+// C^H: there the matched model, which has that C^H by construction. The fit
+// comes from a representative (compression, the level-2 pairing stages), so
+// its stiffness can sit elsewhere in the block than the block's own; C^H is
+// computed from the block itself.
+CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
+                                    const CoarseGrid& level1, int level, double tolerance, bool enhanced,
+                                    CoarseMaterialLookup database, CoarsenedVoxels* counts) {
+  const CoarseMaterialLookup matched =
+      level == 2 ? matched_coarsening(palette, level1, enhanced) : matched_coarsening(palette, enhanced);
+  return [&db, palette, combos = level1.combinations, level, tolerance, database, matched,
+          counts](const ChildIds& ids) {
+    const CoarseMaterialFit* fit = level == 2 ? find_level2_fit(db, combos, ids) : db.find(ids);
+    if (!fit) return database(ids);
+    const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
+    const bool solid = std::find(voxels.begin(), voxels.end(), 0) == voxels.end();
+    const bool mixed = std::any_of(voxels.begin(), voxels.end(), [&](int id) { return id != voxels[0]; });
+    if (!solid || !mixed) return database(ids);
+    ++counts->checked_blocks;
+    const int n = level == 2 ? 4 : 2;
+    if (stiffness_distance(fit_uniform_response(*fit), block_homogenized_stiffness(palette, voxels, n)) <= tolerance)
+      return database(ids);
+    ++counts->replaced_blocks;
+    return matched(ids);
+  };
+}
+
+}  // namespace
+
 CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
-                                         const CoarseGrid* level1) {
+                                         const CoarseGrid* level1, bool enhanced) {
   if (name == "naive") return level1 ? naive_coarsening(palette, *level1) : naive_coarsening(palette);
   if (name == "averaged") return level1 ? averaged_coarsening(palette, *level1) : averaged_coarsening(palette);
   if (name == "galerkin") return level1 ? galerkin_coarsening(palette, *level1) : galerkin_coarsening(palette);
   if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
-  throw InputError("coarse materials: expected naive, averaged, galerkin or homogenized, got '" + name + "'");
+  if (name == "matched") return level1 ? matched_coarsening(palette, *level1, enhanced) : matched_coarsening(palette, enhanced);
+  throw InputError("coarse materials: expected naive, averaged, galerkin, homogenized or matched, got '" + name + "'");
 }
 
 CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette,
                                const CoarseningRequest& request) {
-  if (request.fallback != "naive" && request.fallback != "galerkin")
-    throw InputError("--coarse-fallback: expected naive or galerkin, got '" + request.fallback + "'");
+  if (request.fallback != "naive" && request.fallback != "galerkin" && request.fallback != "matched")
+    throw InputError("--coarse-fallback: expected naive, galerkin or matched, got '" + request.fallback + "'");
   if (request.level < 1 || request.level > 2)
     throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
   if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
-      request.material != "homogenized" && request.material != "galerkin")
-    throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized or galerkin, got '" +
+      request.material != "homogenized" && request.material != "galerkin" && request.material != "matched")
+    throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized, galerkin or matched, got '" +
                      request.material + "'");
+  if (!(request.check_tolerance >= 0) || !std::isfinite(request.check_tolerance))
+    throw InputError("--coarse-check: the tolerance must be >= 0 and finite (0: no check)");
+  if (request.check_tolerance > 0 && request.material != "ddfem")
+    throw InputError("--coarse-check: applies to --coarse-material ddfem only (got " + request.material + ")");
   if (request.fallback != "naive" && request.material != "ddfem")
     throw InputError("--coarse-fallback " + request.fallback + ": applies to --coarse-material ddfem only (got " +
                      request.material + ")");
@@ -54,12 +94,12 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   const CoarseGrid* level1 = request.level == 2 ? &m.level1 : nullptr;
   CoarseMaterialLookup lookup;
   if (request.material != "ddfem") {
-    lookup = baseline_coarsening(request.material, palette, level1);
+    lookup = baseline_coarsening(request.material, palette, level1, m.element == "enhanced");
   } else {
     // Blocks the database holds no fit for (void children in a database
     // built without them, blocks that could not be fitted) are coarsened
     // naively or by the Galerkin element.
-    const CoarseMaterialLookup fallback = baseline_coarsening(request.fallback, palette, level1);
+    const CoarseMaterialLookup fallback = baseline_coarsening(request.fallback, palette, level1, m.element == "enhanced");
     int* fallbacks = &m.fallback_blocks;
     const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
       ++*fallbacks;
@@ -68,6 +108,9 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
     lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
                                 : database_coarsening(*m.database, counted);
     m.fallback = request.fallback;
+    if (request.check_tolerance > 0)
+      lookup = checked_lookup(*m.database, palette, m.level1, request.level, request.check_tolerance,
+                              m.element == "enhanced", lookup, &m);
   }
   m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -15,14 +15,18 @@ namespace msfab {
 
 struct CoarseningRequest {
   int level = 0;                     // 0 = fine, 1, 2
-  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin
+  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin | matched
   std::string database;              // coarse_db path (ddfem)
   // ddfem: how blocks without a fit in the database are coarsened (naive |
-  // galerkin); blocks with void children are the usual ones.
+  // galerkin | matched); blocks with void children are the usual ones.
   std::string fallback = "naive";
   // trilinear | enhanced (condensed bubble modes); empty: the database's
   // element for ddfem, trilinear otherwise.
   std::string element;
+  // ddfem: > 0 checks every solid mixed block's fit against the block's own
+  // homogenized stiffness and coarsens it by the matched model where their
+  // stiffness_distance exceeds this (docs/ddfem.md, "Checked lookup"); 0: off.
+  double check_tolerance = 0;
 };
 
 struct CoarsenedVoxels {
@@ -34,13 +38,16 @@ struct CoarsenedVoxels {
   std::shared_ptr<CoarseDatabase> database;
   std::string element = "trilinear"; // the coarse element used (request resolved)
   std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
+  int checked_blocks = 0;            // ddfem with a check: distinct solid mixed blocks whose fit was checked
+  int replaced_blocks = 0;           // ... and of those, coarsened by the matched model instead
 };
 
-// A baseline of ddfem/baseline_coarsening.hpp by name (naive, averaged,
-// galerkin, homogenized): of level-1 blocks when level1 is null, of level-2
-// cells of that level-1 grid otherwise.
+// A baseline by name (naive, averaged, galerkin, homogenized of
+// ddfem/baseline_coarsening.hpp, matched of ddfem/matched_coarsening.hpp):
+// of level-1 blocks when level1 is null, of level-2 cells of that level-1
+// grid otherwise; `enhanced`: the coarse element has bubble modes.
 CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
-                                         const CoarseGrid* level1);
+                                         const CoarseGrid* level1, bool enhanced = false);
 
 // `palette` is indexed by voxel id ([0] = void). InputError for a bad
 // request: unknown material or fallback, a level other than 1 or 2, ddfem

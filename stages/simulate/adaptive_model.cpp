@@ -16,12 +16,13 @@ using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 // The materials of the uniform models: the database's fits, blocks without
 // one coarsened as the level-2 model's request said (naive or Galerkin).
 CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2) {
-  return database_coarsening(*level2.database->level1, baseline_coarsening(level2.fallback, scene.material_by_id, nullptr));
+  return database_coarsening(*level2.database->level1, baseline_coarsening(level2.fallback, scene.material_by_id, nullptr, level2.element == "enhanced"));
 }
 
 CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseModel& level2) {
   return database_coarsening_level2(*level2.database, level2.level1,
-                                    baseline_coarsening(level2.fallback, scene.material_by_id, &level2.level1));
+                                    baseline_coarsening(level2.fallback, scene.material_by_id, &level2.level1,
+                                                        level2.element == "enhanced"));
 }
 
 // Displacements of a coarse solution (positions x) interpolated to the fine nodes.

@@ -207,6 +207,10 @@ int main(int argc, char** argv) {
                    coarse.fallback_blocks ? fmt::format(" ({} block kinds without a database fit coarsened {})",
                                                         coarse.fallback_blocks, coarsening.fallback)
                                           : std::string());
+    if (coarsened && coarsening.check_tolerance > 0)
+      spdlog::info("checked lookup: {} of {} solid mixed block kinds had a fit farther than {} from their own "
+                   "homogenized stiffness and were coarsened by the matched model",
+                   coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance);
 
     // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
     // step apart, which elements of mixed sizes are not: adaptive models are
@@ -271,6 +275,9 @@ int main(int argc, char** argv) {
       if (coarsening.material == "ddfem") {
         record.coarse_fallback = coarsening.fallback;
         record.fallback_blocks = coarse.fallback_blocks;
+        record.check_tolerance = coarsening.check_tolerance;
+        record.checked_blocks = coarse.checked_blocks;
+        record.replaced_blocks = coarse.replaced_blocks;
       }
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;

@@ -82,6 +82,9 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
     if (!r.coarse_fallback.empty()) {
       f.write_attribute("/coarsening", "fallback", r.coarse_fallback);
       f.write_attribute("/coarsening", "fallback_blocks", r.fallback_blocks);
+      f.write_attribute("/coarsening", "check_tolerance", r.check_tolerance);
+      f.write_attribute("/coarsening", "checked_blocks", r.checked_blocks);
+      f.write_attribute("/coarsening", "replaced_blocks", r.replaced_blocks);
     }
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);

@@ -29,6 +29,8 @@ struct SimulationRecord {
   std::string coarse_material;       // ddfem | naive | averaged | homogenized | galerkin
   std::string coarse_fallback;       // ddfem: naive | galerkin, for blocks without a fit
   int fallback_blocks = 0;           // ddfem: distinct blocks coarsened by the fallback
+  double check_tolerance = 0;        // ddfem: --coarse-check (0: no check)
+  int checked_blocks = 0, replaced_blocks = 0;  // ddfem with a check: solid mixed blocks checked, replaced
   std::string coarse_element = "trilinear";  // trilinear | enhanced
   std::string database;              // ddfem: the coarse_db path
   double coarsening_seconds = 0;
