@@ -32,11 +32,11 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
     const bool solid = std::find(voxels.begin(), voxels.end(), 0) == voxels.end();
     const bool mixed = std::any_of(voxels.begin(), voxels.end(), [&](int id) { return id != voxels[0]; });
     if (!solid || !mixed) return database(ids);
-    ++counts->checked_blocks;
+    if (counts) ++counts->checked_blocks;
     const int n = level == 2 ? 4 : 2;
     if (stiffness_distance(fit_uniform_response(*fit), block_homogenized_stiffness(palette, voxels, n)) <= tolerance)
       return database(ids);
-    ++counts->replaced_blocks;
+    if (counts) ++counts->replaced_blocks;
     return matched(ids);
   };
 }
@@ -51,6 +51,24 @@ CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vec
   if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
   if (name == "matched") return level1 ? matched_coarsening(palette, *level1, enhanced) : matched_coarsening(palette, enhanced);
   throw InputError("coarse materials: expected naive, averaged, galerkin, homogenized or matched, got '" + name + "'");
+}
+
+CoarseMaterialLookup ddfem_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
+                                  const CoarseGrid& level1, int level, const CoarsenedVoxels& settings,
+                                  CoarsenedVoxels* counts) {
+  // Blocks the database holds no fit for (void children in a database built
+  // without them, blocks that could not be fitted) go to the fallback.
+  const bool enhanced = settings.element == "enhanced";
+  const CoarseMaterialLookup fallback =
+      baseline_coarsening(settings.fallback, palette, level == 2 ? &level1 : nullptr, enhanced);
+  const CoarseMaterialLookup counted = [fallback, counts](const ChildIds& ids) {
+    if (counts) ++counts->fallback_blocks;
+    return fallback(ids);
+  };
+  const CoarseMaterialLookup lookup =
+      level == 2 ? database_coarsening_level2(db, level1, counted) : database_coarsening(db, counted);
+  if (!(settings.check_tolerance > 0)) return lookup;
+  return checked_lookup(db, palette, level1, level, settings.check_tolerance, enhanced, lookup, counts);
 }
 
 CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette,
@@ -86,6 +104,12 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
       throw InputError(request.database + ": fitted for the " + fitted_for + " coarse element; --coarse-element " +
                        request.element + " would put its materials on another element");
     m.element = fitted_for;
+    if (request.check_tolerance > 0 && fitted_for != "enhanced")
+      throw InputError("--coarse-check: " + request.database +
+                       " was fitted for the trilinear element, whose fits soften their response to uniform "
+                       "strains on purpose to offset its bending locking; the check compares that response "
+                       "with the block's C^H and needs a database fitted for the enhanced element "
+                       "(fit.element: enhanced)");
   }
   if (!request.element.empty()) m.element = request.element;
   const auto t0 = std::chrono::steady_clock::now();
@@ -96,21 +120,9 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   if (request.material != "ddfem") {
     lookup = baseline_coarsening(request.material, palette, level1, m.element == "enhanced");
   } else {
-    // Blocks the database holds no fit for (void children in a database
-    // built without them, blocks that could not be fitted) are coarsened
-    // naively or by the Galerkin element.
-    const CoarseMaterialLookup fallback = baseline_coarsening(request.fallback, palette, level1, m.element == "enhanced");
-    int* fallbacks = &m.fallback_blocks;
-    const CoarseMaterialLookup counted = [fallback, fallbacks](const ChildIds& ids) {
-      ++*fallbacks;
-      return fallback(ids);
-    };
-    lookup = request.level == 2 ? database_coarsening_level2(*m.database, m.level1, counted)
-                                : database_coarsening(*m.database, counted);
     m.fallback = request.fallback;
-    if (request.check_tolerance > 0)
-      lookup = checked_lookup(*m.database, palette, m.level1, request.level, request.check_tolerance,
-                              m.element == "enhanced", lookup, &m);
+    m.check_tolerance = request.check_tolerance;
+    lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, m, &m);
   }
   m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -38,6 +38,7 @@ struct CoarsenedVoxels {
   std::shared_ptr<CoarseDatabase> database;
   std::string element = "trilinear"; // the coarse element used (request resolved)
   std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
+  double check_tolerance = 0;        // ddfem: the checked lookup's tolerance (request resolved; 0: off)
   int checked_blocks = 0;            // ddfem with a check: distinct solid mixed blocks whose fit was checked
   int replaced_blocks = 0;           // ... and of those, coarsened by the matched model instead
 };
@@ -48,6 +49,14 @@ struct CoarsenedVoxels {
 // grid otherwise; `enhanced`: the coarse element has bubble modes.
 CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vector<MaterialPtr>& palette,
                                          const CoarseGrid* level1, bool enhanced = false);
+
+// The ddfem lookup of coarsen_voxels for `db` (a level-1 database, or a
+// level-2 one over `level1`), with the element, fallback and check of
+// `settings`; counts the fallback, checked and replaced blocks into `counts`
+// (may be null). Adaptive coarsening builds its levels' lookups with it.
+CoarseMaterialLookup ddfem_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
+                                  const CoarseGrid& level1, int level, const CoarsenedVoxels& settings,
+                                  CoarsenedVoxels* counts);
 
 // `palette` is indexed by voxel id ([0] = void). InputError for a bad
 // request: unknown material or fallback, a level other than 1 or 2, ddfem

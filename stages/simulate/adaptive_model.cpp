@@ -13,16 +13,14 @@ namespace {
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-// The materials of the uniform models: the database's fits, blocks without
-// one coarsened as the level-2 model's request said (naive or Galerkin).
+// The materials of the uniform models: the database's lookups with the
+// level-2 model's element, fallback and check.
 CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2) {
-  return database_coarsening(*level2.database->level1, baseline_coarsening(level2.fallback, scene.material_by_id, nullptr, level2.element == "enhanced"));
+  return ddfem_lookup(*level2.database->level1, scene.material_by_id, level2.level1, 1, level2, nullptr);
 }
 
 CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseModel& level2) {
-  return database_coarsening_level2(*level2.database, level2.level1,
-                                    baseline_coarsening(level2.fallback, scene.material_by_id, &level2.level1,
-                                                        level2.element == "enhanced"));
+  return ddfem_lookup(*level2.database, scene.material_by_id, level2.level1, 2, level2, nullptr);
 }
 
 // Displacements of a coarse solution (positions x) interpolated to the fine nodes.
@@ -79,6 +77,7 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
   m.grid = level2.level1;
   m.element = level2.element;
   m.fallback = level2.fallback;
+  m.check_tolerance = level2.check_tolerance;
   m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, level2), 0, &m.stats, m.element == "enhanced");
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   m.seconds = seconds_since(t0);
