@@ -101,7 +101,25 @@ CoarseGrid coarsen_grid(const CoarseGrid& coarse) {
   return c;
 }
 
+CoarseGrid with_one_combination_per_cell(const CoarseGrid& grid) {
+  CoarseGrid out = grid;
+  out.combinations.clear();
+  for (int& c : out.cell_combination)
+    if (c >= 0) {
+      out.combinations.push_back(grid.combinations[c]);
+      c = static_cast<int>(out.combinations.size()) - 1;
+    }
+  return out;
+}
+
 VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& lookup, int points_per_axis,
+                            CoarseMeshStats* stats, bool enhanced_modes) {
+  if (!lookup) throw InputError("coarse mesh: no material lookup given");
+  return build_coarse_mesh(grid, IndexedMaterialLookup([&](int c) { return lookup(grid.combinations[c]); }),
+                           points_per_axis, stats, enhanced_modes);
+}
+
+VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup& lookup, int points_per_axis,
                             CoarseMeshStats* stats, bool enhanced_modes) {
   const auto t0 = Clock::now();
   if (!lookup) throw InputError("coarse mesh: no material lookup given");
@@ -130,7 +148,7 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& 
   mesh.materials.clear();
   mesh.materials.reserve(grid.combinations.size());
   for (size_t c = 0; c < grid.combinations.size(); ++c) {
-    QuadratureMaterials m = lookup(grid.combinations[c]);
+    QuadratureMaterials m = lookup(static_cast<int>(c));
     const int n = static_cast<int>(m.at_point.size());
     if (rule_of(n) == kRules) {
       std::ostringstream msg;

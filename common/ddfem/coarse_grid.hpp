@@ -62,6 +62,15 @@ CoarseGrid coarsen_grid(const CoarseGrid& coarse);
 // one material, or one per quadrature point of the coarse rule.
 using CoarseMaterialLookup = std::function<QuadratureMaterials(const ChildIds& child_ids)>;
 
+// The materials of combination c of the grid (for lookups that need more
+// than the child ids, e.g. the cell's neighbours on a grid with one
+// combination per cell).
+using IndexedMaterialLookup = std::function<QuadratureMaterials(int combination)>;
+
+// The same grid with every solid cell its own combination (its child ids),
+// numbered in cell order: materials per cell instead of per distinct block.
+CoarseGrid with_one_combination_per_cell(const CoarseGrid& grid);
+
 struct CoarseMeshStats {
   int elements = 0;
   int distinct_combinations = 0;  // lookups made (one per distinct combination)
@@ -81,6 +90,8 @@ struct CoarseMeshStats {
 // fine voxel for hex8::composite_gauss_rule(fine_per_cell(), 2) (the
 // Galerkin element, ddfem/baseline_coarsening.hpp), so lookups may mix them.
 VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const CoarseMaterialLookup& lookup, int points_per_axis = 0,
+                            CoarseMeshStats* stats = nullptr, bool enhanced_modes = false);
+VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup& lookup, int points_per_axis = 0,
                             CoarseMeshStats* stats = nullptr, bool enhanced_modes = false);
 
 // Trilinear interpolation from coarse nodes to fine nodes as an

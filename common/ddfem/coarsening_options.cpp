@@ -18,6 +18,9 @@ void add_coarsening_options(CLI::App& app, CoarseningRequest& request, bool elem
                  "ddfem: check each solid mixed block's fit against the block's homogenized stiffness and "
                  "coarsen it by the matched model where they differ by more than this (RMS log of the "
                  "generalized eigenvalues; 0, the default: no check)");
+  app.add_option("--coarse-window", request.window,
+                 "matched: carry each cell onto its stiffness among this many voxels of its real neighbours "
+                 "(materials per cell) instead of its periodic C^H; 0, the default: off");
   if (element_option)
     app.add_option("--coarse-element", request.element,
                    "trilinear (the thesis's) or enhanced (three condensed bubble modes: no bending locking); "

@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "ddfem/baseline_coarsening.hpp"
+#include "ddfem/windowed_stiffness.hpp"
 #include "material/voigt.hpp"
 
 namespace msfab {
@@ -33,16 +34,6 @@ Mat6 lame_stiffness(double mu, double lambda) {
   C.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
   C.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
   return C;
-}
-
-QuadratureMaterials matched_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
-                                  bool enhanced) {
-  const bool has_void = std::find(ids.begin(), ids.end(), 0) != ids.end();
-  const bool homogeneous = std::all_of(ids.begin(), ids.end(), [&](int id) { return id == ids[0]; });
-  if (has_void || homogeneous) return naive_block(palette, ids, n);
-  QuadratureMaterials m;
-  for (const Mat6& C : matched_point_stiffness(palette, ids, n, enhanced)) m.at_point.push_back(homogenized_block_material(C));
-  return m;
 }
 
 }  // namespace
@@ -136,8 +127,16 @@ std::vector<Mat6> congruent_to_response(std::vector<Mat6> C, const hex8::Element
   return C;
 }
 
-std::vector<Mat6> matched_point_stiffness(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
-                                          bool enhanced, int* iterations, double* residual) {
+namespace {
+
+bool solid_and_mixed(const std::vector<int>& ids) {
+  return std::find(ids.begin(), ids.end(), 0) == ids.end() &&
+         std::any_of(ids.begin(), ids.end(), [&](int id) { return id != ids[0]; });
+}
+
+std::vector<Mat6> matched_point_stiffness_to(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
+                                             int n, bool enhanced, const Mat6* target, int* iterations,
+                                             double* residual) {
   if (static_cast<int>(ids.size()) != n * n * n) throw std::invalid_argument("matched_point_stiffness: n^3 ids expected");
   std::vector<Mat6> C;
   for (int id : ids) {
@@ -149,18 +148,60 @@ std::vector<Mat6> matched_point_stiffness(const std::vector<MaterialPtr>& palett
   const hex8::QuadratureRule rule = hex8::gauss_rule(n);
   return congruent_to_response(std::move(C),
                                enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule),
-                               block_homogenized_stiffness(palette, ids, n), iterations, residual);
+                               target ? *target : block_homogenized_stiffness(palette, ids, n), iterations, residual);
+}
+
+}  // namespace
+
+std::vector<Mat6> matched_point_stiffness(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
+                                          bool enhanced, int* iterations, double* residual) {
+  return matched_point_stiffness_to(palette, ids, n, enhanced, nullptr, iterations, residual);
+}
+
+QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
+                                            int n, bool enhanced, const Mat6* target) {
+  if (!solid_and_mixed(ids)) return naive_block(palette, ids, n);
+  int iterations = 0;
+  const std::vector<Mat6> C = matched_point_stiffness_to(palette, ids, n, enhanced, target, &iterations, nullptr);
+  // Already matched (the enhanced element at level 1 with the cell's C^H):
+  // the naive materials themselves, which evaluate faster.
+  if (iterations == 0) return naive_block(palette, ids, n);
+  QuadratureMaterials m;
+  for (const Mat6& Cq : C) m.at_point.push_back(homogenized_block_material(Cq));
+  return m;
+}
+
+QuadratureMaterials windowed_matched_cell(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
+                                          const CoarseGrid& cells, const CoarseGrid* level1, bool enhanced, int margin,
+                                          int cell, bool* unresolved) {
+  *unresolved = false;
+  const int combination = cells.cell_combination.at(cell);
+  if (combination < 0) throw std::invalid_argument("windowed_matched_cell: the cell is void");
+  const ChildIds& child = cells.combinations[combination];
+  const int n = cells.fine_per_cell();
+  const std::vector<int> ids = level1 ? block_level2(child, level1->combinations) : block_level1(child);
+  if (!solid_and_mixed(ids)) return naive_block(palette, ids, n);
+  const int I = cell % cells.nx, J = (cell / cells.nx) % cells.ny, K = cell / (cells.nx * cells.ny);
+  try {
+    const Mat6 A = windowed_stiffness(fine, palette, n * I, n * J, n * K, n, margin);
+    return matched_block_materials(palette, ids, n, enhanced, &A);
+  } catch (const NumericalError&) {
+    *unresolved = true;
+    return matched_block_materials(palette, ids, n, enhanced);
+  }
 }
 
 CoarseMaterialLookup matched_coarsening(const std::vector<MaterialPtr>& palette, bool enhanced) {
-  return [palette, enhanced](const ChildIds& child) { return matched_block(palette, block_level1(child), 2, enhanced); };
+  return [palette, enhanced](const ChildIds& child) {
+    return matched_block_materials(palette, block_level1(child), 2, enhanced);
+  };
 }
 
 CoarseMaterialLookup matched_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1,
                                         bool enhanced) {
   if (level1.level != 1) throw InputError("matched level-2 coarsening needs a level-1 grid");
   return [palette, combos = level1.combinations, enhanced](const ChildIds& child) {
-    return matched_block(palette, block_level2(child, combos), 4, enhanced);
+    return matched_block_materials(palette, block_level2(child, combos), 4, enhanced);
   };
 }
 

@@ -68,6 +68,22 @@ Mat6 rest_voigt_stiffness(const Material& material);
 std::vector<Mat6> congruent_to_response(std::vector<Mat6> C, const hex8::ElementGeometry& geo, const Mat6& target,
                                         int* iterations = nullptr, double* residual = nullptr);
 
+// Matched materials of one block (fine ids laid out as block_level1, n per
+// edge) carried onto `target` instead of the block's C^H; naive materials
+// for a block with void or of one material.
+QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
+                                            int n, bool enhanced, const Mat6* target = nullptr);
+
+// Windowed matched coarsening (`--coarse-window M`): the matched materials
+// of cell `cell` of `cells` (level 1 or 2 of `fine`; `level1` its level-1
+// grid at level 2, else null) carried onto its windowed_stiffness with
+// `margin` voxels of its real neighbours; naive materials for a cell with
+// void or of one material. Where the window does not determine a
+// stiffness, the cell's own C^H is used and *unresolved set.
+QuadratureMaterials windowed_matched_cell(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
+                                          const CoarseGrid& cells, const CoarseGrid* level1, bool enhanced, int margin,
+                                          int cell, bool* unresolved);
+
 // Lookups for build_coarse_mesh: level 1 (children are fine ids) and level 2
 // (children are combinations of `level1`). `enhanced`: the coarse element
 // the mesh is built with.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <cmath>
 #include <set>
 
@@ -85,6 +86,9 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
     throw InputError("--coarse-check: the tolerance must be >= 0 and finite (0: no check)");
   if (request.check_tolerance > 0 && request.material != "ddfem")
     throw InputError("--coarse-check: applies to --coarse-material ddfem only (got " + request.material + ")");
+  if (request.window < 0) throw InputError("--coarse-window: the margin must be >= 0 voxels (0: off)");
+  if (request.window > 0 && request.material != "matched")
+    throw InputError("--coarse-window: applies to --coarse-material matched only (got " + request.material + ")");
   if (request.fallback != "naive" && request.material != "ddfem")
     throw InputError("--coarse-fallback " + request.fallback + ": applies to --coarse-material ddfem only (got " +
                      request.material + ")");
@@ -124,7 +128,37 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
     m.check_tolerance = request.check_tolerance;
     lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, m, &m);
   }
-  m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
+  if (request.window > 0) {
+    // Materials per cell: each cell's window is its own. The cells are
+    // independent (one homogenization each), so they are computed in
+    // parallel; each result depends on its cell alone, not on the threads.
+    m.grid = with_one_combination_per_cell(m.grid);
+    std::vector<int> cell_of;
+    for (int c = 0; c < m.grid.num_cells(); ++c)
+      if (m.grid.cell_combination[c] >= 0) cell_of.push_back(c);  // combination k is the k-th solid cell
+    const int cells = static_cast<int>(cell_of.size());
+    std::vector<char> unresolved(cells, 0);
+    std::vector<QuadratureMaterials> per_cell(cells);
+    std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic)
+    for (int k = 0; k < cells; ++k) {
+      try {
+        bool u = false;
+        per_cell[k] = windowed_matched_cell(grid, palette, m.grid, level1, m.element == "enhanced", request.window,
+                                            cell_of[k], &u);
+        unresolved[k] = u;
+      } catch (...) {
+#pragma omp critical(windowed_failure)
+        if (!failure) failure = std::current_exception();
+      }
+    }
+    if (failure) std::rethrow_exception(failure);
+    for (char u : unresolved) m.unresolved_windows += u;
+    m.mesh = build_coarse_mesh(m.grid, IndexedMaterialLookup([&per_cell](int c) { return per_cell[c]; }), 0, &m.stats,
+                               m.element == "enhanced");
+  } else {
+    m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
+  }
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return m;
 }

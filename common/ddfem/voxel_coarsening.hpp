@@ -27,6 +27,10 @@ struct CoarseningRequest {
   // homogenized stiffness and coarsens it by the matched model where their
   // stiffness_distance exceeds this (docs/ddfem.md, "Checked lookup"); 0: off.
   double check_tolerance = 0;
+  // matched: > 0 carries each cell onto its stiffness among this many voxels
+  // of its real neighbours (windowed_stiffness, one material set per cell)
+  // instead of its periodic C^H; 0: off.
+  int window = 0;
 };
 
 struct CoarsenedVoxels {
@@ -41,6 +45,7 @@ struct CoarsenedVoxels {
   double check_tolerance = 0;        // ddfem: the checked lookup's tolerance (request resolved; 0: off)
   int checked_blocks = 0;            // ddfem with a check: distinct solid mixed blocks whose fit was checked
   int replaced_blocks = 0;           // ... and of those, coarsened by the matched model instead
+  int unresolved_windows = 0;        // matched with a window: cells whose window gave no stiffness (own C^H used)
 };
 
 // A baseline by name (naive, averaged, galerkin, homogenized of

@@ -279,6 +279,8 @@ int main(int argc, char** argv) {
         record.checked_blocks = coarse.checked_blocks;
         record.replaced_blocks = coarse.replaced_blocks;
       }
+      record.window = coarsening.window;
+      record.unresolved_windows = coarse.unresolved_windows;
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();

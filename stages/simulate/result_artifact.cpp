@@ -86,6 +86,10 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
       f.write_attribute("/coarsening", "checked_blocks", r.checked_blocks);
       f.write_attribute("/coarsening", "replaced_blocks", r.replaced_blocks);
     }
+    if (r.window > 0) {
+      f.write_attribute("/coarsening", "window", r.window);
+      f.write_attribute("/coarsening", "unresolved_windows", r.unresolved_windows);
+    }
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);
     f.write_attribute("/coarsening", "fine_elements", r.fine_elements);

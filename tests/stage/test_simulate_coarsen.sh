@@ -202,6 +202,19 @@ check "adaptive coarsening with the checked lookup" -- "$SIM" --config "$BAR" --
 check "adaptive checked target met" -- awk -v e="$(attr_of adaptive_checked error_vs_fine)" 'BEGIN { exit !(e > 0 && e <= 0.02) }'
 expect_exit 2 "fitted for the trilinear element" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2.h5" --coarse-check 0.1 --out "$WORK/o.h5"
+# Windowed matched materials: one material set per cell, the same result
+# on one thread and on two, refused for other materials.
+for t in 1 2; do
+  "$SIM" --config "$BAR" --coarsen 2 --coarse-material matched --coarse-element enhanced --coarse-window 2 --threads $t \
+    --reference "$WORK/fine.h5" --out "$WORK/l2_window_t$t.h5" --quiet >/dev/null
+done
+echo "level-2 windowed matched: $(attr_of l2_window_t2 error_vs_fine) (periodic matched $matched2)"
+check "windowed result independent of the thread count" -- \
+  h5diff -d 0 "$WORK/l2_window_t1.h5" "$WORK/l2_window_t2.h5" /displacement
+check "windowed run records its margin" -- awk -v w="$(attr_of l2_window_t2 window)" \
+  -v u="$(attr_of l2_window_t2 unresolved_windows)" 'BEGIN { exit !(w == 2 && u == 0) }'
+expect_exit 2 "coarse-window: applies to --coarse-material matched only" -- \
+  "$SIM" --config "$BAR" --coarsen 2 --coarse-material naive --coarse-window 2 --out "$WORK/o.h5"
 expect_exit 2 "coarse-check: the tolerance must be >= 0" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2_enhanced.h5" --coarse-check -0.1 --out "$WORK/o.h5"
 expect_exit 2 "coarse-check: applies to --coarse-material ddfem only" -- \

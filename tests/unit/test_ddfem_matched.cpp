@@ -10,6 +10,7 @@
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/matched_coarsening.hpp"
 #include "ddfem/voxel_coarsening.hpp"
+#include "ddfem/windowed_stiffness.hpp"
 #include "material/green_anisotropic.hpp"
 #include "material/neo_hookean.hpp"
 #include "material/voigt.hpp"
@@ -218,5 +219,68 @@ TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffnes
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
   request.check_tolerance = 0.1;
   request.material = "naive";
+  EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
+}
+
+TEST(WindowedStiffness, NoMarginIsTheCellsHomogenizedStiffness) {
+  const auto palette = three_materials();
+  VoxelGrid grid(8, 8, 8, 1e-3, 1);
+  std::mt19937_64 rng(21);
+  for (int& id : grid.ids) id = 1 + static_cast<int>(rng() % 3);
+  std::vector<int> ids;  // the cell at voxel (4, 0, 4), laid out as block_level1
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 4; ++c) ids.push_back(grid.at(4 + a, b, 4 + c));
+  const Mat6 CH = block_homogenized_stiffness(palette, ids, 4);
+  EXPECT_LE((windowed_stiffness(grid, palette, 4, 0, 4, 4, 0) - CH).norm(), 1e-8 * CH.norm());
+  // With a margin the neighbours count: not the cell's periodic C^H.
+  EXPECT_GE((windowed_stiffness(grid, palette, 4, 0, 4, 4, 2) - CH).norm(), 1e-2 * CH.norm());
+}
+
+TEST(WindowedStiffness, ACellAmongCopiesOfItselfGetsItsHomogenizedStiffness) {
+  const auto palette = three_materials();
+  // One material: the material itself.
+  const VoxelGrid uniform(8, 8, 8, 1e-3, 2);
+  const Mat6 C = rest_voigt_stiffness(*palette[2]);
+  EXPECT_LE((windowed_stiffness(uniform, palette, 2, 2, 2, 2, 2) - C).norm(), 1e-8 * C.norm());
+  // A laminate of period 2 along x: the 2 x 2 x 2 cell is one period, its
+  // window three, so the cell's mean strain is the window's and A = C^H.
+  VoxelGrid layers(12, 6, 6, 1e-3, 1);
+  for (int i = 1; i < 12; i += 2)
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 6; ++k) layers.at(i, j, k) = 3;
+  const Mat6 CH = block_homogenized_stiffness(palette, {1, 1, 1, 1, 3, 3, 3, 3}, 2);
+  EXPECT_LE((windowed_stiffness(layers, palette, 4, 2, 2, 2, 2) - CH).norm(), 1e-6 * CH.norm());
+  // A cell with void has no stiffness of its own to match.
+  VoxelGrid holed = uniform;
+  holed.at(3, 3, 3) = 0;
+  EXPECT_THROW(windowed_stiffness(holed, palette, 2, 2, 2, 2, 2), InputError);
+}
+
+TEST(WindowedStiffness, CoarseningWithAWindowGivesEveryCellItsOwnMaterials) {
+  const auto palette = three_materials();
+  VoxelGrid grid(8, 8, 4, 1e-3, 1);
+  std::mt19937_64 rng(4);
+  for (int& id : grid.ids) id = 1 + static_cast<int>(rng() % 3);
+  CoarseningRequest request;
+  request.level = 2;
+  request.material = "matched";
+  request.element = "enhanced";
+  request.window = 2;
+  const CoarsenedVoxels windowed = coarsen_voxels(grid, palette, request);
+  EXPECT_EQ(windowed.grid.combinations.size(), 4u);  // one per cell
+  EXPECT_EQ(windowed.mesh.mesh.materials.size(), 4u);
+  EXPECT_EQ(windowed.unresolved_windows, 0);
+  // Cell (1, 0, 0)'s points are carried onto its windowed stiffness.
+  const int e = windowed.mesh.voxel_element[windowed.grid.index(1, 0, 0)];
+  const QuadratureMaterials& m = windowed.mesh.mesh.materials[windowed.mesh.mesh.element_material[e]];
+  std::vector<Mat6> C;
+  for (const MaterialPtr& p : m.at_point) C.push_back(rest_voigt_stiffness(*p));
+  const Mat6 A = windowed_stiffness(grid, palette, 4, 0, 0, 4, 2);
+  EXPECT_LE((element_uniform_response(C, 4, true) - A).norm(), 1e-5 * A.norm());
+  request.material = "naive";
+  EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
+  request.material = "matched";
+  request.window = -1;
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
 }
