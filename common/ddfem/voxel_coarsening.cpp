@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <exception>
 #include <cmath>
+#include <exception>
 #include <set>
 
 #include "core/errors.hpp"
@@ -40,6 +40,36 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
     if (counts) ++counts->replaced_blocks;
     return matched(ids);
   };
+}
+
+// The coarse mesh of `cells` (one combination per cell) with windowed
+// matched materials. The cells are independent (one homogenization each),
+// so they are computed in parallel; each result depends on its cell alone,
+// not on the threads.
+VoxelMesh windowed_matched_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
+                                const CoarseGrid& cells, const CoarseGrid* level1, bool enhanced, int margin,
+                                CoarseMeshStats* stats, int* unresolved_windows) {
+  std::vector<int> cell_of;  // combination k is the k-th solid cell
+  for (int c = 0; c < cells.num_cells(); ++c)
+    if (cells.cell_combination[c] >= 0) cell_of.push_back(c);
+  const int count = static_cast<int>(cell_of.size());
+  std::vector<char> unresolved(count, 0);
+  std::vector<QuadratureMaterials> per_cell(count);
+  std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic)
+  for (int k = 0; k < count; ++k) {
+    try {
+      bool u = false;
+      per_cell[k] = windowed_matched_cell(fine, palette, cells, level1, enhanced, margin, cell_of[k], &u);
+      unresolved[k] = u;
+    } catch (...) {
+#pragma omp critical(windowed_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+  *unresolved_windows = static_cast<int>(std::count(unresolved.begin(), unresolved.end(), 1));
+  return build_coarse_mesh(cells, IndexedMaterialLookup([&per_cell](int c) { return per_cell[c]; }), 0, stats, enhanced);
 }
 
 }  // namespace
@@ -129,33 +159,9 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
     lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, m, &m);
   }
   if (request.window > 0) {
-    // Materials per cell: each cell's window is its own. The cells are
-    // independent (one homogenization each), so they are computed in
-    // parallel; each result depends on its cell alone, not on the threads.
     m.grid = with_one_combination_per_cell(m.grid);
-    std::vector<int> cell_of;
-    for (int c = 0; c < m.grid.num_cells(); ++c)
-      if (m.grid.cell_combination[c] >= 0) cell_of.push_back(c);  // combination k is the k-th solid cell
-    const int cells = static_cast<int>(cell_of.size());
-    std::vector<char> unresolved(cells, 0);
-    std::vector<QuadratureMaterials> per_cell(cells);
-    std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic)
-    for (int k = 0; k < cells; ++k) {
-      try {
-        bool u = false;
-        per_cell[k] = windowed_matched_cell(grid, palette, m.grid, level1, m.element == "enhanced", request.window,
-                                            cell_of[k], &u);
-        unresolved[k] = u;
-      } catch (...) {
-#pragma omp critical(windowed_failure)
-        if (!failure) failure = std::current_exception();
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
-    for (char u : unresolved) m.unresolved_windows += u;
-    m.mesh = build_coarse_mesh(m.grid, IndexedMaterialLookup([&per_cell](int c) { return per_cell[c]; }), 0, &m.stats,
-                               m.element == "enhanced");
+    m.mesh = windowed_matched_mesh(grid, palette, m.grid, level1, m.element == "enhanced", request.window, &m.stats,
+                                   &m.unresolved_windows);
   } else {
     m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   }
