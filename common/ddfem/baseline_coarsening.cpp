@@ -131,10 +131,7 @@ MaterialPtr homogenized_block_material(const Mat6& C) {
   // project to lambda < 0, which no Neo-Hookean part may have; lambda = 0
   // keeps the split exact (t below is then taken against that part).
   lambda = std::max(lambda, 0.0);
-  Mat6 iso = Mat6::Zero();
-  iso.topLeftCorner<3, 3>().setConstant(lambda);
-  iso.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
-  iso.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
+  const Mat6 iso = lame_C(mu, lambda);
   // The largest t with C - t iso >= 0: the smallest generalized eigenvalue.
   const double t =
       std::clamp(Eigen::GeneralizedSelfAdjointEigenSolver<Mat6>(C, iso, Eigen::EigenvaluesOnly).eigenvalues()[0], 0.0, 1.0);

@@ -28,14 +28,6 @@ Mat6 congruence_to(const Mat6& A, const Mat6& B) {
   return 0.5 * (S + S.transpose());
 }
 
-Mat6 lame_stiffness(double mu, double lambda) {
-  Mat6 C = Mat6::Zero();
-  C.topLeftCorner<3, 3>().setConstant(lambda);
-  C.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
-  C.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
-  return C;
-}
-
 }  // namespace
 
 Mat6 uniform_strain_response(const hex8::ElementGeometry& geo, const std::vector<Mat6>& C) {
@@ -142,7 +134,7 @@ std::vector<Mat6> matched_point_stiffness_to(const std::vector<MaterialPtr>& pal
   for (int id : ids) {
     if (id <= 0 || id >= static_cast<int>(palette.size()) || !palette[id])
       throw InputError("matched coarsening: fine material id " + std::to_string(id) + " is not a solid palette material");
-    C.push_back(lame_stiffness(palette[id]->shear_modulus(), palette[id]->lame_lambda()));
+    C.push_back(lame_C(palette[id]->shear_modulus(), palette[id]->lame_lambda()));
   }
   const hex8::NodeMatrix X = unit_cube();
   const hex8::QuadratureRule rule = hex8::gauss_rule(n);

@@ -23,9 +23,7 @@ namespace {
 CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
                                     const CoarseGrid& level1, int level, double tolerance, bool enhanced,
                                     CoarseMaterialLookup database, CoarsenedVoxels* counts) {
-  const CoarseMaterialLookup matched =
-      level == 2 ? matched_coarsening(palette, level1, enhanced) : matched_coarsening(palette, enhanced);
-  return [&db, palette, combos = level1.combinations, level, tolerance, database, matched,
+  return [&db, palette, combos = level1.combinations, level, tolerance, enhanced, database,
           counts](const ChildIds& ids) {
     const CoarseMaterialFit* fit = level == 2 ? find_level2_fit(db, combos, ids) : db.find(ids);
     if (!fit) return database(ids);
@@ -35,10 +33,10 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
     if (!solid || !mixed) return database(ids);
     if (counts) ++counts->checked_blocks;
     const int n = level == 2 ? 4 : 2;
-    if (stiffness_distance(fit_uniform_response(*fit), block_homogenized_stiffness(palette, voxels, n)) <= tolerance)
-      return database(ids);
+    const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
+    if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
     if (counts) ++counts->replaced_blocks;
-    return matched(ids);
+    return matched_block_materials(palette, voxels, n, enhanced, &CH);
   };
 }
 
@@ -150,19 +148,19 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   m.level1 = coarsen_grid(grid);
   m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
   const CoarseGrid* level1 = request.level == 2 ? &m.level1 : nullptr;
-  CoarseMaterialLookup lookup;
-  if (request.material != "ddfem") {
-    lookup = baseline_coarsening(request.material, palette, level1, m.element == "enhanced");
-  } else {
-    m.fallback = request.fallback;
-    m.check_tolerance = request.check_tolerance;
-    lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, m, &m);
-  }
   if (request.window > 0) {
     m.grid = with_one_combination_per_cell(m.grid);
     m.mesh = windowed_matched_mesh(grid, palette, m.grid, level1, m.element == "enhanced", request.window, &m.stats,
                                    &m.unresolved_windows);
   } else {
+    CoarseMaterialLookup lookup;
+    if (request.material != "ddfem") {
+      lookup = baseline_coarsening(request.material, palette, level1, m.element == "enhanced");
+    } else {
+      m.fallback = request.fallback;
+      m.check_tolerance = request.check_tolerance;
+      lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, m, &m);
+    }
     m.mesh = build_coarse_mesh(m.grid, lookup, 0, &m.stats, m.element == "enhanced");
   }
   m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -90,6 +90,14 @@ Mat6 isotropic_C(double E, double nu) {
   return cubic_C(E, nu, lame_mu(E, nu));
 }
 
+Mat6 lame_C(double mu, double lambda) {
+  Mat6 C = Mat6::Zero();
+  C.topLeftCorner<3, 3>().setConstant(lambda);
+  C.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
+  C.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
+  return C;
+}
+
 Mat6 orthotropic_C(const OrthotropicConstants& k) {
   const double moduli[6] = {k.Ex, k.Ey, k.Ez, k.Gxy, k.Gyz, k.Gzx};
   const char* names[6] = {"Ex", "Ey", "Ez", "Gxy", "Gyz", "Gzx"};

@@ -36,6 +36,9 @@ void check_elastic_constants(double E, double nu);
 Mat6 cubic_C(double E, double nu, double G);
 // Isotropic stiffness: cubic_C(E, nu, E / (2 (1 + nu))).
 Mat6 isotropic_C(double E, double nu);
+// Isotropic stiffness from the Lame parameters (no validation: a part of a
+// split may have lambda = 0 or mu = 0).
+Mat6 lame_C(double mu, double lambda);
 
 // Orthotropic stiffness from engineering constants, as the inverse of the
 // compliance S with S11 = 1/Ex, S12 = -nu_xy/Ex, S23 = -nu_yz/Ey,
