@@ -46,6 +46,11 @@ std::vector<int> block_level2(const ChildIds& child, const std::vector<ChildIds>
   return ids;
 }
 
+bool solid_mixed_block(const std::vector<int>& ids) {
+  return std::find(ids.begin(), ids.end(), 0) == ids.end() &&
+         std::any_of(ids.begin(), ids.end(), [&](int id) { return id != ids[0]; });
+}
+
 QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
   QuadratureMaterials m;
   m.at_point.resize(ids.size());

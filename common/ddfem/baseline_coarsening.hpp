@@ -72,6 +72,9 @@ CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& pale
 // 0 = void).
 std::vector<int> block_level1(const ChildIds& child);
 std::vector<int> block_level2(const ChildIds& child, const std::vector<ChildIds>& level1);
+// True for a block with no void voxel and more than one material: the blocks
+// the matched model and the checked lookups act on.
+bool solid_mixed_block(const std::vector<int>& ids);
 // Naive materials of such a block on the n-point rule (one per voxel).
 QuadratureMaterials naive_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n);
 // C^H of the block taken as a periodic cell (material Voigt order).

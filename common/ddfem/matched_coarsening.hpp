@@ -74,6 +74,13 @@ std::vector<Mat6> congruent_to_response(std::vector<Mat6> C, const hex8::Element
 QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
                                             int n, bool enhanced, const Mat6* target = nullptr);
 
+// The stiffness of solid cell `cell` of `cells` (fine ids `ids`, laid out as
+// block_level1, n = cells.fine_per_cell() per edge) among `margin` voxels of
+// its real neighbours (windowed_stiffness); where the window does not
+// determine one, the cell's own C^H, and *unresolved is set.
+Mat6 cell_windowed_stiffness(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette, const CoarseGrid& cells,
+                             const std::vector<int>& ids, int cell, int margin, bool* unresolved);
+
 // Windowed matched coarsening (`--coarse-window M`): the matched materials
 // of cell `cell` of `cells` (level 1 or 2 of `fine`; `level1` its level-1
 // grid at level 2, else null) carried onto its windowed_stiffness with

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <set>
 
 #include "core/errors.hpp"
@@ -13,6 +14,13 @@
 namespace msfab {
 
 namespace {
+
+// The database's fit for a block, or null (level 1: child ids are fine ids;
+// level 2: indices + 1 into the level-1 grid's `combinations`).
+const CoarseMaterialFit* database_fit(const CoarseDatabase& db, const std::vector<ChildIds>& combinations, int level,
+                                      const ChildIds& ids) {
+  return level == 2 ? find_level2_fit(db, combinations, ids) : db.find(ids);
+}
 
 // The database's lookup, except where a solid mixed block's fit has a
 // response to uniform strains farther than `tolerance` from the block's own
@@ -25,12 +33,10 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
                                     CoarseMaterialLookup database, CoarsenedVoxels* counts) {
   return [&db, palette, combos = level1.combinations, level, tolerance, enhanced, database,
           counts](const ChildIds& ids) {
-    const CoarseMaterialFit* fit = level == 2 ? find_level2_fit(db, combos, ids) : db.find(ids);
+    const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
     if (!fit) return database(ids);
     const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
-    const bool solid = std::find(voxels.begin(), voxels.end(), 0) == voxels.end();
-    const bool mixed = std::any_of(voxels.begin(), voxels.end(), [&](int id) { return id != voxels[0]; });
-    if (!solid || !mixed) return database(ids);
+    if (!solid_mixed_block(voxels)) return database(ids);
     if (counts) ++counts->checked_blocks;
     const int n = level == 2 ? 4 : 2;
     const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
@@ -40,34 +46,65 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
   };
 }
 
-// The coarse mesh of `cells` (one combination per cell) with windowed
-// matched materials. The cells are independent (one homogenization each),
-// so they are computed in parallel; each result depends on its cell alone,
-// not on the threads.
-VoxelMesh windowed_matched_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
-                                const CoarseGrid& cells, const CoarseGrid* level1, bool enhanced, int margin,
-                                CoarseMeshStats* stats, int* unresolved_windows) {
+// What deciding one cell's materials found. Per cell, so that cells can be
+// decided in parallel and counted afterwards.
+struct CellOutcome {
+  bool unresolved = false;  // the window gave no stiffness: the cell's own C^H was used
+  bool checked = false;     // a solid mixed cell whose fit was checked
+  bool replaced = false;    // ... and coarsened by the matched model instead
+};
+using CellMaterials = std::function<QuadratureMaterials(int cell, CellOutcome& outcome)>;
+
+// The coarse mesh of `cells` (one combination per solid cell, as
+// with_one_combination_per_cell numbers them) with each cell's materials
+// from `materials`. The cells are independent (one window homogenization
+// each), so they are computed in parallel; each result depends on its cell
+// alone, not on the threads. The outcomes are summed into `counts`.
+VoxelMesh per_cell_mesh(const CoarseGrid& cells, const CellMaterials& materials, bool enhanced, CoarseMeshStats* stats,
+                        CoarsenedVoxels* counts) {
   std::vector<int> cell_of;  // combination k is the k-th solid cell
   for (int c = 0; c < cells.num_cells(); ++c)
     if (cells.cell_combination[c] >= 0) cell_of.push_back(c);
   const int count = static_cast<int>(cell_of.size());
-  std::vector<char> unresolved(count, 0);
+  std::vector<CellOutcome> outcome(count);
   std::vector<QuadratureMaterials> per_cell(count);
   std::exception_ptr failure;
 #pragma omp parallel for schedule(dynamic)
   for (int k = 0; k < count; ++k) {
     try {
-      bool u = false;
-      per_cell[k] = windowed_matched_cell(fine, palette, cells, level1, enhanced, margin, cell_of[k], &u);
-      unresolved[k] = u;
+      per_cell[k] = materials(cell_of[k], outcome[k]);
     } catch (...) {
-#pragma omp critical(windowed_failure)
+#pragma omp critical(per_cell_failure)
       if (!failure) failure = std::current_exception();
     }
   }
   if (failure) std::rethrow_exception(failure);
-  *unresolved_windows = static_cast<int>(std::count(unresolved.begin(), unresolved.end(), 1));
+  for (const CellOutcome& o : outcome) {
+    counts->unresolved_windows += o.unresolved;
+    counts->checked_blocks += o.checked;
+    counts->replaced_blocks += o.replaced;
+  }
   return build_coarse_mesh(cells, IndexedMaterialLookup([&per_cell](int c) { return per_cell[c]; }), 0, stats, enhanced);
+}
+
+// The windowed check of one cell (`--coarse-check TAU --coarse-window M`):
+// the checked lookup with the cell's stiffness among its real neighbours in
+// place of its periodic C^H, so that a fit is kept only where it responds
+// like the cell in this scene, and otherwise replaced by the matched model
+// carried onto that stiffness (the windowed matched materials).
+QuadratureMaterials windowed_checked_cell(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
+                                          const CoarseDatabase& db, const CoarseGrid& level1, int level,
+                                          const CoarseGrid& cells, const CoarseMaterialLookup& lookup, bool enhanced,
+                                          int margin, double tolerance, int cell, CellOutcome& outcome) {
+  const ChildIds& child = cells.combinations[cells.cell_combination[cell]];
+  const CoarseMaterialFit* fit = database_fit(db, level1.combinations, level, child);
+  const std::vector<int> voxels = level == 2 ? block_level2(child, level1.combinations) : block_level1(child);
+  if (!fit || !solid_mixed_block(voxels)) return lookup(child);
+  outcome.checked = true;
+  const Mat6 A = cell_windowed_stiffness(fine, palette, cells, voxels, cell, margin, &outcome.unresolved);
+  if (stiffness_distance(fit_uniform_response(*fit), A) <= tolerance) return coarse_quadrature_materials(*fit);
+  outcome.replaced = true;
+  return matched_block_materials(palette, voxels, cells.fine_per_cell(), enhanced, &A);
 }
 
 }  // namespace
@@ -115,8 +152,9 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   if (request.check_tolerance > 0 && request.material != "ddfem")
     throw InputError("--coarse-check: applies to --coarse-material ddfem only (got " + request.material + ")");
   if (request.window < 0) throw InputError("--coarse-window: the margin must be >= 0 voxels (0: off)");
-  if (request.window > 0 && request.material != "matched")
-    throw InputError("--coarse-window: applies to --coarse-material matched only (got " + request.material + ")");
+  if (request.window > 0 && request.material != "matched" && !(request.material == "ddfem" && request.check_tolerance > 0))
+    throw InputError("--coarse-window: applies to --coarse-material matched, or ddfem with --coarse-check (got " +
+                     request.material + (request.material == "ddfem" ? " without --coarse-check)" : ")"));
   if (request.fallback != "naive" && request.material != "ddfem")
     throw InputError("--coarse-fallback " + request.fallback + ": applies to --coarse-material ddfem only (got " +
                      request.material + ")");
@@ -148,10 +186,28 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   m.level1 = coarsen_grid(grid);
   m.grid = request.level == 2 ? coarsen_grid(m.level1) : m.level1;
   const CoarseGrid* level1 = request.level == 2 ? &m.level1 : nullptr;
-  if (request.window > 0) {
-    m.grid = with_one_combination_per_cell(m.grid);
-    m.mesh = windowed_matched_mesh(grid, palette, m.grid, level1, m.element == "enhanced", request.window, &m.stats,
-                                   &m.unresolved_windows);
+  if (request.window > 0 && request.material == "matched") {
+    const CoarseGrid cells = with_one_combination_per_cell(m.grid);
+    const bool enhanced = m.element == "enhanced";
+    m.mesh = per_cell_mesh(cells, [&](int cell, CellOutcome& o) {
+      return windowed_matched_cell(grid, palette, cells, level1, enhanced, request.window, cell, &o.unresolved);
+    }, enhanced, &m.stats, &m);
+    m.grid = cells;
+  } else if (request.window > 0) {  // ddfem, checked against each cell's windowed stiffness
+    m.fallback = request.fallback;
+    m.check_tolerance = request.check_tolerance;
+    // Blocks without a fit are counted once per distinct block, as without a window.
+    for (const ChildIds& c : m.grid.combinations) m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
+    CoarsenedVoxels unchecked = m;
+    unchecked.check_tolerance = 0;
+    const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
+    const CoarseGrid cells = with_one_combination_per_cell(m.grid);
+    const bool enhanced = m.element == "enhanced";
+    m.mesh = per_cell_mesh(cells, [&](int cell, CellOutcome& o) {
+      return windowed_checked_cell(grid, palette, *m.database, m.level1, request.level, cells, lookup, enhanced,
+                                   request.window, request.check_tolerance, cell, o);
+    }, enhanced, &m.stats, &m);
+    m.grid = cells;
   } else {
     CoarseMaterialLookup lookup;
     if (request.material != "ddfem") {

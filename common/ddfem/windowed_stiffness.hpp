@@ -19,8 +19,8 @@ namespace msfab {
 
 // The n^3 cell whose first voxel is (i0, j0, k0) of `fine` (material Voigt
 // order). InputError if the cell has a void voxel; NumericalError if the
-// cell's mean strains do not determine A (a cell the window leaves
-// disconnected).
+// window holds void (the body's free surface, which a periodic window turns
+// into a crack) or the cell's mean strains do not determine A.
 Mat6 windowed_stiffness(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette, int i0, int j0, int k0, int n,
                         int margin);
 

@@ -213,7 +213,24 @@ check "windowed result independent of the thread count" -- \
   h5diff -d 0 "$WORK/l2_window_t1.h5" "$WORK/l2_window_t2.h5" /displacement
 check "windowed run records its margin" -- awk -v w="$(attr_of l2_window_t2 window)" \
   -v u="$(attr_of l2_window_t2 unresolved_windows)" 'BEGIN { exit !(w == 2 && u == 0) }'
-expect_exit 2 "coarse-window: applies to --coarse-material matched only" -- \
+# The lookup checked against each cell's windowed stiffness: per cell and
+# in parallel too. The bar's one level-2 fit is far from every cell's
+# stiffness in the bar, so every cell is the windowed matched model.
+for t in 1 2; do
+  "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2_enhanced.h5" --coarse-check 0.1 --coarse-window 2 \
+    --threads $t --reference "$WORK/fine.h5" --out "$WORK/l2_wcheck_t$t.h5" --quiet >/dev/null
+done
+echo "level-2 lookup checked against windows: $(attr_of l2_wcheck_t2 replaced_blocks) of" \
+  "$(attr_of l2_wcheck_t2 checked_blocks) cells replaced, error $(attr_of l2_wcheck_t2 error_vs_fine)"
+check "windowed check independent of the thread count" -- \
+  h5diff -d 0 "$WORK/l2_wcheck_t1.h5" "$WORK/l2_wcheck_t2.h5" /displacement
+check "windowed check counts cells and replaces them by the windowed matched model" -- \
+  awk -v c="$(attr_of l2_wcheck_t2 checked_blocks)" -v r="$(attr_of l2_wcheck_t2 replaced_blocks)" \
+  -v e="$(attr_of l2_wcheck_t2 error_vs_fine)" -v m="$(attr_of l2_window_t2 error_vs_fine)" \
+  'BEGIN { exit !(c > 1 && r == c && e == m) }'
+expect_exit 2 "coarse-window: applies to --coarse-material matched, or ddfem with --coarse-check" -- \
+  "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2_enhanced.h5" --coarse-window 2 --out "$WORK/o.h5"
+expect_exit 2 "coarse-window: applies to --coarse-material matched" -- \
   "$SIM" --config "$BAR" --coarsen 2 --coarse-material naive --coarse-window 2 --out "$WORK/o.h5"
 expect_exit 2 "coarse-check: the tolerance must be >= 0" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2_enhanced.h5" --coarse-check -0.1 --out "$WORK/o.h5"

@@ -255,6 +255,10 @@ TEST(WindowedStiffness, ACellAmongCopiesOfItselfGetsItsHomogenizedStiffness) {
   VoxelGrid holed = uniform;
   holed.at(3, 3, 3) = 0;
   EXPECT_THROW(windowed_stiffness(holed, palette, 2, 2, 2, 2, 2), InputError);
+  // Void beside the cell (a free surface) gives no windowed stiffness; the
+  // coarsenings then take the cell's own C^H.
+  EXPECT_THROW(windowed_stiffness(holed, palette, 4, 2, 2, 2, 2), NumericalError);
+  EXPECT_NO_THROW(windowed_stiffness(holed, palette, 4, 2, 2, 2, 0));
 }
 
 TEST(WindowedStiffness, CoarseningWithAWindowGivesEveryCellItsOwnMaterials) {
@@ -282,5 +286,70 @@ TEST(WindowedStiffness, CoarseningWithAWindowGivesEveryCellItsOwnMaterials) {
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
   request.material = "matched";
   request.window = -1;
+  EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
+}
+
+TEST(WindowedStiffness, CheckedLookupAgainstTheWindowKeepsOnlyFitsThatRespondLikeTheCellInTheScene) {
+  const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
+                                            std::make_shared<NeoHookean>(1e7, 0.45)};
+  BlockMaterials unused_checker;
+  unused_checker.fill(1);  // every fit is the block's naive materials
+  // A random half (x >= 4) beside a laminate of period 2 along y (x < 4):
+  // the laminate's cells whose window lies inside it are among copies of
+  // themselves, so their windowed stiffness is their C^H.
+  VoxelGrid grid(8, 8, 4, 1e-3, 1);
+  std::mt19937_64 rng(11);
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) grid.at(i, j, k) = i < 4 ? 1 + j % 2 : 1 + static_cast<int>(rng() % 2);
+  CoarseningRequest request;
+  request.level = 1;
+  request.database = write_naive_database_with_wrong_checker(palette, unused_checker);
+  request.check_tolerance = 0.1;
+  request.window = 2;
+  const CoarsenedVoxels windowed = coarsen_voxels(grid, palette, request);
+  EXPECT_EQ(windowed.grid.combinations.size(), 32u);  // one per cell
+  EXPECT_EQ(windowed.unresolved_windows, 0);
+
+  // Each cell's fit (naive materials: on the enhanced element at level 1 the
+  // cell's periodic C^H) is kept where the cell's stiffness among its real
+  // neighbours is within the tolerance of it, and carried onto that
+  // stiffness where it is not.
+  int mixed = 0, far = 0;
+  for (int K = 0; K < 2; ++K)
+    for (int J = 0; J < 4; ++J)
+      for (int I = 0; I < 4; ++I) {
+        std::vector<int> ids;
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b)
+            for (int c = 0; c < 2; ++c) ids.push_back(grid.at(2 * I + a, 2 * J + b, 2 * K + c));
+        if (!solid_mixed_block(ids)) continue;
+        ++mixed;
+        const Mat6 A = windowed_stiffness(grid, palette, 2 * I, 2 * J, 2 * K, 2, 2);
+        const Mat6 CH = block_homogenized_stiffness(palette, ids, 2);
+        const bool replace = stiffness_distance(CH, A) > 0.1;
+        far += replace;
+        if (I == 0 && (J == 1 || J == 2)) {
+          EXPECT_FALSE(replace) << "laminate cell " << J << " " << K;
+        }
+        const int e = windowed.mesh.voxel_element[windowed.grid.index(I, J, K)];
+        const QuadratureMaterials& m = windowed.mesh.mesh.materials[windowed.mesh.mesh.element_material[e]];
+        std::vector<Mat6> C;
+        for (const MaterialPtr& p : m.at_point) C.push_back(rest_voigt_stiffness(*p));
+        const Mat6& expected = replace ? A : CH;
+        EXPECT_LE((element_uniform_response(C, 2, true) - expected).norm(), 1e-5 * expected.norm())
+            << "cell " << I << " " << J << " " << K;
+      }
+  EXPECT_EQ(windowed.checked_blocks, mixed);
+  EXPECT_EQ(windowed.replaced_blocks, far);
+  EXPECT_GT(far, 0);      // the window matters somewhere ...
+  EXPECT_LT(far, mixed);  // ... and not everywhere, so both branches are tested
+
+  // Checked against the periodic C^H instead, no naive fit is replaced.
+  request.window = 0;
+  EXPECT_EQ(coarsen_voxels(grid, palette, request).replaced_blocks, 0);
+  // A window needs the check (ddfem) or the matched model.
+  request.window = 2;
+  request.check_tolerance = 0;
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
 }
