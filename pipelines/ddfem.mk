@@ -16,6 +16,7 @@
 #   make -f Makefile.pipeline ddfem-table-checked   matched coarsening, and DDFEM lookups checked against each block's own C^H
 #   make -f Makefile.pipeline ddfem-table-adaptive-checked  adaptive coarsening with the checked lookup
 #   make -f Makefile.pipeline ddfem-table-windowed  matched materials carried onto each cell's stiffness among its real neighbours
+#   make -f Makefile.pipeline ddfem-table-window-checked  DDFEM lookups checked against each cell's stiffness among its real neighbours
 #   make -f Makefile.pipeline ddfem-table-dynamics  DDFEM in dynamics: the fibre bar fine, level 1 and 2, trajectory error and speed
 #   make -f Makefile.pipeline ddfem-table-thesis-settings  the thesis's sampling and fit, and level 2 over 100/400/1024 materials
 #
@@ -46,7 +47,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants ddfem-table-checked ddfem-table-adaptive-checked ddfem-table-windowed \
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants ddfem-table-checked ddfem-table-adaptive-checked ddfem-table-windowed ddfem-table-window-checked \
         ddfem-table-dynamics
 ddfem-db-tiny: stages $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: stages $(OUT)/ddfem/palette3.coarse_db.h5
@@ -196,6 +197,19 @@ ddfem-table-windowed: stages
 	  LEVEL=$$level BENCH_SECTION=ddfem-windowed-level$$level \
 	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-level2-variants docs/BENCHMARKS.md \
 	    naive-enhanced="$(ENHANCED_NAIVE)" matched="--coarse-material matched --coarse-element enhanced" \
+	    matched-window="--coarse-material matched --coarse-element enhanced --coarse-window $(WINDOW)" || exit 1; \
+	done
+
+# The lookup checked against each cell's windowed stiffness instead of its
+# periodic C^H (--coarse-check $(CHECK) --coarse-window $(WINDOW)), both levels.
+ddfem-table-window-checked: stages $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+	for level in 2 1; do \
+	  db=$(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5; [ $$level = 1 ] || db=$(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5; \
+	  LEVEL=$$level BENCH_SECTION=ddfem-window-checked-level$$level \
+	  bash tools/bench_ddfem_databases.sh $(BIN) $(OUT)/bench/ddfem-window-checked docs/BENCHMARKS.md \
+	    naive-enhanced="$(ENHANCED_NAIVE)" \
+	    checked="--database $$db --coarse-fallback galerkin --coarse-check $(CHECK)" \
+	    window-checked="--database $$db --coarse-fallback galerkin --coarse-check $(CHECK) --coarse-window $(WINDOW)" \
 	    matched-window="--coarse-material matched --coarse-element enhanced --coarse-window $(WINDOW)" || exit 1; \
 	done
 

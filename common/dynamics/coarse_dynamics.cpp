@@ -180,6 +180,11 @@ TrajectoryCoarsening coarsening_record(const DynamicsCoarsening& coarsening) {
   r.element = c.element;
   r.fallback = r.material == "ddfem" ? c.fallback : std::string();
   r.fallback_blocks = c.fallback_blocks;
+  r.check_tolerance = c.check_tolerance;
+  r.checked_blocks = c.checked_blocks;
+  r.replaced_blocks = c.replaced_blocks;
+  r.window = coarsening.request.window;
+  r.unresolved_windows = c.unresolved_windows;
   r.fine_elements = coarsening.fine.mesh.num_elements();
   r.seconds = c.seconds;
   return r;

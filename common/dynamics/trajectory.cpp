@@ -452,6 +452,11 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
     f.write_attribute("/coarsening", "element", c.element);
     f.write_attribute("/coarsening", "fallback", c.fallback);
     f.write_attribute("/coarsening", "fallback_blocks", c.fallback_blocks);
+    f.write_attribute("/coarsening", "check_tolerance", c.check_tolerance);
+    f.write_attribute("/coarsening", "checked_blocks", c.checked_blocks);
+    f.write_attribute("/coarsening", "replaced_blocks", c.replaced_blocks);
+    f.write_attribute("/coarsening", "window", c.window);
+    f.write_attribute("/coarsening", "unresolved_windows", c.unresolved_windows);
     f.write_attribute("/coarsening", "fine_elements", c.fine_elements);
     f.write_attribute("/coarsening", "seconds", c.seconds);
   }
@@ -521,6 +526,13 @@ Trajectory read_trajectory_artifact(const std::string& path) {
     c.element = f.read_string_attribute("/coarsening", "element");
     c.fallback = f.read_string_attribute("/coarsening", "fallback");
     c.fallback_blocks = f.read_attribute<int>("/coarsening", "fallback_blocks");
+    if (f.has_attribute("/coarsening", "check_tolerance")) {  // written since the check's counts are recorded
+      c.check_tolerance = f.read_attribute<double>("/coarsening", "check_tolerance");
+      c.checked_blocks = f.read_attribute<int>("/coarsening", "checked_blocks");
+      c.replaced_blocks = f.read_attribute<int>("/coarsening", "replaced_blocks");
+      c.window = f.read_attribute<int>("/coarsening", "window");
+      c.unresolved_windows = f.read_attribute<int>("/coarsening", "unresolved_windows");
+    }
     c.fine_elements = f.read_attribute<int>("/coarsening", "fine_elements");
     c.seconds = f.read_attribute<double>("/coarsening", "seconds");
   }

@@ -54,6 +54,13 @@ struct TrajectoryCoarsening {
   int level = 0;
   std::string material, database, element, fallback;
   int fallback_blocks = 0;  // ddfem: distinct blocks without a database fit
+  // ddfem with --coarse-check: the tolerance (0: off), the solid mixed blocks
+  // checked and those replaced by the matched model (cells with a window).
+  double check_tolerance = 0;
+  int checked_blocks = 0, replaced_blocks = 0;
+  // --coarse-window: the margin (0: off) and the cells whose window gave no
+  // stiffness (their own C^H was used).
+  int window = 0, unresolved_windows = 0;
   int fine_elements = 0;
   double seconds = 0;       // online coarsening time
 };

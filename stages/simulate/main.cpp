@@ -155,6 +155,9 @@ int main(int argc, char** argv) {
       if (coarsening.level != 0) throw InputError("--target-error chooses the levels itself; drop --coarsen");
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
+      if (coarsening.window > 0)
+        throw InputError("--target-error: --coarse-window is not supported (the mixed mesh takes one material set "
+                         "per distinct block, a window needs one per cell); drop it");
       if (scene.newton.linear_solver == "pcg-mg")
         throw InputError((ctx.options.config_path.empty() ? std::string("built-in scene") : ctx.options.config_path) +
                          ": solver.linear_solver: pcg-mg needs a mesh of equal elements and --target-error meshes "

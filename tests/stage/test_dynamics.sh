@@ -152,6 +152,14 @@ check "a coarsened run reports its difference from the fine run" -- grep -q "vs 
 err=$(awk '/vs fine/ { for (i = 1; i <= NF; ++i) if ($i == "max") print $(i + 1) }' "$WORK/fiber_l1.txt" | tr -d ,)
 check "... which is small and not zero (0 < $err < 0.05)" -- awk -v e="$err" 'BEGIN { exit !(e > 0 && e < 0.05) }'
 check "... and runs fewer DOFs" -- grep -q "msfab-dynamics: scene 'fiber-bar', 208 elements" "$WORK/fiber_l1.txt"
+# Windowed matched materials: the trajectory records the margin and the
+# cells left on their own C^H (those next to the void padding of the odd
+# grid).
+"$BIN/msfab-dynamics" --quiet "${FIBER[@]}" --coarsen 1 --coarse-material matched --coarse-window 2 \
+  --out "$WORK/fiber_window.h5" > /dev/null
+check "a windowed run records its margin in the trajectory" -- \
+  bash -c "h5dump -a /coarsening/window '$WORK/fiber_window.h5' | grep -q '(0): 2' &&
+           h5dump -a /coarsening/unresolved_windows '$WORK/fiber_window.h5' | grep -q '(0): [0-9]'"
 "$BIN/msfab-dynamics" --quiet "${FIBER[@]}" --reference "$WORK/fiber_fine.h5" --out "$WORK/fiber_again.h5" > "$WORK/fiber_again.txt"
 check "the fine run against itself: no difference" -- grep -q "vs fine (same mesh): error at release 0.000e+00, max 0.000e+00" "$WORK/fiber_again.txt"
 expect_exit 2 "fiber_fine.h5: the reference has .* rest nodes" -- "$BIN/msfab-dynamics" --out "$WORK/x.h5" \

@@ -230,6 +230,9 @@ check "windowed check counts cells and replaces them by the windowed matched mod
   'BEGIN { exit !(c > 1 && r == c && e == m) }'
 expect_exit 2 "coarse-window: applies to --coarse-material matched, or ddfem with --coarse-check" -- \
   "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2_enhanced.h5" --coarse-window 2 --out "$WORK/o.h5"
+expect_exit 2 "target-error: --coarse-window is not supported" -- \
+  "$SIM" --config "$BAR" --target-error 0.02 --database "$WORK/db2_enhanced.h5" --coarse-check 0.1 --coarse-window 2 \
+  --out "$WORK/o.h5"
 expect_exit 2 "coarse-window: applies to --coarse-material matched" -- \
   "$SIM" --config "$BAR" --coarsen 2 --coarse-material naive --coarse-window 2 --out "$WORK/o.h5"
 expect_exit 2 "coarse-check: the tolerance must be >= 0" -- \

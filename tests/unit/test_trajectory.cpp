@@ -182,6 +182,11 @@ void expect_identical(const Trajectory& a, const Trajectory& b) {
   EXPECT_EQ(a.coarsening.element, b.coarsening.element);
   EXPECT_EQ(a.coarsening.fallback, b.coarsening.fallback);
   EXPECT_EQ(a.coarsening.fallback_blocks, b.coarsening.fallback_blocks);
+  EXPECT_SAME_DOUBLE(a.coarsening.check_tolerance, b.coarsening.check_tolerance);
+  EXPECT_EQ(a.coarsening.checked_blocks, b.coarsening.checked_blocks);
+  EXPECT_EQ(a.coarsening.replaced_blocks, b.coarsening.replaced_blocks);
+  EXPECT_EQ(a.coarsening.window, b.coarsening.window);
+  EXPECT_EQ(a.coarsening.unresolved_windows, b.coarsening.unresolved_windows);
   EXPECT_EQ(a.coarsening.fine_elements, b.coarsening.fine_elements);
   EXPECT_SAME_DOUBLE(a.coarsening.seconds, b.coarsening.seconds);
   EXPECT_EQ(a.comparison.reference, b.comparison.reference);
@@ -249,7 +254,7 @@ TEST_F(TrajectoryArtifact, RoundTripIsBitwiseExact) {
 
 TEST_F(TrajectoryArtifact, CoarseningAndComparisonRoundTrip) {
   Trajectory t = synthetic_trajectory();
-  t.coarsening = {1, "ddfem", "db/palette3.coarse_db.h5", "trilinear", "naive", 3, 12800, 0.0123};
+  t.coarsening = {1, "ddfem", "db/palette3.coarse_db.h5", "enhanced", "galerkin", 3, 0.1, 40, 12, 2, 1, 12800, 0.0123};
   t.comparison = {"fine.h5", 1.5e-3, 2.25e-2, 1.0e-2, 2.0e-2, 1.7e-3, 3.5, 0.18};
   const std::string path = file("coarse.h5");
   write_trajectory_artifact(path, t, {});
