@@ -5,11 +5,13 @@
 #include <cmath>
 #include <exception>
 #include <functional>
+#include <map>
 #include <set>
 
 #include "core/errors.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/matched_coarsening.hpp"
+#include "ddfem/windowed_stiffness.hpp"
 
 namespace msfab {
 
@@ -57,34 +59,49 @@ using CellMaterials = std::function<QuadratureMaterials(int cell, CellOutcome& o
 
 // The coarse mesh of `cells` (one combination per solid cell, as
 // with_one_combination_per_cell numbers them) with each cell's materials
-// from `materials`. The cells are independent (one window homogenization
-// each), so they are computed in parallel; each result depends on its cell
-// alone, not on the threads. The outcomes are summed into `counts`.
-VoxelMesh per_cell_mesh(const CoarseGrid& cells, const CellMaterials& materials, bool enhanced, CoarseMeshStats* stats,
-                        CoarsenedVoxels* counts) {
-  std::vector<int> cell_of;  // combination k is the k-th solid cell
-  for (int c = 0; c < cells.num_cells(); ++c)
-    if (cells.cell_combination[c] >= 0) cell_of.push_back(c);
-  const int count = static_cast<int>(cell_of.size());
+// from `materials`, which depend on the cell's window of `margin` voxels of
+// `fine` alone. So cells with equal windows (a laminate's, a repeated
+// pattern's) are decided once, by the first of them in cell order, and the
+// distinct windows in parallel: each result depends on its window alone,
+// not on the threads. The outcomes are summed into `counts` per cell.
+VoxelMesh per_cell_mesh(const VoxelGrid& fine, const CoarseGrid& cells, int margin, const CellMaterials& materials,
+                        bool enhanced, CoarseMeshStats* stats, CoarsenedVoxels* counts) {
+  const int n = cells.fine_per_cell();
+  std::vector<int> cell_of;     // combination k is the k-th solid cell
+  std::vector<int> window_of;   // ... and its window is the window_of[k]-th distinct one
+  std::vector<int> first_cell;  // the first solid cell of each distinct window
+  std::map<std::vector<int>, int> distinct;
+  for (int c = 0; c < cells.num_cells(); ++c) {
+    if (cells.cell_combination[c] < 0) continue;
+    const int I = c % cells.nx, J = (c / cells.nx) % cells.ny, K = c / (cells.nx * cells.ny);
+    const auto [it, added] =
+        distinct.emplace(cell_window(fine, n * I, n * J, n * K, n, margin), static_cast<int>(first_cell.size()));
+    if (added) first_cell.push_back(c);
+    window_of.push_back(it->second);
+    cell_of.push_back(c);
+  }
+  const int count = static_cast<int>(first_cell.size());
   std::vector<CellOutcome> outcome(count);
-  std::vector<QuadratureMaterials> per_cell(count);
+  std::vector<QuadratureMaterials> per_window(count);
   std::exception_ptr failure;
 #pragma omp parallel for schedule(dynamic)
   for (int k = 0; k < count; ++k) {
     try {
-      per_cell[k] = materials(cell_of[k], outcome[k]);
+      per_window[k] = materials(first_cell[k], outcome[k]);
     } catch (...) {
 #pragma omp critical(per_cell_failure)
       if (!failure) failure = std::current_exception();
     }
   }
   if (failure) std::rethrow_exception(failure);
-  for (const CellOutcome& o : outcome) {
-    counts->unresolved_windows += o.unresolved;
-    counts->checked_blocks += o.checked;
-    counts->replaced_blocks += o.replaced;
+  for (int w : window_of) {
+    counts->unresolved_windows += outcome[w].unresolved;
+    counts->checked_blocks += outcome[w].checked;
+    counts->replaced_blocks += outcome[w].replaced;
   }
-  return build_coarse_mesh(cells, IndexedMaterialLookup([&per_cell](int c) { return per_cell[c]; }), 0, stats, enhanced);
+  counts->distinct_windows = count;
+  return build_coarse_mesh(cells, IndexedMaterialLookup([&](int k) { return per_window[window_of[k]]; }), 0, stats,
+                           enhanced);
 }
 
 // The windowed check of one cell (`--coarse-check TAU --coarse-window M`):
@@ -189,7 +206,7 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   if (request.window > 0 && request.material == "matched") {
     const CoarseGrid cells = with_one_combination_per_cell(m.grid);
     const bool enhanced = m.element == "enhanced";
-    m.mesh = per_cell_mesh(cells, [&](int cell, CellOutcome& o) {
+    m.mesh = per_cell_mesh(grid, cells, request.window, [&](int cell, CellOutcome& o) {
       return windowed_matched_cell(grid, palette, cells, level1, enhanced, request.window, cell, &o.unresolved);
     }, enhanced, &m.stats, &m);
     m.grid = cells;
@@ -203,7 +220,7 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
     const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
     const CoarseGrid cells = with_one_combination_per_cell(m.grid);
     const bool enhanced = m.element == "enhanced";
-    m.mesh = per_cell_mesh(cells, [&](int cell, CellOutcome& o) {
+    m.mesh = per_cell_mesh(grid, cells, request.window, [&](int cell, CellOutcome& o) {
       return windowed_checked_cell(grid, palette, *m.database, m.level1, request.level, cells, lookup, enhanced,
                                    request.window, request.check_tolerance, cell, o);
     }, enhanced, &m.stats, &m);

@@ -45,7 +45,8 @@ struct CoarsenedVoxels {
   double check_tolerance = 0;        // ddfem: the checked lookup's tolerance (request resolved; 0: off)
   int checked_blocks = 0;            // ddfem with a check: distinct solid mixed blocks whose fit was checked
   int replaced_blocks = 0;           // ... and of those, coarsened by the matched model instead
-  int unresolved_windows = 0;        // matched with a window: cells whose window gave no stiffness (own C^H used)
+  int unresolved_windows = 0;        // with a window: cells whose window gave no stiffness (own C^H used)
+  int distinct_windows = 0;          // with a window: distinct windows among the solid cells (each computed once)
 };
 
 // A baseline by name (naive, averaged, galerkin, homogenized of

@@ -24,17 +24,28 @@ constexpr double kMinStrainConditioning = 1e-8;
 
 }  // namespace
 
+std::vector<int> cell_window(const VoxelGrid& fine, int i0, int j0, int k0, int n, int margin) {
+  const int w = n + 2 * margin;
+  std::vector<int> ids;
+  ids.reserve(size_t(w) * w * w);
+  for (int a = 0; a < w; ++a)
+    for (int b = 0; b < w; ++b)
+      for (int c = 0; c < w; ++c)
+        ids.push_back(fine.at(mirrored(i0 - margin + a, fine.nx), mirrored(j0 - margin + b, fine.ny),
+                              mirrored(k0 - margin + c, fine.nz)));
+  return ids;
+}
+
 Mat6 windowed_stiffness(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette, int i0, int j0, int k0, int n,
                         int margin) {
   if (n < 1 || margin < 0) throw std::invalid_argument("windowed_stiffness: n >= 1 and margin >= 0 expected");
   const int w = n + 2 * margin;
   const double h = fine.voxel_size;
   VoxelGrid cell(w, w, w, h, 0);
+  const std::vector<int> window = cell_window(fine, i0, j0, k0, n, margin);
   for (int a = 0; a < w; ++a)
     for (int b = 0; b < w; ++b)
-      for (int c = 0; c < w; ++c)
-        cell.at(a, b, c) = fine.at(mirrored(i0 - margin + a, fine.nx), mirrored(j0 - margin + b, fine.ny),
-                                   mirrored(k0 - margin + c, fine.nz));
+      for (int c = 0; c < w; ++c) cell.at(a, b, c) = window[(size_t(a) * w + b) * w + c];
   for (int a = margin; a < margin + n; ++a)
     for (int b = margin; b < margin + n; ++b)
       for (int c = margin; c < margin + n; ++c)

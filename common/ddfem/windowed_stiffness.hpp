@@ -24,4 +24,9 @@ namespace msfab {
 Mat6 windowed_stiffness(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette, int i0, int j0, int k0, int n,
                         int margin);
 
+// The window of that cell: the (n + 2 margin)^3 voxel ids, the grid mirrored
+// at its faces, x slowest. Cells with equal windows have equal windowed
+// stiffnesses.
+std::vector<int> cell_window(const VoxelGrid& fine, int i0, int j0, int k0, int n, int margin);
+
 }  // namespace msfab

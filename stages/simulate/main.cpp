@@ -284,6 +284,7 @@ int main(int argc, char** argv) {
       }
       record.window = coarsening.window;
       record.unresolved_windows = coarse.unresolved_windows;
+      record.distinct_windows = coarse.distinct_windows;
       record.database = coarsening.database;
       record.coarsening_seconds = coarse.seconds;
       record.fine_elements = fine.mesh.num_elements();

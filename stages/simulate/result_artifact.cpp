@@ -89,6 +89,7 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
     if (r.window > 0) {
       f.write_attribute("/coarsening", "window", r.window);
       f.write_attribute("/coarsening", "unresolved_windows", r.unresolved_windows);
+      f.write_attribute("/coarsening", "distinct_windows", r.distinct_windows);
     }
     f.write_attribute("/coarsening", "database", r.database);
     f.write_attribute("/coarsening", "seconds", r.coarsening_seconds);

@@ -31,7 +31,8 @@ struct SimulationRecord {
   int fallback_blocks = 0;           // ddfem: distinct blocks coarsened by the fallback
   double check_tolerance = 0;        // ddfem: --coarse-check (0: no check)
   int checked_blocks = 0, replaced_blocks = 0;  // ddfem with a check: solid mixed blocks checked, replaced
-  int window = 0, unresolved_windows = 0;        // matched: --coarse-window, cells left on their own C^H
+  int window = 0, unresolved_windows = 0;        // --coarse-window, cells left on their own C^H
+  int distinct_windows = 0;                      // --coarse-window: distinct windows, each computed once
   std::string coarse_element = "trilinear";  // trilinear | enhanced
   std::string database;              // ddfem: the coarse_db path
   double coarsening_seconds = 0;

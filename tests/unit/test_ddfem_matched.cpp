@@ -353,3 +353,36 @@ TEST(WindowedStiffness, CheckedLookupAgainstTheWindowKeepsOnlyFitsThatRespondLik
   request.check_tolerance = 0;
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
 }
+
+TEST(WindowedStiffness, CellsWithEqualWindowsAreComputedOnce) {
+  const auto palette = three_materials();
+  // A laminate of period 2 along x: away from the mirrored faces every
+  // cell sees the same window.
+  VoxelGrid grid(12, 8, 8, 1e-3, 1);
+  for (int i = 1; i < 12; i += 2)
+    for (int j = 0; j < 8; ++j)
+      for (int k = 0; k < 8; ++k) grid.at(i, j, k) = 3;
+  CoarseningRequest request;
+  request.level = 1;
+  request.material = "matched";
+  request.element = "enhanced";
+  request.window = 2;
+  const CoarsenedVoxels windowed = coarsen_voxels(grid, palette, request);
+  EXPECT_EQ(windowed.grid.combinations.size(), 6u * 4 * 4);  // still one material set per cell
+  EXPECT_GT(windowed.distinct_windows, 1);
+  EXPECT_LT(windowed.distinct_windows, 6 * 4 * 4 / 4);
+  auto materials_of = [&](int I, int J, int K) {
+    const int e = windowed.mesh.voxel_element[windowed.grid.index(I, J, K)];
+    return windowed.mesh.mesh.materials[windowed.mesh.mesh.element_material[e]].at_point;
+  };
+  // Two interior cells share the window and so the materials; each is the
+  // cell's own windowed stiffness.
+  EXPECT_EQ(materials_of(2, 1, 1), materials_of(3, 2, 1));
+  const Mat6 A = windowed_stiffness(grid, palette, 6, 4, 2, 2, 2);
+  std::vector<Mat6> C;
+  for (const MaterialPtr& p : materials_of(3, 2, 1)) C.push_back(rest_voigt_stiffness(*p));
+  EXPECT_LE((element_uniform_response(C, 2, true) - A).norm(), 1e-5 * A.norm());
+  // Cells that see a mirrored face have windows of their own.
+  EXPECT_NE(cell_window(grid, 0, 2, 2, 2, 2), cell_window(grid, 4, 2, 2, 2, 2));
+  EXPECT_EQ(cell_window(grid, 4, 2, 2, 2, 2), cell_window(grid, 6, 4, 2, 2, 2));
+}
