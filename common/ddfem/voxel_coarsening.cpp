@@ -67,18 +67,20 @@ using CellMaterials = std::function<QuadratureMaterials(int cell, CellOutcome& o
 VoxelMesh per_cell_mesh(const VoxelGrid& fine, const CoarseGrid& cells, int margin, const CellMaterials& materials,
                         bool enhanced, CoarseMeshStats* stats, CoarsenedVoxels* counts) {
   const int n = cells.fine_per_cell();
-  std::vector<int> cell_of;     // combination k is the k-th solid cell
-  std::vector<int> window_of;   // ... and its window is the window_of[k]-th distinct one
+  std::vector<int> window_of;   // the k-th solid cell (combination k) has the window_of[k]-th distinct window
   std::vector<int> first_cell;  // the first solid cell of each distinct window
-  std::map<std::vector<int>, int> distinct;
-  for (int c = 0; c < cells.num_cells(); ++c) {
-    if (cells.cell_combination[c] < 0) continue;
-    const int I = c % cells.nx, J = (c / cells.nx) % cells.ny, K = c / (cells.nx * cells.ny);
-    const auto [it, added] =
-        distinct.emplace(cell_window(fine, n * I, n * J, n * K, n, margin), static_cast<int>(first_cell.size()));
-    if (added) first_cell.push_back(c);
-    window_of.push_back(it->second);
-    cell_of.push_back(c);
+  {
+    // The windows themselves ((n + 2 margin)^3 ids each) are needed only to
+    // find the distinct ones.
+    std::map<std::vector<int>, int> distinct;
+    for (int c = 0; c < cells.num_cells(); ++c) {
+      if (cells.cell_combination[c] < 0) continue;
+      const int I = c % cells.nx, J = (c / cells.nx) % cells.ny, K = c / (cells.nx * cells.ny);
+      const auto [it, added] =
+          distinct.emplace(cell_window(fine, n * I, n * J, n * K, n, margin), static_cast<int>(first_cell.size()));
+      if (added) first_cell.push_back(c);
+      window_of.push_back(it->second);
+    }
   }
   const int count = static_cast<int>(first_cell.size());
   std::vector<CellOutcome> outcome(count);

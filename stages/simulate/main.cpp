@@ -210,10 +210,18 @@ int main(int argc, char** argv) {
                    coarse.fallback_blocks ? fmt::format(" ({} block kinds without a database fit coarsened {})",
                                                         coarse.fallback_blocks, coarsening.fallback)
                                           : std::string());
-    if (coarsened && coarsening.check_tolerance > 0)
+    if (coarsened && coarsening.check_tolerance > 0 && coarsening.window == 0)
       spdlog::info("checked lookup: {} of {} solid mixed block kinds had a fit farther than {} from their own "
                    "homogenized stiffness and were coarsened by the matched model",
                    coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance);
+    if (coarsened && coarsening.check_tolerance > 0 && coarsening.window > 0)
+      spdlog::info("checked lookup against windows: {} of {} solid mixed cells had a fit farther than {} from their "
+                   "stiffness among {} voxels of their neighbours and were coarsened by the windowed matched model",
+                   coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance, coarsening.window);
+    if (coarsened && coarsening.window > 0)
+      spdlog::info("windows: {} distinct among the solid cells, each homogenized once; {} cells kept their own "
+                   "homogenized stiffness (void in the window, or a stiffness the window does not determine)",
+                   coarse.distinct_windows, coarse.unresolved_windows);
 
     // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
     // step apart, which elements of mixed sizes are not: adaptive models are
