@@ -43,6 +43,11 @@ struct CoarseGrid {
   double seconds = 0;          // wall time spent building this grid
 
   size_t index(int i, int j, int k) const { return size_t(i) + size_t(nx) * (size_t(j) + size_t(ny) * k); }
+  // The first fine voxel (i, j, k) of cell c: the inverse of index, times 2^level.
+  std::array<int, 3> first_voxel(int c) const {
+    const int n = fine_per_cell();
+    return {n * (c % nx), n * ((c / nx) % ny), n * (c / (nx * ny))};
+  }
   int fine_per_cell() const { return 1 << level; }
   int num_cells() const { return nx * ny * nz; }
   int num_elements() const;

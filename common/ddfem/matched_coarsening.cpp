@@ -154,17 +154,16 @@ std::vector<Mat6> newton_to_response(std::vector<Mat6> C, const hex8::ElementGeo
     const Vec21 step = J.colPivHouseholderQr().solve(-F);
     // Backtracking on the residual's norm; S stays near I, so S C_q S stays
     // positive definite.
-    double t = 1;
-    for (int k = 0; k < 30; ++k, t *= 0.5) {
-      const std::vector<Mat6> trial = congruent(C, Mat6::Identity() + symmetric_matrix(t * step));
+    bool decreased = false;
+    for (double t = 1; t > 1e-9 && !decreased; t *= 0.5) {
+      std::vector<Mat6> trial = congruent(C, Mat6::Identity() + symmetric_matrix(t * step));
       const Vec21 Ft = residual(trial);
-      if (Ft.norm() < F.norm()) {
-        C = trial;
+      if ((decreased = Ft.norm() < F.norm())) {
+        C = std::move(trial);
         F = Ft;
-        break;
       }
     }
-    if (!(t > 1e-9)) break;  // no decrease left
+    if (!decreased) break;  // no decrease left
   }
   *r = (uniform_strain_response(geo, C) - target).norm() / scale;
   return C;
@@ -237,13 +236,12 @@ QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& pale
 Mat6 cell_windowed_stiffness(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette, const CoarseGrid& cells,
                              const std::vector<int>& ids, int cell, int margin, bool* unresolved) {
   *unresolved = false;
-  const int n = cells.fine_per_cell();
-  const int I = cell % cells.nx, J = (cell / cells.nx) % cells.ny, K = cell / (cells.nx * cells.ny);
+  const std::array<int, 3> v = cells.first_voxel(cell);
   try {
-    return windowed_stiffness(fine, palette, n * I, n * J, n * K, n, margin);
+    return windowed_stiffness(fine, palette, v[0], v[1], v[2], cells.fine_per_cell(), margin);
   } catch (const NumericalError&) {
     *unresolved = true;
-    return block_homogenized_stiffness(palette, ids, n);
+    return block_homogenized_stiffness(palette, ids, cells.fine_per_cell());
   }
 }
 

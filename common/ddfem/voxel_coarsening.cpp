@@ -75,9 +75,9 @@ VoxelMesh per_cell_mesh(const VoxelGrid& fine, const CoarseGrid& cells, int marg
     std::map<std::vector<int>, int> distinct;
     for (int c = 0; c < cells.num_cells(); ++c) {
       if (cells.cell_combination[c] < 0) continue;
-      const int I = c % cells.nx, J = (c / cells.nx) % cells.ny, K = c / (cells.nx * cells.ny);
+      const std::array<int, 3> v = cells.first_voxel(c);
       const auto [it, added] =
-          distinct.emplace(cell_window(fine, n * I, n * J, n * K, n, margin), static_cast<int>(first_cell.size()));
+          distinct.emplace(cell_window(fine, v[0], v[1], v[2], n, margin), static_cast<int>(first_cell.size()));
       if (added) first_cell.push_back(c);
       window_of.push_back(it->second);
     }
