@@ -29,7 +29,7 @@ RANKS  ?= 1
 # the orbits per second of the same build without mpirun).
 MPIRUN ?= mpirun --oversubscribe --bind-to none -np $(RANKS)
 
-$(OUT)/ddfem/%.coarse_db.h5: configs/ddfem/%.yaml $(BIN)/msfab-ddfem-build
+$(OUT)/ddfem/%.coarse_db.h5: configs/ddfem/%.yaml $(STAGE_ID)/msfab-ddfem-build.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< --out $@ --resume
 
@@ -39,9 +39,9 @@ K1 ?= 400
 # Kept: the compressed level-1 database is an input others reuse (make would
 # delete it as an intermediate of the level-2 build).
 .PRECIOUS: $(OUT)/ddfem/%.k$(K1).coarse_db.h5
-$(OUT)/ddfem/%.k$(K1).coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(BIN)/msfab-ddfem-compress
+$(OUT)/ddfem/%.k$(K1).coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(STAGE_ID)/msfab-ddfem-compress.id
 	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$(K1) --out $@
-$(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k$(K1).coarse_db.h5 $(BIN)/msfab-ddfem-build
+$(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k$(K1).coarse_db.h5 $(STAGE_ID)/msfab-ddfem-build.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
@@ -99,18 +99,18 @@ ddfem-table-mixed: stages $(OUT)/ddfem/palette3_periodic_enhanced_affine.coarse_
 # lookup's features with the single-corner moves, at the level-1
 # compression (k$(K1)c) and at every pairing stage.
 .PRECIOUS: $(OUT)/ddfem/%.k$(K1)c.coarse_db.h5
-$(OUT)/ddfem/%.k$(K1)c.coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(BIN)/msfab-ddfem-compress
+$(OUT)/ddfem/%.k$(K1)c.coarse_db.h5: $(OUT)/ddfem/%.coarse_db.h5 $(STAGE_ID)/msfab-ddfem-compress.id
 	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$(K1) --set corner_moves=true --out $@
 AFFINE_CORNER_L2 := $(foreach v,corners corners800,$(OUT)/ddfem/palette3_periodic_enhanced_affine_$(v).level2.coarse_db.h5)
 $(AFFINE_CORNER_L2): $(OUT)/ddfem/palette3_periodic_enhanced_affine_%.level2.coarse_db.h5: \
   configs/ddfem/palette3_periodic_enhanced_affine_%_level2.yaml \
-  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(BIN)/msfab-ddfem-build
+  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 $(STAGE_ID)/msfab-ddfem-build.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1)c.coarse_db.h5 --out $@ --resume
 $(OUT)/ddfem/palette3_periodic_enhanced_affine_voxels.level2.coarse_db.h5: \
   configs/ddfem/palette3_periodic_enhanced_affine_voxels_level2.yaml \
-  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 $(BIN)/msfab-ddfem-build
+  $(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 $(STAGE_ID)/msfab-ddfem-build.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3_periodic_enhanced_affine.k$(K1).coarse_db.h5 --out $@ --resume
@@ -230,12 +230,12 @@ DDFEM_K1_SWEEP := 100 400 1024
 DDFEM_L2_BASES := k400 k1024 full
 DDFEM_SETTINGS_L1 := palette3 palette3_thesis palette3_eq28fit palette3_thesis_sampling
 $(foreach k,$(DDFEM_K1_SWEEP),$(OUT)/ddfem/palette3.k$(k).coarse_db.h5): \
-  $(OUT)/ddfem/palette3.k%.coarse_db.h5: $(OUT)/ddfem/palette3.coarse_db.h5 $(BIN)/msfab-ddfem-compress
+  $(OUT)/ddfem/palette3.k%.coarse_db.h5: $(OUT)/ddfem/palette3.coarse_db.h5 $(STAGE_ID)/msfab-ddfem-compress.id
 	$(BIN)/msfab-ddfem-compress --database $< --set representatives=$* --out $@
 $(OUT)/ddfem/palette3.full.coarse_db.h5: $(OUT)/ddfem/palette3.coarse_db.h5
 	cp $< $@
 $(OUT)/ddfem/palette3.level2.%.coarse_db.h5: configs/ddfem/palette3_level2.yaml $(OUT)/ddfem/palette3.%.coarse_db.h5 \
-                                             $(BIN)/msfab-ddfem-build
+                                             $(STAGE_ID)/msfab-ddfem-build.id
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-ddfem-build --config $< \
 	  --set base_database=$(OUT)/ddfem/palette3.$*.coarse_db.h5 --out $@ --resume
 .PHONY: ddfem-table-thesis-settings

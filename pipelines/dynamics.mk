@@ -21,35 +21,35 @@
 # out/design/*.jump_design.h5.
 DYN := $(OUT)/dynamics
 
-$(DYN)/drop_face_%.trajectory.h5: configs/dynamics/block_drop_face.yaml $(BIN)/msfab-dynamics
+$(DYN)/drop_face_%.trajectory.h5: configs/dynamics/block_drop_face.yaml $(STAGE_ID)/msfab-dynamics.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --set simulation.impact=$* --threads $(THREADS) $(QUIET) --out $@
 
-$(DYN)/drop_oblique.trajectory.h5: configs/dynamics/block_drop_oblique.yaml $(BIN)/msfab-dynamics
+$(DYN)/drop_oblique.trajectory.h5: configs/dynamics/block_drop_oblique.yaml $(STAGE_ID)/msfab-dynamics.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) $(QUIET) --out $@
 
-$(DYN)/rig_fine.trajectory.h5: configs/dynamics/cantilever_pluck.yaml $(BIN)/msfab-dynamics
+$(DYN)/rig_fine.trajectory.h5: configs/dynamics/cantilever_pluck.yaml $(STAGE_ID)/msfab-dynamics.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --set geometry.voxel_size=0.00075 --set simulation.duration=0.03 \
 	  --marker 0.06 0 0.006 --marker-csv $(DYN)/rig_fine_tip.csv --threads $(THREADS) $(QUIET) --out $@
 
-$(DYN)/rig.dac_model.h5: configs/dac/cantilever_from_fine.yaml $(DYN)/rig_fine.trajectory.h5 $(BIN)/msfab-dac-calibrate
+$(DYN)/rig.dac_model.h5: configs/dac/cantilever_from_fine.yaml $(DYN)/rig_fine.trajectory.h5 $(STAGE_ID)/msfab-dac-calibrate.id
 	$(BIN)/msfab-dac-calibrate --config $< --set marker_csv=$(abspath $(DYN))/rig_fine_tip.csv --out $@
 
-$(DYN)/rig_dac.trajectory.h5: configs/dynamics/cantilever_dac.yaml $(DYN)/rig.dac_model.h5 $(BIN)/msfab-dynamics
+$(DYN)/rig_dac.trajectory.h5: configs/dynamics/cantilever_dac.yaml $(DYN)/rig.dac_model.h5 $(STAGE_ID)/msfab-dynamics.id
 	$(BIN)/msfab-dynamics --config $< --set 'materials[0].dac_model=$(abspath $(DYN))/rig.dac_model.h5' \
 	  --marker 0.06 0 0.006 --marker-csv $(DYN)/rig_dac_tip.csv --threads $(THREADS) $(QUIET) --out $@
 
-$(DYN)/flipper.trajectory.h5: configs/dynamics/flipper_jumper.yaml $(BIN)/msfab-dynamics
+$(DYN)/flipper.trajectory.h5: configs/dynamics/flipper_jumper.yaml $(STAGE_ID)/msfab-dynamics.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
 
-$(DYN)/catapult.trajectory.h5: configs/dynamics/catapult.yaml $(BIN)/msfab-dynamics
+$(DYN)/catapult.trajectory.h5: configs/dynamics/catapult.yaml $(STAGE_ID)/msfab-dynamics.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-dynamics --config $< --threads $(THREADS) --out $@
 
-$(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(BIN)/msfab-jump-design
+$(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(STAGE_ID)/msfab-jump-design.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-jump-design --config $< --out $@
 

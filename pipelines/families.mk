@@ -14,31 +14,31 @@
 #
 # Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
 # a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
-$(OUT)/families/two.microstructures.h5: configs/families/two_templates.yaml $(BIN)/msfab-family-generate
+$(OUT)/families/two.microstructures.h5: configs/families/two_templates.yaml $(STAGE_ID)/msfab-family-generate.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ $(QUIET)
 
-$(OUT)/families/two.families.h5: $(OUT)/families/two.microstructures.h5 $(BIN)/msfab-families
+$(OUT)/families/two.families.h5: $(OUT)/families/two.microstructures.h5 $(STAGE_ID)/msfab-families.id
 	$(BIN)/msfab-families --structures $< --set 'selection.nu=[-1,0.5]' --set min_members=10 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
-$(OUT)/families/%.family1.microstructures.h5: $(OUT)/families/%.families.h5 $(BIN)/msfab-family-generate
+$(OUT)/families/%.family1.microstructures.h5: $(OUT)/families/%.families.h5 $(STAGE_ID)/msfab-family-generate.id
 	$(BIN)/msfab-family-generate --families $< --family 1 --sweep 5 --threads $(THREADS) --out $@
 
 $(OUT)/families/stiff_nu.families.h5: configs/families/stiff_nu.yaml $(OUT)/gamut/cubic3d_families.gamut.h5 \
-    $(BIN)/msfab-families
+    $(STAGE_ID)/msfab-families.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_families.microstructures.h5 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
 $(OUT)/families/auxetic_directed.families.h5: configs/families/auxetic_directed.yaml \
-    $(OUT)/gamut/cubic3d_auxetic.gamut.h5 $(BIN)/msfab-families
+    $(OUT)/gamut/cubic3d_auxetic.gamut.h5 $(STAGE_ID)/msfab-families.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_auxetic.microstructures.h5 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
 $(OUT)/families/auxetic_directed_32.families.h5: configs/families/auxetic_directed.yaml \
-    $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5 $(BIN)/msfab-families
+    $(OUT)/gamut/cubic3d_auxetic_32.gamut.h5 $(STAGE_ID)/msfab-families.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-families --config $< --structures $(OUT)/gamut/cubic3d_auxetic_32.microstructures.h5 \
 	  --set min_members=3 --seed $(SEED) --threads $(THREADS) --out $@

@@ -28,11 +28,11 @@ CONVERGE_GROWTH ?= 0.01
 CONVERGE_WINDOW ?= 10
 CONVERGE_CYCLES ?= 300
 
-$(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
+$(OUT)/gamut/%.gamut.h5: configs/gamut/%.yaml $(STAGE_ID)/msfab-gamut-sample.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume
 
-$(OUT)/gamut/converged/%.gamut.h5: configs/gamut/%.yaml $(BIN)/msfab-gamut-sample
+$(OUT)/gamut/converged/%.gamut.h5: configs/gamut/%.yaml $(STAGE_ID)/msfab-gamut-sample.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume \
 	  --set cycles=$(CONVERGE_CYCLES) --set plot_every_cycle=false \

@@ -3,7 +3,7 @@
 #   make -f Makefile.pipeline out/scenes/bending.result.h5
 STATIC_SCENES := pushing bending twisting buckling fibers
 
-$(OUT)/scenes/%.result.h5: configs/scenes/%.yaml $(BIN)/msfab-simulate
+$(OUT)/scenes/%.result.h5: configs/scenes/%.yaml $(STAGE_ID)/msfab-simulate.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-simulate --config $< --out $@ --threads $(THREADS)
 

@@ -80,7 +80,7 @@ TWO_SCALE_SCENES := bar gripper3d bridge_cubic cantilever_cubic
 $(OUT)/gamut/graded_lattice.gamut.h5: $(OUT)/families/graded_lattice.microstructures.h5
 HAND_MADE_FAMILIES := graded_lattice graded_lattice_grid
 $(HAND_MADE_FAMILIES:%=$(OUT)/families/%.microstructures.h5): $(OUT)/families/%.microstructures.h5: \
-    configs/families/%.yaml $(BIN)/msfab-family-generate
+    configs/families/%.yaml $(STAGE_ID)/msfab-family-generate.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ $(QUIET)
 
@@ -92,7 +92,7 @@ $(BAR_GAMUT).microstructures.h5: $(BAR_GAMUT).gamut.h5
 	@test -s $@ && touch -r $< $@
 
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.design.h5): $(TOPOPT_DIR)/%.design.h5: configs/topopt/%.yaml \
-    $(TWO_SCALE_SPACE) $(BIN)/msfab-topopt
+    $(TWO_SCALE_SPACE) $(STAGE_ID)/msfab-topopt.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< $(TWO_SCALE_SPACE_ARGS) $(TOPOPT_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
@@ -110,7 +110,7 @@ FILL_MPIRUN ?=
 MATCH ?= all
 FILL_ARGS ?=
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.structures.h5): $(TOPOPT_DIR)/%.structures.h5: $(TOPOPT_DIR)/%.design.h5 \
-    $(TWO_SCALE_SET) $(BIN)/msfab-fill-targets
+    $(TWO_SCALE_SET) $(STAGE_ID)/msfab-fill-targets.id
 ifeq ($(FILL_TARGETS),0)
 	cp $(TWO_SCALE_SET) $@.tmp && mv $@.tmp $@
 else
@@ -123,7 +123,7 @@ endif
 MAP_EXPORTS_bar := --set export.stl=true --set export.png=true
 MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.mapped.h5): $(TOPOPT_DIR)/%.mapped.h5: $(TOPOPT_DIR)/%.design.h5 \
-    $(TOPOPT_DIR)/%.structures.h5 $(BIN)/msfab-map
+    $(TOPOPT_DIR)/%.structures.h5 $(STAGE_ID)/msfab-map.id
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
 	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
@@ -134,17 +134,17 @@ VERIFY_SETTINGS_.h4 := --set homogenized_elements=4
 VERIFY_SETTINGS_.solid := --set fill=solid
 define TWO_SCALE_CHECK
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%$(1).verify.h5): $(TOPOPT_DIR)/%$(1).verify.h5: $(TOPOPT_DIR)/%.mapped.h5 \
-    $(TOPOPT_DIR)/%.design.h5 $(BIN)/msfab-verify-map
+    $(TOPOPT_DIR)/%.design.h5 $(STAGE_ID)/msfab-verify-map.id
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/$$*.design.h5 --mapped $$< \
 	  --structures $(TOPOPT_DIR)/$$*.structures.h5 $(VERIFY_SETTINGS_$(1)) --threads $(THREADS) --out $$@
 endef
 $(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
-$(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(BIN)/msfab-map
+$(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(STAGE_ID)/msfab-map.id
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
 	  $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
-$(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(BIN)/msfab-verify-map
+$(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(STAGE_ID)/msfab-verify-map.id
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \
 	  --structures $(TOPOPT_DIR)/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
@@ -152,7 +152,7 @@ $(CUBES_GAMUT).microstructures.h5: $(CUBES_GAMUT).gamut.h5
 	@test -s $@ && touch -r $< $@
 
 $(OUT)/topopt/cubes.md: $(CUBES_GAMUT).microstructures.h5 tools/bench_cubes.sh configs/assign/cube.yaml \
-    $(BIN)/msfab-assign $(BIN)/msfab-map $(BIN)/msfab-verify-map
+    $(STAGE_ID)/msfab-assign.id $(STAGE_ID)/msfab-map.id $(STAGE_ID)/msfab-verify-map.id
 	@mkdir -p $(@D)
 	bash tools/bench_cubes.sh $(BIN) $(OUT)/topopt/cubes $(CUBES_GAMUT).microstructures.h5 > $@.tmp
 	mv $@.tmp $@
@@ -160,7 +160,7 @@ $(OUT)/topopt/cubes.md: $(CUBES_GAMUT).microstructures.h5 tools/bench_cubes.sh c
 
 # The bridge at the thesis's optimization grid: optimization only (its
 # 254k cells are 537 M voxels at 16^3, beyond a full-resolution check here).
-$(OUT)/topopt/bridge_cubic_large.design.h5: configs/topopt/bridge_cubic_large.yaml $(BAR_GAMUT).gamut.h5 $(BIN)/msfab-topopt
+$(OUT)/topopt/bridge_cubic_large.design.h5: configs/topopt/bridge_cubic_large.yaml $(BAR_GAMUT).gamut.h5 $(STAGE_ID)/msfab-topopt.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-topopt --config $< --set gamut=$(BAR_GAMUT).gamut.h5 --threads $(THREADS) --out $@
 
@@ -176,10 +176,10 @@ HUGE_FAMILY := $(OUT)/families/graded_lattice_grid64.microstructures.h5
 HUGE_ITERATIONS ?= 4
 HUGE_CONFIG := configs/topopt/bridge_family_huge.yaml
 HUGE_TOPOPT = $(BIN)/msfab-topopt --config $(HUGE_CONFIG) --set family=$(HUGE_FAMILY) --threads $(THREADS)
-$(HUGE_FAMILY): configs/families/graded_lattice_grid.yaml $(BIN)/msfab-family-generate
+$(HUGE_FAMILY): configs/families/graded_lattice_grid.yaml $(STAGE_ID)/msfab-family-generate.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-family-generate --config $< --set resolution=64 --threads $(THREADS) --out $@ $(QUIET)
-$(HUGE_DIR)/bridge80.design.h5: $(HUGE_CONFIG) $(HUGE_FAMILY) $(BIN)/msfab-topopt
+$(HUGE_DIR)/bridge80.design.h5: $(HUGE_CONFIG) $(HUGE_FAMILY) $(STAGE_ID)/msfab-topopt.id
 	@mkdir -p $(@D)
 	$(HUGE_TOPOPT) --set grid="{size: [80, 40, 20], cell_size: 4.0}" --set optimizer.max_iterations=30 \
 	  --set domain="[{box: {min: [0, 0, 76], max: [320, 160, 80]}, role: solid}]" --out $@
@@ -188,7 +188,7 @@ $(HUGE_DIR)/bridge160.design.h5: $(HUGE_DIR)/bridge80.design.h5
 	  --set domain="[{box: {min: [0, 0, 78], max: [320, 160, 80]}, role: solid}]" --set initial="{design: $<}" --out $@
 $(HUGE_DIR)/bridge320.design.h5: $(HUGE_DIR)/bridge160.design.h5
 	$(HUGE_TOPOPT) --set optimizer.max_iterations=$(HUGE_ITERATIONS) --set initial="{design: $<}" --out $@
-$(HUGE_DIR)/bridge320.mapped.h5: $(HUGE_DIR)/bridge320.design.h5 $(HUGE_FAMILY) $(BIN)/msfab-map
+$(HUGE_DIR)/bridge320.mapped.h5: $(HUGE_DIR)/bridge320.design.h5 $(HUGE_FAMILY) $(STAGE_ID)/msfab-map.id
 	$(BIN)/msfab-map --design $< --structures $(HUGE_FAMILY) --set half_shift=false --set candidates=1 \
 	  --seed $(SEED) --threads $(THREADS) --out $@
 
@@ -201,7 +201,7 @@ GAMUT_gripper_pull := cubic2d_void
 GAMUT_gripper_push := cubic2d_void
 GAMUT_gripper_stretch := cubic2d_void
 define THESIS_2D_DESIGN
-$(OUT)/topopt/$(1).design.h5: configs/topopt/$(1).yaml $(OUT)/gamut/$(2).gamut.h5 $(BIN)/msfab-topopt
+$(OUT)/topopt/$(1).design.h5: configs/topopt/$(1).yaml $(OUT)/gamut/$(2).gamut.h5 $(STAGE_ID)/msfab-topopt.id
 	@mkdir -p $$(@D)
 	$(BIN)/msfab-topopt --config $$< --set gamut=$(OUT)/gamut/$(2).gamut.h5 --threads $(THREADS) --out $$@
 endef
@@ -211,13 +211,13 @@ $(foreach s,$(THESIS_2D_SCENES),$(eval $(call THESIS_2D_DESIGN,$(s),$(GAMUT_$(s)
 # structures (every cubic material is orthotropic), then runs to convergence.
 FIG316_CUBIC := $(OUT)/gamut/converged/cubic2d_void
 FIG316_ORTHO := $(OUT)/gamut/converged/orthotropic2d_void_seeded
-$(FIG316_ORTHO).gamut.h5: configs/gamut/orthotropic2d_void.yaml $(FIG316_CUBIC).gamut.h5 $(BIN)/msfab-gamut-sample
+$(FIG316_ORTHO).gamut.h5: configs/gamut/orthotropic2d_void.yaml $(FIG316_CUBIC).gamut.h5 $(STAGE_ID)/msfab-gamut-sample.id
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-gamut-sample --config $< --seed $(SEED) --out $@ --resume \
 	  --set cycles=$(CONVERGE_CYCLES) --set plot_every_cycle=false \
 	  --set stop='{coverage_growth: $(CONVERGE_GROWTH), window: $(CONVERGE_WINDOW)}' \
 	  --set initial_set='{path: $(abspath $(FIG316_CUBIC)).microstructures.h5}'
-$(OUT)/topopt/fig316.md: $(FIG316_CUBIC).gamut.h5 $(FIG316_ORTHO).gamut.h5 tools/bench_topopt.sh $(BIN)/msfab-topopt
+$(OUT)/topopt/fig316.md: $(FIG316_CUBIC).gamut.h5 $(FIG316_ORTHO).gamut.h5 tools/bench_topopt.sh $(STAGE_ID)/msfab-topopt.id
 	@mkdir -p $(@D)
 	CANTILEVER_ONLY=1 CUBIC2D=$(FIG316_CUBIC).gamut.h5 ORTHO2D=$(FIG316_ORTHO).gamut.h5 \
 	  bash tools/bench_topopt.sh $(BUILD) > $@.tmp

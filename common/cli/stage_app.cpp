@@ -178,7 +178,12 @@ void StageApp::add_common_options() {
 }
 
 void StageApp::add_version_option() {
-  cli_.set_version_flag("--version", name_ + " " + version() + " (revision " + git_revision() + ")");
+  std::string text = name_ + " " + version() + " (revision " + git_revision() + ")";
+  if (*stage_identity() != '\0')
+    text += "\nstage identity " + std::string(stage_identity()) + "\n  (SHA-256 of the " +
+            std::to_string(stage_identity_source_count()) +
+            " source files it is built from; the pipeline reruns this stage's artifacts when it changes)";
+  cli_.set_version_flag("--version", text);
 }
 
 void StageApp::set_default_config(std::string yaml_text) { default_config_ = std::move(yaml_text); }

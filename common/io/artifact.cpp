@@ -38,7 +38,9 @@ std::string versions_text(int min_version, int max_version) {
 }  // namespace
 
 std::string producer_string(const std::string& executable) {
-  return executable + " " + version() + " (git " + git_revision() + ")";
+  const std::string identity = stage_identity();
+  return executable + " " + version() + " (git " + git_revision() +
+         (identity.empty() ? "" : ", stage " + identity.substr(0, 12)) + ")";
 }
 
 std::string utc_timestamp_now() {

@@ -7,6 +7,7 @@ source "$SRC/tests/stage/lib.sh"
 BUILD=$(dirname "$BIN")
 cp -r "$SRC/configs" "$SRC/pipelines" "$SRC/Makefile.pipeline" "$WORK/"
 ln -s "$SRC/python" "$WORK/python"; ln -s "$SRC/common" "$WORK/common"; ln -s "$SRC/stages" "$WORK/stages"; ln -s "$SRC/CMakeLists.txt" "$WORK/CMakeLists.txt"
+ln -s "$SRC/tools" "$WORK/tools"; ln -s "$SRC/cmake" "$WORK/cmake"
 mkdir -p "$BUILD" && touch "$BUILD/.deps-ok"
 # The binaries are newer than the sources after a build; make must not rebuild them.
 touch "$BIN"/msfab-*

@@ -2,7 +2,8 @@
 # The layers of common/: every #include of a file in common/<module>/ names
 # the module itself or one it links (directly or through others) in
 # common/CMakeLists.txt, as the build wrote them to module_deps.txt; and
-# docs/modules.md shows the same table (tools/module_table.sh).
+# docs/modules.md shows the same table (tools/module_table.sh). Each stage's
+# includes are among the modules its build links and lists.
 BIN=$1 SRC=$(cd "$2" && pwd)
 source "$SRC/tests/stage/lib.sh"
 DEPS="$BIN/../module_deps.txt"
@@ -34,6 +35,23 @@ for m in $modules; do
         PASSES=$((PASSES + 1))
       fi
     done
+  done
+done
+# Each stage links the modules its files include (stages/CMakeLists.txt), and
+# its identity lists their files: an #include added since the build was
+# configured would escape both.
+for dir in "$SRC"/stages/*/; do
+  stage=$(basename "$dir") list="$BIN/../identity/msfab-$stage.files"
+  [ -f "$dir/main.cpp" ] || continue
+  check "the build lists the sources of msfab-$stage" -- test -s "$list"
+  for used in $(cat "$dir"/*.cpp "$dir"/*.hpp 2>/dev/null | sed -n 's|^#include "\([a-z_]*\)/.*|\1|p' | sort -u); do
+    [ -d "$SRC/common/$used" ] || continue
+    if ! grep -q "^common/$used/" "$list"; then
+      echo "FAIL: stages/$stage includes $used/, which its build does not list (re-run cmake)"
+      FAILURES=$((FAILURES + 1))
+    else
+      PASSES=$((PASSES + 1))
+    fi
   done
 done
 check "every module of common/ is in the table" -- bash -c "for d in '$SRC'/common/*/; do grep -q \"^\$(basename \$d):\" '$DEPS' || exit 1; done"
