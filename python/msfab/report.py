@@ -1,5 +1,7 @@
 """An HTML report of msfab artifacts: speed against error, solver
-convergence, dynamics traces, designs and gamuts, drawn with matplotlib.
+convergence, dynamics traces, designs, gamuts, microstructure families and
+DAC calibrations, drawn with matplotlib. The stages draw no charts
+themselves: this is where their pictures come from.
 
     python3 -m msfab report out/report.html out/        # every artifact below out/
     python3 -m msfab report demo.html a.h5 b.h5
@@ -280,6 +282,180 @@ def _microstructures(page, path, a):
                  "max": unit.max(axis=0).tolist()})
 
 
+def _property_axes(names):
+    """Indices of the stiffness and Poisson coordinates drawn against each
+    other: (E, ν) for cubic and isotropic spaces, (Ex, ν_xy) for orthotropic."""
+    lower = [n.lower() for n in names]
+    e = next((i for i, n in enumerate(lower) if n.startswith("e")), 0)
+    nu = next((i for i, n in enumerate(lower) if n.startswith("nu")), 1 if len(names) > 1 else 0)
+    return e, nu
+
+
+def _gamut(page, path, a):
+    """The level set's zero contour projected on (E, ν) — inside where some
+    structure with those two properties exists, whatever the others — over
+    the structures of the set written beside it, and the coverage per cycle."""
+    plt = _pyplot()
+    root = a.attrs("/")
+    names = [n.strip() for n in str(root["property_names"]).split(",")]
+    phi = np.asarray(a["/level_set/phi"], dtype=float)
+    ls = a.attrs("/level_set")
+    d, n = phi.ndim, phi.shape[0]
+    lower, spacing = float(ls["lower"]), float(ls["spacing"])
+    ie, inu = _property_axes(names)
+    # phi is C-ordered over (p_{d-1}, ..., p_0): axis d-1-k holds coordinate k.
+    other = tuple(ax for ax in range(d) if ax not in (d - 1 - ie, d - 1 - inu))
+    table = phi.min(axis=other) if other else phi
+    if d - 1 - ie < d - 1 - inu:  # keep [nu index, E index] for contour(x=E, y=nu)
+        table = table.T
+    nodes = lower + (np.arange(n) + 0.5) * spacing
+    history = {k: np.asarray(a[f"/history/{k}"], dtype=float) for k in ("cycle", "coverage", "samples")
+               if f"/history/{k}" in a}
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2), gridspec_kw={"width_ratios": [1.2, 1]},
+                                      constrained_layout=True)
+    data = {"dimension": d, "cells": n, "inside_fraction_of_projection": float((table < 0).mean())}
+    left.contourf(nodes, nodes, table, levels=[table.min() - 1, 0], colors=["#dde6f5"])
+    left.contour(nodes, nodes, table, levels=[0], colors="k", linewidths=1.2)
+    sibling = path[:-len(".gamut.h5")] + ".microstructures.h5" if path.endswith(".gamut.h5") else None
+    if sibling and os.path.isfile(sibling):
+        try:
+            with open_artifact(sibling) as m:
+                unit = np.asarray(m["/unit_properties"], dtype=float)
+                step = np.asarray(m["/step"]) if "/step" in m else np.zeros(len(unit), int)
+            steps = {0: "initial", 1: "discrete", 2: "continuous", 3: "void variant", 4: "directed push",
+                     5: "at a design's target"}
+            for k in np.unique(step):
+                inside = step == k
+                left.scatter(unit[inside, ie], unit[inside, inu], s=6, label=f"{steps.get(int(k), k)} "
+                             f"({int(inside.sum())})")
+            left.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), markerscale=2, title="step")
+            data["structures"] = len(unit)
+        except ArtifactError:
+            pass
+    left.set_xlabel(f"{names[ie]} (normalized)")
+    left.set_ylabel(f"{names[inu]} (normalized)")
+    left.set_xlim(0, 1)
+    left.set_ylim(0, 1)
+    left.set_title("gamut: the level set's zero contour, projected")
+    left.grid(True, alpha=0.3)
+    if "coverage" in history:
+        right.plot(history["cycle"], history["coverage"], "o-", ms=3)
+        right.set_xlabel("sampling cycle")
+        right.set_ylabel("coverage (fraction of the unit cube inside)")
+        right.set_ylim(bottom=0)
+        right.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+        right.grid(True, alpha=0.3)
+        data["coverage"] = history["coverage"].tolist()
+    right.set_title("coverage per cycle")
+    page.figure(fig, f"gamut_level_set_{_label(path)}",
+                f"{_label(path)} ({root['space']}, {d}-dimensional level set on {n} cells per axis): the zero "
+                f"contour of its minimum over the other coordinates in the ({names[ie]}, {names[inu]}) plane, "
+                "with the structures sampled (by the step that found them), and the coverage after each cycle", data)
+
+
+def _families(page, path, a):
+    """Isomap embedding and property coverage of the selected structures,
+    coloured by family, and a table of the families."""
+    plt = _pyplot()
+    root = a.attrs("/")
+    selection = np.asarray(a["/selection"], dtype=np.int64)
+    family = np.asarray(a["/clusters/family"], dtype=int)
+    embedding = np.asarray(a["/embedding/coordinates"], dtype=float)
+    count = int(root["families"])
+    properties = None
+    for entry in a.inputs:  # the input set, for E, ν and G of the selected structures
+        where = entry.path if os.path.isabs(entry.path) else os.path.join(os.path.dirname(path), entry.path)
+        for candidate in (entry.path, where):
+            if os.path.isfile(candidate):
+                try:
+                    with open_artifact(candidate) as m:
+                        if m.schema == "msfab.microstructures":
+                            properties = np.asarray(m["/properties"], dtype=float)[selection]
+                except (ArtifactError, IndexError):
+                    properties = None
+                break
+        if properties is not None:
+            break
+    panels = 3 if properties is not None and properties.shape[1] >= 3 else 1
+    fig, axes = plt.subplots(1, panels, figsize=(4.6 * panels, 4.0), squeeze=False, constrained_layout=True)
+    colours = plt.get_cmap("tab10")
+
+    def scatter(ax, x, y):
+        other = family < 0
+        if other.any():
+            ax.scatter(x[other], y[other], s=5, color="#bbbbbb", label=f"no family ({int(other.sum())})")
+        for f in range(count):
+            mine = family == f
+            ax.scatter(x[mine], y[mine], s=9, color=colours(f % 10), label=f"family {f + 1} ({int(mine.sum())})")
+        ax.grid(True, alpha=0.3)
+
+    y = embedding[:, 1] if embedding.shape[1] > 1 else np.zeros(len(embedding))
+    scatter(axes[0][0], embedding[:, 0], y)
+    axes[0][0].set_xlabel("Isomap coordinate 1")
+    axes[0][0].set_ylabel("Isomap coordinate 2")
+    axes[0][0].set_title("embedding of the selected structures")
+    axes[0][0].legend(fontsize=7, loc="best", markerscale=2)
+    data = {"selected": len(selection), "families": count}
+    if panels == 3:
+        E, nu, G = properties[:, 0], properties[:, 1], properties[:, 2]
+        log_e = np.log10(E / float(root["E_stiff"]))
+        shear = 2 * G * (1 + nu) / E
+        scatter(axes[0][1], nu, log_e)
+        axes[0][1].set_xlabel("Poisson's ratio ν")
+        axes[0][1].set_ylabel("log10 E / E_stiff")
+        axes[0][1].set_title("coverage: E and ν")
+        scatter(axes[0][2], nu, shear)
+        axes[0][2].set_xlabel("Poisson's ratio ν")
+        axes[0][2].set_ylabel("shear ratio G' = 2G(1+ν)/E")
+        axes[0][2].set_title("coverage: ν and G'")
+    page.figure(fig, f"families_{_label(path)}", f"{_label(path)}: the {len(selection)} selected structures in "
+                "their Isomap embedding" + (" and in property space" if panels == 3 else
+                                             " (the input set was not found, so no property panels)") +
+                ", coloured by family", data)
+    rows = []
+    for f in range(count):
+        g = f"/families/{f}"
+        if g not in a:
+            continue
+        at = a.attrs(g)
+        members = len(np.atleast_1d(a[g + "/members"]))
+        fmt = lambda r: "–".join(f"{float(v):.3g}" for v in np.atleast_1d(r))  # noqa: E731
+        rows.append((f + 1, members, int(at["beams"]), fmt(at["E_range"]), fmt(at["nu_range"]),
+                     fmt(at["shear_ratio_range"]), f"{float(at['representative_difference']):.3g}",
+                     "yes" if int(at.get("has_reduced", 0)) else "no"))
+    page.table(["family", "members", "template beams", "E / E_stiff", "ν", "G'", "template voxel difference",
+                "reduced parameters"], rows)
+
+
+def _dac_model(page, path, a):
+    """A DAC calibration: the coarse rig's frequencies before and after the
+    modulus fit, against the target, and the fitted constants."""
+    plt = _pyplot()
+    root = a.attrs("/")
+    eig = np.sqrt(np.maximum(np.atleast_1d(np.asarray(a["/coarse_eigenvalues"], dtype=float)), 0)) / (2 * np.pi)
+    scale = np.sqrt(float(root["youngs_modulus"]) / float(root["reference_modulus"]))
+    fig, ax = plt.subplots(figsize=(6.4, 3.6), constrained_layout=True)
+    k = np.arange(1, len(eig) + 1)
+    ax.plot(k, eig, "o", label=f"coarse mesh, E_m = {float(root['reference_modulus']):.3g} Pa")
+    ax.plot(k, eig * scale, "s", label=f"calibrated, E_n = {float(root['youngs_modulus']):.3g} Pa")
+    ax.axhline(float(root["target_frequency"]), color="k", lw=0.8, ls="--",
+               label=f"target {float(root['target_frequency']):.4g} Hz")
+    ax.set_xlabel("mode")
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_xticks(k)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"{_label(path)}: {root['material']}")
+    page.figure(fig, f"dac_{_label(path)}", f"{_label(path)}: the coarse rig's modal frequencies with the reference "
+                "modulus and with the calibrated one (frequencies scale with √E), against the target (DAC, "
+                "thesis §4.4)", {"frequencies": eig.tolist(), "scale": float(scale)})
+    page.table(["material", "E_n (Pa)", "damping a (1/s)", "damping b (s)", "target f (Hz)", "target decay (1/s)",
+                "coarse elements", "voxel size (m)"],
+               [(root["material"], f"{float(root['youngs_modulus']):.4g}", f"{float(root['damping_a']):.4g}",
+                 f"{float(root['damping_b']):.4g}", f"{float(root['target_frequency']):.4g}",
+                 f"{float(root['target_decay']):.4g}", int(root["elements"]), f"{float(root['voxel_size']):.3g}")])
+
+
 def _verify_map(page, checks):
     if not checks:
         return
@@ -381,8 +557,8 @@ def build_report(paths, out_html, title="msfab report"):
                 cells.append((path, a))
             elif a.schema == "msfab.verify_map":
                 checks.append((path, a))
-            elif a.schema in ("msfab.trajectory", "msfab.design", "msfab.microstructures", "msfab.mapped",
-                              "msfab.jump_design"):
+            elif a.schema in ("msfab.trajectory", "msfab.design", "msfab.microstructures", "msfab.gamut",
+                              "msfab.mapped", "msfab.jump_design", "msfab.families", "msfab.dac_model"):
                 drawn.append((path, a))
             else:
                 others.append((path, f"{a.schema} v{a.schema_version}, made by {a.producer}"))
@@ -390,7 +566,11 @@ def build_report(paths, out_html, title="msfab report"):
         _static_results(page, results)
         kinds = {"msfab.trajectory": ("Dynamics (msfab-dynamics)", _trajectory),
                  "msfab.design": ("Designs (msfab-topopt)", _design),
-                 "msfab.microstructures": ("Gamuts (msfab-gamut-sample)", _microstructures),
+                 "msfab.gamut": ("Gamuts (msfab-gamut-sample)", _gamut),
+                 "msfab.microstructures": ("Microstructure sets (msfab-gamut-sample, msfab-family-generate)",
+                                           _microstructures),
+                 "msfab.families": ("Microstructure families (msfab-families)", _families),
+                 "msfab.dac_model": ("Dynamics-aware coarsening (msfab-dac-calibrate)", _dac_model),
                  "msfab.mapped": ("Mapped designs (msfab-map)", _mapped),
                  "msfab.jump_design": ("Design loops (msfab-jump-design)", _jump_design)}
         for schema, (heading, draw) in kinds.items():

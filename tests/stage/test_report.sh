@@ -19,9 +19,9 @@ mkdir art
 "$BIN/msfab-topopt" --quiet --set optimizer.max_iterations=20 --out art/design.h5 > /dev/null
 echo "not hdf5" > art/broken.h5
 
-expect_exit 0 "report.html: 5 pictures" -- "$PY" -m msfab report report.html art
-check "the page shows every picture" -- bash -c 'test $(grep -o "report_files/[0-9][0-9]_[^\"]*\.png" report.html | sort -u | wc -l) = 5'
-check "the page lists what it does not draw" -- grep -q "tiny.gamut.h5" report.html
+expect_exit 0 "report.html: 6 pictures" -- "$PY" -m msfab report report.html art
+check "the page shows every picture" -- bash -c 'test $(grep -o "report_files/[0-9][0-9]_[^\"]*\.png" report.html | sort -u | wc -l) = 6'
+check "the gamut's level set has its own picture" -- grep -q "gamut_level_set_tiny.gamut.png" report.html
 check "an unreadable file is named" -- grep -q "broken.h5.*not read" report.html
 
 check "pictures show the artifacts' numbers" -- "$PY" - <<'PY'
@@ -54,7 +54,12 @@ with h5py.File("art/design.h5") as f:
     rho = f["/cells/raw"][()][:, names.index("rho")]
     expect("design objective history", np.array_equal(design["objective"], f["/history/objective"][()]))
     expect("design density range", design["min"] == rho.min() and design["max"] == rho.max())
-gamut = data[next(n for n in data if "gamut" in n)]
+gamut = data[next(n for n in data if "gamut_tiny.microstructures" in n)]
+level_set = data[next(n for n in data if "gamut_level_set" in n)]
+with h5py.File("art/tiny.gamut.h5") as f:
+    expect("coverage per cycle drawn", np.array_equal(level_set["coverage"], f["/history/coverage"][()]))
+    phi = f["/level_set/phi"][()]
+    expect("the projection holds the inside", 0 < level_set["inside_fraction_of_projection"] <= 1 and (phi < 0).any())
 with h5py.File("art/tiny.microstructures.h5") as f:
     expect("every structure drawn", gamut["structures"] == len(f["/unit_properties"]))
 finish()
