@@ -22,18 +22,21 @@ closure() {
   echo "$seen" | tr ' ' '\n' | sed '/^$/d'
 }
 
+# included_modules FILE...: the folders named by the files' #include lines.
+included_modules() { cat "$@" 2>/dev/null | sed -n 's|^#include "\([a-z_]*\)/.*|\1|p' | sort -u; }
+# tally OK MESSAGE: a pass when OK is 0, otherwise a failure printing MESSAGE.
+tally() {
+  if [ "$1" = 0 ]; then PASSES=$((PASSES + 1)); else echo "FAIL: $2"; FAILURES=$((FAILURES + 1)); fi
+}
+
 modules=$(awk -F: '{ print $1 }' "$DEPS")
 for m in $modules; do
   allowed=$(closure "$m")
   for f in "$SRC"/common/"$m"/*.hpp "$SRC"/common/"$m"/*.cpp; do
     [ -e "$f" ] || continue
-    for used in $(sed -n 's|^#include "\([a-z_]*\)/.*|\1|p' "$f" | sort -u); do
-      if ! grep -qx "$used" <<<"$allowed"; then
-        echo "FAIL: ${f#$SRC/} includes $used/, which $m does not link (common/CMakeLists.txt)"
-        FAILURES=$((FAILURES + 1))
-      else
-        PASSES=$((PASSES + 1))
-      fi
+    for used in $(included_modules "$f"); do
+      grep -qx "$used" <<<"$allowed"
+      tally $? "${f#$SRC/} includes $used/, which $m does not link (common/CMakeLists.txt)"
     done
   done
 done
@@ -44,14 +47,10 @@ for dir in "$SRC"/stages/*/; do
   stage=$(basename "$dir") list="$BIN/../identity/msfab-$stage.files"
   [ -f "$dir/main.cpp" ] || continue
   check "the build lists the sources of msfab-$stage" -- test -s "$list"
-  for used in $(cat "$dir"/*.cpp "$dir"/*.hpp 2>/dev/null | sed -n 's|^#include "\([a-z_]*\)/.*|\1|p' | sort -u); do
+  for used in $(included_modules "$dir"/*.cpp "$dir"/*.hpp); do
     [ -d "$SRC/common/$used" ] || continue
-    if ! grep -q "^common/$used/" "$list"; then
-      echo "FAIL: stages/$stage includes $used/, which its build does not list (re-run cmake)"
-      FAILURES=$((FAILURES + 1))
-    else
-      PASSES=$((PASSES + 1))
-    fi
+    grep -q "^common/$used/" "$list"
+    tally $? "stages/$stage includes $used/, which its build does not list (re-run cmake)"
   done
 done
 check "every module of common/ is in the table" -- bash -c "for d in '$SRC'/common/*/; do grep -q \"^\$(basename \$d):\" '$DEPS' || exit 1; done"
