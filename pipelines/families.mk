@@ -12,8 +12,8 @@
 #   make -f Makefile.pipeline families-auxetic-check  every member of the first auxetic family (16^3) under
 #                                              finite uniaxial stress, Neo-Hookean, against linear C^H; a minute
 #
-# Writes out/families/{two,stiff_nu}.families.h5 with plots in *.plots/, and
-# a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
+# Writes out/families/{two,stiff_nu}.families.h5 with a picture per family
+# in *.plots/, and a sweep of each family's first reduced parameter (*.family1.microstructures.h5).
 $(OUT)/families/two.microstructures.h5: configs/families/two_templates.yaml $(STAGE_ID)/msfab-family-generate.id
 	@mkdir -p $(@D)
 	$(BIN)/msfab-family-generate --config $< --threads $(THREADS) --out $@ $(QUIET)

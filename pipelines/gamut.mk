@@ -16,8 +16,8 @@
 #   make -f Makefile.pipeline gamut-converge-3d  the same for the 3D cubic void gamut; hours on 2 cores, use RANKS
 #   make -f Makefile.pipeline gamut-bench    sampler vs random sampling, docs/BENCHMARKS.md section
 #
-# Each run writes out/gamut/<name>.gamut.h5, <name>.microstructures.h5 and
-# <name>.plots/ (per-cycle PNGs, coverage.png, history.csv). RANKS=<n> runs
+# Each run writes out/gamut/<name>.gamut.h5 and <name>.microstructures.h5
+# (`make report` draws them). RANKS=<n> runs
 # on n MPI ranks; an interrupted run resumes from its checkpoint when the
 # target is made again. SEED=<n> picks the random streams.
 SEED ?= 1

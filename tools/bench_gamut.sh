@@ -21,7 +21,7 @@ run() {  # run NAME CONFIG MODE SEED EXTRA...
   echo "bench: gamut $name $mode seed $seed ..." >&2
   local log="$OUTDIR/$name.$mode.$seed.log"
   /usr/bin/time -f "%e" -o "$OUTDIR/time" "$BIN/msfab-gamut-sample" --config "$config" --set mode=$mode \
-    --set plot_every_cycle=false --seed "$seed" --out "$OUTDIR/$name.$mode.$seed.gamut.h5" "$@" > "$log" 2>&1
+    --seed "$seed" --out "$OUTDIR/$name.$mode.$seed.gamut.h5" "$@" > "$log" 2>&1
   local n cov nu E wall
   n=$(sed -n 's/.*: [a-z0-9]*, \([0-9]*\) structures.*/\1/p' "$log")
   cov=$(sed -n 's/^  coverage \([0-9.]*\).*/\1/p' "$log")

@@ -1,17 +1,13 @@
 #include "dynamics/trajectory.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <stdexcept>
-#include <tuple>
 #include <utility>
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
-#include "io/chart.hpp"
 #include "io/mesh_io.hpp"
 #include "io/xdmf.hpp"
 
@@ -336,73 +332,6 @@ void read_events(const H5File& f, Trajectory& t) {
   for (std::size_t i = 0; i < time.size(); ++i) t.events[i] = {time[i], kinds[i], details[i]};
 }
 
-// --- plots -----------------------------------------------------------------
-
-const Rgb kKinetic{220, 40, 40}, kElastic{40, 90, 200}, kGravity{30, 160, 60}, kTotal{0, 0, 0};
-const Rgb kCom{40, 90, 200};
-
-Rgb phase_color(SimulationPhase p) {
-  switch (p) {
-    case SimulationPhase::kQuasistatic: return {150, 150, 150};
-    case SimulationPhase::kElastic: return {230, 140, 20};
-    case SimulationPhase::kRigid: return {150, 60, 190};
-  }
-  return {150, 150, 150};
-}
-
-std::string upper(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
-// The finite range of some series, widened so that a constant (or empty)
-// series still gives the chart a positive extent, plus a margin.
-std::pair<double, double> plot_range(const std::vector<const std::vector<double>*>& series, double margin) {
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const auto* s : series)
-    for (double v : *s)
-      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-  if (!(hi >= lo)) return {0.0, 1.0};
-  double span = hi - lo;
-  if (!(span > 1e-12 * std::max(std::abs(lo), std::abs(hi)))) {
-    const double half = std::abs(lo) > 0 ? 0.5 * std::abs(lo) : 0.5;
-    return {lo - half, hi + half};
-  }
-  const double pad = margin * span;
-  return {lo - pad, hi + pad};
-}
-
-// Non-finite values (a run that diverged) break the curve instead of
-// reaching the rasterizer.
-void finite_polyline(Chart& chart, const std::vector<double>& x, const std::vector<double>& y, Rgb color) {
-  std::vector<double> xs, ys;
-  const auto flush = [&] {
-    if (!xs.empty()) chart.polyline(xs, ys, color);
-    xs.clear(), ys.clear();
-  };
-  for (std::size_t i = 0; i < x.size() && i < y.size(); ++i) {
-    if (std::isfinite(x[i]) && std::isfinite(y[i])) xs.push_back(x[i]), ys.push_back(y[i]);
-    else flush();
-  }
-  flush();
-}
-
-// A vertical line where the phase changes, coloured by the phase entered;
-// the ends sit a hair outside the plot area so polyline draws no dots there.
-void mark_phase_changes(Chart& chart, const ChartAxes& axes, const Trajectory& t,
-                        std::vector<std::pair<std::string, Rgb>>& legend) {
-  const double eps = 1e-6 * (axes.y1 - axes.y0);
-  bool entered[3] = {false, false, false};
-  for (std::size_t i = 1; i < t.samples.size(); ++i) {
-    const SimulationPhase p = t.samples[i].phase;
-    if (p == t.samples[i - 1].phase || !std::isfinite(t.samples[i].time)) continue;
-    chart.polyline({t.samples[i].time, t.samples[i].time}, {axes.y0 - eps, axes.y1 + eps}, phase_color(p));
-    entered[static_cast<int>(p)] = true;
-  }
-  for (SimulationPhase p : kPhases)
-    if (entered[static_cast<int>(p)]) legend.emplace_back("BEGIN " + upper(phase_name(p)), phase_color(p));
-}
-
 }  // namespace
 
 const char* phase_name(SimulationPhase phase) {
@@ -548,54 +477,6 @@ Trajectory read_trajectory_artifact(const std::string& path) {
     c.seconds_per_step = f.read_attribute<double>("/comparison", "seconds_per_step");
   }
   return t;
-}
-
-std::vector<std::string> write_trajectory_plots(const std::string& prefix, const Trajectory& t) {
-  std::vector<double> time, kinetic, elastic, gravity, total, height;
-  for (const TrajectorySample& s : t.samples) {
-    time.push_back(s.time);
-    kinetic.push_back(s.kinetic);
-    elastic.push_back(s.elastic);
-    gravity.push_back(s.gravity);
-    total.push_back(s.total());
-    height.push_back(s.center_of_mass.z());
-  }
-  const auto [t0, t1] = plot_range({&time}, 0.0);
-  const std::string title_scene = t.scene.empty() ? "" : ": " + upper(t.scene);
-  std::vector<std::string> written;
-
-  ChartAxes energy_axes;
-  energy_axes.x0 = t0, energy_axes.x1 = t1;
-  std::tie(energy_axes.y0, energy_axes.y1) = plot_range({&kinetic, &elastic, &gravity, &total}, 0.05);
-  energy_axes.x_label = "TIME (S)";
-  energy_axes.y_label = "ENERGY (J)";
-  energy_axes.title = "ENERGY" + title_scene;
-  Chart energy(800, 560, energy_axes);
-  std::vector<std::pair<std::string, Rgb>> energy_legend = {
-      {"KINETIC", kKinetic}, {"ELASTIC", kElastic}, {"GRAVITY", kGravity}, {"TOTAL", kTotal}};
-  mark_phase_changes(energy, energy_axes, t, energy_legend);
-  finite_polyline(energy, time, kinetic, kKinetic);
-  finite_polyline(energy, time, elastic, kElastic);
-  finite_polyline(energy, time, gravity, kGravity);
-  finite_polyline(energy, time, total, kTotal);
-  energy.legend(energy_legend);
-  written.push_back(prefix + "energy.png");
-  energy.write(written.back());
-
-  ChartAxes com_axes;
-  com_axes.x0 = t0, com_axes.x1 = t1;
-  std::tie(com_axes.y0, com_axes.y1) = plot_range({&height}, 0.05);
-  com_axes.x_label = "TIME (S)";
-  com_axes.y_label = "CENTRE OF MASS Z (M)";
-  com_axes.title = "CENTRE OF MASS HEIGHT" + title_scene;
-  Chart com(800, 560, com_axes);
-  std::vector<std::pair<std::string, Rgb>> com_legend = {{"HEIGHT", kCom}};
-  mark_phase_changes(com, com_axes, t, com_legend);
-  finite_polyline(com, time, height, kCom);
-  com.legend(com_legend);
-  written.push_back(prefix + "com_height.png");
-  com.write(written.back());
-  return written;
 }
 
 }  // namespace msfab

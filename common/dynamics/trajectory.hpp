@@ -2,7 +2,7 @@
 // The record of one dynamics run: per-step samples (energies, centre of
 // mass, contacts, cost), full states at output frames, and events. It is
 // what `msfab-dynamics` writes as the `msfab.trajectory` artifact
-// (docs/artifacts.md) with an XDMF time series for ParaView and plots.
+// (docs/artifacts.md) with an XDMF time series for ParaView.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -107,10 +107,5 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
 // Reads what write_trajectory_artifact wrote (InputError naming the file and
 // field on anything missing or inconsistent).
 Trajectory read_trajectory_artifact(const std::string& path);
-
-// PNG plots: "<prefix>energy.png" (kinetic, elastic, gravity, total against
-// time, phases shaded or marked) and "<prefix>com_height.png" (centre-of-mass
-// height against time). Returns the paths written.
-std::vector<std::string> write_trajectory_plots(const std::string& prefix, const Trajectory& trajectory);
 
 }  // namespace msfab

@@ -1,6 +1,6 @@
 #pragma once
-// A small RGB raster with the drawing the toolkit's plots need (pixels,
-// lines, discs, a 3 x 5 block font) and a PNG writer (zlib deflate).
+// A small RGB raster for pictures of voxels (one pixel block per voxel)
+// and a PNG writer (zlib deflate). Charts are drawn by `msfab report`.
 // Written atomically like every output: "<path>.tmp", then renamed.
 #include <array>
 #include <cstdint>
@@ -19,12 +19,6 @@ class PngImage {
   // (x, y) with y down; out-of-range pixels are ignored.
   void set(int x, int y, Rgb color);
   Rgb get(int x, int y) const;
-  void line(double x0, double y0, double x1, double y1, Rgb color);
-  void disc(double x, double y, double radius, Rgb color);
-  // Upper-case letters, digits and " .,-+=:/()_"; other characters draw as
-  // blanks. Each glyph is 3 x 5 blocks of `scale` pixels; returns the width.
-  int text(int x, int y, const std::string& s, Rgb color, int scale = 2);
-  static int text_width(const std::string& s, int scale = 2) { return static_cast<int>(s.size()) * 4 * scale; }
   // std::runtime_error naming the path if it cannot be written.
   void write_png(const std::string& path) const;
 

@@ -238,6 +238,13 @@ def _design(page, path, a):
         left.set_ylabel("objective")
         left.grid(True, which="both", alpha=0.3)
         data["objective"] = objective.tolist()
+        if "/history/max_violation" in a:
+            violation = np.asarray(a["/history/max_violation"], dtype=float)
+            if np.any(violation > 0):
+                twin = left.twinx()
+                twin.semilogy(np.arange(len(violation)), np.maximum(violation, 1e-16), ":", color="tab:red")
+                twin.set_ylabel("largest constraint violation", color="tab:red")
+                data["max_violation"] = violation.tolist()
     left.set_title("convergence")
     if "rho" in names:
         field, what = raw[:, names.index("rho")], "density ρ"
@@ -254,7 +261,7 @@ def _design(page, path, a):
     fig.colorbar(image, ax=right, label=what)
     data.update({"field": what, "min": float(values.min()), "max": float(values.max()), "grid": grid})
     page.figure(fig, f"design_{_label(path)}", f"{_label(path)} ({root['space']}, {nx}×{ny}×{nz} cells): "
-                "objective over the iterations and the design", data)
+                "objective (and, dotted, the largest constraint violation) over the iterations, and the design", data)
 
 
 # -- gamuts ----------------------------------------------------------------------

@@ -11,9 +11,9 @@
 //      DKE or BBI (4.19, B.20-B.21)
 //   4. with rigid flight enabled: rigid projection (B.22), DMV free flight,
 //      projection back before the next contact (B.23)
-//   5. write the `msfab.trajectory` artifact, its ParaView time series and
-//      the energy and centre-of-mass plots; with --reference, the run's
-//      difference from the fine run frame by frame
+//   5. write the `msfab.trajectory` artifact and its ParaView time series
+//      (`msfab report` draws its energies and centre of mass); with
+//      --reference, the run's difference from the fine run frame by frame
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -34,11 +34,6 @@
 using namespace msfab;
 
 namespace {
-
-std::string plot_prefix(const std::string& out) {
-  const auto dot = out.rfind(".h5");
-  return (dot == std::string::npos ? out : out.substr(0, dot)) + "_";
-}
 
 struct MarkerTrace {
   int node = -1;
@@ -199,7 +194,7 @@ int main(int argc, char** argv) {
       trajectory.comparison = comparison_record(difference, reference);
     }
 
-    // 5. Artifact and plots.
+    // 5. Artifact.
     TrajectoryProvenance provenance;
     provenance.config_text = ctx.config.resolved_text();
     provenance.seed = ctx.options.seed;
@@ -207,11 +202,9 @@ int main(int argc, char** argv) {
     if (!coarsening.database.empty()) provenance.inputs.push_back(coarsening.database);
     if (!reference.empty()) provenance.inputs.push_back(reference);
     const std::string xmf = write_trajectory_artifact(out, trajectory, provenance);
-    const std::vector<std::string> plots = write_trajectory_plots(plot_prefix(out), trajectory);
 
     print_summary(scene, trajectory);
     std::printf("  artifact: %s\n  ParaView: %s\n", out.c_str(), xmf.c_str());
-    for (const std::string& p : plots) std::printf("  plot: %s\n", p.c_str());
     if (!reference.empty()) print_difference(difference);
   });
 }

@@ -16,7 +16,7 @@
 //      (voxel difference above `max_voxel_difference`) are dropped
 //   7. principal component regression of the members' properties on their
 //      parameters: two reduced parameters per family
-//   8. write `msfab.families` and the plots
+//   8. write `msfab.families` and a picture per family
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -37,7 +37,7 @@
 #include "families/isomap.hpp"
 #include "families/structure_distance.hpp"
 #include "families/template_fit.hpp"
-#include "family_plots.hpp"
+#include "family_pictures.hpp"
 #include "gamut/gamut_artifact.hpp"
 #include "gamut/microstructure_set.hpp"
 
@@ -75,7 +75,7 @@ template:
 reduced:
   parameters: 2            # reduced parameters per family (Appendix A: 2)
   variance_kept: 0.99      # principal components kept
-plots: true                # <stem>.plots/*.png
+plots: true                # <stem>.plots/family<k>.png
 )";
 
 struct Settings {
@@ -381,9 +381,9 @@ int main(int argc, char** argv) {
     if (!gamut_path.empty()) inputs.push_back(gamut_path);
     write_families_artifact(out, result, "msfab-families", ctx.config.resolved_text(), inputs, ctx.options.seed);
     if (settings.plots) {
-      const std::string folder = plot_folder_for(out);
-      write_family_plots(folder, result, set);
-      spdlog::info("plots in {}", folder);
+      const std::string folder = picture_folder_for(out);
+      write_family_pictures(folder, result, set);
+      spdlog::info("family pictures in {}", folder);
     }
     std::printf("msfab-families: %.1f s; %s\n", seconds_since(start), out.c_str());
   });

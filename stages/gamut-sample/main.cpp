@@ -13,7 +13,7 @@
 //        continuous step  structures nearest the boundary pushed along the
 //                         normal, q = p + step grad Phi, by SIMP + MMA
 //        level set, coverage, resampling by Eq. 3.1-3.2, checkpoint
-//   4. write `msfab.microstructures` and `msfab.gamut`, and the plots
+//   4. write `msfab.microstructures` and `msfab.gamut`
 //
 // Homogenizations and continuous optimizations are spread over MPI ranks;
 // every random draw is keyed by (seed, cycle, item), so the result is the
@@ -28,12 +28,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
-#include <sstream>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "gamut_plots.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "io/atomic_file.hpp"
@@ -82,15 +80,6 @@ ArtifactInput add_set_and_gamut(CommitGroup& group, const std::string& set_path,
   return set_input;
 }
 
-void write_history_csv(const std::string& path, const std::vector<GamutCycle>& history) {
-  std::ostringstream f;
-  f << "cycle,samples,discrete_added,continuous_added,coverage,seconds\n";
-  for (const GamutCycle& c : history)
-    f << c.cycle << ',' << c.samples << ',' << c.discrete_added << ',' << c.continuous_added << ',' << c.coverage
-      << ',' << c.seconds << '\n';
-  write_file_atomically(path, f.str());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,14 +90,13 @@ int main(int argc, char** argv) {
   app.set_default_config(kDefaultSamplerConfig);
   bool resume = false;
   int max_cycles = 0;
-  std::string structures_path, plots_dir;
+  std::string structures_path;
   app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config and seed required)");
   app.cli().add_option("--max-cycles", max_cycles,
                        "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
       ->check(CLI::NonNegativeNumber);
   app.cli().add_option("--structures", structures_path,
                        "the microstructures artifact (default: <out without .gamut.h5>.microstructures.h5)");
-  app.cli().add_option("--plots", plots_dir, "folder for the PNG plots and history.csv (default: <out stem>.plots)");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
@@ -137,23 +125,11 @@ int main(int argc, char** argv) {
                        "lower population or resolution");
     }
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
-    if (plots_dir.empty()) plots_dir = stem_of(out) + ".plots";
-    // The second artifact and the plots folder are checked before any work,
-    // on every rank (a rank that threw alone would leave the others waiting).
+    // The second artifact is checked before any work, on every rank (a rank that threw alone would leave the others waiting).
     try {
       AtomicFile probe(structures_path);
     } catch (const InputError& e) {
       throw InputError(std::string("--structures ") + e.what());
-    }
-    {
-      std::error_code ec;
-      if (std::filesystem::exists(plots_dir, ec) && !std::filesystem::is_directory(plots_dir, ec))
-        throw InputError("--plots " + plots_dir + ": is a file, expected a folder for the plots");
-    }
-    if (rank == 0) {
-      std::error_code ec;
-      std::filesystem::create_directories(plots_dir, ec);
-      if (ec) throw InputError("--plots " + plots_dir + ": cannot create the plots folder (" + ec.message() + ")");
     }
     const std::string run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
     const GamutSampler sampler(options, ctx.options.seed);
@@ -178,11 +154,7 @@ int main(int argc, char** argv) {
       gamut = sampler.level_set(state);
       state.history.push_back({0, static_cast<int>(state.set.items.size()), init.added, 0, coverage(*gamut),
                                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
-      if (rank == 0) {
-        write_sampler_checkpoint(ckpt, run_text, state);
-        if (options.plot_every_cycle)
-          plot_gamut_projection(plots_dir + "/cycle_00.png", state.set, *gamut, sampler.space(), "CYCLE 0");
-      }
+      if (rank == 0) write_sampler_checkpoint(ckpt, run_text, state);
     }
 
     // 3. Cycles.
@@ -217,16 +189,11 @@ int main(int argc, char** argv) {
                        continuous.expanded, continuous.tried);
         if (options.directed_per_cycle > 0) log_step("directed", directed);
         write_sampler_checkpoint(ckpt, run_text, state);
-        if (options.plot_every_cycle) {
-          char name[32];
-          std::snprintf(name, sizeof name, "/cycle_%02d.png", cycle);
-          plot_gamut_projection(plots_dir + name, state.set, *gamut, sampler.space(), "CYCLE " + std::to_string(cycle));
-        }
       }
       ++this_run;
     }
 
-    // 4. Artifacts and plots (void variants, a collective step, first).
+    // 4. Artifacts (void variants, a collective step, first).
     StepReport void_report;
     SamplerState voids;
     if (options.void_variants) voids = sampler.void_variants(state, &void_report);
@@ -248,10 +215,6 @@ int main(int argc, char** argv) {
       CommitGroup artifacts;
       const ArtifactInput set_input =
           add_set_and_gamut(artifacts, structures_path, state.set, out, g, {}, run_text, ctx.options.seed);
-      plot_gamut_projection(plots_dir + "/gamut.png", state.set, g.level_set, sampler.space(),
-                            options.space + " gamut, " + std::to_string(state.set.items.size()) + " structures");
-      plot_shear_projections(plots_dir + "/gamut", state.set, sampler.space());
-      plot_coverage(plots_dir + "/coverage.png", state.history);
       if (options.void_variants) {
         log_step("void variants", void_report);
         if (voids.set.items.empty()) throw NumericalError("void variants: no structure survives removing the soft material");
@@ -262,13 +225,10 @@ int main(int argc, char** argv) {
         const std::string vstem = stem_of(out) + ".void";
         add_set_and_gamut(artifacts, vstem + ".microstructures.h5", voids.set, vstem + ".gamut.h5", vg, {set_input},
                           run_text, ctx.options.seed);
-        plot_gamut_projection(plots_dir + "/void_variants.png", voids.set, vg.level_set, sampler.space(),
-                              "VOID VARIANTS, " + std::to_string(voids.set.items.size()) + " STRUCTURES");
         std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",
                     voids.set.items.size(), state.set.items.size(), vstem.c_str());
       }
       artifacts.commit();
-      write_history_csv(plots_dir + "/history.csv", state.history);
       std::filesystem::remove(ckpt);
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
       int by_step[5] = {0, 0, 0, 0, 0};
@@ -306,7 +266,8 @@ int main(int argc, char** argv) {
         std::printf("  range %s: [%.6g, %.6g]\n", names[a].c_str(), lo, hi);
       }
       std::printf("  time: %.1f s wall\n", wall);
-      std::printf("  artifacts: %s, %s\n  plots: %s\n", out.c_str(), structures_path.c_str(), plots_dir.c_str());
+      std::printf("  artifacts: %s, %s (`msfab report` draws them, docs/python.md)\n", out.c_str(),
+                  structures_path.c_str());
     }
   });
   MPI_Finalize();

@@ -30,7 +30,6 @@ void_stiffness: 1.0e-6
 use_symmetry: true        # cell problems on the symmetric part (exact); false: six cases on the whole cell
 min_feature: 1            # the printer's smallest beam or gap, voxels (1: no limit)
 backbone: 0               # half-width (voxels) of axis beams through the centre that every structure keeps (0: none)
-plot_every_cycle: true
 mode: sampler             # sampler | random (the benchmark's baseline) | set (initial_set's structures alone)
 void_variants: false      # also write the structures with the soft material removed (thesis 3.6.1)
 )";
@@ -227,7 +226,6 @@ SamplerOptions read_sampler_options(const Config& config) {
   if (!(o.density_radius > 0 && o.density_radius <= 1)) config.fail("density_radius", "must be in (0, 1]");
   o.boundary_depth = config.get_or<double>("boundary_depth", o.boundary_depth);
   if (!(o.boundary_depth > 0 && o.boundary_depth <= 1)) config.fail("boundary_depth", "must be in (0, 1]");
-  o.plot_every_cycle = config.get_or<bool>("plot_every_cycle", o.plot_every_cycle);
   o.void_variants = config.get_or<bool>("void_variants", o.void_variants);
   if (o.void_variants && o.soft_is_void) config.fail("void_variants", "needs a soft material to remove (materials.soft)");
   if (config.has("mode")) {

@@ -80,7 +80,6 @@ struct SamplerOptions {
   double density_radius = 0.1;   // h of Eq. 3.2 (a tenth of the lattice's extent)
   double boundary_depth = 0.1;   // depth of the boundary weight in Eq. 3.1
 
-  bool plot_every_cycle = true;
   // §3.6.1: after sampling, the soft material of every structure replaced
   // by void, cleaned and homogenized again (a second pair of artifacts).
   bool void_variants = false;

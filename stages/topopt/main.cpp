@@ -12,7 +12,7 @@
 //      Voigt bound C(p_i) <= rho_i C_stiff per cell, with Ipopt
 //      (limited-memory Hessian) or, for large grids, MMA with a subproblem
 //      that separates over the cells; SIMP by optimality criteria or MMA
-//   5. write `msfab.design` with its ParaView sidecar, a convergence plot and a density picture
+//   5. write `msfab.design` with its ParaView sidecar
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -216,8 +216,6 @@ int main(int argc, char** argv) {
     // 5. Report and artifact.
     const Design design = make_design(objective, r, gamut.E_stiff > 0 ? gamut.E_stiff : scene.E0, scene.decades);
     write_design_artifact(out, design, "msfab-topopt", config.resolved_text(), inputs, ctx.options.seed);
-    const std::string plot = write_convergence_plot(out, r, space);
-    const std::string picture = write_density_picture(out, design);
     const GridSolveStats& st = objective.elasticity().stats();
     std::printf("msfab-topopt: %s after %d iterations (%d objective evaluations), %.2f s\n", r.status.c_str(),
                 r.iterations, r.evaluations, r.seconds);
@@ -242,6 +240,6 @@ int main(int argc, char** argv) {
                 (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) * per, st.assemble_seconds * per,
                 st.factorize_seconds * per, st.solve_seconds * per);
     if (st.iterations > 0) std::printf("  CG iterations per solve: %.1f\n", double(st.iterations) / st.solves);
-    std::printf("  artifact: %s (plot %s, picture %s)\n", out.c_str(), plot.c_str(), picture.c_str());
+    std::printf("  artifact: %s\n", out.c_str());
   });
 }

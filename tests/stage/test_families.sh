@@ -28,8 +28,29 @@ check "(a) the frame's members form one cluster" -- test "$(wc -w <<<"$second")"
 check "(a) the two clusters differ" -- test "$first" != "$second"
 check "(a) each family has 30 members and a one-beam template" -- \
   test "$(grep -cE '^  family [12]: 30 members, .*template 1 beams' <<<"$out")" = 2
-check "(a) plots" -- test -s "$WORK/two.plots/embedding.png" -a -s "$WORK/two.plots/coverage_nu_G.png" -a \
-  -s "$WORK/two.plots/family1.png"
+check "(a) a picture per family" -- test -s "$WORK/two.plots/family1.png" -a -s "$WORK/two.plots/family2.png" -a \
+  ! -e "$WORK/two.plots/family3.png"
+# The report's families page (python/msfab/report.py) draws what the
+# artifact holds, with the input set's properties found through provenance.
+check "(a) the report draws the families and their properties" -- env PYTHONPATH="$SRC/python:$SRC/tests/stage" \
+  PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 - "$WORK" <<'PY'
+import json, subprocess, sys
+import h5py
+import matplotlib.image
+work = sys.argv[1]
+subprocess.run([sys.executable, "-m", "msfab", "report", f"{work}/families_report.html", f"{work}/two.families.h5"],
+               check=True, stdout=subprocess.DEVNULL)
+from expectations import expect, finish
+data = json.load(open(f"{work}/families_report_files/data.json"))
+name = next(n for n in data if "families_two" in n)
+with h5py.File(f"{work}/two.families.h5") as f:
+    expect("selected structures", data[name]["selected"] == len(f["/selection"]))
+    expect("families", data[name]["families"] == int(f.attrs["families"]) == 2)
+image = matplotlib.image.imread(f"{work}/families_report_files/{name}")
+expect("three panels (the input set was found)", image.shape[1] > 2.5 * image.shape[0])
+expect("the table names both families", open(f"{work}/families_report.html").read().count("<td>30</td>") >= 2)
+finish()
+PY
 
 # Memory (docs/cli.md): the distance matrices refused up front under a small limit.
 expect_exit 2 "distances between 60 selected structures needs about .*, more than the 1 MiB of --memory-limit" -- \

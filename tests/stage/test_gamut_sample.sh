@@ -1,5 +1,5 @@
 #!/bin/bash
-# msfab-gamut-sample on a tiny 2D gamut: artifacts and plots are written;
+# msfab-gamut-sample on a tiny 2D gamut: the artifacts are written;
 # the result (directed pushes included) is identical for 1 and 3 MPI ranks, for 1 and 2 threads, and
 # after a stop and --resume; a run to convergence stops where the coverage
 # stops growing; bad settings exit 2 naming the key.
@@ -23,8 +23,7 @@ check "microstructures schema" -- bash -c "h5dump -a /schema '$WORK/one.microstr
 check "level set is 4-D, 12 cells per axis" -- bash -c "h5dump -H -d /level_set/phi '$WORK/one.gamut.h5' | grep -q '( 12, 12, 12, 12 )'"
 check "voxels packed at two bits per voxel (3 ids): 16 bytes per 8 x 8 cell" -- bash -c "h5dump -H -d /voxels '$WORK/one.microstructures.h5' | grep -q ', 16 )'"
 check "history has cycles 0..3" -- bash -c "h5dump -d /history/cycle '$WORK/one.gamut.h5' | grep -q '0, 1, 2, 3'"
-check "plots written" -- bash -c "for f in gamut coverage cycle_00 cycle_03; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
-check "history.csv written" -- bash -c "[ \$(wc -l < '$WORK/one.plots/history.csv') = 5 ]"
+check "no plots folder" -- test ! -e "$WORK/one.plots"
 check "no checkpoint left" -- test ! -e "$WORK/one.gamut.h5.checkpoint.h5"
 # The two artifacts are one commit (io/commit_group.hpp): no journal left,
 # and the gamut records the hash of the very set beside it.
@@ -164,7 +163,6 @@ expect_exit 0 "stopped after cycle 1 of 3" -- "$SAMPLE" --config "$TINY" --seed 
 expect_exit 0 "resuming after cycle 1" -- "$SAMPLE" --config "$TINY" --seed 7 --set continuous.adaptive_step=true \
   --out "$WORK/adaptpart.gamut.h5" --resume
 check "an adaptive run stopped and resumed is the same run" -- same_run "$WORK/adapt" "$WORK/adaptpart"
-check "cubic gamuts draw E and nu against G'" -- bash -c "for f in gamut_E_G gamut_nu_G; do head -c 4 '$WORK/one.plots/'\$f.png | grep -q PNG || exit 1; done"
 
 # Bad settings.
 expect_exit 2 "stop.coverage_growth.*must be in \[0, 1\)" -- "$SAMPLE" --config "$TINY" --set stop.coverage_growth=1.5 \

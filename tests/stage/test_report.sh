@@ -53,6 +53,9 @@ with h5py.File("art/design.h5") as f:
     names = (names.decode() if isinstance(names, bytes) else str(names)).split(",")
     rho = f["/cells/raw"][()][:, names.index("rho")]
     expect("design objective history", np.array_equal(design["objective"], f["/history/objective"][()]))
+    violation = f["/history/max_violation"][()]
+    expect("constraint violation drawn when there is some", ("max_violation" in design) == bool((violation > 0).any()))
+    expect("... as recorded", "max_violation" not in design or np.array_equal(design["max_violation"], violation))
     expect("design density range", design["min"] == rho.min() and design["max"] == rho.max())
 gamut = data[next(n for n in data if "gamut_tiny.microstructures" in n)]
 level_set = data[next(n for n in data if "gamut_level_set" in n)]

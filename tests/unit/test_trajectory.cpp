@@ -310,32 +310,6 @@ TEST_F(TrajectoryArtifact, SidecarNamesEveryFrame) {
   for (std::size_t k = 0; k < 3; ++k) EXPECT_SAME_DOUBLE(times[k], t.frames[k].time);
 }
 
-TEST_F(TrajectoryArtifact, PlotsArePngFiles) {
-  const std::string signature = "\x89PNG\r\n\x1a\n";
-  const auto check = [&](const std::vector<std::string>& written, const std::string& prefix) {
-    ASSERT_EQ(written.size(), 2u);
-    EXPECT_EQ(written[0], prefix + "energy.png");
-    EXPECT_EQ(written[1], prefix + "com_height.png");
-    for (const std::string& png : written) {
-      ASSERT_TRUE(fs::exists(png)) << png;
-      EXPECT_GT(fs::file_size(png), signature.size()) << png;
-      EXPECT_EQ(read_text(png).substr(0, 8), signature) << png;
-    }
-  };
-  Trajectory t = synthetic_trajectory();  // three phases and a NaN energy
-  check(write_trajectory_plots(file("run."), t), file("run."));
-  for (const auto& entry : fs::directory_iterator(dir_))
-    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
-
-  // Degenerate ranges: constant series over constant time, one sample, none.
-  for (TrajectorySample& s : t.samples) s = TrajectorySample{};
-  check(write_trajectory_plots(file("flat."), t), file("flat."));
-  t.samples.resize(1);
-  check(write_trajectory_plots(file("single."), t), file("single."));
-  t.samples.clear();
-  check(write_trajectory_plots(file("none."), t), file("none."));
-}
-
 TEST_F(TrajectoryArtifact, MissingFolderIsInputErrorAndLeavesNothing) {
   const fs::path folder = dir_ / "missing";
   const std::string path = (folder / "run.h5").string();

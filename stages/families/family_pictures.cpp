@@ -1,0 +1,78 @@
+#include "family_pictures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "families/beam_template.hpp"
+#include "io/png_image.hpp"
+
+namespace msfab {
+
+namespace {
+
+// A structure seen along z: each pixel's grey is the depth of the first
+// solid voxel (near = dark), so beams in front read as darker than those
+// behind; void through the whole cell is white.
+void draw_depth_view(PngImage& image, int x0, int y0, int scale, const std::vector<int>& ids, int n) {
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      int depth = n;
+      for (int k = 0; k < n; ++k)
+        if (ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0) {
+          depth = k;
+          break;
+        }
+      const std::uint8_t g = depth == n ? 255 : std::uint8_t(30 + 170 * depth / n);
+      for (int a = 0; a < scale; ++a)
+        for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {g, g, g});
+    }
+}
+
+// One layer of a structure: solid black, void white.
+void draw_slice(PngImage& image, int x0, int y0, int scale, const std::vector<int>& ids, int n, int k) {
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const bool solid = ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0;
+      const std::uint8_t g = solid ? 30 : 255;
+      for (int a = 0; a < scale; ++a)
+        for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {g, g, g});
+    }
+}
+
+}  // namespace
+
+std::string picture_folder_for(const std::string& out) {
+  for (const std::string suffix : {".families.h5", ".h5"})
+    if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
+      return out.substr(0, out.size() - suffix.size()) + ".plots";
+  return out + ".plots";
+}
+
+void write_family_pictures(const std::string& folder, const FamiliesResult& r, const MicrostructureSet& set) {
+  std::filesystem::create_directories(folder);
+  // Per family: representative (left) and its fitted template (right), at
+  // the set's resolution, one pixel block per voxel: seen along z with
+  // depth shading (top), and the layers z = n/4 and z = 0 (below), which
+  // cut through the fundamental tetrahedron and the cell face.
+  const int n = set.nx, scale = std::max(1, 192 / n), gap = 12, side = n * scale;
+  for (std::size_t f = 0; f < r.families.size(); ++f) {
+    const FamilyRecord& fam = r.families[f];
+    PngImage image(2 * side + 3 * gap, 3 * side + 4 * gap, {255, 255, 255});
+    const std::vector<int>& rep = set.items[std::size_t(fam.representative)].ids;
+    std::vector<int> tpl;
+    if (fam.representative_template.size() > 0)
+      tpl = rasterize_template(template_from_parameters(fam.representative_template, fam.caps), n).ids;
+    for (int col = 0; col < 2; ++col) {
+      const std::vector<int>& ids = col == 0 ? rep : tpl;
+      if (ids.empty()) continue;
+      const int x0 = gap + col * (side + gap);
+      draw_depth_view(image, x0, gap, scale, ids, n);
+      draw_slice(image, x0, 2 * gap + side, scale, ids, n, n / 4);
+      draw_slice(image, x0, 3 * gap + 2 * side, scale, ids, n, 0);
+    }
+    image.write_png(folder + "/family" + std::to_string(f + 1) + ".png");
+  }
+}
+
+}  // namespace msfab
