@@ -1,6 +1,6 @@
 #pragma once
 // A small RGB raster for pictures of voxels (one pixel block per voxel)
-// and a PNG writer (zlib deflate). Charts are drawn by `msfab report`.
+// and a PNG writer (zlib deflate). Charts are drawn by `python3 -m msfab report`.
 // Written atomically like every output: "<path>.tmp", then renamed.
 #include <array>
 #include <cstdint>

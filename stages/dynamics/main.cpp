@@ -12,7 +12,7 @@
 //   4. with rigid flight enabled: rigid projection (B.22), DMV free flight,
 //      projection back before the next contact (B.23)
 //   5. write the `msfab.trajectory` artifact and its ParaView time series
-//      (`msfab report` draws its energies and centre of mass); with
+//      (`python3 -m msfab report` draws its energies and centre of mass); with
 //      --reference, the run's difference from the fine run frame by frame
 #include <spdlog/spdlog.h>
 

@@ -2,7 +2,7 @@
 // Pictures of a family discovery run (thesis Fig. 3-6, 3-7): per family, its
 // representative next to the structure its template generates. The
 // embedding and the coverage in the E–ν and ν–G' planes are drawn by
-// `msfab report` from the artifact (docs/python.md).
+// `python3 -m msfab report` from the artifact (docs/python.md).
 #include <string>
 
 #include "families/families_artifact.hpp"

@@ -266,7 +266,7 @@ int main(int argc, char** argv) {
         std::printf("  range %s: [%.6g, %.6g]\n", names[a].c_str(), lo, hi);
       }
       std::printf("  time: %.1f s wall\n", wall);
-      std::printf("  artifacts: %s, %s (`msfab report` draws them, docs/python.md)\n", out.c_str(),
+      std::printf("  artifacts: %s, %s (`python3 -m msfab report` draws them, docs/python.md)\n", out.c_str(),
                   structures_path.c_str());
     }
   });

@@ -1,6 +1,6 @@
 #pragma once
 // What msfab-topopt writes: the `msfab.design` content of an optimization
-// result (`msfab report` draws its convergence and cells).
+// result (`python3 -m msfab report` draws its convergence and cells).
 #include "topopt/design_artifact.hpp"
 #include "topopt/topology_optimizers.hpp"
 
