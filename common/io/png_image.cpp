@@ -37,11 +37,6 @@ void PngImage::set(int x, int y, Rgb c) {
   std::copy(c.begin(), c.end(), rgb_.begin() + 3 * (std::size_t(y) * w_ + x));
 }
 
-Rgb PngImage::get(int x, int y) const {
-  const std::size_t i = 3 * (std::size_t(y) * w_ + x);
-  return {rgb_[i], rgb_[i + 1], rgb_[i + 2]};
-}
-
 void PngImage::write_png(const std::string& path) const {
   std::vector<std::uint8_t> raw;
   raw.reserve(std::size_t(h_) * (3 * w_ + 1));

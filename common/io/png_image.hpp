@@ -18,7 +18,6 @@ class PngImage {
   int height() const { return h_; }
   // (x, y) with y down; out-of-range pixels are ignored.
   void set(int x, int y, Rgb color);
-  Rgb get(int x, int y) const;
   // std::runtime_error naming the path if it cannot be written.
   void write_png(const std::string& path) const;
 

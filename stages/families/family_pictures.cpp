@@ -1,7 +1,6 @@
 #include "family_pictures.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 
 #include "families/beam_template.hpp"
@@ -11,33 +10,32 @@ namespace msfab {
 
 namespace {
 
+bool solid(const std::vector<int>& ids, int n, int i, int j, int k) {
+  return ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0;
+}
+
+// Voxel (i, j) of an n x n view as a scale x scale block, y up.
+void paint_voxel(PngImage& image, int x0, int y0, int scale, int n, int i, int j, std::uint8_t grey) {
+  for (int a = 0; a < scale; ++a)
+    for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {grey, grey, grey});
+}
+
 // A structure seen along z: each pixel's grey is the depth of the first
 // solid voxel (near = dark), so beams in front read as darker than those
 // behind; void through the whole cell is white.
 void draw_depth_view(PngImage& image, int x0, int y0, int scale, const std::vector<int>& ids, int n) {
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
-      int depth = n;
-      for (int k = 0; k < n; ++k)
-        if (ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0) {
-          depth = k;
-          break;
-        }
-      const std::uint8_t g = depth == n ? 255 : std::uint8_t(30 + 170 * depth / n);
-      for (int a = 0; a < scale; ++a)
-        for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {g, g, g});
+      int depth = 0;
+      while (depth < n && !solid(ids, n, i, j, depth)) ++depth;
+      paint_voxel(image, x0, y0, scale, n, i, j, depth == n ? 255 : std::uint8_t(30 + 170 * depth / n));
     }
 }
 
 // One layer of a structure: solid black, void white.
 void draw_slice(PngImage& image, int x0, int y0, int scale, const std::vector<int>& ids, int n, int k) {
   for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      const bool solid = ids[std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * k)] != 0;
-      const std::uint8_t g = solid ? 30 : 255;
-      for (int a = 0; a < scale; ++a)
-        for (int b = 0; b < scale; ++b) image.set(x0 + i * scale + a, y0 + (n - 1 - j) * scale + b, {g, g, g});
-    }
+    for (int i = 0; i < n; ++i) paint_voxel(image, x0, y0, scale, n, i, j, solid(ids, n, i, j, k) ? 30 : 255);
 }
 
 }  // namespace

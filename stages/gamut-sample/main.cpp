@@ -125,7 +125,8 @@ int main(int argc, char** argv) {
                        "lower population or resolution");
     }
     if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
-    // The second artifact is checked before any work, on every rank (a rank that threw alone would leave the others waiting).
+    // The second artifact is checked before any work, on every rank (a rank
+    // that threw alone would leave the others waiting).
     try {
       AtomicFile probe(structures_path);
     } catch (const InputError& e) {
