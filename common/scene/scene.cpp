@@ -16,6 +16,7 @@
 #include "fem/surface_voxelizer.hpp"
 #include "fem/voxel_shapes.hpp"
 #include "io/surface_mesh_io.hpp"
+#include "io/vdb_grid_io.hpp"
 #include "io/voxel_array_io.hpp"
 #include "material/linear_anisotropic.hpp"
 #include "material/linear_isotropic.hpp"
@@ -81,12 +82,35 @@ Region read_region(const Config& parent, const VoxelGrid& grid) {
   return r;
 }
 
-// `voxels: {file: F.npy}` or `{file: F.raw, dtype: uint8}`: every voxel's id
-// from the file (docs/scenes.md, "Your own object").
-// Returns the file's path.
+bool is_vdb_file(const std::string& path) {
+  return path.size() >= 4 && path.compare(path.size() - 4, 4, ".vdb") == 0;
+}
+
+// `voxels: {file: F.npy}`, `{file: F.raw, dtype: uint8}` or
+// `{file: F.vdb, grid: ids, origin: [i, j, k]}`: every voxel's id from the
+// file (docs/scenes.md, "Your own object"). Returns the file's path.
 std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
   const std::string path = c.get_path("file");
-  const std::vector<int> ids = read_voxel_ids(path, grid.nx, grid.ny, grid.nz, c.get_or<std::string>("dtype", ""));
+  std::vector<int> ids;
+  if (is_vdb_file(path)) {
+    if (c.has("dtype")) c.fail("dtype", "a .vdb file says its own value type; drop it");
+    std::array<long long, 3> origin{0, 0, 0};
+    if (c.has("origin")) {
+      const auto o = c.get<std::vector<int>>("origin");
+      if (o.size() != 3) c.fail("origin", "expected the index coordinate [i, j, k] of the grid's voxel (0, 0, 0)");
+      origin = {o[0], o[1], o[2]};
+    }
+    VdbVoxelIds read = read_vdb_voxel_ids(path, c.get_or<std::string>("grid", ""), grid.nx, grid.ny, grid.nz, origin);
+    if (read.active_outside > 0)
+      spdlog::warn("{}: {} active voxels lie outside the grid's {} x {} x {} voxels from index ({}, {}, {}) and are "
+                   "cut off",
+                   path, read.active_outside, grid.nx, grid.ny, grid.nz, origin[0], origin[1], origin[2]);
+    ids = std::move(read.ids);
+  } else {
+    for (const char* key : {"grid", "origin"})
+      if (c.has(key)) c.fail(key, "is for .vdb files only");
+    ids = read_voxel_ids(path, grid.nx, grid.ny, grid.nz, c.get_or<std::string>("dtype", ""));
+  }
   std::map<int, long long> unknown;
   for (int id : ids)
     if (id >= static_cast<int>(material_by_id.size()) || (id > 0 && !material_by_id[id])) ++unknown[id];
@@ -95,6 +119,45 @@ std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector
                        std::to_string(unknown.begin()->second) + " voxels), which is not in the palette (0 = void)");
   grid.ids = ids;
   return path;
+}
+
+// Where a part's file sits in the scene: a file point p lies at
+// scale * p + offset (metres).
+struct Placement {
+  double scale = 1.0;
+  Vec3 offset = Vec3::Zero();
+};
+Placement read_placement(const Config& c) {
+  Placement p;
+  p.scale = c.get_or<double>("scale", 1.0);
+  if (!(p.scale > 0) || !std::isfinite(p.scale)) c.fail("scale", "must be a positive finite number");
+  if (c.has("offset")) p.offset = read_vec3(c, "offset");
+  return p;
+}
+
+// The layout's VDB shape `c` (a `vdb` item's mapping), its threshold, and
+// the box of its inside in scene coordinates.
+struct PlacedVolume {
+  VdbVolume volume;
+  Placement placement;
+  double threshold;
+  std::array<Vec3, 2> box;
+};
+PlacedVolume placed_volume(const Config& c) {
+  const std::string path = c.get_path("file");
+  VdbVolume volume = VdbVolume::read(path, c.get_or<std::string>("grid", ""));
+  const Placement placement = read_placement(c);
+  const double threshold = c.get_or<double>("threshold", volume.default_threshold());
+  if (!std::isfinite(threshold)) c.fail("threshold", "must be a finite number");
+  std::array<Vec3, 2> box = volume.inside_box(threshold);
+  if (!(box[0].array() <= box[1].array()).all()) {
+    std::ostringstream o;
+    o << path << ": " << volume.describe() << " has no stored value " << (volume.is_level_set() ? "below" : "above")
+      << " the threshold " << threshold << ", so nothing is inside";
+    c.fail("file", o.str());
+  }
+  for (Vec3& corner : box) corner = placement.scale * corner + placement.offset;
+  return {std::move(volume), placement, threshold, box};
 }
 
 // The layout's surface mesh `c` (a `mesh` item's mapping) in scene
@@ -112,15 +175,14 @@ TriangleSurface placed_surface(const Config& c) {
       << a.transpose() << ") to (" << b.transpose() << ")";
     c.fail("file", o.str());
   }
-  const double scale = c.get_or<double>("scale", 1.0);
-  if (!(scale > 0) || !std::isfinite(scale)) c.fail("scale", "must be a positive finite number");
-  const Vec3 offset = c.has("offset") ? read_vec3(c, "offset") : Vec3::Zero();
-  for (Vec3& p : surface.vertices) p = scale * p + offset;
+  const Placement placement = read_placement(c);
+  for (Vec3& p : surface.vertices) p = placement.scale * p + placement.offset;
   return surface;
 }
 
 // `grid: {voxel_size: h, size_from_parts: true, margin: m}`: the grid that
-// covers the bounding box of the layout's surface meshes plus m voxels on
+// covers the bounding box of the layout's surface meshes and VDB shapes
+// plus m voxels on
 // every side, its origin at the box's lower corner minus the margin.
 VoxelGrid grid_around_parts(const Config& config) {
   const Config g = config.child("grid");
@@ -130,13 +192,14 @@ VoxelGrid grid_around_parts(const Config& config) {
   const int margin = g.get_or<int>("margin", 0);
   if (margin < 0) g.fail("margin", "must be >= 0 voxels");
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  for (const Config& item : config.children("layout"))
-    if (item.has("mesh")) {
-      const auto box = bounding_box(placed_surface(item.child("mesh")));
-      lo = lo.cwiseMin(box[0]), hi = hi.cwiseMax(box[1]);
-    }
+  for (const Config& item : config.children("layout")) {
+    std::array<Vec3, 2> box{lo, hi};
+    if (item.has("mesh")) box = bounding_box(placed_surface(item.child("mesh")));
+    if (item.has("vdb")) box = placed_volume(item.child("vdb")).box;
+    lo = lo.cwiseMin(box[0]), hi = hi.cwiseMax(box[1]);
+  }
   if (!(lo.array() <= hi.array()).all())
-    g.fail("size_from_parts", "needs at least one `mesh` item in the layout");
+    g.fail("size_from_parts", "needs at least one `mesh` or `vdb` item in the layout");
   std::array<int, 3> n{};
   for (int a = 0; a < 3; ++a) {
     // A part whose extent is a whole number of voxels up to round-off takes exactly that many.
@@ -169,6 +232,34 @@ std::string paint_mesh_file(const Config& item, VoxelGrid& grid, int id) {
   if ((lo.array() < grid.origin.array()).any() || (hi.array() > grid_hi.array()).any())
     spdlog::warn("{}: the surface reaches beyond the grid and is cut off there; {}", path, box.str());
   spdlog::debug("{}: {} triangles, {} voxels painted with id {}", path, surface.triangles.size(), painted, id);
+  return path;
+}
+
+// `vdb: {file: F.vdb, grid: name, scale: s, offset: [x, y, z], threshold: t},
+// id: n`: the voxels whose centre lies inside the level set or density take
+// id n. Returns the file's path.
+std::string paint_vdb_file(const Config& item, VoxelGrid& grid, int id) {
+  const Config c = item.child("vdb");
+  const std::string path = c.get_path("file");
+  const PlacedVolume part = placed_volume(c);
+  long long painted = 0;
+  for (int k = 0; k < grid.nz; ++k)
+    for (int j = 0; j < grid.ny; ++j)
+      for (int i = 0; i < grid.nx; ++i) {
+        const Vec3 in_file = (grid.voxel_center(i, j, k) - part.placement.offset) / part.placement.scale;
+        if (part.volume.inside(in_file, part.threshold)) grid.at(i, j, k) = id, ++painted;
+      }
+  const Vec3 grid_hi = grid.origin + grid.extent();
+  std::ostringstream box;
+  box << "the box of its inside after scale and offset is [" << part.box[0].transpose() << "] - ["
+      << part.box[1].transpose() << "], the grid's [" << grid.origin.transpose() << "] - [" << grid_hi.transpose()
+      << "]";
+  if (painted == 0)
+    c.fail("file", path + ": " + part.volume.describe() + " contains no voxel centre: " + box.str() +
+                       " (check scale, offset, threshold and grid)");
+  if ((part.box[0].array() < grid.origin.array()).any() || (part.box[1].array() > grid_hi.array()).any())
+    spdlog::warn("{}: the shape reaches beyond the grid and is cut off there; {}", path, box.str());
+  spdlog::debug("{}: {}, {} voxels painted with id {}", path, part.volume.describe(), painted, id);
   return path;
 }
 
@@ -247,9 +338,11 @@ std::vector<std::string> paint_layout(const Config& config, VoxelGrid& grid,
       files.push_back(paint_voxel_file(item.child("voxels"), grid, material_by_id));
     } else if (item.has("mesh")) {
       files.push_back(paint_mesh_file(item, grid, id_of("id")));
+    } else if (item.has("vdb")) {
+      files.push_back(paint_vdb_file(item, grid, id_of("id")));
     } else {
       item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field, "
-                    "voxels, mesh");
+                    "voxels, mesh, vdb");
     }
   }
   return files;
