@@ -210,9 +210,9 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
 
   try {
     LogLevel level = parse_log_level(options_.log_level);
-    if (options_.quiet && level < LogLevel::warn) level = LogLevel::warn;
+    if ((options_.quiet || rank_ != 0) && level < LogLevel::warn) level = LogLevel::warn;
     init_logging(name_, level);
-    Progress::set_quiet(options_.quiet);
+    Progress::set_quiet(options_.quiet || rank_ != 0);
     if (options_.threads > 0) omp_set_num_threads(options_.threads);
 
     StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};

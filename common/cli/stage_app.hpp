@@ -93,6 +93,11 @@ class StageApp {
   // "<built-in defaults of NAME>". Without it the config starts empty.
   void set_default_config(std::string yaml_text);
 
+  // For stages run on several MPI ranks (parallel/mpi_session.hpp): ranks
+  // other than 0 draw no progress and log only warnings and errors, so a
+  // job speaks with one voice.
+  void set_rank(int rank) { rank_ = rank; }
+
   int run(int argc, const char* const* argv, const std::function<void(StageContext&)>& body);
 
  private:
@@ -102,6 +107,7 @@ class StageApp {
   CLI::App cli_;
   StageOptions options_;
   std::optional<std::string> default_config_;
+  int rank_ = 0;
 };
 
 // argv joined with shell quoting where needed, e.g. "msfab-map --set 'a=b c'".

@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "io/input_file.hpp"
+#include "io/path_names.hpp"
 
 namespace msfab {
 namespace {
@@ -169,7 +170,7 @@ std::vector<int> parse_npy_voxel_ids(const std::string& bytes, const std::string
 }
 
 std::vector<int> read_voxel_ids(const std::string& path, int nx, int ny, int nz, const std::string& raw_dtype) {
-  const bool npy = path.size() >= 4 && path.compare(path.size() - 4, 4, ".npy") == 0;
+  const bool npy = ends_with(path, ".npy");
   if (npy) return parse_npy_voxel_ids(read_text_file(path, kMaxVoxelArrayBytes), path, nx, ny, nz);
   ElementType type;
   if (!raw_dtype_type(raw_dtype, type)) {

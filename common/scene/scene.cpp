@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "fem/surface_voxelizer.hpp"
 #include "fem/voxel_shapes.hpp"
+#include "io/path_names.hpp"
 #include "io/surface_mesh_io.hpp"
 #include "io/vdb_grid_io.hpp"
 #include "io/voxel_array_io.hpp"
@@ -82,17 +83,13 @@ Region read_region(const Config& parent, const VoxelGrid& grid) {
   return r;
 }
 
-bool is_vdb_file(const std::string& path) {
-  return path.size() >= 4 && path.compare(path.size() - 4, 4, ".vdb") == 0;
-}
-
 // `voxels: {file: F.npy}`, `{file: F.raw, dtype: uint8}` or
 // `{file: F.vdb, grid: ids, origin: [i, j, k]}`: every voxel's id from the
 // file (docs/scenes.md, "Your own object"). Returns the file's path.
 std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector<MaterialPtr>& material_by_id) {
   const std::string path = c.get_path("file");
   std::vector<int> ids;
-  if (is_vdb_file(path)) {
+  if (ends_with(path, ".vdb")) {
     if (c.has("dtype")) c.fail("dtype", "a .vdb file says its own value type; drop it");
     std::array<long long, 3> origin{0, 0, 0};
     if (c.has("origin")) {

@@ -16,7 +16,6 @@
 //
 // A fit depends only on its block and the config, so the database is
 // identical for any rank or thread count and after resume.
-#include <mpi.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -31,35 +30,32 @@
 #include "core/errors.hpp"
 #include "build_plan.hpp"
 #include "fit_record.hpp"
+#include "parallel/fan_out.hpp"
+#include "parallel/mpi_session.hpp"
 
 using namespace msfab;
 
 namespace {
 
 // Fits this rank's share of items [begin, end) and gathers all of them on
-// every rank (allreduce keeps ranks in step; the payload is small).
+// every rank (parallel/fan_out.hpp: ranks stay in step; the payload is small).
 void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::vector<std::int64_t>& pending,
-               std::size_t begin, std::size_t end, int rank, int size, FittedOrbits& done) {
+               std::size_t begin, std::size_t end, FittedOrbits& done) {
   const int count = static_cast<int>(end - begin);
-  const std::size_t record = fit_record_size(plan.points);
-  std::vector<double> mine(static_cast<std::size_t>(count) * record, 0.0);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int i = 0; i < count; ++i) {
-    if (i % size != rank) continue;
+  const int record = static_cast<int>(fit_record_size(plan.points));
+  const std::vector<double> all = fan_out(count, record, [&](int i, double* row) {
+    const std::int64_t block = pending[begin + i];
     CoarseMaterialFit fit(plan.points);
-    const bool element = plan.void_children(pending[begin + i]) < 8;  // an all-void block has nothing to fit
+    const bool element = plan.void_children(block) < 8;  // an all-void block has nothing to fit
     try {
-      if (element) fit = fit_coarse_material(plan.block(pending[begin + i]), options.fit);
-    } catch (const std::exception& e) {  // must not escape the parallel region
+      if (element) fit = fit_coarse_material(plan.block(block), options.fit);
+    } catch (const std::exception& e) {  // a failed block is recorded as not fitted (a resume retries it)
       fit = CoarseMaterialFit(plan.points);
-      spdlog::error("block {}: {}", pending[begin + i], e.what());
+      spdlog::error("block {}: {}", block, e.what());
     }
-    if (element && !fit.fitted) spdlog::warn("block {}: not fitted: {}", pending[begin + i], fit.not_fitted_reason);
-    pack_fit(fit, &mine[static_cast<std::size_t>(i) * record]);
-  }
-  // Rows not owned are zero, so a sum over ranks assembles the round exactly.
-  std::vector<double> all(mine.size());
-  MPI_Allreduce(mine.data(), all.data(), static_cast<int>(mine.size()), MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    if (element && !fit.fitted) spdlog::warn("block {}: not fitted: {}", block, fit.not_fitted_reason);
+    pack_fit(fit, row);
+  });
   for (int i = 0; i < count; ++i)
     done[pending[begin + i]] = unpack_fit(&all[static_cast<std::size_t>(i) * record], plan.points);
 }
@@ -67,12 +63,10 @@ void fit_round(const BuildPlan& plan, const BuildOptions& options, const std::ve
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-
+  const MpiSession mpi(&argc, &argv);
+  const int rank = mpi.rank(), size = mpi.size();
   StageApp app("msfab-ddfem-build", "Offline DDFEM coarse-material database (thesis §2.3), MPI-parallel");
+  app.set_rank(rank);
   app.add_common_options();
   app.set_default_config(kDefaultBuildConfig);
   bool resume = false;
@@ -84,11 +78,6 @@ int main(int argc, char** argv) {
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t0 = std::chrono::steady_clock::now();
-
-    if (rank != 0) {  // one voice per job
-      Progress::set_quiet(true);
-      spdlog::set_level(spdlog::level::warn);
-    }
 
     // 1. Palette (or the level-1 database) and options.
     const BuildOptions options = read_build_options(ctx.config);
@@ -149,7 +138,7 @@ int main(int argc, char** argv) {
         return;
       }
       const std::size_t end = std::min(pending.size(), begin + per_round);
-      fit_round(plan, options, pending, begin, end, rank, size, done);
+      fit_round(plan, options, pending, begin, end, done);
       if (rank == 0) write_checkpoint(ckpt, config_text, done, plan.points);
       progress.set(plan.items.size() - (pending.size() - end));
       ++rounds;
@@ -182,6 +171,5 @@ int main(int argc, char** argv) {
       std::printf("  artifact: %s (%.1f kB)\n", out.c_str(), std::filesystem::file_size(out) / 1024.0);
     }
   });
-  MPI_Finalize();
   return code;
 }

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "families/beam_template.hpp"
+#include "io/path_names.hpp"
 #include "io/png_image.hpp"
 
 namespace msfab {
@@ -41,10 +42,7 @@ void draw_slice(PngImage& image, int x0, int y0, int scale, const std::vector<in
 }  // namespace
 
 std::string picture_folder_for(const std::string& out) {
-  for (const std::string suffix : {".families.h5", ".h5"})
-    if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
-      return out.substr(0, out.size() - suffix.size()) + ".plots";
-  return out + ".plots";
+  return without_suffix(out, {".families.h5", ".h5"}) + ".plots";
 }
 
 void write_family_pictures(const std::string& folder, const FamiliesResult& r, const MicrostructureSet& set) {

@@ -23,7 +23,6 @@
 //
 // Every target's work is deterministic and independent of the others, so
 // the result is the same for any rank or thread count.
-#include <mpi.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -39,6 +38,7 @@
 #include "mapping/set_lineage.hpp"
 #include "mapping/target_fill.hpp"
 #include "parallel/fan_out.hpp"
+#include "parallel/mpi_session.hpp"
 
 using namespace msfab;
 
@@ -132,10 +132,11 @@ void report(const char* when, const CellCoverage& c, double gap) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  const int rank = mpi_rank(), size = mpi_size();
+  const MpiSession mpi(&argc, &argv);
+  const int rank = mpi.rank(), size = mpi.size();
   StageApp app("msfab-fill-targets",
                "Generate microstructures at the design targets its set does not cover (continuous step, thesis 3.2.2)");
+  app.set_rank(rank);
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string design_path, structures_path;
@@ -146,10 +147,6 @@ int main(int argc, char** argv) {
       ->type_name("FILE")
       ->required();
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
-    if (rank != 0) {
-      Progress::set_quiet(true);
-      spdlog::set_level(spdlog::level::warn);
-    }
     const Settings settings = read_settings(ctx.config);
     ctx.finish_config();
     const std::string& out = ctx.require_out();
@@ -237,6 +234,5 @@ int main(int argc, char** argv) {
       std::printf("  artifact: %s\n", out.c_str());
     }
   });
-  MPI_Finalize();
   return code;
 }

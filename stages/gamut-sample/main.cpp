@@ -18,7 +18,6 @@
 // Homogenizations and continuous optimizations are spread over MPI ranks;
 // every random draw is keyed by (seed, cycle, item), so the result is the
 // same for any rank or thread count and after --resume.
-#include <mpi.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -36,20 +35,15 @@
 #include "homog/periodic_homogenization.hpp"
 #include "io/atomic_file.hpp"
 #include "io/commit_group.hpp"
+#include "io/path_names.hpp"
 #include "parallel/fan_out.hpp"
+#include "parallel/mpi_session.hpp"
 #include "sampler.hpp"
 #include "sampler_checkpoint.hpp"
 
 using namespace msfab;
 
 namespace {
-
-std::string stem_of(const std::string& out) {
-  const std::string suffix = ".gamut.h5";
-  if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
-    return out.substr(0, out.size() - suffix.size());
-  return out;
-}
 
 // A base material as a tensor of the space: 6 x 6 in 3D, the plane-strain
 // in-plane block in 2D (what a solid cell of it homogenizes to).
@@ -83,9 +77,10 @@ ArtifactInput add_set_and_gamut(CommitGroup& group, const std::string& set_path,
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  const int rank = mpi_rank(), size = mpi_size();
+  const MpiSession mpi(&argc, &argv);
+  const int rank = mpi.rank(), size = mpi.size();
   StageApp app("msfab-gamut-sample", "Microstructure gamut sampling, discrete + continuous (thesis 3.2), MPI-parallel");
+  app.set_rank(rank);
   app.add_common_options();
   app.set_default_config(kDefaultSamplerConfig);
   bool resume = false;
@@ -100,10 +95,6 @@ int main(int argc, char** argv) {
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
-    if (rank != 0) {
-      Progress::set_quiet(true);
-      spdlog::set_level(spdlog::level::warn);
-    }
 
     // 1. Settings.
     const SamplerOptions options = read_sampler_options(ctx.config);
@@ -124,7 +115,7 @@ int main(int argc, char** argv) {
                                   std::to_string(options.resolution) + (three_d ? "^3" : "^2") + " voxels",
                        "lower population or resolution");
     }
-    if (structures_path.empty()) structures_path = stem_of(out) + ".microstructures.h5";
+    if (structures_path.empty()) structures_path = without_suffix(out, {".gamut.h5"}) + ".microstructures.h5";
     // The second artifact is checked before any work, on every rank (a rank
     // that threw alone would leave the others waiting).
     try {
@@ -223,7 +214,7 @@ int main(int argc, char** argv) {
         vg.level_set = sampler.level_set(voids);
         vg.history.clear();
         vg.bound_soft.setZero();
-        const std::string vstem = stem_of(out) + ".void";
+        const std::string vstem = without_suffix(out, {".gamut.h5"}) + ".void";
         add_set_and_gamut(artifacts, vstem + ".microstructures.h5", voids.set, vstem + ".gamut.h5", vg, {set_input},
                           run_text, ctx.options.seed);
         std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",
@@ -271,6 +262,5 @@ int main(int argc, char** argv) {
                   structures_path.c_str());
     }
   });
-  MPI_Finalize();
   return code;
 }

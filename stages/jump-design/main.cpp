@@ -15,7 +15,6 @@
 //      fraction of samples that still meet the goal
 //   5. write `msfab.jump_design` (every evaluation, initial and final
 //      designs, the variation samples) and print initial against final
-#include <mpi.h>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -32,18 +31,19 @@
 #include "design_robustness.hpp"
 #include "design_search.hpp"
 #include "parallel/fan_out.hpp"
+#include "parallel/mpi_session.hpp"
 
 using namespace msfab;
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  const int rank = mpi_rank(), size = mpi_size();
+  const MpiSession mpi(&argc, &argv);
+  const int rank = mpi.rank(), size = mpi.size();
   StageApp app("msfab-jump-design", "Design loop for jumping mechanisms with COBYLA over dynamics runs (thesis 4.5.1)");
+  app.set_rank(rank);
   app.add_common_options();
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
-    if (rank != 0) Progress::set_quiet(true);
 
     // 1. Problem and scene checks.
     const DesignProblem problem = read_design_problem(ctx.config);
@@ -84,6 +84,5 @@ int main(int argc, char** argv) {
       print_design_summary(problem, run, out);
     }
   });
-  MPI_Finalize();
   return code;
 }

@@ -23,6 +23,7 @@
 #include "cli/stage_app.hpp"
 #include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "io/path_names.hpp"
 #include "mapping/mapper.hpp"
 #include "mapping/set_lineage.hpp"
 #include "mapping/voxel_model.hpp"
@@ -77,12 +78,6 @@ Settings read_settings(const Config& config) {
 }
 
 // "run/part.mapped.h5" -> "run/part"; otherwise drop ".h5".
-std::string stem_of(const std::string& out) {
-  for (const std::string suffix : {".mapped.h5", ".h5"})
-    if (out.size() > suffix.size() && out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0)
-      return out.substr(0, out.size() - suffix.size());
-  return out;
-}
 
 }  // namespace
 
@@ -102,7 +97,7 @@ int main(int argc, char** argv) {
     ctx.finish_config();
     const std::string out = ctx.require_out();
     ctx.check_out_folder();
-    const std::string stem = stem_of(out);
+    const std::string stem = without_suffix(out, {".mapped.h5", ".h5"});
 
     const MicrostructureSet set = read_microstructures_artifact(structures_path);
     const Design design = read_design_artifact(design_path);
