@@ -20,6 +20,7 @@
 #include "io/atomic_file.hpp"
 #include "io/commit_group.hpp"
 #include "io/hdf5_file.hpp"
+#include "io/path_names.hpp"
 #include "io/sha256.hpp"
 #include "io/xdmf.hpp"
 
@@ -516,6 +517,19 @@ TEST_F(ArtifactReaderTest, NonHdf5AndForeignFilesAreInputErrors) {
   const std::string unmarked =
       input_error_message([&] { ArtifactReader in(foreign, "msfab.result", 1); });
   EXPECT_NE(unmarked.find("not an msfab artifact"), std::string::npos) << unmarked;
+}
+
+// Side outputs are named after the --out path's stem: the first listed
+// suffix that matches is dropped, a name that is only the suffix is kept.
+TEST(PathNames, SuffixesAreDroppedInOrderAndOnlyWhenSomethingIsLeft) {
+  EXPECT_TRUE(ends_with("a/part.vdb", ".vdb"));
+  EXPECT_FALSE(ends_with("a/part.vdb.bak", ".vdb"));
+  EXPECT_FALSE(ends_with("vdb", ".vdb"));
+  EXPECT_EQ(without_suffix("out/x.mapped.h5", {".mapped.h5", ".h5"}), "out/x");
+  EXPECT_EQ(without_suffix("out/x.h5", {".mapped.h5", ".h5"}), "out/x");
+  EXPECT_EQ(without_suffix("out/x.gamut.h5", {".h5", ".gamut.h5"}), "out/x.gamut");
+  EXPECT_EQ(without_suffix("out/x.txt", {".h5"}), "out/x.txt");
+  EXPECT_EQ(without_suffix(".h5", {".h5"}), ".h5");
 }
 
 TEST(ArtifactInputs, FormatAndParseRoundTrip) {

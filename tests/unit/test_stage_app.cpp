@@ -32,7 +32,7 @@ struct StageRun {
 };
 
 StageRun run_stage(std::vector<std::string> args, const std::function<void(StageContext&)>& body,
-                   const char* default_config = nullptr) {
+                   const char* default_config = nullptr, int rank = 0) {
   args.insert(args.begin(), "msfab-test");
   std::vector<const char*> argv;
   for (const auto& a : args) argv.push_back(a.c_str());
@@ -41,6 +41,7 @@ StageRun run_stage(std::vector<std::string> args, const std::function<void(Stage
   StageApp app("msfab-test", "a stage used by the unit tests");
   app.add_common_options();
   if (default_config) app.set_default_config(default_config);
+  app.set_rank(rank);
   testing::internal::CaptureStderr();
   testing::internal::CaptureStdout();
   result.exit_code = app.run(static_cast<int>(argv.size()), argv.data(), [&](StageContext& ctx) {
@@ -201,6 +202,28 @@ TEST(StageAppProgress, CountsTicksFromManyThreadsAndReportsCompletion) {
   const auto first = text.find("cells: 20000 done in");
   EXPECT_NE(first, std::string::npos) << text;
   EXPECT_EQ(text.find("cells: 20000 done in", first + 1), std::string::npos) << text;
+}
+
+// A job on several MPI ranks speaks through rank 0: the others keep their
+// warnings and errors but draw no progress and log no info lines.
+TEST(StageApp, OnlyRankZeroLogsInfoAndProgress) {
+  const auto body = [](StageContext&) {
+    spdlog::info("info line");
+    spdlog::warn("warning line");
+    Progress progress("items", 4);
+    for (int i = 0; i < 4; ++i) progress.tick();
+    progress.done();
+  };
+  const StageRun root = run_stage({}, body, nullptr, 0);
+  const StageRun other = run_stage({}, body, nullptr, 1);
+  Progress::set_quiet(false);
+  ASSERT_EQ(root.exit_code, 0);
+  ASSERT_EQ(other.exit_code, 0);
+  EXPECT_TRUE(contains(root.stderr_text, "info line")) << root.stderr_text;
+  EXPECT_TRUE(contains(root.stderr_text, "items: 4 done in")) << root.stderr_text;
+  EXPECT_TRUE(contains(other.stderr_text, "warning line")) << other.stderr_text;
+  EXPECT_FALSE(contains(other.stderr_text, "info line")) << other.stderr_text;
+  EXPECT_FALSE(contains(other.stderr_text, "items:")) << other.stderr_text;
 }
 
 TEST(StageAppProgress, QuietProgressPrintsNothing) {
