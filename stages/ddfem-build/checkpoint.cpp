@@ -5,20 +5,13 @@
 
 #include "core/errors.hpp"
 #include "fit_record.hpp"
-#include "io/atomic_file.hpp"
-#include "io/hdf5_file.hpp"
+#include "io/checkpoint_file.hpp"
 
 namespace msfab {
 
-std::string checkpoint_path(const std::string& out) { return out + ".checkpoint.h5"; }
-
 void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done, int points) {
   const int size = fit_record_size(points);
-  AtomicFile tmp(path);
-  {
-    H5File f = H5File::create_in(tmp);
-    f.write_attribute("/", "schema", "msfab.coarse_db.checkpoint");
-    f.write_attribute("/", "config", config_text);
+  write_checkpoint_file(path, "msfab.coarse_db.checkpoint", config_text, [&](H5File& f) {
     MatX rows(done.size(), 1 + size);
     int r = 0;
     for (const auto& [code, fit] : done) {
@@ -29,17 +22,12 @@ void write_checkpoint(const std::string& path, const std::string& config_text, c
       ++r;
     }
     f.write_matrix("/orbits", rows);
-    f.close();
-  }
-  tmp.commit();
+  });
 }
 
 FittedOrbits read_checkpoint(const std::string& path, const std::string& config_text, int points) {
-  const H5File f = H5File::open(path);
-  if (!f.exists("/orbits") || f.read_string_attribute("/", "schema") != "msfab.coarse_db.checkpoint")
-    throw InputError(path + ": not a database-builder checkpoint");
-  if (f.read_string_attribute("/", "config") != config_text)
-    throw InputError(path + ": checkpoint was written with a different configuration; delete it or rerun without --resume");
+  const H5File f = open_checkpoint_file(path, "msfab.coarse_db.checkpoint", "database-builder", config_text);
+  if (!f.exists("/orbits")) throw InputError(path + ": the checkpoint has no /orbits");
   const MatX rows = f.read_matrix<double>("/orbits");
   if (rows.cols() != 1 + fit_record_size(points))
     throw InputError(path + ": /orbits has " + std::to_string(rows.cols()) + " columns, expected " +

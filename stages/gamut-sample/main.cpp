@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
                    options.cycles, size, omp_get_max_threads());
 
     // 2. Initial population, or the checkpoint.
-    const std::string ckpt = sampler_checkpoint_path(out);
+    const std::string ckpt = checkpoint_path(out);
     SamplerState state;
     std::optional<GamutLevelSet> gamut;  // of the current set (none yet after resuming)
     if (resume && std::filesystem::exists(ckpt)) {

@@ -1,20 +1,12 @@
 #include "sampler_checkpoint.hpp"
 
-
 #include "core/errors.hpp"
-#include "io/atomic_file.hpp"
-#include "io/hdf5_file.hpp"
+#include "io/checkpoint_file.hpp"
 
 namespace msfab {
 
-std::string sampler_checkpoint_path(const std::string& out) { return out + ".checkpoint.h5"; }
-
 void write_sampler_checkpoint(const std::string& path, const std::string& run_text, const SamplerState& s) {
-  AtomicFile tmp(path);
-  {
-    H5File f = H5File::create_in(tmp);
-    f.write_attribute("/", "schema", "msfab.gamut.checkpoint");
-    f.write_attribute("/", "config", run_text);
+  write_checkpoint_file(path, "msfab.gamut.checkpoint", run_text, [&](H5File& f) {
     f.write_attribute("/", "cycles_done", static_cast<std::int32_t>(s.cycles_done));
     f.write_attribute("/", "push_step", s.push_step);
     write_microstructure_set(f, "/set", s.set);
@@ -25,17 +17,11 @@ void write_sampler_checkpoint(const std::string& path, const std::string& run_te
       rows.insert(rows.end(), {double(c.cycle), double(c.samples), double(c.discrete_added),
                                double(c.continuous_added), c.coverage, c.seconds});
     f.write_dataset("/history", rows, {hsize_t(s.history.size()), 6});
-    f.close();
-  }
-  tmp.commit();
+  });
 }
 
 SamplerState read_sampler_checkpoint(const std::string& path, const std::string& run_text) {
-  const H5File f = H5File::open(path);
-  if (!f.has_attribute("/", "schema") || f.read_string_attribute("/", "schema") != "msfab.gamut.checkpoint")
-    throw InputError(path + ": not a gamut-sampler checkpoint");
-  if (f.read_string_attribute("/", "config") != run_text)
-    throw InputError(path + ": checkpoint was written with a different configuration or seed; delete it or rerun without --resume");
+  const H5File f = open_checkpoint_file(path, "msfab.gamut.checkpoint", "gamut-sampler", run_text);
   SamplerState s;
   s.cycles_done = f.read_attribute<std::int32_t>("/", "cycles_done");
   if (f.has_attribute("/", "push_step")) s.push_step = f.read_attribute<double>("/", "push_step");

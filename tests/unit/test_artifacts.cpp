@@ -18,6 +18,7 @@
 #include "core/version.hpp"
 #include "io/artifact.hpp"
 #include "io/atomic_file.hpp"
+#include "io/checkpoint_file.hpp"
 #include "io/commit_group.hpp"
 #include "io/hdf5_file.hpp"
 #include "io/path_names.hpp"
@@ -521,6 +522,35 @@ TEST_F(ArtifactReaderTest, NonHdf5AndForeignFilesAreInputErrors) {
 
 // Side outputs are named after the --out path's stem: the first listed
 // suffix that matches is dropped, a name that is only the suffix is kept.
+// A checkpoint is read back only by the run that wrote it: another schema
+// or another run text is refused, naming the file; a rewrite leaves no
+// temporary behind.
+TEST_F(ScratchDir, CheckpointIsReadOnlyByTheRunThatWroteIt) {
+  const std::string path = checkpoint_path(file("run.h5"));
+  EXPECT_EQ(path, file("run.h5.checkpoint.h5"));
+  for (int round = 1; round <= 2; ++round)
+    write_checkpoint_file(path, "msfab.test.checkpoint", "config: 1\n# seed 7\n", [&](H5File& f) {
+      f.write_vector("/done", std::vector<double>(round, 1.5));
+    });
+  EXPECT_TRUE(temporaries().empty());
+  const H5File f = open_checkpoint_file(path, "msfab.test.checkpoint", "test", "config: 1\n# seed 7\n");
+  EXPECT_EQ(f.read_vector<double>("/done"), std::vector<double>(2, 1.5));
+  try {
+    open_checkpoint_file(path, "msfab.other.checkpoint", "other-stage", "config: 1\n# seed 7\n");
+    ADD_FAILURE() << "another schema was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": not a other-stage checkpoint");
+  }
+  try {
+    open_checkpoint_file(path, "msfab.test.checkpoint", "test", "config: 1\n# seed 8\n");
+    ADD_FAILURE() << "another run's text was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": checkpoint was written with a different configuration or seed"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(PathNames, SuffixesAreDroppedInOrderAndOnlyWhenSomethingIsLeft) {
   EXPECT_TRUE(ends_with("a/part.vdb", ".vdb"));
   EXPECT_FALSE(ends_with("a/part.vdb.bak", ".vdb"));
