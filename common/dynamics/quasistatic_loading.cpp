@@ -10,6 +10,7 @@
 
 #include "core/errors.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/regularized_step.hpp"
 
 namespace msfab {
 namespace {
@@ -320,26 +321,20 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
         solver.analyze(system);
         analyzed = pattern;
       }
-      double shift = 0;
-      bool ok = false;
-      for (int attempt = 0; attempt < 12 && !ok; ++attempt) {
-        if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
-        if (!solver.factorize(system, shift)) continue;
-        for (int d = 0; d < n; ++d) rhs[d] = held[d] ? 0.0 : -r[d];
-        try {
-          step = solver.solve(rhs);
-        } catch (const NumericalError& e) {
-          spdlog::debug("quasistatic: linear solve failed with shift {:.2e}: {}", shift, e.what());
-          continue;
-        }
-        if (!step.allFinite()) continue;
-        for (int d = 0; d < n; ++d)
-          if (held[d]) step[d] = 0;
-        if (ties) ties->expand(step);
-        ok = g.dot(step) < 0 || free_sq == 0;
-      }
-      rec.shift = shift;
-      if (!ok) {
+      const RegularizedStep regularized = solve_regularized_step(
+          solver, system, diag,
+          [&](double, VecX& b) {
+            for (int d = 0; d < n; ++d) b[d] = held[d] ? 0.0 : -r[d];
+          },
+          [&](VecX& s) {
+            for (int d = 0; d < n; ++d)
+              if (held[d]) s[d] = 0;
+            if (ties) ties->expand(s);
+            return g.dot(s) < 0 || free_sq == 0;
+          },
+          rhs, step, "quasistatic: ");
+      rec.shift = regularized.shift;
+      if (!regularized.ok) {
         result.history.push_back(rec);
         why = "the Newton system could not be solved even with regularization";
         return false;

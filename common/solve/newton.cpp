@@ -8,6 +8,7 @@
 
 #include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "solve/regularized_step.hpp"
 
 namespace msfab {
 namespace {
@@ -187,38 +188,31 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
       // multiple of the identity is added, as interior-point codes do.
       t0 = Clock::now();
       constrain_matrix(K, fixed, diag);
-      double shift = 0;
-      bool ok = false;
-      std::string last_linear_error;
-      for (int attempt = 0; attempt < 12 && !ok; ++attempt) {
-        if (attempt > 0) shift = (shift == 0) ? 1e-8 * diag : shift * 10;
-        if (!solver->factorize(K, shift)) continue;
-        for (int i = 0; i < n; ++i) rhs[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
-        try {
-          dx = solver->solve(rhs);
-        } catch (const NumericalError& e) {
-          // An iterative solver meets indefiniteness only while solving.
-          spdlog::debug("linear solve failed with shift {:.2e}: {}", shift, e.what());
-          last_linear_error = e.what();
-          continue;
-        }
-        if (!dx.allFinite()) continue;
-        double slope = 0;
-        for (int i = 0; i < n; ++i)
-          if (!fixed[i]) slope += g[i] * dx[i];
-        ok = gap_norm > 0 || slope < 0;
-      }
+      const RegularizedStep regularized = solve_regularized_step(
+          *solver, K, diag,
+          [&](double shift, VecX& b) {
+            for (int i = 0; i < n; ++i) b[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
+          },
+          [&](VecX& step) {
+            double slope = 0;
+            for (int i = 0; i < n; ++i)
+              if (!fixed[i]) slope += g[i] * step[i];
+            return gap_norm > 0 || slope < 0;
+          },
+          rhs, dx, "");
+      const double shift = regularized.shift;
       result.timings.solve += seconds_since(t0);
       spdlog::debug("linear solver {}: factorize {:.3f} s, solve {:.3f} s, {} iterations", solver->name(),
                     solver->stats().factorize_seconds, solver->stats().solve_seconds, solver->stats().iterations);
       rec.shift = shift;
       rec.linear_iterations = solver->stats().iterations;
-      if (!ok) {
+      if (!regularized.ok) {
         add_record(rec);
         why = "the Newton system could not be solved even with regularization";
         // A shift does not help an iterative solver that ran out of
         // iterations: say what it reported (e.g. the key of its limit).
-        if (!last_linear_error.empty()) why += "; the linear solver reported: " + last_linear_error;
+        if (!regularized.last_linear_error.empty())
+          why += "; the linear solver reported: " + regularized.last_linear_error;
         return false;
       }
 
