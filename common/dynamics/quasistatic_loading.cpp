@@ -10,6 +10,7 @@
 
 #include "core/errors.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/load_continuation.hpp"
 #include "solve/regularized_step.hpp"
 
 namespace msfab {
@@ -109,6 +110,377 @@ void validate(const ElasticAssembler& assembler, const std::vector<Obstacle>& ob
   if (opt.threads < 0) fail("option threads must be >= 0");
 }
 
+// One quasistatic press: the state (positions, contacts, ties) and the
+// steps of its Newton iteration at a load factor.
+class Press {
+ public:
+  Press(const ElasticAssembler& assembler, const std::vector<Obstacle>& obstacles, const VecX& force, const VecX& x0,
+        const QuasistaticOptions& opt)
+      : assembler_(assembler),
+        obstacles_(obstacles),
+        force_(force),
+        opt_(opt),
+        mesh_(assembler.mesh()),
+        n_(mesh_.num_dofs()),
+        nodes_(mesh_.num_nodes()),
+        X_(assembler.rest_positions()),
+        dx_(characteristic_element_size(mesh_)),
+        max_depth_(opt.penetration_tolerance * dx_),
+        touch_(std::max(opt.touch_tolerance, 1e-12) * dx_),
+        length_scale_((mesh_.bbox_max() - mesh_.bbox_min()).norm()),
+        // A node starting deeper than this behind a face is on its far
+        // side, not touching it (surface_contact.hpp).
+        tie_depth_limit_(0.25 * dx_),
+        active_{std::vector<int>(nodes_, kFree), std::vector<ContactPlane>(nodes_)},
+        g_(n_), g_trial_(n_), rhs_(n_), step_(n_), trial_(n_), r_(n_),
+        fixed_(n_, 0), held_(n_, 0) {
+    result_.characteristic_size = dx_;
+    result_.x = x0.size() == n_ ? x0 : X_;
+  }
+
+  // The contacts at the start, the solver's pattern and the ties.
+  void start();
+  // Newton at load factor s from the current state; true on convergence,
+  // else `why` says what failed.
+  bool newton_at(double s, int load_step, std::string& why);
+
+  struct Saved {
+    VecX q;
+    ActiveSet active;
+    std::vector<SelfContactTie> ties;
+  };
+  Saved save() const { return {result_.x, active_, ties_ ? ties_->ties() : std::vector<SelfContactTie>()}; }
+  void restore(const Saved& saved) {
+    result_.x = saved.q;
+    active_ = saved.active;
+    if (ties_) ties_->assign(saved.ties);
+  }
+
+  const QuasistaticResult& result() const { return result_; }
+  // The result with the reactions of the converged state.
+  QuasistaticResult finish(int load_steps);
+
+ private:
+  // The scales of one iterate: the mean free diagonal stiffness, the
+  // residual's reference and the energy's rounding level.
+  struct Scales {
+    double diag = 1, scale = 0, noise_floor = 0;
+  };
+
+  VecX& q() { return result_.x; }
+  bool tied(int d) const { return ties_ && ties_->is_slave(d / 3); }
+  VecX reduced_gradient(const VecX& grad) const { return ties_ ? ties_->reduce(grad) : grad; }
+  void update_fixed() {
+    for (int i = 0; i < nodes_; ++i) fixed_[3 * i] = fixed_[3 * i + 1] = fixed_[3 * i + 2] = active_.obstacle[i] != kFree;
+  }
+  Scales scales(const VecX& fs) const;
+  int release_pulling_contacts(double scale);
+  double free_residual_squared();
+  RegularizedStep newton_step(double diag, double free_sq);
+  bool line_search(const VecX& fs, double potential, double free_sq, double noise_floor, double& alpha);
+  int project_penetrations();
+
+  const ElasticAssembler& assembler_;
+  const std::vector<Obstacle>& obstacles_;
+  const VecX& force_;
+  const QuasistaticOptions& opt_;
+  const HexMesh& mesh_;
+  const int n_, nodes_;
+  const VecX X_;
+  const double dx_, max_depth_, touch_, length_scale_, tie_depth_limit_;
+
+  QuasistaticResult result_;
+  ActiveSet active_;
+  SpMat K_;
+  std::unique_ptr<CholmodSolver> solver_;
+  std::unique_ptr<SelfContactTies> ties_;
+  int analyzed_ = -1;  // the ties' version whose reduced pattern the solver holds (-1: K's own)
+  VecX g_, g_trial_, rhs_, step_, trial_, r_;
+  std::vector<char> fixed_, held_;
+};
+
+void Press::start() {
+  // Initial active set: every vertex touching an obstacle, the slightly
+  // penetrating ones projected onto the face they are in.
+  for (int i = 0; i < nodes_; ++i) {
+    const Nearest c = nearest_obstacle(obstacles_, q().segment<3>(3 * i));
+    if (c.obstacle == kFree || c.distance > touch_) continue;
+    if (c.distance < -max_depth_) {
+      std::ostringstream msg;
+      msg << "quasistatic loading: initial positions: node " << i << " lies " << -c.distance
+          << " m inside obstacle '" << obstacles_[c.obstacle].name << "' (tolerance " << max_depth_
+          << " m = penetration_tolerance * element size)";
+      throw InputError(msg.str());
+    }
+    if (c.distance < 0) q().segment<3>(3 * i) -= c.distance * c.plane.normal;
+    active_.obstacle[i] = c.obstacle;
+    active_.plane[i] = c.plane;
+  }
+  if (!std::isfinite(assembler_.energy(q())))
+    throw InputError("quasistatic loading: initial positions invert an element (det F <= 0)");
+
+  K_ = assembler_.pattern();
+  LinearSolverOptions linear;
+  linear.threads = opt_.threads;
+  solver_ = std::make_unique<CholmodSolver>(linear);
+  solver_->analyze(K_);
+
+  if (opt_.self_contact) ties_ = std::make_unique<SelfContactTies>(mesh_);
+  // Nodes touching a face at the start are tied from the start, as
+  // vertices touching an obstacle start active.
+  if (ties_) {
+    ties_->activate(q(), q(), touch_, tie_depth_limit_, [&](int node) { return active_.obstacle[node] != kFree; });
+    if (!std::isfinite(assembler_.energy(q())))
+      throw InputError("quasistatic loading: initial positions: putting touching nodes onto faces inverts an element");
+  }
+}
+
+Press::Scales Press::scales(const VecX& fs) const {
+  Scales out;
+  double diag = 0, reaction_sq = 0;
+  int free_dofs = 0;
+  for (int d = 0; d < n_; ++d) {
+    if (fixed_[d] || tied(d)) {
+      reaction_sq += g_[d] * g_[d];
+    } else {
+      diag += std::abs(K_.coeff(d, d));
+      ++free_dofs;
+    }
+  }
+  out.diag = free_dofs ? diag / free_dofs : 1.0;
+  // Rounding level of the energy: a diagonal stiffness entry times dx^2
+  // is about the energy of one element at unit strain.
+  out.noise_floor = 1e-13 * out.diag * dx_ * dx_ * nodes_;
+  out.scale = std::max({fs.norm(), std::sqrt(reaction_sq), 1e-12 * out.diag * length_scale_});
+  return out;
+}
+
+// Releases vertices the obstacle would have to pull on. On an edge or
+// corner the obstacle can push along any face normal there, so a vertex
+// goes only if its reaction pulls away from all of them; the face pushing
+// hardest is the one kept. Ties release the same way.
+int Press::release_pulling_contacts(double scale) {
+  int released = 0;
+  for (int i = 0; i < nodes_; ++i) {
+    if (active_.obstacle[i] == kFree) continue;
+    const Vec3 reaction = g_.segment<3>(3 * i);
+    double push = active_.plane[i].normal.dot(reaction);
+    for (const auto& [o, face] : touching_faces(obstacles_, q().segment<3>(3 * i), touch_)) {
+      const double p = face.normal.dot(reaction);
+      if (p > push) push = p, active_.obstacle[i] = o, active_.plane[i] = face;
+    }
+    if (push < -opt_.relative_tolerance * scale) {
+      active_.obstacle[i] = kFree;
+      ++released;
+    }
+  }
+  if (ties_) released += ties_->release(q(), g_, opt_.relative_tolerance * scale);
+  if (released) update_fixed();
+  return released;
+}
+
+// The gradient on the unknowns that move freely (held: in contact or tied),
+// reduced onto the ties' masters; returns its squared norm.
+double Press::free_residual_squared() {
+  r_ = reduced_gradient(g_);
+  double free_sq = 0;
+  for (int d = 0; d < n_; ++d) {
+    held_[d] = fixed_[d] || tied(d);
+    if (!held_[d]) free_sq += r_[d] * r_[d];
+  }
+  return free_sq;
+}
+
+// The Newton step with the active vertices fixed where they are and the
+// tied ones following their faces; an indefinite Hessian (or a non-descent
+// step) gets a growing shift.
+RegularizedStep Press::newton_step(double diag, double free_sq) {
+  SpMat reduced;
+  SpMat& system = ties_ && !ties_->empty() ? (reduced = ties_->reduce(K_)) : K_;
+  constrain_matrix(system, held_, diag);
+  const int pattern = &system == &K_ ? -1 : ties_->version();
+  if (pattern != analyzed_) {
+    solver_->analyze(system);
+    analyzed_ = pattern;
+  }
+  return solve_regularized_step(
+      *solver_, system, diag,
+      [&](double, VecX& b) {
+        for (int d = 0; d < n_; ++d) b[d] = held_[d] ? 0.0 : -r_[d];
+      },
+      [&](VecX& s) {
+        for (int d = 0; d < n_; ++d)
+          if (held_[d]) s[d] = 0;
+        if (ties_) ties_->expand(s);
+        return g_.dot(s) < 0 || free_sq == 0;
+      },
+      rhs_, step_, "quasistatic: ");
+}
+
+// Projected line search into trial_: halves while a free vertex would go
+// deeper than max_depth into an obstacle, an element would invert, or the
+// potential does not decrease enough.
+bool Press::line_search(const VecX& fs, double potential, double free_sq, double noise_floor, double& alpha) {
+  const double slope = g_.dot(step_);
+  alpha = 1;
+  for (int ls = 0; ls < opt_.max_line_search; ++ls, alpha *= 0.5) {
+    trial_ = q() + alpha * step_;
+    bool too_deep = false;
+    for (int i = 0; i < nodes_ && !too_deep; ++i) {
+      if (active_.obstacle[i] != kFree) continue;
+      for (const Obstacle& o : obstacles_)
+        if (penetrates(o, q().segment<3>(3 * i), trial_.segment<3>(3 * i), max_depth_)) {
+          too_deep = true;
+          break;
+        }
+    }
+    if (too_deep || (ties_ && ties_->penetrates(q(), trial_, max_depth_, tie_depth_limit_))) continue;
+    const double Et = assembler_.energy(trial_);
+    if (!std::isfinite(Et)) continue;
+    const double pt = Et - fs.dot(trial_ - X_);
+    if (pt <= potential + opt_.armijo * alpha * slope) return true;
+    // Close to equilibrium the decrease drowns in the rounding of the
+    // energy sum; there a step that lowers the free residual is taken.
+    if (std::abs(pt - potential) <= noise_floor) {
+      assembler_.evaluate(trial_, &g_trial_, nullptr);
+      g_trial_ -= fs;
+      const VecX r_trial = reduced_gradient(g_trial_);
+      double trial_sq = 0;
+      for (int d = 0; d < n_; ++d)
+        if (!held_[d]) trial_sq += r_trial[d] * r_trial[d];
+      if (trial_sq < free_sq) return true;
+    }
+  }
+  return false;
+}
+
+// Free vertices of trial_ that went into an obstacle: back onto its face,
+// held; free nodes that went behind a face of the mesh: onto it, tied (a
+// tied node follows its face and is left to it). Returns how many.
+int Press::project_penetrations() {
+  int activated = 0;
+  for (int i = 0; i < nodes_; ++i) {
+    if (active_.obstacle[i] != kFree || tied(3 * i)) continue;
+    for (int round = 0; round < 4; ++round) {  // a corner may need one projection per face
+      const Nearest c = nearest_obstacle(obstacles_, trial_.segment<3>(3 * i));
+      if (c.obstacle == kFree || c.distance >= 0) break;
+      trial_.segment<3>(3 * i) -= c.distance * c.plane.normal;
+      if (active_.obstacle[i] == kFree) ++activated;
+      active_.obstacle[i] = c.obstacle;
+      active_.plane[i] = c.plane;
+    }
+  }
+  if (ties_)
+    activated += ties_->activate(q(), trial_, 0.0, tie_depth_limit_,
+                                 [&](int node) { return active_.obstacle[node] != kFree; });
+  return activated;
+}
+
+bool Press::newton_at(double s, int load_step, std::string& why) {
+  const VecX fs = s * force_;
+  int activated = 0;           // free vertices made active after the previous step
+  std::vector<double> recent;  // residuals since the active set last changed
+  // The iteration limit counts Newton iterations at a settled active set:
+  // a contact front that peels or spreads moves by a row of vertices per
+  // iteration, so on a fine mesh the active set alone can take more than
+  // max_iterations updates (the 0.5 mm flipper lifting its base: 60). A
+  // hard cap of kActiveSetRounds times the limit stops a cycling set.
+  int last_change = 0;
+  const int hard_cap = kActiveSetRounds * opt_.max_iterations;
+  for (int it = 0;; ++it) {
+    const double E = assembler_.evaluate(q(), &g_, &K_);
+    if (!std::isfinite(E)) {
+      why = "the configuration is inverted (an element has det F <= 0)";
+      return false;
+    }
+    g_ -= fs;  // gradient of the total potential; at an active vertex the reaction
+    const double potential = E - fs.dot(q() - X_);
+    update_fixed();
+    const Scales sc = scales(fs);
+    const int released = release_pulling_contacts(sc.scale);
+    const double free_sq = free_residual_squared();
+
+    QuasistaticIteration rec;
+    rec.load_step = load_step;
+    rec.load_factor = s;
+    rec.iteration = it;
+    rec.residual = std::sqrt(free_sq) / sc.scale;
+    rec.energy = potential;
+    rec.active = active_.count() + (ties_ ? static_cast<int>(ties_->ties().size()) : 0);
+    rec.released = released;
+    // Converged at the tolerance, or at the round-off floor: with the
+    // active set settled, a residual within 1000x the tolerance that has
+    // not fallen by 10% over the last 5 iterations (a small load
+    // increment on a fine mesh stalls near 1e-7 of its own force).
+    recent.push_back(rec.residual);
+    const size_t c = recent.size();
+    const bool stalled = c > 5 && rec.residual <= 1e3 * opt_.relative_tolerance && rec.residual > 0.9 * recent[c - 6];
+    if (released == 0 && activated == 0 && (rec.residual <= opt_.relative_tolerance || stalled)) {
+      result_.history.push_back(rec);
+      return true;
+    }
+    if (released || activated) {
+      recent.clear();
+      last_change = it;
+    }
+    if (it - last_change == opt_.max_iterations || it == hard_cap) {
+      result_.history.push_back(rec);
+      why = "no convergence in " + std::to_string(it) + " iterations (" + std::to_string(it - last_change) +
+            " since the active set last changed; limits " + std::to_string(opt_.max_iterations) + " and " +
+            std::to_string(hard_cap) + ")";
+      return false;
+    }
+
+    const RegularizedStep regularized = newton_step(sc.diag, free_sq);
+    rec.shift = regularized.shift;
+    if (!regularized.ok) {
+      result_.history.push_back(rec);
+      why = "the Newton system could not be solved even with regularization";
+      return false;
+    }
+    double alpha = 1;
+    if (!line_search(fs, potential, free_sq, sc.noise_floor, alpha)) {
+      result_.history.push_back(rec);
+      why = "the projected line search found no admissible decrease";
+      return false;
+    }
+    activated = project_penetrations();
+    if (activated && !std::isfinite(assembler_.energy(trial_))) {
+      result_.history.push_back(rec);
+      why = "projecting penetrating vertices onto the obstacles (or faces) inverted an element";
+      return false;
+    }
+    rec.step_length = alpha;
+    rec.activated = activated;
+    result_.history.push_back(rec);
+    spdlog::debug("quasistatic load {:.4f} iter {:2d} residual {:.3e} alpha {:.3g} active {} (-{} +{})", s, it,
+                  rec.residual, alpha, rec.active, released, activated);
+    q() = trial_;
+    ++result_.iterations;
+  }
+  return false;
+}
+
+QuasistaticResult Press::finish(int load_steps) {
+  // Reactions from the converged state (g was evaluated there last).
+  result_.load_steps = load_steps;
+  result_.elastic_energy = assembler_.energy(q());
+  for (int i = 0; i < nodes_; ++i) {
+    if (active_.obstacle[i] == kFree) continue;
+    ContactVertex c;
+    c.node = i;
+    c.obstacle = active_.obstacle[i];
+    c.plane = active_.plane[i];
+    c.reaction = g_.segment<3>(3 * i);
+    result_.contacts.push_back(c);
+  }
+  if (ties_) {
+    ties_->record_reactions(g_);
+    result_.self_contacts = ties_->ties();
+  }
+  return result_;
+}
+
 }  // namespace
 
 double characteristic_element_size(const HexMesh& mesh) {
@@ -154,320 +526,29 @@ std::string format_quasistatic_history(const std::vector<QuasistaticIteration>& 
 QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, const std::vector<Obstacle>& obstacles,
                                             const VecX& force, const VecX& x0, const QuasistaticOptions& opt) {
   validate(assembler, obstacles, force, x0, opt);
-  const HexMesh& mesh = assembler.mesh();
-  const int n = mesh.num_dofs(), nodes = mesh.num_nodes();
-  const VecX X = assembler.rest_positions();
-  const double dx = characteristic_element_size(mesh);
-  const double max_depth = opt.penetration_tolerance * dx;
-  const double touch = std::max(opt.touch_tolerance, 1e-12) * dx;
-  const double length_scale = (mesh.bbox_max() - mesh.bbox_min()).norm();
-
-  QuasistaticResult result;
-  result.characteristic_size = dx;
-  VecX& q = result.x;
-  q = x0.size() == n ? x0 : X;
-
-  // Initial active set: every vertex touching an obstacle, the slightly
-  // penetrating ones projected onto the face they are in.
-  ActiveSet active{std::vector<int>(nodes, kFree), std::vector<ContactPlane>(nodes)};
-  for (int i = 0; i < nodes; ++i) {
-    const Nearest c = nearest_obstacle(obstacles, q.segment<3>(3 * i));
-    if (c.obstacle == kFree || c.distance > touch) continue;
-    if (c.distance < -max_depth) {
-      std::ostringstream msg;
-      msg << "quasistatic loading: initial positions: node " << i << " lies " << -c.distance
-          << " m inside obstacle '" << obstacles[c.obstacle].name << "' (tolerance " << max_depth
-          << " m = penetration_tolerance * element size)";
-      throw InputError(msg.str());
-    }
-    if (c.distance < 0) q.segment<3>(3 * i) -= c.distance * c.plane.normal;
-    active.obstacle[i] = c.obstacle;
-    active.plane[i] = c.plane;
-  }
-  if (!std::isfinite(assembler.energy(q)))
-    throw InputError("quasistatic loading: initial positions invert an element (det F <= 0)");
-
-  SpMat K = assembler.pattern();
-  LinearSolverOptions linear;
-  linear.threads = opt.threads;
-  CholmodSolver solver(linear);
-  solver.analyze(K);
-
-  std::unique_ptr<SelfContactTies> ties;
-  if (opt.self_contact) ties = std::make_unique<SelfContactTies>(mesh);
-  // A node starting deeper than this behind a face is on its far side, not
-  // touching it (surface_contact.hpp).
-  const double tie_depth_limit = 0.25 * dx;
-  int analyzed = -1;  // the ties' version whose reduced pattern the solver holds (-1: K's own)
-  auto tied = [&](int d) { return ties && ties->is_slave(d / 3); };
-  auto reduced_gradient = [&](const VecX& grad) { return ties ? ties->reduce(grad) : grad; };
-  // Nodes touching a face at the start are tied from the start, as
-  // vertices touching an obstacle start active.
-  if (ties) {
-    ties->activate(q, q, touch, tie_depth_limit, [&](int node) { return active.obstacle[node] != kFree; });
-    if (!std::isfinite(assembler.energy(q)))
-      throw InputError("quasistatic loading: initial positions: putting touching nodes onto faces inverts an element");
-  }
-
-  VecX g(n), g_trial(n), rhs(n), step(n), trial(n), r(n);
-  std::vector<char> fixed(n, 0), held(n, 0);
-  auto update_fixed = [&]() {
-    for (int i = 0; i < nodes; ++i) fixed[3 * i] = fixed[3 * i + 1] = fixed[3 * i + 2] = active.obstacle[i] != kFree;
-  };
-
-  // Newton at load factor s from the current state; true on convergence.
-  auto newton_at = [&](double s, int load_step, std::string& why) -> bool {
-    const VecX fs = s * force;
-    int activated = 0;  // free vertices made active after the previous step
-    std::vector<double> recent;  // residuals since the active set last changed
-    // The iteration limit counts Newton iterations at a settled active set:
-    // a contact front that peels or spreads moves by a row of vertices per
-    // iteration, so on a fine mesh the active set alone can take more than
-    // max_iterations updates (the 0.5 mm flipper lifting its base: 60). A
-    // hard cap of kActiveSetRounds times the limit stops a cycling set.
-    int last_change = 0;
-    const int hard_cap = kActiveSetRounds * opt.max_iterations;
-    for (int it = 0;; ++it) {
-      const double E = assembler.evaluate(q, &g, &K);
-      if (!std::isfinite(E)) {
-        why = "the configuration is inverted (an element has det F <= 0)";
-        return false;
-      }
-      g -= fs;  // gradient of the total potential; at an active vertex the reaction
-      const double potential = E - fs.dot(q - X);
-      update_fixed();
-      double diag = 0, reaction_sq = 0;
-      int free_dofs = 0;
-      for (int d = 0; d < n; ++d) {
-        if (fixed[d] || tied(d)) {
-          reaction_sq += g[d] * g[d];
-        } else {
-          diag += std::abs(K.coeff(d, d));
-          ++free_dofs;
-        }
-      }
-      diag = free_dofs ? diag / free_dofs : 1.0;
-      // Rounding level of the energy: a diagonal stiffness entry times dx^2
-      // is about the energy of one element at unit strain.
-      const double noise_floor = 1e-13 * diag * dx * dx * nodes;
-      const double scale = std::max({fs.norm(), std::sqrt(reaction_sq), 1e-12 * diag * length_scale});
-
-      // Release vertices the obstacle would have to pull on. On an edge or
-      // corner the obstacle can push along any face normal there, so a
-      // vertex goes only if its reaction pulls away from all of them; the
-      // face pushing hardest is the one reported.
-      int released = 0;
-      for (int i = 0; i < nodes; ++i) {
-        if (active.obstacle[i] == kFree) continue;
-        const Vec3 reaction = g.segment<3>(3 * i);
-        double push = active.plane[i].normal.dot(reaction);
-        for (const auto& [o, face] : touching_faces(obstacles, q.segment<3>(3 * i), touch)) {
-          const double p = face.normal.dot(reaction);
-          if (p > push) push = p, active.obstacle[i] = o, active.plane[i] = face;
-        }
-        if (push < -opt.relative_tolerance * scale) {
-          active.obstacle[i] = kFree;
-          ++released;
-        }
-      }
-      if (ties) released += ties->release(q, g, opt.relative_tolerance * scale);
-      if (released) update_fixed();
-      r = reduced_gradient(g);
-      double free_sq = 0;
-      for (int d = 0; d < n; ++d) {
-        held[d] = fixed[d] || tied(d);
-        if (!held[d]) free_sq += r[d] * r[d];
-      }
-
-      QuasistaticIteration rec;
-      rec.load_step = load_step;
-      rec.load_factor = s;
-      rec.iteration = it;
-      rec.residual = std::sqrt(free_sq) / scale;
-      rec.energy = potential;
-      rec.active = active.count() + (ties ? static_cast<int>(ties->ties().size()) : 0);
-      rec.released = released;
-      // Converged at the tolerance, or at the round-off floor: with the
-      // active set settled, a residual within 1000x the tolerance that has
-      // not fallen by 10% over the last 5 iterations (a small load
-      // increment on a fine mesh stalls near 1e-7 of its own force).
-      recent.push_back(rec.residual);
-      const size_t c = recent.size();
-      const bool stalled = c > 5 && rec.residual <= 1e3 * opt.relative_tolerance && rec.residual > 0.9 * recent[c - 6];
-      if (released == 0 && activated == 0 && (rec.residual <= opt.relative_tolerance || stalled)) {
-        result.history.push_back(rec);
-        return true;
-      }
-      if (released || activated) {
-        recent.clear();
-        last_change = it;
-      }
-      if (it - last_change == opt.max_iterations || it == hard_cap) {
-        result.history.push_back(rec);
-        why = "no convergence in " + std::to_string(it) + " iterations (" + std::to_string(it - last_change) +
-              " since the active set last changed; limits " + std::to_string(opt.max_iterations) + " and " +
-              std::to_string(hard_cap) + ")";
-        return false;
-      }
-
-      // Newton step with the active vertices fixed where they are and the
-      // tied ones following their faces; an indefinite Hessian (or a
-      // non-descent step) gets a growing shift.
-      SpMat reduced;
-      SpMat& system = ties && !ties->empty() ? (reduced = ties->reduce(K)) : K;
-      constrain_matrix(system, held, diag);
-      const int pattern = &system == &K ? -1 : ties->version();
-      if (pattern != analyzed) {
-        solver.analyze(system);
-        analyzed = pattern;
-      }
-      const RegularizedStep regularized = solve_regularized_step(
-          solver, system, diag,
-          [&](double, VecX& b) {
-            for (int d = 0; d < n; ++d) b[d] = held[d] ? 0.0 : -r[d];
-          },
-          [&](VecX& s) {
-            for (int d = 0; d < n; ++d)
-              if (held[d]) s[d] = 0;
-            if (ties) ties->expand(s);
-            return g.dot(s) < 0 || free_sq == 0;
-          },
-          rhs, step, "quasistatic: ");
-      rec.shift = regularized.shift;
-      if (!regularized.ok) {
-        result.history.push_back(rec);
-        why = "the Newton system could not be solved even with regularization";
-        return false;
-      }
-
-      // Projected line search: halve while a free vertex would go deeper
-      // than max_depth into an obstacle, an element would invert, or the
-      // potential does not decrease enough.
-      const double slope = g.dot(step);
-      double alpha = 1;
-      bool accepted = false;
-      for (int ls = 0; ls < opt.max_line_search; ++ls, alpha *= 0.5) {
-        trial = q + alpha * step;
-        bool too_deep = false;
-        for (int i = 0; i < nodes && !too_deep; ++i) {
-          if (active.obstacle[i] != kFree) continue;
-          for (const Obstacle& o : obstacles)
-            if (penetrates(o, q.segment<3>(3 * i), trial.segment<3>(3 * i), max_depth)) {
-              too_deep = true;
-              break;
-            }
-        }
-        if (too_deep || (ties && ties->penetrates(q, trial, max_depth, tie_depth_limit))) continue;
-        const double Et = assembler.energy(trial);
-        if (!std::isfinite(Et)) continue;
-        const double pt = Et - fs.dot(trial - X);
-        if (pt <= potential + opt.armijo * alpha * slope) {
-          accepted = true;
-          break;
-        }
-        // Close to equilibrium the decrease drowns in the rounding of the
-        // energy sum; there a step that lowers the free residual is taken.
-        if (std::abs(pt - potential) <= noise_floor) {
-          assembler.evaluate(trial, &g_trial, nullptr);
-          g_trial -= fs;
-          const VecX r_trial = reduced_gradient(g_trial);
-          double trial_sq = 0;
-          for (int d = 0; d < n; ++d)
-            if (!held[d]) trial_sq += r_trial[d] * r_trial[d];
-          if (trial_sq < free_sq) {
-            accepted = true;
-            break;
-          }
-        }
-      }
-      if (!accepted) {
-        result.history.push_back(rec);
-        why = "the projected line search found no admissible decrease";
-        return false;
-      }
-
-      // Free vertices that went into an obstacle: back onto its face, held.
-      // (A tied node follows its face and is left to it.)
-      activated = 0;
-      for (int i = 0; i < nodes; ++i) {
-        if (active.obstacle[i] != kFree || tied(3 * i)) continue;
-        for (int round = 0; round < 4; ++round) {  // a corner may need one projection per face
-          const Nearest c = nearest_obstacle(obstacles, trial.segment<3>(3 * i));
-          if (c.obstacle == kFree || c.distance >= 0) break;
-          trial.segment<3>(3 * i) -= c.distance * c.plane.normal;
-          if (active.obstacle[i] == kFree) ++activated;
-          active.obstacle[i] = c.obstacle;
-          active.plane[i] = c.plane;
-        }
-      }
-      // Free nodes that went behind a face of the mesh: onto it, tied.
-      if (ties)
-        activated += ties->activate(q, trial, 0.0, tie_depth_limit, [&](int node) { return active.obstacle[node] != kFree; });
-      if (activated && !std::isfinite(assembler.energy(trial))) {
-        result.history.push_back(rec);
-        why = "projecting penetrating vertices onto the obstacles (or faces) inverted an element";
-        return false;
-      }
-      rec.step_length = alpha;
-      rec.activated = activated;
-      result.history.push_back(rec);
-      spdlog::debug("quasistatic load {:.4f} iter {:2d} residual {:.3e} alpha {:.3g} active {} (-{} +{})", s, it,
-                    rec.residual, alpha, rec.active, released, activated);
-      q = trial;
-      ++result.iterations;
-    }
-    return false;
-  };
+  Press press(assembler, obstacles, force, x0, opt);
+  press.start();
 
   // Load continuation with adaptive halving of failing increments.
-  const int steps = opt.load_steps;
-  double s_done = 0, ds = 1.0 / steps;
-  int halvings = 0, load_step = 0;
-  while (s_done < 1.0 - 1e-12) {
-    const double s = std::min(1.0, s_done + ds);
-    const VecX q_saved = q;
-    const ActiveSet active_saved = active;
-    const std::vector<SelfContactTie> ties_saved = ties ? ties->ties() : std::vector<SelfContactTie>();
-    std::string why;
-    ++load_step;
-    if (newton_at(s, load_step, why)) {
-      s_done = s;
-      if (halvings > 0) ds = std::min(2 * ds, 1.0 / steps);
-      halvings = 0;
-      continue;
-    }
-    q = q_saved;
-    active = active_saved;
-    if (ties) ties->assign(ties_saved);
-    if (halvings >= opt.max_step_halvings) {
-      std::ostringstream msg;
-      msg << "quasistatic loading failed at load factor " << s << " after " << halvings
-          << " load-step halvings: " << why << "\n"
-          << format_quasistatic_history(result.history);
-      throw NumericalError(msg.str());
-    }
+  Press::Saved saved;
+  LoadContinuation continuation;
+  continuation.steps = opt.load_steps;
+  continuation.max_halvings = opt.max_step_halvings;
+  continuation.solve_at = [&](double s, int load_step, std::string& why) { return press.newton_at(s, load_step, why); };
+  continuation.save = [&] { saved = press.save(); };
+  continuation.restore = [&] { press.restore(saved); };
+  continuation.on_halving = [](double s, const std::string& why) {
     spdlog::debug("quasistatic load factor {:.4f} failed ({}); halving the increment", s, why);
-    ds *= 0.5;
-    ++halvings;
+  };
+  const LoadContinuationResult loaded = continue_load(continuation);
+  if (!loaded.converged) {
+    std::ostringstream msg;
+    msg << "quasistatic loading failed at load factor " << loaded.failed_at << " after " << loaded.halvings
+        << " load-step halvings: " << loaded.why << "\n"
+        << format_quasistatic_history(press.result().history);
+    throw NumericalError(msg.str());
   }
-
-  // Reactions from the converged state (g was evaluated there last).
-  result.load_steps = load_step;
-  result.elastic_energy = assembler.energy(q);
-  for (int i = 0; i < nodes; ++i) {
-    if (active.obstacle[i] == kFree) continue;
-    ContactVertex c;
-    c.node = i;
-    c.obstacle = active.obstacle[i];
-    c.plane = active.plane[i];
-    c.reaction = g.segment<3>(3 * i);
-    result.contacts.push_back(c);
-  }
-  if (ties) {
-    ties->record_reactions(g);
-    result.self_contacts = ties->ties();
-  }
-  return result;
+  return press.finish(loaded.load_steps);
 }
 
 }  // namespace msfab

@@ -4,10 +4,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <sstream>
 
 #include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "solve/load_continuation.hpp"
 #include "solve/regularized_step.hpp"
 
 namespace msfab {
@@ -77,236 +79,273 @@ double static_solve_peak_bytes(double elements, double dofs, const NewtonOptions
                                                           : assembled;
 }
 
+namespace {
+
+// Newton's method on one static problem (thesis Algorithm 1): the solver,
+// work vectors and the iteration at one load factor.
+class StaticNewton {
+ public:
+  StaticNewton(const ElasticAssembler& assembler, const DirichletConditions& dirichlet, const VecX& force,
+               const NewtonOptions& options, NewtonResult& result)
+      : assembler_(assembler),
+        dirichlet_(dirichlet),
+        fixed_(dirichlet.fixed),
+        force_(force),
+        options_(options),
+        result_(result),
+        n_(assembler.num_dofs()),
+        X_(assembler.rest_positions()),
+        length_scale_((assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm()),
+        K_(assembler.pattern()),
+        g_(n_), gap_(n_), rhs_(n_), dx_(n_), Kgap_(n_), g_trial_(n_), trial_(n_) {
+    LinearSolverOptions linear = options.linear;
+    const std::string solver_name = static_linear_solver(n_, options);
+    if (solver_name == "pcg-mg" && !linear.node_positions)
+      linear.node_positions = std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
+    solver_ = make_linear_solver(solver_name, linear);
+    spdlog::debug("linear solver: {}", solver_->name());
+    const auto t0 = Clock::now();
+    solver_->analyze(K_);
+    result_.timings.solve += seconds_since(t0);
+  }
+
+  // Runs Newton at load factor s from result.x; true on convergence, else
+  // `why` says what failed.
+  bool at(double s, int step, std::string& why);
+
+ private:
+  struct LineSearch {
+    bool accepted = false;
+    double alpha = 1;
+    bool round_off_step = false;  // a full step where energy differences are noise
+  };
+  LineSearch line_search(const VecX& fs, double potential, double gap_norm, double scale);
+
+  double free_norm(const VecX& v) const {
+    double s = 0;
+    for (int i = 0; i < n_; ++i)
+      if (!fixed_[i]) s += v[i] * v[i];
+    return std::sqrt(s);
+  }
+  double fixed_norm(const VecX& v) const {
+    double s = 0;
+    for (int i = 0; i < n_; ++i)
+      if (fixed_[i]) s += v[i] * v[i];
+    return std::sqrt(s);
+  }
+  // Every iteration's record goes to the history and to the caller's hook.
+  void add_record(const NewtonIteration& rec) {
+    result_.history.push_back(rec);
+    if (options_.on_iteration) options_.on_iteration(rec);
+  }
+
+  const ElasticAssembler& assembler_;
+  const DirichletConditions& dirichlet_;
+  const std::vector<char>& fixed_;
+  const VecX& force_;
+  const NewtonOptions& options_;
+  NewtonResult& result_;
+  const int n_;
+  const VecX X_;
+  const double length_scale_;
+  SpMat K_;
+  std::unique_ptr<LinearSolver> solver_;
+  VecX g_, gap_, rhs_, dx_, Kgap_, g_trial_, trial_;
+};
+
+// Backtracking line search on the total potential (Armijo) into trial_; an
+// inverted state has +inf energy and is always rejected. While the
+// prescribed gap is still open the potential may rise, so only feasibility
+// is required.
+//
+// Near equilibrium the decrease asked for falls below the round-off of the
+// potential itself: the elastic energy is a sum of first-order terms
+// (I1 - 3 against ln J) that cancel to second order, so its absolute error
+// is ~eps x force x length while the decrease is ~residual^2. Armijo on the
+// energy alone then rejects every step (a Neo-Hookean cantilever under a
+// tiny tip load stalled for 54 iterations). When the change of the
+// potential is within that round-off, the decrease is measured by the
+// directional derivative, which has no such cancellation: the trapezoid
+// estimate alpha/2 (g.dx + g_trial.dx), exact for a quadratic potential,
+// must meet the same Armijo condition.
+StaticNewton::LineSearch StaticNewton::line_search(const VecX& fs, double potential, double gap_norm, double scale) {
+  double slope = 0;
+  for (int i = 0; i < n_; ++i)
+    if (!fixed_[i]) slope += g_[i] * dx_[i];
+  const double energy_round_off = kEnergyRoundOff * scale * length_scale_;
+  LineSearch out;
+  for (int ls = 0; ls < options_.max_line_search; ++ls, out.alpha *= 0.5) {
+    trial_ = result_.x + out.alpha * dx_;
+    const double Et = assembler_.energy(trial_);
+    if (!std::isfinite(Et)) continue;
+    const double pt = Et - fs.dot(trial_ - X_);
+    const bool within_round_off = std::abs(pt - potential) <= energy_round_off;
+    out.accepted = gap_norm > 0 || pt <= potential + options_.armijo * out.alpha * slope;
+    if (!out.accepted && within_round_off) {
+      assembler_.evaluate(trial_, &g_trial_, nullptr);
+      double slope_trial = 0;
+      for (int i = 0; i < n_; ++i)
+        if (!fixed_[i]) slope_trial += (g_trial_[i] - fs[i]) * dx_[i];
+      out.accepted = 0.5 * (slope + slope_trial) <= options_.armijo * slope;
+    }
+    out.round_off_step = out.accepted && out.alpha == 1.0 && within_round_off && gap_norm == 0;
+    if (out.accepted) break;
+  }
+  return out;
+}
+
+bool StaticNewton::at(double s, int step, std::string& why) {
+  const VecX fs = s * force_;
+  VecX target = X_ + s * dirichlet_.displacement;
+  double stiffness_scale = 0;
+  // Round-off floor: consecutive full steps taken where energy differences
+  // are noise (see the line search) that no longer halve the residual.
+  double previous_residual = 0;
+  bool round_off_step = false;
+  int stagnant_steps = 0;
+  for (int it = 0; it <= options_.max_iterations; ++it) {
+    auto t0 = Clock::now();
+    const double E = assembler_.evaluate(result_.x, &g_, &K_);
+    if (!std::isfinite(E)) {
+      why = "the configuration is inverted (an element has det F <= 0)";
+      return false;
+    }
+    g_ -= fs;
+    const double potential = E - fs.dot(result_.x - X_);
+    gap_.setZero();
+    for (int i = 0; i < n_; ++i)
+      if (fixed_[i]) gap_[i] = target[i] - result_.x[i];
+    const double gap_norm = gap_.norm();
+    if (gap_norm > 0) Kgap_ = K_ * gap_;
+    const double diag = mean_free_diagonal(K_, fixed_);
+    if (stiffness_scale == 0) stiffness_scale = diag;
+    // Force scale: applied loads and the reactions at prescribed DOFs.
+    const double scale = std::max({fs.norm(), fixed_norm(g_), 1e-12 * stiffness_scale * length_scale_});
+    const double residual = free_norm(g_) / scale;
+    result_.timings.assembly += seconds_since(t0);
+
+    NewtonIteration rec;
+    rec.load_step = step;
+    rec.load_factor = s;
+    rec.iteration = it;
+    rec.residual = residual;
+    rec.energy = potential;
+    const bool gap_closed = gap_norm <= 1e-12 * length_scale_;
+    stagnant_steps = (round_off_step && residual > 0.5 * previous_residual) ? stagnant_steps + 1 : 0;
+    previous_residual = residual;
+    if (gap_closed && residual <= options_.relative_tolerance) {
+      add_record(rec);
+      return true;
+    }
+    // The gradient has a round-off floor too (positions are the unknowns,
+    // so strains come from F - I): a tolerance below it cannot be met.
+    // Two full Newton steps in the round-off regime of the energy that do
+    // not halve the residual mean the floor is reached; that is the
+    // solution, and more iterations only redraw the noise.
+    if (gap_closed && stagnant_steps >= 2) {
+      add_record(rec);
+      spdlog::warn("Newton: the residual stagnates at {:.2e}, the round-off level of this problem, above the "
+                   "tolerance {:.1e}; accepted as converged",
+                   residual, options_.relative_tolerance);
+      return true;
+    }
+    if (it == options_.max_iterations) {
+      add_record(rec);
+      why = "no convergence in " + std::to_string(options_.max_iterations) + " iterations";
+      return false;
+    }
+
+    // Newton step with inertia regularization: if the Hessian is not
+    // positive definite (or the step is not a descent direction) a growing
+    // multiple of the identity is added, as interior-point codes do.
+    t0 = Clock::now();
+    constrain_matrix(K_, fixed_, diag);
+    const RegularizedStep regularized = solve_regularized_step(
+        *solver_, K_, diag,
+        [&](double shift, VecX& b) {
+          for (int i = 0; i < n_; ++i) b[i] = fixed_[i] ? (diag + shift) * gap_[i] : -g_[i] - (gap_norm > 0 ? Kgap_[i] : 0.0);
+        },
+        [&](VecX& candidate) {
+          double slope = 0;
+          for (int i = 0; i < n_; ++i)
+            if (!fixed_[i]) slope += g_[i] * candidate[i];
+          return gap_norm > 0 || slope < 0;
+        },
+        rhs_, dx_, "");
+    const double shift = regularized.shift;
+    result_.timings.solve += seconds_since(t0);
+    spdlog::debug("linear solver {}: factorize {:.3f} s, solve {:.3f} s, {} iterations", solver_->name(),
+                  solver_->stats().factorize_seconds, solver_->stats().solve_seconds, solver_->stats().iterations);
+    rec.shift = shift;
+    rec.linear_iterations = solver_->stats().iterations;
+    if (!regularized.ok) {
+      add_record(rec);
+      why = "the Newton system could not be solved even with regularization";
+      // A shift does not help an iterative solver that ran out of
+      // iterations: say what it reported (e.g. the key of its limit).
+      if (!regularized.last_linear_error.empty())
+        why += "; the linear solver reported: " + regularized.last_linear_error;
+      return false;
+    }
+
+    t0 = Clock::now();
+    const LineSearch searched = line_search(fs, potential, gap_norm, scale);
+    round_off_step = searched.round_off_step;
+    const bool accepted = searched.accepted;
+    const double alpha = searched.alpha;
+    result_.timings.line_search += seconds_since(t0);
+    rec.step_length = accepted ? alpha : 0;
+    add_record(rec);
+    spdlog::debug("newton load {:.4f} iter {:2d} residual {:.3e} energy {:.6e} alpha {:.3g} shift {:.2e}", s, it,
+                  residual, potential, rec.step_length, shift);
+    if (!accepted) {
+      why = "line search failed to find a decrease";
+      return false;
+    }
+    result_.x = trial_;
+    ++result_.iterations;
+  }
+  return false;
+}
+
+
+}  // namespace
+
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                           const VecX& force, const NewtonOptions& options, const VecX& x0) {
   const auto t_start = Clock::now();
   const int n = assembler.num_dofs();
-  const VecX X = assembler.rest_positions();
-  const std::vector<char>& fixed = dirichlet.fixed;
-  if (static_cast<int>(fixed.size()) != n || dirichlet.displacement.size() != n || force.size() != n)
+  if (static_cast<int>(dirichlet.fixed.size()) != n || dirichlet.displacement.size() != n || force.size() != n)
     throw std::invalid_argument("solve_static: DOF vectors do not match the mesh");
 
   NewtonResult result;
-  result.x = x0.size() == n ? x0 : X;
-  SpMat K = assembler.pattern();
-  LinearSolverOptions linear = options.linear;
-  const std::string solver_name = static_linear_solver(n, options);
-  if (solver_name == "pcg-mg" && !linear.node_positions)
-    linear.node_positions = std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
-  auto solver = make_linear_solver(solver_name, linear);
-  spdlog::debug("linear solver: {}", solver->name());
-  {
-    const auto t0 = Clock::now();
-    solver->analyze(K);
-    result.timings.solve += seconds_since(t0);
-  }
-  VecX g(n), gap(n), rhs(n), dx(n), Kgap(n), g_trial(n);
-  auto free_norm = [&](const VecX& v) {
-    double s = 0;
-    for (int i = 0; i < n; ++i)
-      if (!fixed[i]) s += v[i] * v[i];
-    return std::sqrt(s);
-  };
-  auto fixed_norm = [&](const VecX& v) {
-    double s = 0;
-    for (int i = 0; i < n; ++i)
-      if (fixed[i]) s += v[i] * v[i];
-    return std::sqrt(s);
-  };
-  const double length_scale = (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm();
-
-  // Every iteration's record goes to the history and to the caller's hook.
-  auto add_record = [&](const NewtonIteration& rec) {
-    result.history.push_back(rec);
-    if (options.on_iteration) options.on_iteration(rec);
-  };
-
-  // Runs Newton at one load factor from result.x; returns true on convergence.
-  auto newton_at = [&](double s, int step, std::string& why) -> bool {
-    const VecX fs = s * force;
-    VecX target = X + s * dirichlet.displacement;
-    double stiffness_scale = 0;
-    // Round-off floor: consecutive full steps taken where energy differences
-    // are noise (see the line search) that no longer halve the residual.
-    double previous_residual = 0;
-    bool round_off_step = false;
-    int stagnant_steps = 0;
-    for (int it = 0; it <= options.max_iterations; ++it) {
-      auto t0 = Clock::now();
-      const double E = assembler.evaluate(result.x, &g, &K);
-      if (!std::isfinite(E)) {
-        why = "the configuration is inverted (an element has det F <= 0)";
-        return false;
-      }
-      g -= fs;
-      const double potential = E - fs.dot(result.x - X);
-      gap.setZero();
-      for (int i = 0; i < n; ++i)
-        if (fixed[i]) gap[i] = target[i] - result.x[i];
-      const double gap_norm = gap.norm();
-      if (gap_norm > 0) Kgap = K * gap;
-      const double diag = mean_free_diagonal(K, fixed);
-      if (stiffness_scale == 0) stiffness_scale = diag;
-      // Force scale: applied loads and the reactions at prescribed DOFs.
-      const double scale = std::max({fs.norm(), fixed_norm(g), 1e-12 * stiffness_scale * length_scale});
-      const double residual = free_norm(g) / scale;
-      result.timings.assembly += seconds_since(t0);
-
-      NewtonIteration rec;
-      rec.load_step = step;
-      rec.load_factor = s;
-      rec.iteration = it;
-      rec.residual = residual;
-      rec.energy = potential;
-      const bool gap_closed = gap_norm <= 1e-12 * length_scale;
-      stagnant_steps = (round_off_step && residual > 0.5 * previous_residual) ? stagnant_steps + 1 : 0;
-      previous_residual = residual;
-      if (gap_closed && residual <= options.relative_tolerance) {
-        add_record(rec);
-        return true;
-      }
-      // The gradient has a round-off floor too (positions are the unknowns,
-      // so strains come from F - I): a tolerance below it cannot be met.
-      // Two full Newton steps in the round-off regime of the energy that do
-      // not halve the residual mean the floor is reached; that is the
-      // solution, and more iterations only redraw the noise.
-      if (gap_closed && stagnant_steps >= 2) {
-        add_record(rec);
-        spdlog::warn("Newton: the residual stagnates at {:.2e}, the round-off level of this problem, above the "
-                     "tolerance {:.1e}; accepted as converged",
-                     residual, options.relative_tolerance);
-        return true;
-      }
-      if (it == options.max_iterations) {
-        add_record(rec);
-        why = "no convergence in " + std::to_string(options.max_iterations) + " iterations";
-        return false;
-      }
-
-      // Newton step with inertia regularization: if the Hessian is not
-      // positive definite (or the step is not a descent direction) a growing
-      // multiple of the identity is added, as interior-point codes do.
-      t0 = Clock::now();
-      constrain_matrix(K, fixed, diag);
-      const RegularizedStep regularized = solve_regularized_step(
-          *solver, K, diag,
-          [&](double shift, VecX& b) {
-            for (int i = 0; i < n; ++i) b[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
-          },
-          [&](VecX& step) {
-            double slope = 0;
-            for (int i = 0; i < n; ++i)
-              if (!fixed[i]) slope += g[i] * step[i];
-            return gap_norm > 0 || slope < 0;
-          },
-          rhs, dx, "");
-      const double shift = regularized.shift;
-      result.timings.solve += seconds_since(t0);
-      spdlog::debug("linear solver {}: factorize {:.3f} s, solve {:.3f} s, {} iterations", solver->name(),
-                    solver->stats().factorize_seconds, solver->stats().solve_seconds, solver->stats().iterations);
-      rec.shift = shift;
-      rec.linear_iterations = solver->stats().iterations;
-      if (!regularized.ok) {
-        add_record(rec);
-        why = "the Newton system could not be solved even with regularization";
-        // A shift does not help an iterative solver that ran out of
-        // iterations: say what it reported (e.g. the key of its limit).
-        if (!regularized.last_linear_error.empty())
-          why += "; the linear solver reported: " + regularized.last_linear_error;
-        return false;
-      }
-
-      // Backtracking line search on the total potential (Armijo); an
-      // inverted state has +inf energy and is always rejected. While the
-      // prescribed gap is still open the potential may rise, so only
-      // feasibility is required.
-      //
-      // Near equilibrium the decrease asked for falls below the round-off of
-      // the potential itself: the elastic energy is a sum of first-order
-      // terms (I1 - 3 against ln J) that cancel to second order, so its
-      // absolute error is ~eps x force x length while the decrease is
-      // ~residual^2. Armijo on the energy alone then rejects every step (a
-      // Neo-Hookean cantilever under a tiny tip load stalled for 54
-      // iterations). When the change of the potential is within that
-      // round-off, the decrease is measured by the directional derivative,
-      // which has no such cancellation: the trapezoid estimate
-      // alpha/2 (g.dx + g_trial.dx), exact for a quadratic potential, must
-      // meet the same Armijo condition.
-      t0 = Clock::now();
-      double slope = 0;
-      for (int i = 0; i < n; ++i)
-        if (!fixed[i]) slope += g[i] * dx[i];
-      const double energy_round_off = kEnergyRoundOff * scale * length_scale;
-      double alpha = 1;
-      bool accepted = false;
-      VecX trial(n);
-      for (int ls = 0; ls < options.max_line_search; ++ls, alpha *= 0.5) {
-        trial = result.x + alpha * dx;
-        const double Et = assembler.energy(trial);
-        if (!std::isfinite(Et)) continue;
-        const double pt = Et - fs.dot(trial - X);
-        const bool within_round_off = std::abs(pt - potential) <= energy_round_off;
-        accepted = gap_norm > 0 || pt <= potential + options.armijo * alpha * slope;
-        if (!accepted && within_round_off) {
-          assembler.evaluate(trial, &g_trial, nullptr);
-          double slope_trial = 0;
-          for (int i = 0; i < n; ++i)
-            if (!fixed[i]) slope_trial += (g_trial[i] - fs[i]) * dx[i];
-          accepted = 0.5 * (slope + slope_trial) <= options.armijo * slope;
-        }
-        round_off_step = accepted && alpha == 1.0 && within_round_off && gap_norm == 0;
-        if (accepted) break;
-      }
-      result.timings.line_search += seconds_since(t0);
-      rec.step_length = accepted ? alpha : 0;
-      add_record(rec);
-      spdlog::debug("newton load {:.4f} iter {:2d} residual {:.3e} energy {:.6e} alpha {:.3g} shift {:.2e}", s, it,
-                    residual, potential, rec.step_length, shift);
-      if (!accepted) {
-        why = "line search failed to find a decrease";
-        return false;
-      }
-      result.x = trial;
-      ++result.iterations;
-    }
-    return false;
-  };
+  result.x = x0.size() == n ? x0 : assembler.rest_positions();
+  StaticNewton newton(assembler, dirichlet, force, options, result);
 
   // Load stepping with adaptive halving of failing increments.
-  const int steps = std::max(1, options.load_steps);
-  double s_done = 0, ds = 1.0 / steps;
-  int halvings = 0, step = 0;
-  while (s_done < 1.0 - 1e-12) {
-    const double s = std::min(1.0, s_done + ds);
-    const VecX x_saved = result.x;
-    std::string why;
-    ++step;
-    if (newton_at(s, step, why)) {
-      spdlog::debug("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
-      if (options.on_load_step) options.on_load_step(s);
-      s_done = s;
-      if (halvings > 0) ds = std::min(2 * ds, 1.0 / steps);  // recover after a cut
-      halvings = 0;
-      continue;
-    }
-    if (halvings >= options.max_step_halvings) {
-      result.x = x_saved;
-      std::ostringstream msg;
-      msg << "Newton failed at load factor " << s << " after " << options.max_step_halvings
-          << " load-step halvings: " << why;
-      result.failure = msg.str();
-      result.converged = false;
-      result.load_steps = step;
-      result.timings.total = seconds_since(t_start);
-      return result;
-    }
+  VecX x_saved;
+  LoadContinuation continuation;
+  continuation.steps = options.load_steps;
+  continuation.max_halvings = options.max_step_halvings;
+  continuation.solve_at = [&](double s, int step, std::string& why) { return newton.at(s, step, why); };
+  continuation.save = [&] { x_saved = result.x; };
+  continuation.restore = [&] { result.x = x_saved; };
+  continuation.on_converged = [&](double s) {
+    spdlog::debug("load factor {:.4f} converged ({} Newton iterations so far)", s, result.iterations);
+    if (options.on_load_step) options.on_load_step(s);
+  };
+  continuation.on_halving = [](double s, const std::string& why) {
     spdlog::warn("load factor {:.4f} failed ({}); halving the load increment", s, why);
-    result.x = x_saved;
-    ds *= 0.5;
-    ++halvings;
+  };
+  const LoadContinuationResult loaded = continue_load(continuation);
+  if (!loaded.converged) {
+    std::ostringstream msg;
+    msg << "Newton failed at load factor " << loaded.failed_at << " after " << options.max_step_halvings
+        << " load-step halvings: " << loaded.why;
+    result.failure = msg.str();
   }
-  result.converged = true;
-  result.load_steps = step;
+  result.converged = loaded.converged;
+  result.load_steps = loaded.load_steps;
   result.timings.total = seconds_since(t_start);
   return result;
 }
