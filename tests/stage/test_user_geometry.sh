@@ -262,31 +262,24 @@ got = (ids.reshape(10, 10, 10).transpose(2, 1, 0) == 1).astype(np.int32)  # stor
 print('ball voxels', got.sum(), 'expected', want.sum())
 sys.exit(0 if np.array_equal(got, want) and 100 < want.sum() < 400 else 1)"
 
-scene vdb_two "  - {voxels: {file: bracket_ids.vdb}}"
-expect_exit 2 "bracket_ids.vdb: the file holds 2 grids \('ids', 'mask'\); name one with .grid." -- \
-  "$SIM" --config "$WORK/vdb_two.yaml" --out "$WORK/x.h5"
-scene vdb_name "  - {voxels: {file: bracket_ids.vdb, grid: stress}}"
-expect_exit 2 "no grid named 'stress'; the file holds 'ids', 'mask'" -- "$SIM" --config "$WORK/vdb_name.yaml" --out "$WORK/x.h5"
-scene vdb_half "  - {voxels: {file: half.vdb}}"
-expect_exit 2 "half.vdb: grid 'ids' holds 0.5 at index \(2, 3, 1\), which is not a material id" -- \
-  "$SIM" --config "$WORK/vdb_half.yaml" --out "$WORK/x.h5"
-scene vdb_three "  - {voxels: {file: three.vdb}}"
-expect_exit 2 "three.vdb uses material id 3 \(1 voxels\), which is not in the palette" -- \
-  "$SIM" --config "$WORK/vdb_three.yaml" --out "$WORK/x.h5"
-scene vdb_vector "  - {vdb: {file: vector.vdb}, id: 1}"
-expect_exit 2 "vector.vdb: grid 'velocity' holds values of type vec3s; a shape needs a float, double or bool grid" -- \
-  "$SIM" --config "$WORK/vdb_vector.yaml" --out "$WORK/x.h5"
-scene vdb_not "  - {vdb: {file: not.vdb}, id: 1}"
-expect_exit 2 "not.vdb: not a readable OpenVDB file" -- "$SIM" --config "$WORK/vdb_not.yaml" --out "$WORK/x.h5"
-scene vdb_far "  - {vdb: {file: bracket_fog.vdb, scale: 0.001, offset: [1, 0, 0]}, id: 1}"
-expect_exit 2 "bracket_fog.vdb: grid 'density' \(float, density, voxel 1\) contains no voxel centre" -- \
-  "$SIM" --config "$WORK/vdb_far.yaml" --out "$WORK/x.h5"
-scene vdb_dtype "  - {voxels: {file: bracket_ids.vdb, grid: ids, dtype: uint8}}"
-expect_exit 2 "dtype.*a .vdb file says its own value type" -- "$SIM" --config "$WORK/vdb_dtype.yaml" --out "$WORK/x.h5"
-scene vdb_threshold "  - {vdb: {file: bracket_fog.vdb, threshold: 1.5}, id: 1}"
-expect_exit 2 "grid 'density' \(float, density, voxel 1\) has no stored value above the threshold 1.5, so nothing is inside" -- \
-  "$SIM" --config "$WORK/vdb_threshold.yaml" --out "$WORK/x.h5"
-scene npy_origin "  - {voxels: {file: bracket.npy, origin: [0, 0, 0]}}"
-expect_exit 2 "origin.*is for .vdb files only" -- "$SIM" --config "$WORK/npy_origin.yaml" --out "$WORK/x.h5"
+refused() {  # refused NAME LAYOUT PATTERN: the scene exits 2 with PATTERN in its message
+  scene "$1" "$2"
+  expect_exit 2 "$3" -- "$SIM" --config "$WORK/$1.yaml" --out "$WORK/x.h5"
+}
+refused vdb_two "  - {voxels: {file: bracket_ids.vdb}}" \
+  "bracket_ids.vdb: the file holds 2 grids \('ids', 'mask'\); name one with .grid."
+refused vdb_name "  - {voxels: {file: bracket_ids.vdb, grid: stress}}" "no grid named 'stress'; the file holds 'ids', 'mask'"
+refused vdb_half "  - {voxels: {file: half.vdb}}" \
+  "half.vdb: grid 'ids' holds 0.5 at index \(2, 3, 1\), which is not a material id"
+refused vdb_three "  - {voxels: {file: three.vdb}}" "three.vdb uses material id 3 \(1 voxels\), which is not in the palette"
+refused vdb_vector "  - {vdb: {file: vector.vdb}, id: 1}" \
+  "vector.vdb: grid 'velocity' holds values of type vec3s; a shape needs a float, double or bool grid"
+refused vdb_not "  - {vdb: {file: not.vdb}, id: 1}" "not.vdb: not a readable OpenVDB file"
+refused vdb_far "  - {vdb: {file: bracket_fog.vdb, scale: 0.001, offset: [1, 0, 0]}, id: 1}" \
+  "bracket_fog.vdb: grid 'density' \(float, density, voxel 1\) contains no voxel centre"
+refused vdb_dtype "  - {voxels: {file: bracket_ids.vdb, grid: ids, dtype: uint8}}" "dtype.*a .vdb file says its own value type"
+refused vdb_threshold "  - {vdb: {file: bracket_fog.vdb, threshold: 1.5}, id: 1}" \
+  "grid 'density' \(float, density, voxel 1\) has no stored value above the threshold 1.5, so nothing is inside"
+refused npy_origin "  - {voxels: {file: bracket.npy, origin: [0, 0, 0]}}" "origin.*is for .vdb files only"
 check "nothing written for refused .vdb scenes" -- test ! -e "$WORK/x.h5"
 finish
