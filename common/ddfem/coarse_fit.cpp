@@ -280,6 +280,73 @@ bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& 
   return true;
 }
 
+// Enhanced element: the samples' basis at the bubble amplitudes that the
+// fit's current parameters choose, sample by sample (a sample whose
+// condensed state cannot be evaluated keeps its previous amplitudes).
+void update_bubble_basis(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X, const CoarseMaterialFit& fit,
+                         FitSamples& samples) {
+  const QuadratureMaterials m = fit_materials(fit);
+  const hex8::ElementGeometry geo = coarse_element_geometry(coarse, X, m);
+  for (size_t s = 0; s < samples.basis.size(); ++s) {
+    Mat3 A;
+    CoarseEnergyBasis e;
+    if (!hex_condensed_bubbles(geo, m, deformed(X, *samples.corners[s]), A)) continue;
+    if (!coarse_energy_basis(coarse, X, *samples.corners[s], fit.v, e, A)) continue;
+    samples.basis[s] = e;
+  }
+}
+
+// The least-squares system of Eq. 2.9. Data rows: each training sample's
+// residual relative to its own energy (or to the block's RMS training
+// energy, `energy_ref` > 0, for the absolute residual), times sqrt(weight);
+// then the regularizer's rows sqrt(reg) * (p_j - p0_j) / scale_j, which
+// fill_data_rows leaves alone.
+struct FitSystem {
+  MatX A;
+  VecX b;
+  double energy_ref = 0;  // 0: residuals relative to each sample's energy
+};
+int fill_data_rows(const FitSamples& samples, const std::vector<char>& held, const std::vector<double>& weight,
+                   const ParameterColumns& columns, const CoarseFitOptions& options, FitSystem& system) {
+  const int per_point = columns.per_point, centre = columns.centre;
+  const int points = centre / per_point;  // the point columns come first
+  const VecX& scale = columns.scale;
+  int r = 0;
+  for (int s = 0; s < static_cast<int>(samples.V0.size()); ++s) {
+    if (held[s]) continue;
+    const CoarseEnergyBasis& e = samples.basis[s];
+    const double w = std::sqrt(weight[s]) / (system.energy_ref > 0 ? system.energy_ref : samples.V0[s]);
+    for (int k = 0; k < points; ++k) {
+      system.A(r, per_point * k) = w * e.a[k] * scale[per_point * k];
+      system.A(r, per_point * k + 1) = w * e.b[k] * scale[per_point * k + 1];
+      if (options.anisotropic) system.A(r, per_point * k + 2) = w * e.s[k] * scale[per_point * k + 2];
+    }
+    if (options.centre_point) {
+      system.A(r, centre) = w * e.a_centre * scale[centre];
+      system.A(r, centre + 1) = w * e.b_centre * scale[centre + 1];
+    }
+    system.b[r] = w * samples.V0[s];
+    ++r;
+  }
+  return r;
+}
+
+// The NNLS solution's scaled columns back into the fit's parameters.
+void unpack_parameters(const NnlsResult& x, const ParameterColumns& columns, const CoarseFitOptions& options,
+                       CoarseMaterialFit& fit) {
+  const int per_point = columns.per_point, centre = columns.centre;
+  const VecX& scale = columns.scale;
+  for (int k = 0; k < fit.points(); ++k) {
+    fit.mu[k] = x.x[per_point * k] * scale[per_point * k];
+    fit.lambda[k] = x.x[per_point * k + 1] * scale[per_point * k + 1];
+    fit.C[k] = options.anisotropic ? x.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
+  }
+  if (options.centre_point) {
+    fit.mu_centre = x.x[centre] * scale[centre];
+    fit.lambda_centre = x.x[centre + 1] * scale[centre + 1];
+  }
+}
+
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
                                    const std::vector<Vec3>& directions, const CoarseFitOptions& options) {
   if (!(options.regularization >= 0.0)) throw InputError("coarse fit: regularization must be >= 0");
@@ -303,24 +370,8 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   const hex8::ElementGeometry coarse = coarse_fit_geometry(X, points, options.enhanced_element);
   fit.enhanced = options.enhanced_element;
   FitSamples samples = usable_samples(set, coarse, X, fit);
-  std::vector<CoarseEnergyBasis>& basis = samples.basis;
   const std::vector<double>& V0 = samples.V0;
-  const std::vector<ForceKind>& kind = samples.kind;
-  const std::vector<const Vec24*>& corners = samples.corners;
-  // Enhanced element: the basis at the bubble amplitudes that the current
-  // parameters choose, sample by sample (a sample whose condensed state
-  // cannot be evaluated keeps its previous amplitudes).
-  auto update_bubbles = [&]() {
-    const QuadratureMaterials m = fit_materials(fit);
-    const hex8::ElementGeometry geo = coarse_element_geometry(coarse, X, m);
-    for (size_t s = 0; s < basis.size(); ++s) {
-      Mat3 A;
-      CoarseEnergyBasis e;
-      if (!hex_condensed_bubbles(geo, m, deformed(X, *corners[s]), A)) continue;
-      if (!coarse_energy_basis(coarse, X, *corners[s], fit.v, e, A)) continue;
-      basis[s] = e;
-    }
-  };
+  auto update_bubbles = [&]() { update_bubble_basis(coarse, X, fit, samples); };
   if (options.enhanced_element) {
     // Start from the fine materials at their points, as the regularizer does.
     for (int k = 0; k < points; ++k) fit.mu[k] = fit.mu0[k], fit.lambda[k] = fit.lambda0[k];
@@ -335,9 +386,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
   }
 
   const ParameterColumns columns = parameter_columns(fit, options);
-  const int per_point = columns.per_point, centre = columns.centre, np = columns.count;
-  const VecX& scale = columns.scale;
-  const VecX& target = columns.target;
+  const int np = columns.count;
   // Sample weights: kind weight / samples of that kind in the same split,
   // normalized per split, so the data term is a weighted mean squared
   // relative error.
@@ -348,66 +397,32 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
                                    [&](int id) { return id != 0 && id == block.material_ids[0]; });
   if (options.mixed_blocks_affine_only && !uniform)
     for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) kind_weight[int(k)] = 0.0;
-  const std::vector<double> weight = sample_weights(kind, held, kind_weight, options.balance_kinds);
+  const std::vector<double> weight = sample_weights(samples.kind, held, kind_weight, options.balance_kinds);
 
-  // Rows: each training sample's residual relative to its own energy (or to
-  // the block's RMS training energy for the absolute residual), times
-  // sqrt(weight); then sqrt(reg) * (p_j - p0_j) / scale_j.
-  const bool absolute = options.residual == CoarseFitOptions::Residual::absolute;
-  double energy_ref = 0;
-  if (absolute) {
+  FitSystem system;
+  if (options.residual == CoarseFitOptions::Residual::absolute) {
     for (int s = 0; s < ns; ++s)
-      if (!held[s]) energy_ref += weight[s] * V0[s] * V0[s];
-    energy_ref = std::sqrt(energy_ref);
-    if (!(energy_ref > 0)) {
+      if (!held[s]) system.energy_ref += weight[s] * V0[s] * V0[s];
+    system.energy_ref = std::sqrt(system.energy_ref);
+    if (!(system.energy_ref > 0)) {
       fit.not_fitted_reason = "no training sample has a weight";
       return fit;
     }
   }
   const int rows = fit.samples_train + np;
-  MatX A = MatX::Zero(rows, np);
-  VecX b = VecX::Zero(rows);
-  auto fill_data_rows = [&]() {
-    int r = 0;
-    for (int s = 0; s < ns; ++s) {
-      if (held[s]) continue;
-      const double w = std::sqrt(weight[s]) / (absolute ? energy_ref : V0[s]);
-      for (int k = 0; k < points; ++k) {
-        A(r, per_point * k) = w * basis[s].a[k] * scale[per_point * k];
-        A(r, per_point * k + 1) = w * basis[s].b[k] * scale[per_point * k + 1];
-        if (options.anisotropic) A(r, per_point * k + 2) = w * basis[s].s[k] * scale[per_point * k + 2];
-      }
-      if (options.centre_point) {
-        A(r, centre) = w * basis[s].a_centre * scale[centre];
-        A(r, centre + 1) = w * basis[s].b_centre * scale[centre + 1];
-      }
-      b[r] = w * V0[s];
-      ++r;
-    }
-    return r;
-  };
-  int r = fill_data_rows();
+  system.A = MatX::Zero(rows, np);
+  system.b = VecX::Zero(rows);
+  int r = fill_data_rows(samples, held, weight, columns, options, system);
   // lambda is Eq. 2.9's for the 8 points of a level-1 element; with more
   // points (64 at level 2) each weighs 8 / points, so the regularizer's pull
   // on a uniform relative change of the material is the same at every level.
   const double reg = std::sqrt(options.regularization * 8.0 / points);
   for (int j = 0; j < np; ++j, ++r) {
-    A(r, j) = reg;
-    b[r] = reg * target[j];
+    system.A(r, j) = reg;
+    system.b[r] = reg * columns.target[j];
   }
-  NnlsResult sol = solve_nnls(A, b);
-  auto unpack = [&](const NnlsResult& x) {
-    for (int k = 0; k < points; ++k) {
-      fit.mu[k] = x.x[per_point * k] * scale[per_point * k];
-      fit.lambda[k] = x.x[per_point * k + 1] * scale[per_point * k + 1];
-      fit.C[k] = options.anisotropic ? x.x[per_point * k + 2] * scale[per_point * k + 2] : 0.0;
-    }
-    if (options.centre_point) {
-      fit.mu_centre = x.x[centre] * scale[centre];
-      fit.lambda_centre = x.x[centre + 1] * scale[centre + 1];
-    }
-  };
-  if (sol.converged) unpack(sol);
+  NnlsResult sol = solve_nnls(system.A, system.b);
+  if (sol.converged) unpack_parameters(sol, columns, options, fit);
   // Enhanced element: alternate bubbles for the parameters and parameters
   // for the bubbles until the scaled parameters move less than 1e-3. The
   // basis left behind is always that of the final parameters' own bubbles,
@@ -416,12 +431,12 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     for (fit.bubble_rounds = 1;; ++fit.bubble_rounds) {
       update_bubbles();
       if (fit.bubble_rounds >= options.bubble_rounds) break;
-      fill_data_rows();
-      const NnlsResult next = solve_nnls(A, b);
+      fill_data_rows(samples, held, weight, columns, options, system);
+      const NnlsResult next = solve_nnls(system.A, system.b);
       if (!next.converged) break;
       const double moved = (next.x - sol.x).cwiseAbs().maxCoeff();
       sol = next;
-      unpack(sol);
+      unpack_parameters(sol, columns, options, fit);
       if (moved <= 1e-3 * std::max(1.0, sol.x.cwiseAbs().maxCoeff())) {
         update_bubbles();
         break;
@@ -452,7 +467,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
     return fit;
   }
 
-  record_fit_errors(basis, V0, held, weight, fit);
+  record_fit_errors(samples.basis, V0, held, weight, fit);
   fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return fit;
 }
