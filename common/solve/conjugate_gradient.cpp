@@ -48,6 +48,31 @@ Eigen::Vector2d step_and_residual(double alpha, const VecX& p, const VecX& q, co
 
 }  // namespace
 
+CgSetup multigrid_cg_setup(std::function<void(const VecX&, VecX&)> multiply,
+                           std::function<void(const VecX&, VecX&)> cycle, double tolerance, int max_iterations,
+                           int threads, const std::string& label) {
+  CgSetup cg;
+  if (multiply) {
+    cg.op.multiply = multiply;
+    cg.op.multiply_dot = [multiply, threads](const VecX& x, VecX& y) {
+      multiply(x, y);
+      return parallel_dot(x, y, threads);
+    };
+  }
+  cg.preconditioner.apply = [cycle, threads](const VecX& r, VecX& z) {
+    cycle(r, z);
+    return parallel_dot(r, z, threads);
+  };
+  cg.preconditioner.check_definite = true;
+  cg.settings.tolerance = tolerance;
+  cg.settings.max_iterations = max_iterations;
+  cg.settings.threads = threads;
+  cg.settings.label = label;
+  cg.settings.curvature_label = label;
+  cg.settings.curvature_message_has_residual = true;
+  return cg;
+}
+
 VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b,
                         const CgSettings& settings, LinearSolveStats& stats) {
   const auto start = std::chrono::steady_clock::now();

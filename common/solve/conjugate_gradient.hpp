@@ -60,6 +60,22 @@ struct CgSettings {
 // (listing the relative residual every max_iterations / 8 iterations), or on
 // non-positive curvature or r . M^-1 r (then stats.positive_definite is
 // false).
+// CG around a multigrid cycle, as the multigrid solvers run it: the
+// operator's product with x . y taken after it, the cycle as the
+// preconditioner, checked for definiteness after each application (a cycle
+// whose coarse operators lost definiteness shows up there first), and
+// settings whose messages name `label`. Callers add what is their own (a
+// fused product, a progress hook, the config key of the limit). An empty
+// `multiply` leaves the operator empty.
+struct CgSetup {
+  CgOperator op;
+  CgPreconditioner preconditioner;
+  CgSettings settings;
+};
+CgSetup multigrid_cg_setup(std::function<void(const VecX& x, VecX& y)> multiply,
+                           std::function<void(const VecX& r, VecX& z)> cycle, double tolerance, int max_iterations,
+                           int threads, const std::string& label);
+
 VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b,
                         const CgSettings& settings, LinearSolveStats& stats);
 

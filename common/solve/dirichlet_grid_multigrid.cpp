@@ -595,26 +595,10 @@ VecX DirichletGridMultigrid::solve(VecX b) {
     throw std::invalid_argument("DirichletGridMultigrid::solve: right-hand side has " + std::to_string(b.size()) +
                                 " entries, the grid has " + std::to_string(n) + " unknowns");
   const int threads = options_.threads;
-  CgOperator op;
-  op.multiply = [this](const VecX& x, VecX& y) { multiply_rows(x, y); };
-  op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
-    multiply_rows(x, y);
-    return parallel_dot(x, y, threads);
-  };
-  CgPreconditioner preconditioner;
-  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
-    cycle(r, z);
-    return parallel_dot(r, z, threads);
-  };
-  preconditioner.check_definite = true;
-  CgSettings settings;
-  settings.tolerance = options_.tolerance;
-  settings.max_iterations = options_.max_iterations;
-  settings.threads = threads;
-  settings.label = "matrix-free multigrid CG";
-  settings.curvature_label = "matrix-free multigrid CG";
-  settings.curvature_message_has_residual = true;
-  settings.progress = [](int iteration, double residual) {
+  CgSetup cg = multigrid_cg_setup([this](const VecX& x, VecX& y) { multiply_rows(x, y); },
+                                  [this](const VecX& r, VecX& z) { cycle(r, z); }, options_.tolerance,
+                                  options_.max_iterations, threads, "matrix-free multigrid CG");
+  cg.settings.progress = [](int iteration, double residual) {
     spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
   };
   // Nodes without a row have every unknown fixed: their rows of A are s I,
@@ -628,7 +612,7 @@ VecX DirichletGridMultigrid::solve(VecX b) {
       for (int d = 0; d < 3; ++d)
         if (const double v = b[3 * p + d]; v != 0.0) outside.emplace_back(3 * p + d, v / fixed_scale_);
   VecX().swap(b);
-  VecX x_rows = conjugate_gradient(op, preconditioner, rows_b, settings, stats_);
+  VecX x_rows = conjugate_gradient(cg.op, cg.preconditioner, rows_b, cg.settings, stats_);
   VecX().swap(rows_b);
   VecX x = VecX::Zero(n);
   scatter_rows_into(x_rows, x, 0.0);

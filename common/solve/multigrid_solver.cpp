@@ -182,12 +182,14 @@ VecX MultigridSolver::solve(const VecX& b) {
   }
   require_rhs_size(b, n_, "MultigridSolver");
   const int threads = options_.threads;
-  CgOperator op;
+  CgSetup cg = multigrid_cg_setup(nullptr, [this](const VecX& r, VecX& z) { cycle(0, r, z); }, options_.pcg_tolerance,
+                                  options_.pcg_max_iterations, threads, "pcg-mg");
+  cg.settings.max_iterations_key = options_.pcg_max_iterations_key;
   if (n_ > 0) {
     const BlockMatrix& A = levels_.front()->matrix;  // A + shift I
-    op.multiply = [&A, threads](const VecX& x, VecX& y) { block_multiply(A, x, y, threads); };
+    cg.op.multiply = [&A, threads](const VecX& x, VecX& y) { block_multiply(A, x, y, threads); };
     // y = A x and x . y in one pass over the matrix.
-    op.multiply_dot = [&A, threads](const VecX& x, VecX& y) {
+    cg.op.multiply_dot = [&A, threads](const VecX& x, VecX& y) {
       y.resize(A.unknowns());
       return chunked_reduce(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
         double sum = 0.0;
@@ -199,22 +201,7 @@ VecX MultigridSolver::solve(const VecX& b) {
       });
     };
   }
-  CgPreconditioner preconditioner;
-  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
-    cycle(0, r, z);
-    return parallel_dot(r, z, threads);
-  };
-  // A cycle whose coarse operators lost definiteness shows up here first.
-  preconditioner.check_definite = true;
-  CgSettings settings;
-  settings.tolerance = options_.pcg_tolerance;
-  settings.max_iterations = options_.pcg_max_iterations;
-  settings.max_iterations_key = options_.pcg_max_iterations_key;
-  settings.threads = threads;
-  settings.label = "pcg-mg";
-  settings.curvature_label = "pcg-mg";
-  settings.curvature_message_has_residual = true;
-  return conjugate_gradient(op, preconditioner, b, settings, stats_);
+  return conjugate_gradient(cg.op, cg.preconditioner, b, cg.settings, stats_);
 }
 
 Eigen::Index MultigridSolver::level_unknowns(int level) const {

@@ -392,27 +392,13 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
 
 VecX PeriodicGridMultigrid::solve_cg(const VecX& consistent) {
   const int threads = options_.threads;
-  CgOperator op;
-  op.multiply = [this](const VecX& x, VecX& y) { multiply(x, y); };
-  op.multiply_dot = [this, threads](const VecX& x, VecX& y) {
-    multiply(x, y);
-    return parallel_dot(x, y, threads);
-  };
-  CgPreconditioner preconditioner;
-  preconditioner.apply = [this, threads](const VecX& r, VecX& z) {
-    cycle(0, r, z);
-    project_zero_mean(z, threads);
-    return parallel_dot(r, z, threads);
-  };
-  preconditioner.check_definite = true;
-  CgSettings settings;
-  settings.tolerance = options_.tolerance;
-  settings.max_iterations = options_.max_iterations;
-  settings.threads = threads;
-  settings.label = "periodic multigrid CG";
-  settings.curvature_label = "periodic multigrid CG";
-  settings.curvature_message_has_residual = true;
-  VecX x = conjugate_gradient(op, preconditioner, consistent, settings, stats_);
+  const CgSetup cg = multigrid_cg_setup([this](const VecX& x, VecX& y) { multiply(x, y); },
+                                        [this, threads](const VecX& r, VecX& z) {
+                                          cycle(0, r, z);
+                                          project_zero_mean(z, threads);
+                                        },
+                                        options_.tolerance, options_.max_iterations, threads, "periodic multigrid CG");
+  VecX x = conjugate_gradient(cg.op, cg.preconditioner, consistent, cg.settings, stats_);
   project_zero_mean(x, threads);
   return x;
 }
