@@ -230,6 +230,8 @@ ball.name = "ball"
 vdb.write(f"{work}/ball.vdb", grids=[ball])
 np.save(f"{work}/ball_expected.npy", (d < r).astype(np.int32))
 open(f"{work}/not.vdb", "w").write("solid bracket\nendsolid\n")
+whole = open(f"{work}/bracket_ids.vdb", "rb").read()
+open(f"{work}/truncated.vdb", "wb").write(whole[:len(whole) // 2])
 PY
 scene vdb_ids "  - {voxels: {file: bracket_ids.vdb, grid: ids}}"
 scene vdb_mask "  - {voxels: {file: bracket_ids.vdb, grid: mask}}"
@@ -275,6 +277,7 @@ refused vdb_three "  - {voxels: {file: three.vdb}}" "three.vdb uses material id 
 refused vdb_vector "  - {vdb: {file: vector.vdb}, id: 1}" \
   "vector.vdb: grid 'velocity' holds values of type vec3s; a shape needs a float, double or bool grid"
 refused vdb_not "  - {vdb: {file: not.vdb}, id: 1}" "not.vdb: not a readable OpenVDB file"
+refused vdb_truncated "  - {voxels: {file: truncated.vdb, grid: ids}}" "truncated.vdb: not a readable OpenVDB file"
 refused vdb_far "  - {vdb: {file: bracket_fog.vdb, scale: 0.001, offset: [1, 0, 0]}, id: 1}" \
   "bracket_fog.vdb: grid 'density' \(float, density, voxel 1\) contains no voxel centre"
 refused vdb_dtype "  - {voxels: {file: bracket_ids.vdb, grid: ids, dtype: uint8}}" "dtype.*a .vdb file says its own value type"
