@@ -280,6 +280,8 @@ bool fit_resists_uniform_strains(const CoarseMaterialFit& fit, const FineBlock& 
   return true;
 }
 
+namespace {
+
 // Enhanced element: the samples' basis at the bubble amplitudes that the
 // fit's current parameters choose, sample by sample (a sample whose
 // condensed state cannot be evaluated keeps its previous amplitudes).
@@ -347,6 +349,23 @@ void unpack_parameters(const NnlsResult& x, const ParameterColumns& columns, con
   }
 }
 
+// Sample weights: kind weight / samples of that kind in the same split,
+// normalized per split, so the data term is a weighted mean squared
+// relative error; a mixed block may keep only its affine samples.
+std::vector<double> block_sample_weights(const FineBlock& block, const std::vector<ForceKind>& kind,
+                                         const std::vector<char>& held, const CoarseFitOptions& options) {
+  for (double w : options.kind_weight)
+    if (!(w >= 0.0) || !std::isfinite(w)) throw InputError("coarse fit: kind weights must be finite and >= 0");
+  std::array<double, 5> kind_weight = options.kind_weight;
+  const bool uniform = std::all_of(block.material_ids.begin(), block.material_ids.end(),
+                                   [&](int id) { return id != 0 && id == block.material_ids[0]; });
+  if (options.mixed_blocks_affine_only && !uniform)
+    for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) kind_weight[int(k)] = 0.0;
+  return sample_weights(kind, held, kind_weight, options.balance_kinds);
+}
+
+}  // namespace
+
 CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet& set,
                                    const std::vector<Vec3>& directions, const CoarseFitOptions& options) {
   if (!(options.regularization >= 0.0)) throw InputError("coarse fit: regularization must be >= 0");
@@ -387,17 +406,7 @@ CoarseMaterialFit fit_from_samples(const FineBlock& block, const ForceSampleSet&
 
   const ParameterColumns columns = parameter_columns(fit, options);
   const int np = columns.count;
-  // Sample weights: kind weight / samples of that kind in the same split,
-  // normalized per split, so the data term is a weighted mean squared
-  // relative error.
-  for (double w : options.kind_weight)
-    if (!(w >= 0.0) || !std::isfinite(w)) throw InputError("coarse fit: kind weights must be finite and >= 0");
-  std::array<double, 5> kind_weight = options.kind_weight;
-  const bool uniform = std::all_of(block.material_ids.begin(), block.material_ids.end(),
-                                   [&](int id) { return id != 0 && id == block.material_ids[0]; });
-  if (options.mixed_blocks_affine_only && !uniform)
-    for (ForceKind k : {ForceKind::bend, ForceKind::twist, ForceKind::pinch}) kind_weight[int(k)] = 0.0;
-  const std::vector<double> weight = sample_weights(samples.kind, held, kind_weight, options.balance_kinds);
+  const std::vector<double> weight = block_sample_weights(block, samples.kind, held, options);
 
   FitSystem system;
   if (options.residual == CoarseFitOptions::Residual::absolute) {
