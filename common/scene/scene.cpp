@@ -179,8 +179,8 @@ TriangleSurface placed_surface(const Config& c) {
 
 // `grid: {voxel_size: h, size_from_parts: true, margin: m}`: the grid that
 // covers the bounding box of the layout's surface meshes and VDB shapes
-// plus m voxels on
-// every side, its origin at the box's lower corner minus the margin.
+// plus m voxels on every side, its origin at the box's lower corner minus
+// the margin.
 VoxelGrid grid_around_parts(const Config& config) {
   const Config g = config.child("grid");
   for (const char* key : {"size", "origin"})
