@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   std::vector<int> degrees = {2};
   std::vector<int> coarsest = {PeriodicMultigridOptions{}.coarsest_nodes};
   std::vector<std::string> kinds = {"random", "sphere", "frame"};
-  std::vector<std::string> solvers = {"multigrid"};
+  std::vector<std::string> solvers = {"matrix-free"};
   std::vector<std::string> symmetries = {"none", "cyclic", "mirror", "both"};
   int batch = 0;
   bool direct = true;
@@ -165,15 +165,15 @@ int main(int argc, char** argv) {
       reference_options.use_symmetry = false;
       reference_options.use_mirror_symmetry = false;
       if (direct && n <= 32) {
-        reference_options.solver = "direct";
+        reference_options.solver = "cholmod";
         const HomogenizationResult r = homogenize(cell, palette, reference_options);
         C_ref = r.C;
         direct_seconds = r.seconds;
         std::printf("| %s | %d | direct | cell | | | | 6 | | %.3f | %.3g | (reference) | |\n", kind.c_str(), n,
                     r.seconds, 1 / r.seconds);
       } else {
-        reference_options.solver = "multigrid";
-        reference_options.multigrid_tolerance = 1e-11;
+        reference_options.solver = "matrix-free";
+        reference_options.tolerance = 1e-11;
         C_ref = homogenize(cell, palette, reference_options).C;
       }
       std::fflush(stdout);
@@ -186,23 +186,23 @@ int main(int argc, char** argv) {
           for (int degree : degrees)
             for (double tolerance : tolerances)
               for (int coarse : coarsest) {
-                if (solver == "direct" && (degree != degrees[0] || tolerance != tolerances[0] || coarse != coarsest[0]))
+                if (solver == "cholmod" && (degree != degrees[0] || tolerance != tolerances[0] || coarse != coarsest[0]))
                   continue;  // the direct solver has none of these knobs
                 HomogenizationOptions o;
                 o.solver = solver;
-                o.multigrid_tolerance = tolerance;
+                o.tolerance = tolerance;
                 o.multigrid_smoother_degree = degree;
                 o.use_symmetry = symmetry == "cyclic" || symmetry == "both";
                 o.use_mirror_symmetry = symmetry == "mirror" || symmetry == "both";
                 o.multigrid_coarsest_nodes = coarse;
                 const HomogenizationResult r = homogenize(cell, palette, o);
                 std::printf("| %s | %d | %s | %s |", kind.c_str(), n, r.solver.c_str(), r.octant ? "octant" : "cell");
-                if (r.solver == "multigrid")
+                if (r.solver == "matrix-free")
                   std::printf(" %.0e | %d | %s |", tolerance, degree, r.octant ? "" : std::to_string(coarse).c_str());
                 else
                   std::printf(" | | |");
                 std::printf(" %d | %s | %.3f | %.3g | %.1e |", r.symmetric_cases ? 2 : 6,
-                            r.solver == "multigrid" ? std::to_string(r.iterations).c_str() : "", r.seconds,
+                            r.solver == "matrix-free" ? std::to_string(r.iterations).c_str() : "", r.seconds,
                             1 / r.seconds, (r.C - C_ref).norm() / C_ref.norm());
                 if (direct_seconds > 0)
                   std::printf(" %.1f |\n", direct_seconds / r.seconds);

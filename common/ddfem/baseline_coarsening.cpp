@@ -124,7 +124,7 @@ Mat6 block_homogenized_stiffness(const std::vector<MaterialPtr>& palette, const 
   for (int id : ids)
     if (id != 0) palette_material_checked(palette, id);  // a clear error for an unknown id
   HomogenizationOptions options;
-  options.solver = "direct";
+  options.solver = "cholmod";
   options.threads = 1;
   return to_material_voigt_order(homogenize(cell, palette, options).C);
 }

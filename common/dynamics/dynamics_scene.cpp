@@ -10,6 +10,7 @@
 #include "dynamics/scene_parameters.hpp"
 #include "fem/hex_mesh_bodies.hpp"
 #include "fem/voxel_shapes.hpp"
+#include "io/material_config.hpp"
 #include "material/neo_hookean.hpp"
 #include "scene/scene.hpp"
 
@@ -49,8 +50,8 @@ std::vector<SceneMaterial> read_materials(const Config& c) {
   for (const Config& m : c.children("materials")) {
     SceneMaterial s;
     s.name = m.get<std::string>("name");
-    s.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open);
-    s.density = m.require_positive<double>("density", "density (kg/m^3)");
+    s.nu = read_poissons_ratio(m);
+    s.density = read_density(m);
     if (m.has("dac_model")) {
       // The numerical modulus and damping fitted by msfab-dac-calibrate.
       for (const char* key : {"E", "damping_a", "damping_b"})
@@ -60,7 +61,7 @@ std::vector<SceneMaterial> read_materials(const Config& c) {
       s.damping_a = dac.damping_a;
       s.damping_b = dac.damping_b;
     } else {
-      s.E = m.require_positive<double>("E", "Young's modulus (the numerical modulus E_n for coarse meshes)");
+      s.E = read_youngs_modulus(m, "Young's modulus (the numerical modulus E_n for coarse meshes)");
       s.damping_a = m.get_or<double>("damping_a", 0.0);
       s.damping_b = m.get_or<double>("damping_b", 0.0);
     }

@@ -200,9 +200,9 @@ bool mirror_invariant(const VoxelStiffnessField& f) {
 
 std::string octant_solver(const VoxelStiffnessField& f, const std::string& option) {
   const bool grid = DirichletGridMultigrid::supports(f.nx / 2, f.ny / 2, f.nz / 2);
-  if (option == "direct") return option;
-  if (option == "multigrid") return grid ? option : "direct";
-  if (option == "auto") return grid && f.voxels() / 8 > kAutoOctantMultigridVoxels ? "multigrid" : "direct";
+  if (option == "cholmod") return option;
+  if (option == "matrix-free") return grid ? option : "cholmod";
+  if (option == "auto") return grid && f.voxels() / 8 > kAutoOctantMultigridVoxels ? "matrix-free" : "cholmod";
   throw InputError("homogenization: unknown solver '" + option + "' (choose auto, direct or multigrid)");
 }
 
@@ -219,13 +219,15 @@ OctantSolveReport solve_on_octant(const VoxelStiffnessField& field, const std::v
       if (pin_group(m) == group) members.push_back(m);
     if (members.empty()) continue;
     const std::vector<char> fixed = pinned_unknowns(o, group);
-    if (report.solver == "direct") {
+    if (report.solver == "cholmod") {
       const OctantCholesky cholesky(octant, o, fixed);
       report.unknowns = std::max<std::int64_t>(report.unknowns, cholesky.unknowns());
       for (int m : members) fluctuation[m] = unfold(field, o, m, cholesky.solve(octant_load(octant, o, m, fixed)));
     } else {
       DirichletMultigridOptions mg;
       mg.tolerance = options.tolerance;
+      mg.max_iterations = options.max_iterations;
+      mg.max_iterations_key = options.max_iterations_key;
       mg.smoother_degree = options.smoother_degree;
       mg.threads = options.threads;
       // A cell problem takes 10-50 CG iterations per set-up, too few to repay

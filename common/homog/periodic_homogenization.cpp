@@ -117,24 +117,24 @@ Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationRes
 }
 
 std::string homogenization_solver(int nx, int ny, int nz, const std::string& option) {
-  if (option == "direct") return option;
-  if (option == "multigrid") {
+  if (option == "cholmod") return option;
+  if (option == "matrix-free") {
     if (!PeriodicGridMultigrid::supports(nx, ny, nz))
-      throw InputError("homogenization: solver multigrid needs every cell dimension even and at least 4, got " +
+      throw InputError("homogenization: solver matrix-free needs every cell dimension even and at least 4, got " +
                        std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz));
     return option;
   }
   if (option == "auto")
     return PeriodicGridMultigrid::supports(nx, ny, nz) && std::int64_t(nx) * ny * nz >= kAutoMultigridVoxels
-               ? "multigrid"
-               : "direct";
-  throw InputError("homogenization: unknown solver '" + option + "' (choose auto, direct or multigrid)");
+               ? "matrix-free"
+               : "cholmod";
+  throw InputError("homogenization: unknown solver '" + option + "' (choose auto, cholmod or matrix-free)");
 }
 
 double homogenization_peak_bytes(int nx, int ny, int nz, const std::string& option) {
   const double n = double(nx) * ny * nz;
   if (nz == 1) return 24e3 * n;
-  return homogenization_solver(nx, ny, nz, option) == "direct" ? 3.3e3 * std::pow(n, 4.0 / 3.0) : 1.3e3 * n;
+  return homogenization_solver(nx, ny, nz, option) == "cholmod" ? 3.3e3 * std::pow(n, 4.0 / 3.0) : 1.3e3 * n;
 }
 
 namespace {
@@ -244,7 +244,9 @@ VecX permute_fluctuation(const VecX& chi, int n) {
 void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, const HomogenizationOptions& options,
                      HomogenizationResult& out, const std::vector<int>& cases) {
   PeriodicMultigridOptions mg;
-  mg.tolerance = options.multigrid_tolerance;
+  mg.tolerance = options.tolerance;
+  mg.max_iterations = options.max_iterations;
+  mg.max_iterations_key = options.max_iterations_key;
   mg.threads = options.threads;
   mg.smoother_degree = options.multigrid_smoother_degree;
   mg.coarsest_nodes = options.multigrid_coarsest_nodes;
@@ -278,8 +280,9 @@ bool cyclic_invariant(const VoxelStiffnessField& f) {
 HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const HomogenizationOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   validate_field(field, "homogenization");
-  if (!(options.multigrid_tolerance > 0) || options.multigrid_tolerance >= 1)
-    throw InputError("homogenization: multigrid_tolerance must lie in (0, 1)");
+  if (!(options.tolerance > 0) || options.tolerance >= 1)
+    throw InputError("homogenization: tolerance must lie in (0, 1)");
+  if (options.max_iterations < 1) throw InputError("homogenization: max_iterations must be at least 1");
   const int nx = field.nx, ny = field.ny, nz = field.nz;
   const double h = field.h;
   const std::int64_t cells = field.voxels();
@@ -291,14 +294,16 @@ HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const
   if (out.octant) {
     OctantSolverOptions octant;
     octant.solver = options.solver;
-    octant.tolerance = options.multigrid_tolerance;
+    octant.tolerance = options.tolerance;
+    octant.max_iterations = options.max_iterations;
+    octant.max_iterations_key = options.max_iterations_key;
     octant.smoother_degree = options.multigrid_smoother_degree;
     octant.threads = options.threads;
     const OctantSolveReport report = solve_on_octant(field, cases, octant, out.fluctuation);
     out.solver = report.solver;
     out.unknowns = report.unknowns;
     out.iterations = report.iterations;
-  } else if (const Eigen::MatrixXd loads = strain_loads(field); out.solver == "direct") {
+  } else if (const Eigen::MatrixXd loads = strain_loads(field); out.solver == "cholmod") {
     solve_direct(field, loads, out, cases);
   } else {
     solve_multigrid(field, loads, options, out, cases);

@@ -25,15 +25,21 @@ struct HomogenizationOptions {
   // stiffness ("ersatz material"), so a cell with void is never singular;
   // its bias on C^H is of this relative order.
   double void_stiffness = 1e-6;
-  // Cell solver: "direct" (sparse Cholesky with one node pinned), "multigrid"
-  // (matrix-free multigrid-preconditioned CG, solve/periodic_grid_multigrid.hpp;
-  // every dimension even and at least 4), or "auto": multigrid for grids it
-  // supports from kAutoMultigridVoxels voxels on, direct below.
+  // Cell solver (the kinds of io/linear_solver_config.hpp): "cholmod"
+  // (sparse Cholesky with one node pinned), "matrix-free" (multigrid-
+  // preconditioned CG without an assembled matrix,
+  // solve/periodic_grid_multigrid.hpp; every dimension even and at least 4),
+  // or "auto": matrix-free for grids it supports from kAutoMultigridVoxels
+  // voxels on, cholmod below.
   std::string solver = "auto";
   // Multigrid: relative residual at which CG stops. C^H is an energy, so its
   // error falls much faster than the residual: at 1e-6 it was below 1e-10
   // relative on random, inclusion and void-frame cells (docs/BENCHMARKS.md).
-  double multigrid_tolerance = 1e-6;
+  double tolerance = 1e-6;
+  // Matrix-free: CG iterations after which a solve fails, and the config key
+  // that sets them (named in that message; empty: none).
+  int max_iterations = 2000;
+  std::string max_iterations_key;
   // Multigrid: Chebyshev smoother degree on the finest level (a tuning knob).
   int multigrid_smoother_degree = 2;
   // Multigrid: coarsening stops at this many lattice nodes (then a sparse
@@ -69,7 +75,7 @@ struct HomogenizationResult {
   std::vector<double> volume_fraction;  // per palette id, [0] = void
   int pieces = 0;                 // connected solid pieces (voxels sharing a node, periodically)
   std::int64_t unknowns = 0;      // 3 per lattice node (direct: less the 3 pinned ones)
-  std::string solver;             // "direct" or "multigrid"
+  std::string solver;             // "cholmod" or "matrix-free"
   int iterations = 0;             // multigrid: CG iterations over the strain cases solved
   bool symmetric_cases = false;   // two cases solved, four carried by the cyclic permutation
   bool octant = false;            // solved on one octant (mirror symmetry); unknowns are the octant's
@@ -91,7 +97,7 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
 // homogenize(), and of the continuous sampling step, whose voxels mix two
 // materials. The stiffness must be positive definite up to rigid motions.
 // volume_fraction and pieces are left empty. InputError for an invalid field
-// or solver option (also "multigrid" on a grid it cannot coarsen).
+// or solver option (also "matrix-free" on a grid it cannot coarsen).
 HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const HomogenizationOptions& options = {});
 
 // The solver homogenize_elements() uses for this grid and option.

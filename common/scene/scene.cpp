@@ -15,6 +15,8 @@
 #include "core/errors.hpp"
 #include "fem/surface_voxelizer.hpp"
 #include "fem/voxel_shapes.hpp"
+#include "io/linear_solver_config.hpp"
+#include "io/material_config.hpp"
 #include "io/path_names.hpp"
 #include "io/surface_mesh_io.hpp"
 #include "io/vdb_grid_io.hpp"
@@ -43,8 +45,7 @@ int read_axis(const Config& c, const std::string& key) {
 
 MaterialPtr make_material(const Config& c, PaletteEntry& p) {
   p.model = c.one_of("model", {"neo-hookean", "linear", "linear-anisotropic"});
-  p.density = c.get_or<double>("density", 1000.0);
-  if (!(p.density > 0) || !std::isfinite(p.density)) c.fail("density", "density must be positive and finite");
+  p.density = read_density(c, 1000.0);
   if (p.model == "linear-anisotropic") {
     const auto v = c.get<std::vector<double>>("C");
     if (v.size() != 36) c.fail("C", "expected the 6x6 Voigt stiffness as 36 numbers (row by row)");
@@ -56,8 +57,9 @@ MaterialPtr make_material(const Config& c, PaletteEntry& p) {
       c.fail("C", e.what());
     }
   }
-  p.E = c.require_positive("E", "Young's modulus");
-  p.nu = c.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
+  const ElasticConstants elastic = read_elastic_constants(c);
+  p.E = elastic.E;
+  p.nu = elastic.nu;
   if (p.model == "neo-hookean") return std::make_shared<NeoHookean>(p.E, p.nu);
   return std::make_shared<LinearIsotropic>(p.E, p.nu);
 }
@@ -434,14 +436,19 @@ Scene read_scene(const Config& config) {
     o.load_steps = c.get_or<int>("load_steps", o.load_steps);
     if (o.load_steps < 1) c.fail("load_steps", "must be at least 1");
     o.max_step_halvings = c.get_or<int>("max_step_halvings", o.max_step_halvings);
-    o.linear_solver = c.get_or<std::string>("linear_solver", o.linear_solver);
-    o.linear.pcg_tolerance = c.get_or<double>("pcg_tolerance", o.linear.pcg_tolerance);
-    o.linear.pcg_max_iterations = c.get_or<int>("pcg_max_iterations", o.linear.pcg_max_iterations);
-    o.linear.pcg_max_iterations_key = c.key_path("pcg_max_iterations");
+    LinearSolverChoice defaults;
+    defaults.kind = o.linear_solver;
+    defaults.tolerance = o.linear.pcg_tolerance;
+    defaults.max_iterations = o.linear.pcg_max_iterations;
+    LinearSolverKeys keys;
+    keys.legacy_tolerance = "pcg_tolerance";
+    keys.legacy_max_iterations = "pcg_max_iterations";
+    const LinearSolverChoice linear = read_linear_solver_choice(c, {"auto", "cholmod", "pcg", "pcg-mg"}, defaults, keys);
+    o.linear_solver = linear.kind;
+    o.linear.pcg_tolerance = linear.tolerance;
+    o.linear.pcg_max_iterations = linear.max_iterations;
+    o.linear.pcg_max_iterations_key = linear.max_iterations_key;
     o.linear.pcg_preconditioner = c.get_or<std::string>("pcg_preconditioner", o.linear.pcg_preconditioner);
-    auto names = linear_solver_names();
-    names.insert(names.begin(), "auto");
-    if (std::find(names.begin(), names.end(), o.linear_solver) == names.end()) c.one_of("linear_solver", names);
     o.auto_iterative_dofs = c.get_or<int>("auto_iterative_dofs", o.auto_iterative_dofs);
   }
   return s;

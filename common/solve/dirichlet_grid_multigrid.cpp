@@ -598,6 +598,7 @@ VecX DirichletGridMultigrid::solve(VecX b) {
   CgSetup cg = multigrid_cg_setup([this](const VecX& x, VecX& y) { multiply_rows(x, y); },
                                   [this](const VecX& r, VecX& z) { cycle(r, z); }, options_.tolerance,
                                   options_.max_iterations, threads, "matrix-free multigrid CG");
+  cg.settings.max_iterations_key = options_.max_iterations_key;
   cg.settings.progress = [](int iteration, double residual) {
     spdlog::debug("  matrix-free multigrid CG: iteration {}, relative residual {:.3g}", iteration, residual);
   };

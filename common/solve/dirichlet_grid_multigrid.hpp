@@ -30,6 +30,7 @@
 // coarse correction) is a fixed SPD operator, so plain CG applies.
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fem/voxel_stiffness_field.hpp"
@@ -45,6 +46,7 @@ class MultigridSolver;
 struct DirichletMultigridOptions {
   double tolerance = 1e-8;   // stop when ||b - A x|| <= tolerance ||b||
   int max_iterations = 2000;
+  std::string max_iterations_key;  // the config key that sets max_iterations, for messages (empty: none)
   int smoother_degree = 2;   // Chebyshev degree on the grid (matrix products per smoothing)
   int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
   int threads = 0;           // 0: the OpenMP default

@@ -392,12 +392,13 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
 
 VecX PeriodicGridMultigrid::solve_cg(const VecX& consistent) {
   const int threads = options_.threads;
-  const CgSetup cg = multigrid_cg_setup([this](const VecX& x, VecX& y) { multiply(x, y); },
-                                        [this, threads](const VecX& r, VecX& z) {
-                                          cycle(0, r, z);
-                                          project_zero_mean(z, threads);
-                                        },
-                                        options_.tolerance, options_.max_iterations, threads, "periodic multigrid CG");
+  CgSetup cg = multigrid_cg_setup([this](const VecX& x, VecX& y) { multiply(x, y); },
+                                  [this, threads](const VecX& r, VecX& z) {
+                                    cycle(0, r, z);
+                                    project_zero_mean(z, threads);
+                                  },
+                                  options_.tolerance, options_.max_iterations, threads, "periodic multigrid CG");
+  cg.settings.max_iterations_key = options_.max_iterations_key;
   VecX x = conjugate_gradient(cg.op, cg.preconditioner, consistent, cg.settings, stats_);
   project_zero_mean(x, threads);
   return x;

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fem/voxel_stiffness_field.hpp"
@@ -41,6 +42,7 @@ namespace msfab {
 struct PeriodicMultigridOptions {
   double tolerance = 1e-8;  // stop when ||b - K x|| <= tolerance ||b|| (b projected)
   int max_iterations = 1000;
+  std::string max_iterations_key;  // the config key that sets max_iterations, for messages (empty: none)
   int smoother_degree = 2;   // Chebyshev degree on the finest level (twice that below)
   int coarsest_nodes = 64;  // coarsening stops at the first level with at most this many nodes
   // Coarse levels' smoothers in single precision (ChebyshevSmoother). A

@@ -84,6 +84,7 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
     DirichletMultigridOptions mg;
     mg.tolerance = options_.pcg_tolerance;
     mg.max_iterations = options_.pcg_max_iterations;
+    mg.max_iterations_key = options_.pcg_max_iterations_key;
     mg.smoother_degree = options_.mg_smoother_degree;
     mg.coarse_unknowns = options_.mg_coarse_unknowns;
     mg.threads = options_.threads;

@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "io/linear_solver_config.hpp"
+#include "io/material_config.hpp"
 
 namespace msfab {
 
@@ -201,13 +203,13 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
     config.fail("space", "is " + std::string(1, scene.space[scene.space.size() - 2]) + "D but grid.size is " +
                              std::to_string(dim) + "D");
   const Config mat = config.has("material") ? config.child("material") : Config();
-  scene.E0 = mat.get_or<double>("E", 1.0);
-  scene.nu = mat.get_or<double>("nu", 0.3);
+  const ElasticConstants solid =
+      read_elastic_constants(mat, dim == 3 ? PoissonRange::Solid : PoissonRange::InPlane, ElasticConstants{1.0, 0.3});
+  scene.E0 = solid.E;
+  scene.nu = solid.nu;
   scene.penalty = mat.get_or<double>("penalty", 3.0);
   scene.E_min_ratio = mat.get_or<double>("E_min_ratio", 1e-9);
   scene.decades = mat.get_or<double>("decades", 4.0);
-  if (!(scene.E0 > 0)) mat.fail("E", "must be > 0");
-  if (!(scene.nu > -1 && scene.nu < (dim == 3 ? 0.5 : 1.0))) mat.fail("nu", "must be in (-1, 0.5) in 3D, (-1, 1) in 2D");
   if (!(scene.penalty >= 1)) mat.fail("penalty", "must be >= 1");
   if (!(scene.E_min_ratio > 0 && scene.E_min_ratio < 1)) mat.fail("E_min_ratio", "must be in (0, 1)");
   if (!(scene.decades > 0)) mat.fail("decades", "must be > 0");
@@ -275,7 +277,17 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
   read_mass_terms(config, g, scene);
   s.filter_radius = config.get_or<double>("filter.radius", 0.0);
   if (!(s.filter_radius >= 0)) config.fail("filter.radius", "must be >= 0");
-  s.solver = config.has("solver") ? config.one_of("solver", {"auto", "cholmod", "pcg-mg", "matrix-free"}) : "auto";
+  LinearSolverChoice defaults;
+  defaults.tolerance = s.solver_options.pcg_tolerance;
+  defaults.max_iterations = s.solver_options.pcg_max_iterations;
+  LinearSolverKeys keys;
+  keys.legacy_kind = "solver";
+  const LinearSolverChoice linear =
+      read_linear_solver_choice(config, {"auto", "cholmod", "pcg-mg", "matrix-free"}, defaults, keys);
+  s.solver = linear.kind;
+  s.solver_options.pcg_tolerance = linear.tolerance;
+  s.solver_options.pcg_max_iterations = linear.max_iterations;
+  s.solver_options.pcg_max_iterations_key = linear.max_iterations_key;
   return scene;
 }
 

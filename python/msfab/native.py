@@ -41,8 +41,8 @@ def _bindings():
                       "PYTHONPATH, or set MSFAB_BUILD to the build folder")
 
 
-def homogenize(ids, materials, *, voxel_size=None, void_stiffness=None, solver=None, multigrid_tolerance=None,
-               use_symmetry=None, threads=1):
+def homogenize(ids, materials, *, voxel_size=None, void_stiffness=None, linear_solver=None, linear_tolerance=None,
+               linear_max_iterations=None, use_symmetry=None, threads=1, solver=None, multigrid_tolerance=None):
     """Periodic homogenization of a voxel cell, as msfab-homogenize.
 
     ids: integer array of shape (nx, ny, nz), ids[i, j, k] the material of
@@ -50,13 +50,17 @@ def homogenize(ids, materials, *, voxel_size=None, void_stiffness=None, solver=N
     materials: the palette as in a config, e.g. [{"id": 1, "model":
     "linear", "E": 1e6, "nu": 0.3}, ...]. The keyword options are the
     stage's config keys (docs/homogenization.md); None keeps its default.
+    solver and multigrid_tolerance are the earlier names of linear_solver
+    and linear_tolerance, still read (with a warning).
     Returns a dict: C (6 x 6), C_plane (3 x 3, 2D cells), solid_fraction,
     pieces, solver, unknowns, seconds. Raises msfab.InputError (a
     ValueError) naming the key on bad input.
     """
     config = {"materials": list(materials)}
-    for key, value in (("voxel_size", voxel_size), ("void_stiffness", void_stiffness), ("solver", solver),
-                       ("multigrid_tolerance", multigrid_tolerance), ("use_symmetry", use_symmetry)):
+    for key, value in (("voxel_size", voxel_size), ("void_stiffness", void_stiffness),
+                       ("linear_solver", linear_solver), ("linear_tolerance", linear_tolerance),
+                       ("linear_max_iterations", linear_max_iterations), ("use_symmetry", use_symmetry),
+                       ("solver", solver), ("multigrid_tolerance", multigrid_tolerance)):
         if value is not None:
             config[key] = value
     return _bindings().homogenize(ids, json.dumps(config, default=float), threads)

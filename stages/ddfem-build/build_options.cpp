@@ -1,6 +1,7 @@
 #include "build_options.hpp"
 
 #include "core/errors.hpp"
+#include "io/material_config.hpp"
 
 namespace msfab {
 
@@ -43,10 +44,10 @@ BuildOptions read_build_options(const Config& config) {
   for (const Config& m : palette) {
     DbMaterial d;
     d.name = m.get_or("name", "");
-    d.E = m.require_positive<double>("E", "Young's modulus");
-    d.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
-    d.density = m.get_or<double>("density", 1000.0);
-    if (!(d.density > 0)) m.fail("density", "must be > 0");
+    const ElasticConstants elastic = read_elastic_constants(m);
+    d.E = elastic.E;
+    d.nu = elastic.nu;
+    d.density = read_density(m, 1000.0);
     m.check_no_unknown_keys();
     o.materials.push_back(d);
   }

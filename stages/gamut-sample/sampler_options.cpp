@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/errors.hpp"
+#include "io/material_config.hpp"
 
 namespace msfab {
 
@@ -37,8 +38,9 @@ void_variants: false      # also write the structures with the soft material rem
 namespace {
 BaseMaterial read_base(const Config& m) {
   BaseMaterial b;
-  b.E = m.require_positive<double>("E", "Young's modulus");
-  b.nu = m.require_range<double>("nu", -1.0, 0.5, Bounds::Open, "Poisson's ratio");
+  const ElasticConstants elastic = read_elastic_constants(m);
+  b.E = elastic.E;
+  b.nu = elastic.nu;
   m.check_no_unknown_keys();
   return b;
 }

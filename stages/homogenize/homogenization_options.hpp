@@ -1,6 +1,6 @@
 #pragma once
 // The cell solver settings of msfab-homogenize's config (void_stiffness,
-// solver, multigrid_tolerance, use_symmetry), read into the options of
+// linear_solver, linear_tolerance, linear_max_iterations, use_symmetry), read into the options of
 // homog/periodic_homogenization.hpp; shared by the stage and the Python
 // bindings, so both solve a cell the same way.
 #include "homog/periodic_homogenization.hpp"

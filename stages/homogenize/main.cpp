@@ -45,14 +45,12 @@ layout:
   - {box: {min: [0.333, 0, 0.333], max: [0.667, 1, 0.667]}, id: 1}
   - {box: {min: [0.333, 0.333, 0], max: [0.667, 0.667, 1]}, id: 1}
 void_stiffness: 1.0e-6
-solver: auto
 use_symmetry: true
 )";
 
 // Batch mode: materials and cells come from the structures artifact.
 constexpr const char* kBatchDefaults = R"(
 void_stiffness: 1.0e-6
-solver: auto
 refine: 1
 use_symmetry: true
 )";
@@ -89,8 +87,8 @@ void run_batch(StageContext& ctx, const std::string& structures) {
   std::printf("msfab-homogenize: %d structures of %d x %d x %d voxels (%s), %.3f s (%.2f structures/s)\n",
               report.structures, set.nx, set.ny, set.nz, report.solver.c_str(), report.seconds,
               report.structures / report.seconds);
-  if (report.solver == "multigrid")
-    std::printf("  multigrid: %.1f CG iterations per structure (over the strain cases solved)\n",
+  if (report.solver == "matrix-free")
+    std::printf("  matrix-free multigrid: %.1f CG iterations per structure (over the strain cases solved)\n",
                 double(report.iterations) / report.structures);
   std::printf("  change of C^H against the input: median %.3e, max %.3e (relative Frobenius)\n",
               report.median_relative_change, report.max_relative_change);
@@ -119,7 +117,7 @@ int main(int argc, char** argv) {
       ctx.check_memory(homogenization_peak_bytes(nx, ny, nz, options.solver),
                        "a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
                            " cell with the " + options.solver + " solver",
-                       "use a smaller cell" + std::string(nz > 1 && options.solver == "direct" ? " or solver: multigrid" : ""));
+                       "use a smaller cell" + std::string(nz > 1 && options.solver == "cholmod" ? " or linear_solver: matrix-free" : ""));
     });
     options.threads = ctx.options.threads;
     std::optional<FiniteStrainCheck> finite_strain = read_finite_strain_check(ctx.config);
@@ -141,10 +139,10 @@ int main(int argc, char** argv) {
                 in.cell.nz, static_cast<long long>(r.unknowns), r.octant ? " (one octant, mirror symmetry)" : "",
                 r.solver.c_str(), r.seconds);
     const char* cases = r.symmetric_cases ? "2 strain cases (4 more by the cyclic symmetry)" : "the 6 strain cases";
-    if (r.solver == "multigrid")
-      std::printf("  multigrid: %d CG iterations over %s\n", r.iterations, cases);
+    if (r.solver == "matrix-free")
+      std::printf("  matrix-free multigrid: %d CG iterations over %s\n", r.iterations, cases);
     else
-      std::printf("  direct: %s\n", cases);
+      std::printf("  cholmod: %s\n", cases);
     std::printf("  solid fraction %.4f, pieces %d\n", 1.0 - r.volume_fraction[0], r.pieces);
     const double dev = cubic_deviation(r.C);
     if (plane) {

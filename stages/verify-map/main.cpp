@@ -26,6 +26,7 @@
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "io/artifact.hpp"
+#include "io/linear_solver_config.hpp"
 #include "io/sha256.hpp"
 #include "models.hpp"
 #include "topopt/edge_joints.hpp"
@@ -45,12 +46,13 @@ void_ratio: 1.0e-6       # void: ersatz: void voxels and forced-empty cells are 
 fill: mapped             # mapped | solid (every non-empty cell solid in both models: the mesh-only reference)
                          # | tile (every design cell holds structure tile_structure, unshifted: a periodic tiling)
 tile_structure: 0        # fill: tile: index into the microstructure set
-solver: auto             # full-resolution model: auto | cholmod | pcg-mg | matrix-free
+# linear_solver: auto    # full-resolution model: auto | cholmod | pcg-mg | matrix-free
 coarse_space: material   # matrix-free solver: material (coarse nodes copied per piece of material in
                          # their support) | lattice (trilinear hat functions across gaps)
-homogenized_solver: auto # the design grid
+# homogenized_linear_solver: auto  # the design grid: the same kinds
 homogenized_elements: 1  # hexahedra per cell edge in the homogenized model (> 1: without most of the coarse mesh's stiffness)
-tolerance: 1.0e-8        # iterative solvers: relative residual
+# linear_tolerance: 1.0e-8      # iterative solvers (both models): relative residual
+# linear_max_iterations: 10000  # iterative solvers: CG iterations before the check fails
 )";
 
 struct Settings {
@@ -59,10 +61,9 @@ struct Settings {
   ModelFill fill = ModelFill::mapped;
   std::string fill_name = "mapped";
   int tile_structure = -1;  // fill: tile
-  std::string solver = "auto", homogenized_solver = "auto";
+  LinearSolverChoice solver, homogenized_solver;
   bool material_coarse_space = true;
   int homogenized_elements = 1;
-  double tolerance = 1e-8;
 };
 
 Settings read_settings(const Config& config, const std::string& solver_option) {
@@ -77,14 +78,22 @@ Settings read_settings(const Config& config, const std::string& solver_option) {
     if (tile < 0) config.fail("tile_structure", "must be >= 0");
     s.tile_structure = tile;
   }
-  s.solver = config.get_or<std::string>("solver", "auto");
-  if (!solver_option.empty()) s.solver = solver_option;
-  s.homogenized_solver = config.get_or<std::string>("homogenized_solver", "auto");
+  const std::vector<std::string> kinds = {"auto", "cholmod", "pcg-mg", "matrix-free"};
+  LinearSolverKeys full_keys;
+  full_keys.legacy_kind = "solver";
+  full_keys.legacy_tolerance = "tolerance";
+  s.solver = read_linear_solver_choice(config, kinds, LinearSolverChoice{}, full_keys);
+  if (!solver_option.empty()) override_linear_solver_kind(s.solver, solver_option, kinds, "--solver");
+  // The homogenized model's own kind; tolerance and iteration limit are shared.
+  LinearSolverKeys homogenized_keys;
+  homogenized_keys.kind = "homogenized_linear_solver";
+  homogenized_keys.legacy_kind = "homogenized_solver";
+  LinearSolverChoice homogenized_defaults = s.solver;
+  homogenized_defaults.kind = "auto";
+  s.homogenized_solver = read_linear_solver_choice(config, kinds, homogenized_defaults, homogenized_keys);
   s.material_coarse_space = config.one_of("coarse_space", {"material", "lattice"}) == "material";
   s.homogenized_elements = config.get_or<int>("homogenized_elements", 1);
   if (s.homogenized_elements < 1 || s.homogenized_elements > 64) config.fail("homogenized_elements", "must be 1..64");
-  s.tolerance = config.get_or<double>("tolerance", 1e-8);
-  if (!(s.tolerance > 0 && s.tolerance < 1)) config.fail("tolerance", "must be in (0, 1)");
   return s;
 }
 
@@ -197,14 +206,18 @@ void remove_void_from_voxels(const CellRefinement& refinement, const std::vector
                  100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
 }
 
-// GridElasticity, with a bad solver name reported against its config key.
+// GridElasticity, with a solver the grid does not allow reported against
+// the key that chose it.
 std::unique_ptr<GridElasticity> make_model(const CellGrid& grid, std::vector<char> fixed,
-                                           const std::string& solver, const std::string& key,
-                                           const LinearSolverOptions& options, bool material_coarse_space = false) {
+                                           const LinearSolverChoice& solver, LinearSolverOptions options,
+                                           bool material_coarse_space = false) {
+  options.pcg_tolerance = solver.tolerance;
+  options.pcg_max_iterations = solver.max_iterations;
+  options.pcg_max_iterations_key = solver.max_iterations_key;
   try {
-    return std::make_unique<GridElasticity>(grid, std::move(fixed), solver, options, material_coarse_space);
+    return std::make_unique<GridElasticity>(grid, std::move(fixed), solver.kind, options, material_coarse_space);
   } catch (const InputError& e) {
-    throw InputError(key + " = " + solver + ": " + e.what());
+    throw InputError(solver.kind_key + " = " + solver.kind + ": " + e.what());
   }
 }
 
@@ -225,7 +238,8 @@ int main(int argc, char** argv) {
   app.cli().add_option("--scene", scene_path,
                        "topopt scene YAML with the supports and loads (default: the design's own config)")
       ->type_name("FILE");
-  app.cli().add_option("--solver", solver_option, "solver of the full-resolution model (same as --set solver=NAME)")
+  app.cli().add_option("--solver", solver_option,
+                       "linear solver of the full-resolution model (same as --set linear_solver=NAME)")
       ->type_name("NAME");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
@@ -254,7 +268,6 @@ int main(int argc, char** argv) {
 
     LinearSolverOptions solver_options;
     solver_options.threads = ctx.options.threads;
-    solver_options.pcg_tolerance = settings.tolerance;
 
     VerifyReport report;
     report.fill = settings.fill_name;
@@ -284,7 +297,7 @@ int main(int argc, char** argv) {
     }
     if (settings.remove_void) remove_void_from_cells(hgrid, hsolid, hfixed, report, design_path);
     const auto homogenized_model =
-        make_model(hgrid, hfixed, settings.homogenized_solver, "homogenized_solver", solver_options,
+        make_model(hgrid, hfixed, settings.homogenized_solver, solver_options,
                    settings.material_coarse_space);
     GridElasticity& homogenized = *homogenized_model;
     {
@@ -348,7 +361,7 @@ int main(int argc, char** argv) {
                  100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
                  fine.unknowns(), report.inactive_nodes_full);
     // The model keeps the support flags from here on (one grid-sized copy, not two).
-    const auto full_model = make_model(fine, std::move(supports.fixed), settings.solver, "solver", solver_options,
+    const auto full_model = make_model(fine, std::move(supports.fixed), settings.solver, solver_options,
                                        settings.material_coarse_space);
     GridElasticity& full = *full_model;
     if (full.solver_name() == "matrix-free") {

@@ -27,16 +27,31 @@ sed 's/solid.txt/flat.txt/' "$WORK/file.yaml" > "$WORK/flat.yaml"
 expect_exit 0 "2D plane strain: Ex 1\.0989e\+06" -- "$H" --config "$WORK/flat.yaml" --out "$WORK/flat.h5"
 check "2D tensor written" -- bash -c "h5dump -H -d /C2 '$WORK/flat.h5' | grep -q '( 3, 3 )'"
 
-# The multigrid solver on the default frame at 24^3 agrees with the direct one.
-expect_exit 0 "multigrid: [0-9]+ CG iterations" -- "$H" --set cell.size='[24, 24, 24]' --set solver=multigrid --out "$WORK/mg.h5"
-check "direct at 24^3" -- "$H" --set cell.size='[24, 24, 24]' --set solver=direct --out "$WORK/direct.h5" --quiet
-check "multigrid and direct tensors agree to 1e-2 Pa (C ~ 1e5 Pa)" -- h5diff -q --delta=1e-2 "$WORK/mg.h5" "$WORK/direct.h5" /C /C
+# The matrix-free multigrid solver on the default frame at 24^3 agrees with CHOLMOD.
+expect_exit 0 "matrix-free multigrid: [0-9]+ CG iterations" -- "$H" --set cell.size='[24, 24, 24]' \
+  --set linear_solver=matrix-free --out "$WORK/mg.h5"
+check "cholmod at 24^3" -- "$H" --set cell.size='[24, 24, 24]' --set linear_solver=cholmod --out "$WORK/direct.h5" --quiet
+check "matrix-free and cholmod tensors agree to 1e-2 Pa (C ~ 1e5 Pa)" -- h5diff -q --delta=1e-2 "$WORK/mg.h5" "$WORK/direct.h5" /C /C
+check "the artifact names the solver" -- bash -c "h5dump -a /solver '$WORK/mg.h5' | grep -q '\"matrix-free\"'"
+# The earlier names (solver: multigrid, multigrid_tolerance) still read, with a
+# warning naming the key to write, and give the same bits.
+expect_exit 0 "solver is an earlier name; write linear_solver" -- "$H" --set cell.size='[24, 24, 24]' \
+  --set solver=multigrid --set multigrid_tolerance=1e-6 --out "$WORK/mg_old.h5"
+check "earlier names, same tensor bit for bit" -- h5diff -q "$WORK/mg.h5" "$WORK/mg_old.h5" /C /C
+expect_exit 2 "solver = multigrid: is the earlier name of linear_solver; give only one of them" -- "$H" --set solver=multigrid \
+  --set linear_solver=cholmod --out "$WORK/bad.h5"
+expect_exit 2 "linear_solver = pcg: linear solver 'pcg' is unknown here; choose one of auto, cholmod, matrix-free" -- \
+  "$H" --set linear_solver=pcg --out "$WORK/bad.h5"
+expect_exit 2 "linear_max_iterations = 0: must be at least 1" -- "$H" --set linear_max_iterations=0 --out "$WORK/bad.h5"
+expect_exit 3 "periodic multigrid CG did not converge.* set by linear_max_iterations" -- "$H" --set cell.size='[24, 24, 24]' \
+  --set linear_solver=matrix-free --set linear_max_iterations=2 --set use_symmetry=false --out "$WORK/bad.h5"
 # The frame is mirror-symmetric: solved on one octant, the same tensor as the whole cell.
 check "the frame is solved on one octant" -- bash -c "h5dump -a /domain '$WORK/frame.h5' | grep -q octant"
 check "use_symmetry: false solves the whole cell" -- bash -c \
   "'$H' --set use_symmetry=false --out '$WORK/whole.h5' --quiet && h5dump -a /domain '$WORK/whole.h5' | grep -q '\"cell\"'"
 check "octant and whole cell agree to 1e-3 Pa" -- h5diff -q --delta=1e-3 "$WORK/frame.h5" "$WORK/whole.h5" /C /C
-expect_exit 2 "solver multigrid needs every cell dimension even" -- "$H" --set cell.size='[12, 12, 9]' --set solver=multigrid --out "$WORK/bad.h5"
+expect_exit 2 "solver matrix-free needs every cell dimension even" -- "$H" --set cell.size='[12, 12, 9]' \
+  --set linear_solver=matrix-free --out "$WORK/bad.h5"
 
 # Batch mode: a small 3D set from the sampler, homogenized again.
 cat > "$WORK/set.yaml" <<'Y'
@@ -56,11 +71,11 @@ expect_exit 0 "change of C\^H against the input: median 0\.000e\+00, max 0\.000e
   "$H" --structures "$WORK/set.microstructures.h5" --out "$WORK/same.microstructures.h5"
 check "same solver, same tensors and properties" -- bash -c "h5diff -q '$WORK/set.microstructures.h5' '$WORK/same.microstructures.h5' /C /C &&
   h5diff -q '$WORK/set.microstructures.h5' '$WORK/same.microstructures.h5' /properties /properties"
-expect_exit 0 "structures of 16 x 16 x 16 voxels \(multigrid\)" -- "$H" --structures "$WORK/set.microstructures.h5" \
-  --set refine=2 --set solver=multigrid --threads 1 --out "$WORK/fine1.microstructures.h5"
+expect_exit 0 "structures of 16 x 16 x 16 voxels \(matrix-free\)" -- "$H" --structures "$WORK/set.microstructures.h5" \
+  --set refine=2 --set linear_solver=matrix-free --threads 1 --out "$WORK/fine1.microstructures.h5"
 check "refined cells are stored (16^3 voxels, one bit each)" -- bash -c "h5dump -H -d /voxels '$WORK/fine1.microstructures.h5' | grep -q ', 512 )'"
 check "refined set, threads inside each solve" -- "$H" --structures "$WORK/set.microstructures.h5" \
-  --set refine=2 --set solver=multigrid --threads 8 --out "$WORK/fine8.microstructures.h5" --quiet
+  --set refine=2 --set linear_solver=matrix-free --threads 8 --out "$WORK/fine8.microstructures.h5" --quiet
 check "1 and 8 threads give the same refined set" -- h5diff -q "$WORK/fine1.microstructures.h5" "$WORK/fine8.microstructures.h5" /C /C
 expect_exit 2 "batch mode .* drop it" -- "$H" --structures "$WORK/set.microstructures.h5" --set 'materials=[]' --out "$WORK/bad.h5"
 expect_exit 2 "refine.*must be 1..16" -- "$H" --structures "$WORK/set.microstructures.h5" --set refine=0 --out "$WORK/bad.h5"

@@ -11,8 +11,8 @@ T="timeout 30"
 
 expect_exit 2 "a 4096 x 4096 x 4096 cell with the auto solver needs about .* GiB, more than the .* available" -- \
   $T "$H" --set 'cell.size=[4096,4096,4096]' --out "$WORK/h.h5"
-expect_exit 2 "64 x 64 x 64 cell with the direct solver .* or solver: multigrid" -- \
-  $T "$H" --set 'cell.size=[64,64,64]' --set solver=direct --out "$WORK/h.h5"
+expect_exit 2 "64 x 64 x 64 cell with the cholmod solver .* or linear_solver: matrix-free" -- \
+  $T "$H" --set 'cell.size=[64,64,64]' --set linear_solver=cholmod --out "$WORK/h.h5"
 expect_exit 2 "grid of 100000 x 100000 cells \(grid.size\) needs about" -- \
   $T "$BIN/msfab-topopt" --set 'grid.size=[100000,100000]' --out "$WORK/t.h5"
 expect_exit 2 "grid of 400 x 400 x 400 cells \(grid.size\) with elements_per_cell 4" -- \
@@ -69,7 +69,7 @@ check "refused runs leave nothing" -- bash -c "! ls '$WORK' | grep -Eq '^(big|m|
 # 64^3 direct solve let through to its first step by a large limit.
 expect_exit 2 "12 x 12 x 12 cell with the auto solver needs about .* MiB, more than the 1 MiB of --memory-limit" -- \
   $T "$H" --memory-limit 1M --out "$WORK/h.h5"
-expect_exit 0 "" -- $T "$H" --memory-limit 64G --set 'cell.size=[8,8,8]' --set solver=direct --out "$WORK/small.h5" --quiet
+expect_exit 0 "" -- $T "$H" --memory-limit 64G --set 'cell.size=[8,8,8]' --set linear_solver=cholmod --out "$WORK/small.h5" --quiet
 expect_exit 2 "memory-limit '12X': expected a size such as 64G" -- $T "$H" --memory-limit 12X --out "$WORK/h.h5"
 expect_exit 2 "memory-limit '0': expected a size" -- $T "$H" --memory-limit 0 --out "$WORK/h.h5"
 

@@ -99,6 +99,7 @@ ids = np.ones((4, 4, 4), dtype=int)
 stiff = [{"id": 1, "model": "linear", "E": 1.0e6, "nu": 0.3}]
 cases = [
     (lambda: msfab.homogenize(ids, [{"id": 1, "model": "linear", "E": -1.0, "nu": 0.3}]), "materials[0].E"),
+    (lambda: msfab.homogenize(ids, stiff, linear_solver="bogus"), "linear_solver = bogus"),
     (lambda: msfab.homogenize(ids, stiff, solver="bogus"), "solver = bogus"),
     (lambda: msfab.homogenize(2 * ids, stiff), "has id 2, which is not a material"),
     (lambda: msfab.homogenize(ids.astype(float), stiff), "expected an integer array"),

@@ -177,7 +177,10 @@ expect_exit 2 "unknown key 'voids'" -- "$V" "${A[@]}" --set voids=remove --out "
 # Hinged on one line of nodes, the bar can turn about it: no piece is held.
 sed 's/supports: .*/supports: [{box: {min: [0, 0, 0], max: [0, 0, 2]}}]/' "$WORK/bar.yaml" > "$WORK/hinge.yaml"
 expect_exit 2 "supports hold none of the design's non-empty cells" -- "$V" "${A[@]}" --scene "$WORK/hinge.yaml" --out "$B"
-expect_exit 2 "solver = bogus: linear solver 'bogus' is unknown" -- "$V" "${A[@]}" --solver bogus --out "$B"
+expect_exit 2 "--solver bogus: linear solver 'bogus' is unknown here; choose one of auto, cholmod, pcg-mg, matrix-free" -- "$V" "${A[@]}" --solver bogus --out "$B"
+expect_exit 2 "homogenized_linear_solver = pcg: linear solver 'pcg' is unknown here" -- "$V" "${A[@]}" \
+  --set homogenized_linear_solver=pcg --out "$B"
+expect_exit 2 "linear_tolerance = 1: must be in \(0, 1\)" -- "$V" "${A[@]}" --set linear_tolerance=1 --out "$B"
 expect_exit 2 "--mapped is required" -- "$V" --design "$WORK/bar.design.h5" --structures "$S" --out "$B"
 expect_exit 2 "output folder does not exist" -- "$V" "${A[@]}" --out "$WORK/nowhere/x.verify.h5"
 check "nothing written on bad input" -- test ! -e "$B"

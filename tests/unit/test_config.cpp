@@ -12,6 +12,8 @@
 #include "core/errors.hpp"
 #include "io/config.hpp"
 #include "io/input_file.hpp"
+#include "io/linear_solver_config.hpp"
+#include "io/material_config.hpp"
 
 namespace msfab {
 namespace {
@@ -426,6 +428,75 @@ TEST(InputFile, SameFileByInodeOrByPath) {
   std::ofstream((dir / "b.h5").string()) << "x";
   EXPECT_FALSE(same_file(a, (dir / "b.h5").string()));
   std::filesystem::remove_all(dir);
+}
+
+TEST(LinearSolverConfig, ReadsTheThreeKeysWithTheStagesDefaults) {
+  const Config c = Config::from_string("solver: {linear_solver: pcg, linear_tolerance: 1.0e-10}\n", "s.yaml");
+  LinearSolverChoice defaults;
+  defaults.max_iterations = 77;
+  const LinearSolverChoice got = read_linear_solver_choice(c.child("solver"), {"auto", "cholmod", "pcg"}, defaults);
+  EXPECT_EQ(got.kind, "pcg");
+  EXPECT_EQ(got.tolerance, 1e-10);
+  EXPECT_EQ(got.max_iterations, 77);
+  EXPECT_EQ(got.max_iterations_key, "solver.linear_max_iterations");
+  EXPECT_EQ(got.kind_key, "solver.linear_solver");
+  c.check_no_unknown_keys();
+}
+
+TEST(LinearSolverConfig, EarlierNamesReadAsTheCurrentOnes) {
+  LinearSolverKeys keys;
+  keys.legacy_kind = "solver";
+  keys.legacy_tolerance = "multigrid_tolerance";
+  const Config old = Config::from_string("solver: multigrid\nmultigrid_tolerance: 1.0e-4\n", "h.yaml");
+  const LinearSolverChoice got = read_linear_solver_choice(old, {"auto", "cholmod", "matrix-free"}, {}, keys);
+  EXPECT_EQ(got.kind, "matrix-free");
+  EXPECT_EQ(got.tolerance, 1e-4);
+  EXPECT_EQ(got.tolerance_key, "multigrid_tolerance");
+  old.check_no_unknown_keys();
+  const Config direct = Config::from_string("linear_solver: direct\n", "h.yaml");
+  EXPECT_EQ(read_linear_solver_choice(direct, {"auto", "cholmod"}, {}, keys).kind, "cholmod");
+  const Config both = Config::from_string("solver: multigrid\nlinear_solver: cholmod\n", "h.yaml");
+  EXPECT_CONTAINS(input_error_of([&] { read_linear_solver_choice(both, {"auto", "cholmod"}, {}, keys); }),
+                  ("h.yaml: solver = multigrid: is the earlier name of linear_solver; give only one of them"));
+}
+
+TEST(LinearSolverConfig, RefusesWhatTheStageDoesNotOffer) {
+  const std::vector<std::string> offered = {"auto", "cholmod", "matrix-free"};
+  const auto error_for = [&](const std::string& yaml) {
+    const Config c = Config::from_string(yaml, "h.yaml");
+    return input_error_of([&] { read_linear_solver_choice(c, offered, {}); });
+  };
+  EXPECT_CONTAINS(error_for("linear_solver: pcg\n"),
+                  ("h.yaml: linear_solver = pcg: linear solver 'pcg' is unknown here; choose one of auto, cholmod, "
+                   "matrix-free"));
+  EXPECT_CONTAINS(error_for("linear_tolerance: 1\n"), ("linear_tolerance = 1: must be in (0, 1)"));
+  EXPECT_CONTAINS(error_for("linear_tolerance: 0\n"), ("linear_tolerance = 0: must be in (0, 1)"));
+  EXPECT_CONTAINS(error_for("linear_max_iterations: 0\n"), ("linear_max_iterations = 0: must be at least 1"));
+  LinearSolverChoice choice;
+  EXPECT_CONTAINS(input_error_of([&] { override_linear_solver_kind(choice, "pcg", offered, "--solver"); }),
+                  ("--solver pcg: linear solver 'pcg' is unknown here"));
+  override_linear_solver_kind(choice, "multigrid", offered, "--solver");
+  EXPECT_EQ(choice.kind, "matrix-free");
+  EXPECT_EQ(choice.kind_key, "--solver");
+}
+
+TEST(MaterialConfig, OneReaderForElasticConstantsAndDensity) {
+  const Config c = Config::from_string(
+      "materials:\n  - {E: 2.0e6, nu: 0.7, density: 1200}\n  - {E: 0, nu: 0.3}\n  - {nu: 0.2}\n", "m.yaml");
+  const auto m = c.children("materials");
+  EXPECT_CONTAINS(input_error_of([&] { read_elastic_constants(m[0]); }),
+                  ("m.yaml: materials[0].nu = 0.7: Poisson's ratio must be in (-1, 0.5)"));
+  const ElasticConstants in_plane = read_elastic_constants(m[0], PoissonRange::InPlane);
+  EXPECT_EQ(in_plane.E, 2e6);
+  EXPECT_EQ(in_plane.nu, 0.7);
+  EXPECT_EQ(read_density(m[0]), 1200);
+  EXPECT_CONTAINS(input_error_of([&] { read_elastic_constants(m[1]); }),
+                  ("materials[1].E = 0: Young's modulus must be positive"));
+  EXPECT_CONTAINS(input_error_of([&] { read_density(m[1]); }), ("missing required key 'materials[1].density'"));
+  EXPECT_EQ(read_density(m[1], 1000.0), 1000);
+  const ElasticConstants fallback = read_elastic_constants(m[2], PoissonRange::Solid, ElasticConstants{1.0, 0.3});
+  EXPECT_EQ(fallback.E, 1.0);
+  EXPECT_EQ(fallback.nu, 0.2);
 }
 
 }  // namespace

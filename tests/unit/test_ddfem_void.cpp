@@ -49,7 +49,7 @@ TEST(DdfemVoid, PeriodicBlockEnergyIsTheHomogenizedEnergy) {
       {1, 2, 2, 1, 2, 1, 1, 0}, {1, 0, 2, 0, 2, 0, 1, 0}, {2, 2, 0, 0, 0, 0, 0, 0}};
   HomogenizationOptions homog;
   homog.void_stiffness = 1e-9;
-  homog.solver = "direct";
+  homog.solver = "cholmod";
   for (const BlockMaterials& ids : blocks) {
     const FineBlock block = make_fine_block(ids, palette, kVoxel);
     const PeriodicBlockSolver solver(block);

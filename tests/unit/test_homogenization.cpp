@@ -234,20 +234,20 @@ TEST(Homogenization, CyclicSymmetryTwoSolvesEqualSixSolves) {
   // permutation) against six separate solves: direct at 6^3, multigrid at
   // 16^3, two phases 100x apart.
   const auto pal = two_phases(1e6, 0.3, 1e4, 0.45);
-  for (const std::string solver : {"direct", "multigrid"}) {
-    const int n = solver == "direct" ? 6 : 16;
+  for (const std::string solver : {"cholmod", "matrix-free"}) {
+    const int n = solver == "cholmod" ? 6 : 16;
     const VoxelGrid cell = cyclic_random_cell(n, 11);
     HomogenizationOptions six, two;
     six.solver = two.solver = solver;
     six.use_symmetry = false;
-    six.multigrid_tolerance = two.multigrid_tolerance = 1e-12;
+    six.tolerance = two.tolerance = 1e-12;
     const HomogenizationResult a = homogenize(cell, pal, six), b = homogenize(cell, pal, two);
     EXPECT_FALSE(a.symmetric_cases);
     EXPECT_TRUE(b.symmetric_cases) << solver;
     EXPECT_LT((a.C - b.C).norm(), 1e-10 * a.C.norm()) << solver;
     for (int m = 0; m < 6; ++m)
       EXPECT_LT((a.fluctuation[m] - b.fluctuation[m]).norm(), 1e-8 * a.fluctuation[m].norm() + 1e-14) << solver << " case " << m;
-    if (solver == "multigrid") {
+    if (solver == "matrix-free") {
       EXPECT_LT(b.iterations, 0.5 * a.iterations);
     }
     // Chiral: off-cubic couplings are present, so the test does not pass by a cubic tensor alone.
@@ -286,14 +286,14 @@ TEST(Homogenization, MirrorSymmetricCellsSolvedOnOneOctantMatchTheWholeCell) {
     VoxelGrid cell = mirrored_random_cell(c.nx, c.ny, c.nz, 5, c.with_void);
     if (c.cubic) mirror_fundamental_domain(cell, CellSymmetry::cubic);
     HomogenizationOptions whole;
-    whole.solver = "direct";
+    whole.solver = "cholmod";
     whole.use_symmetry = whole.use_mirror_symmetry = false;
     const HomogenizationResult a = homogenize(cell, pal, whole);
     EXPECT_FALSE(a.octant);
-    for (const std::string solver : {"direct", "multigrid"}) {
+    for (const std::string solver : {"cholmod", "matrix-free"}) {
       HomogenizationOptions o;
       o.solver = solver;
-      o.multigrid_tolerance = 1e-12;
+      o.tolerance = 1e-12;
       const HomogenizationResult b = homogenize(cell, pal, o);
       const std::string what = solver + " " + std::to_string(c.nx) + "x" + std::to_string(c.ny) + "x" +
                                std::to_string(c.nz) + (c.with_void ? " void" : "");

@@ -116,13 +116,13 @@ TEST(PeriodicMultigrid, HomogenizationMatchesTheDirectSolverWithVoid) {
     for (int b = 0; b < 3; ++b) with_void.at(a, b, 0) = 0;  // a void slab along x
   for (const VoxelGrid& cell : {periodic_sphere_inclusion(16, 0.3, 1, 2), with_void}) {
     HomogenizationOptions direct, multigrid;
-    direct.solver = "direct";
-    multigrid.solver = "multigrid";
-    multigrid.multigrid_tolerance = 1e-9;
+    direct.solver = "cholmod";
+    multigrid.solver = "matrix-free";
+    multigrid.tolerance = 1e-9;
     const HomogenizationResult a = homogenize(cell, palette(), direct);
     const HomogenizationResult b = homogenize(cell, palette(), multigrid);
-    EXPECT_EQ(a.solver, "direct");
-    EXPECT_EQ(b.solver, "multigrid");
+    EXPECT_EQ(a.solver, "cholmod");
+    EXPECT_EQ(b.solver, "matrix-free");
     EXPECT_LT((a.C - b.C).norm(), 1e-8 * a.C.norm());
     std::printf("[periodic-mg] 16^3 %s: |dC|/|C| %.2e, %d CG iterations (6 cases), direct %.2f s, multigrid %.2f s\n",
                 cell.ids[0] == 0 ? "with void" : "two materials", (a.C - b.C).norm() / a.C.norm(), b.iterations,
@@ -132,7 +132,7 @@ TEST(PeriodicMultigrid, HomogenizationMatchesTheDirectSolverWithVoid) {
 
 TEST(PeriodicMultigrid, IterationsAreNearlyIndependentOfTheGrid) {
   HomogenizationOptions o;
-  o.solver = "multigrid";
+  o.solver = "matrix-free";
   int iterations[2];
   for (int t = 0; t < 2; ++t) {
     const int n = t == 0 ? 16 : 32;
@@ -173,7 +173,7 @@ TEST(PeriodicMultigrid, ExtremeContrastFallsBackToDoublePrecisionSmoothers) {
     for (int b = n / 2 - 1; b <= n / 2; ++b)
       for (int c = n / 2 - 1; c <= n / 2; ++c) lattice.at(a, b, c) = lattice.at(b, a, c) = lattice.at(b, c, a) = 1;
   HomogenizationOptions o;
-  o.solver = "multigrid";
+  o.solver = "matrix-free";
   o.void_stiffness = 1e-9;
   const std::vector<MaterialPtr> solid = {nullptr, std::make_shared<LinearIsotropic>(1e6, 0.3)};
   HomogenizationResult r;
@@ -220,16 +220,16 @@ TEST(PeriodicMultigrid, BadGridsAndOptionsAreInputErrors) {
   o.tolerance = 0;
   EXPECT_THROW(PeriodicGridMultigrid(random_field(8, 8, 8, 1), o), InputError);
   HomogenizationOptions h;
-  h.solver = "multigrid";
+  h.solver = "matrix-free";
   EXPECT_THROW(homogenize(VoxelGrid(6, 6, 5, 1e-3, 1), palette(), h), InputError);
   h.solver = "lu";
   EXPECT_THROW(homogenize(VoxelGrid(8, 8, 8, 1e-3, 1), palette(), h), InputError);
-  EXPECT_EQ(homogenization_solver(32, 32, 32, "auto"), "multigrid");
-  EXPECT_EQ(homogenization_solver(16, 16, 16, "auto"), "multigrid");
-  EXPECT_EQ(homogenization_solver(10, 10, 10, "auto"), "direct");
-  EXPECT_EQ(homogenization_solver(64, 64, 1, "auto"), "direct");
-  EXPECT_EQ(homogenization_solver(30, 30, 30, "auto"), "multigrid");
-  EXPECT_EQ(homogenization_solver(33, 32, 32, "auto"), "direct");
+  EXPECT_EQ(homogenization_solver(32, 32, 32, "auto"), "matrix-free");
+  EXPECT_EQ(homogenization_solver(16, 16, 16, "auto"), "matrix-free");
+  EXPECT_EQ(homogenization_solver(10, 10, 10, "auto"), "cholmod");
+  EXPECT_EQ(homogenization_solver(64, 64, 1, "auto"), "cholmod");
+  EXPECT_EQ(homogenization_solver(30, 30, 30, "auto"), "matrix-free");
+  EXPECT_EQ(homogenization_solver(33, 32, 32, "auto"), "cholmod");
 }
 
 }  // namespace
