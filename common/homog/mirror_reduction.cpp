@@ -6,6 +6,7 @@
 #include "core/errors.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/conjugate_gradient.hpp"
 #include "solve/dirichlet_grid_multigrid.hpp"
 
 namespace msfab {
@@ -72,8 +73,7 @@ VecX octant_load(const VoxelStiffnessField& f, const Octant& o, int m, const std
   e[m] = 1;
   const Mat3 eps = strain_tensor(e);
   Eigen::Matrix<double, 24, 1> affine;
-  for (int a = 0; a < 8; ++a)
-    affine.segment<3>(3 * a) = eps * (f.h * Vec3(a >> 2 & 1, a >> 1 & 1, a & 1));
+  for (int a = 0; a < 8; ++a) affine.segment<3>(3 * a) = eps * (f.h * Vec3(a >> 2 & 1, a >> 1 & 1, a & 1));
   std::vector<Eigen::Matrix<double, 24, 1>> basis_load(f.basis.size());
   for (std::size_t b = 0; b < f.basis.size(); ++b) basis_load[b] = -(f.basis[b] * affine);
   VecX load = VecX::Zero(3 * o.nodes());
@@ -225,11 +225,8 @@ OctantSolveReport solve_on_octant(const VoxelStiffnessField& field, const std::v
       for (int m : members) fluctuation[m] = unfold(field, o, m, cholesky.solve(octant_load(octant, o, m, fixed)));
     } else {
       DirichletMultigridOptions mg;
-      mg.tolerance = options.tolerance;
-      mg.max_iterations = options.max_iterations;
-      mg.max_iterations_key = options.max_iterations_key;
+      copy_cg_limits(options, mg);
       mg.smoother_degree = options.smoother_degree;
-      mg.threads = options.threads;
       // A cell problem takes 10-50 CG iterations per set-up, too few to repay
       // factoring a 3000-unknown first coarse level (half the time at 32^3).
       mg.coarse_unknowns = 300;

@@ -10,6 +10,7 @@
 #include "fem/hex_element.hpp"
 #include "homog/mirror_reduction.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/conjugate_gradient.hpp"
 #include "solve/periodic_grid_multigrid.hpp"
 
 namespace msfab {
@@ -72,7 +73,8 @@ HomogenizationResult homogenize(const VoxelGrid& cell, const std::vector<Materia
   for (std::size_t id = 1; id < palette.size(); ++id) {
     if (!palette[id] || fraction[id] == 0) continue;
     field.basis[id] = voxel_stiffness(palette[id], cell.voxel_size);
-    if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus()) stiffest = static_cast<int>(id);
+    if (stiffest < 0 || palette[id]->shear_modulus() > palette[stiffest]->shear_modulus())
+      stiffest = static_cast<int>(id);
   }
   field.basis[0] = options.void_stiffness * field.basis[stiffest];
   field.weights.assign(cell.size() * palette.size(), 0.0);
@@ -97,8 +99,8 @@ hex8::NodeMatrix voxel_corners(double h) {
   return X;
 }
 
-Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationResult& r, int nx, int ny, int nz, double h,
-                                                         std::int64_t voxel) {
+Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationResult& r, int nx, int ny, int nz,
+                                                         double h, std::int64_t voxel) {
   const hex8::NodeMatrix X = voxel_corners(h);
   const int i = static_cast<int>(voxel % nx), j = static_cast<int>((voxel / nx) % ny),
             k = static_cast<int>(voxel / (std::int64_t(nx) * ny));
@@ -108,8 +110,9 @@ Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationRes
     e[m] = 1;
     const Mat3 eps = strain_tensor(e);
     for (int a = 0; a < 8; ++a) {
-      const std::int64_t q = wrap_periodic(i + (a >> 2 & 1), nx) +
-                             nx * (wrap_periodic(j + (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k + (a & 1), nz));
+      const std::int64_t q =
+          wrap_periodic(i + (a >> 2 & 1), nx) +
+          nx * (wrap_periodic(j + (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k + (a & 1), nz));
       U.col(m).segment<3>(3 * a) = eps * X.row(a).transpose() + r.fluctuation[m].segment<3>(3 * q);
     }
   }
@@ -160,12 +163,15 @@ Eigen::MatrixXd strain_loads(const VoxelStiffnessField& field) {
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(3 * nodes, 6);
 #pragma omp parallel for schedule(static)
   for (std::int64_t p = 0; p < nodes; ++p) {
-    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny), k = static_cast<int>(p / (std::int64_t(nx) * ny));
+    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny),
+              k = static_cast<int>(p / (std::int64_t(nx) * ny));
     for (int a = 0; a < 8; ++a) {  // p is corner a of element (i, j, k) - offset(a)
-      const std::int64_t e = wrap_periodic(i - (a >> 2 & 1), nx) +
-                             nx * (wrap_periodic(j - (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k - (a & 1), nz));
+      const std::int64_t e =
+          wrap_periodic(i - (a >> 2 & 1), nx) +
+          nx * (wrap_periodic(j - (a >> 1 & 1), ny) + std::int64_t(ny) * wrap_periodic(k - (a & 1), nz));
       for (int b = 0; b < field.basis_size(); ++b)
-        if (const double w = field.weight(e, b); w != 0.0) B.middleRows<3>(3 * p) += w * basis_loads[b].middleRows<3>(3 * a);
+        if (const double w = field.weight(e, b); w != 0.0)
+          B.middleRows<3>(3 * p) += w * basis_loads[b].middleRows<3>(3 * a);
     }
   }
   return B;
@@ -185,7 +191,8 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
   std::vector<std::vector<Eigen::Triplet<double>>> per_node(N);
 #pragma omp parallel for schedule(static)
   for (std::int64_t p = 0; p < N; ++p) {
-    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny), k = static_cast<int>(p / (std::int64_t(nx) * ny));
+    const int i = static_cast<int>(p % nx), j = static_cast<int>((p / nx) % ny),
+              k = static_cast<int>(p / (std::int64_t(nx) * ny));
     auto& trip = per_node[p];
     if (p == 0) continue;
     for (int a = 0; a < 8; ++a) {  // p is node a of element e = (i, j, k) - offset(a)
@@ -196,7 +203,8 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
         if (q == 0) continue;
         for (int r = 0; r < 3; ++r)
           for (int c = 0; c < 3; ++c)
-            trip.emplace_back(static_cast<int>(3 * q + r - 3), static_cast<int>(3 * p + c - 3), K(3 * b + r, 3 * a + c));
+            trip.emplace_back(static_cast<int>(3 * q + r - 3), static_cast<int>(3 * p + c - 3),
+                              K(3 * b + r, 3 * a + c));
       }
     }
   }
@@ -211,7 +219,8 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
   solver_options.threads = 1;
   CholmodSolver solver(solver_options);
   solver.analyze(A);
-  if (!solver.factorize(A)) throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
+  if (!solver.factorize(A))
+    throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
   for (int m : cases) {
     const VecX x = solver.solve(loads.col(m).tail(3 * N - 3));
     out.fluctuation[m] = VecX::Zero(3 * N);
@@ -234,20 +243,18 @@ VecX permute_fluctuation(const VecX& chi, int n) {
   VecX out(chi.size());
   const std::int64_t nodes = std::int64_t(n) * n * n;
   for (std::int64_t p = 0; p < nodes; ++p) {
-    const int i = static_cast<int>(p % n), j = static_cast<int>((p / n) % n), k = static_cast<int>(p / (std::int64_t(n) * n));
+    const int i = static_cast<int>(p % n), j = static_cast<int>((p / n) % n),
+              k = static_cast<int>(p / (std::int64_t(n) * n));
     const std::int64_t q = k + n * (i + std::int64_t(n) * j);
     for (int r = 0; r < 3; ++r) out[3 * q + (r + 1) % 3] = chi[3 * p + r];
   }
   return out;
 }
 
-void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, const HomogenizationOptions& options,
-                     HomogenizationResult& out, const std::vector<int>& cases) {
+void solve_multigrid(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads,
+                     const HomogenizationOptions& options, HomogenizationResult& out, const std::vector<int>& cases) {
   PeriodicMultigridOptions mg;
-  mg.tolerance = options.tolerance;
-  mg.max_iterations = options.max_iterations;
-  mg.max_iterations_key = options.max_iterations_key;
-  mg.threads = options.threads;
+  copy_cg_limits(options, mg);
   mg.smoother_degree = options.multigrid_smoother_degree;
   mg.coarsest_nodes = options.multigrid_coarsest_nodes;
   PeriodicGridMultigrid solver(field, mg);
@@ -271,7 +278,8 @@ bool cyclic_invariant(const VoxelStiffnessField& f) {
   for (int a = 0; a < 8; ++a) cyclic.corner[a] = cyclic_corner(a);
   if (!basis_invariant(f, cyclic)) return false;
   for (std::int64_t v = 0; v < f.voxels(); ++v) {
-    const int i = static_cast<int>(v % n), j = static_cast<int>((v / n) % n), k = static_cast<int>(v / (std::int64_t(n) * n));
+    const int i = static_cast<int>(v % n), j = static_cast<int>((v / n) % n),
+              k = static_cast<int>(v / (std::int64_t(n) * n));
     if (!same_weights(f, v, k + n * (i + std::int64_t(n) * j))) return false;
   }
   return true;
@@ -294,11 +302,8 @@ HomogenizationResult homogenize_elements(const VoxelStiffnessField& field, const
   if (out.octant) {
     OctantSolverOptions octant;
     octant.solver = options.solver;
-    octant.tolerance = options.tolerance;
-    octant.max_iterations = options.max_iterations;
-    octant.max_iterations_key = options.max_iterations_key;
+    copy_cg_limits(options, octant);
     octant.smoother_degree = options.multigrid_smoother_degree;
-    octant.threads = options.threads;
     const OctantSolveReport report = solve_on_octant(field, cases, octant, out.fluctuation);
     out.solver = report.solver;
     out.unknowns = report.unknowns;

@@ -27,8 +27,7 @@ struct CgPreconditioner {
   // of r . z. Given for a preconditioner that acts on each reduction chunk
   // of solve/sparse_ops.hpp on its own (e.g. (block) Jacobi): CG then fuses
   // it into the pass that updates x and r, reading the memory once.
-  std::function<double(const double* r, double* z, Eigen::Index begin, Eigen::Index end)>
-      apply_chunk;
+  std::function<double(const double* r, double* z, Eigen::Index begin, Eigen::Index end)> apply_chunk;
   // Throw NumericalError unless r . M^-1 r > 0 after each application; for
   // a preconditioner whose definiteness is not guaranteed by its setup.
   bool check_definite = false;
@@ -76,7 +75,18 @@ CgSetup multigrid_cg_setup(std::function<void(const VecX& x, VecX& y)> multiply,
                            std::function<void(const VecX& r, VecX& z)> cycle, double tolerance, int max_iterations,
                            int threads, const std::string& label);
 
-VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b,
-                        const CgSettings& settings, LinearSolveStats& stats);
+// The CG stopping rule and thread count, copied between option structs that
+// name them alike (tolerance, max_iterations, max_iterations_key, threads):
+// the homogenization's, the octant solver's and the grid multigrids'.
+template <class To, class From>
+void copy_cg_limits(const From& from, To& to) {
+  to.tolerance = from.tolerance;
+  to.max_iterations = from.max_iterations;
+  to.max_iterations_key = from.max_iterations_key;
+  to.threads = from.threads;
+}
+
+VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b, const CgSettings& settings,
+                        LinearSolveStats& stats);
 
 }  // namespace msfab
