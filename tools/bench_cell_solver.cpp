@@ -27,8 +27,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <sstream>
@@ -106,24 +106,38 @@ int main(int argc, char** argv) {
   bool direct = true;
   for (int a = 1; a < argc; ++a) {
     const bool more = a + 1 < argc;
-    if (!std::strcmp(argv[a], "--sizes") && more) sizes = parse_list<int>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--tolerances") && more) tolerances = parse_list<double>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--degrees") && more) degrees = parse_list<int>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--coarsest") && more) coarsest = parse_list<int>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--kinds") && more) kinds = parse_list<std::string>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--solvers") && more) solvers = parse_list<std::string>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--symmetries") && more) symmetries = parse_list<std::string>(argv[++a]);
-    else if (!std::strcmp(argv[a], "--batch") && more) batch = std::atoi(argv[++a]);
-    else if (!std::strcmp(argv[a], "--no-direct")) direct = false;
+    if (!std::strcmp(argv[a], "--sizes") && more)
+      sizes = parse_list<int>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--tolerances") && more)
+      tolerances = parse_list<double>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--degrees") && more)
+      degrees = parse_list<int>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--coarsest") && more)
+      coarsest = parse_list<int>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--kinds") && more)
+      kinds = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--solvers") && more)
+      solvers = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--symmetries") && more)
+      symmetries = parse_list<std::string>(argv[++a]);
+    else if (!std::strcmp(argv[a], "--batch") && more)
+      batch = std::atoi(argv[++a]);
+    else if (!std::strcmp(argv[a], "--no-direct"))
+      direct = false;
     else {
-      std::fprintf(stderr, "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--solvers L] [--symmetries L] [--batch K] [--no-direct]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [--sizes L] [--tolerances L] [--degrees L] [--kinds L] [--coarsest L] [--solvers L] "
+                   "[--symmetries L] [--batch K] [--no-direct]\n",
+                   argv[0]);
       return 2;
     }
   }
   const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<LinearIsotropic>(1e6, 0.45),
                                             std::make_shared<LinearIsotropic>(1e3, 0.45)};
   if (batch > 0) {
-    std::printf("| cell | n | cells | threads | symmetry | seconds | cells/s | max rel. difference of C |\n|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| cell | n | cells | threads | symmetry | seconds | cells/s | max rel. difference of C "
+        "|\n|---|---|---|---|---|---|---|---|\n");
     for (const std::string& kind : kinds)
       for (int n : sizes) {
         std::vector<VoxelGrid> cells;
@@ -144,17 +158,24 @@ int main(int argc, char** argv) {
           const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
           double difference = 0;
           for (int c = 0; c < batch; ++c)
-            if (mode == "whole") reference[c] = C[c];
-            else difference = std::max(difference, (C[c] - reference[c]).norm() / reference[c].norm());
-          const char* label = mode == "whole" ? "whole cell, 6 cases" : mode == "cyclic" ? "whole cell, 2 cases (cyclic)" : "default (octant; 2 cases if cubic)";
+            if (mode == "whole")
+              reference[c] = C[c];
+            else
+              difference = std::max(difference, (C[c] - reference[c]).norm() / reference[c].norm());
+          const char* label = mode == "whole"    ? "whole cell, 6 cases"
+                              : mode == "cyclic" ? "whole cell, 2 cases (cyclic)"
+                                                 : "default (octant; 2 cases if cubic)";
           std::printf("| %s | %d | %d | %d | %s | %.3f | %.3g | %s |\n", kind.c_str(), n, batch, omp_get_max_threads(),
-                      label, seconds, batch / seconds, mode == "whole" ? "(reference)" : format_error(difference).c_str());
+                      label, seconds, batch / seconds,
+                      mode == "whole" ? "(reference)" : format_error(difference).c_str());
           std::fflush(stdout);
         }
       }
     return 0;
   }
-  std::printf("| cell | n | solver | domain | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | cells/s | rel. error of C | speed-up vs direct |\n");
+  std::printf(
+      "| cell | n | solver | domain | tolerance | degree | coarsest nodes | cases solved | CG iterations | seconds | "
+      "cells/s | rel. error of C | speed-up vs direct |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const std::string& kind : kinds)
     for (int n : sizes) {
@@ -186,7 +207,8 @@ int main(int argc, char** argv) {
           for (int degree : degrees)
             for (double tolerance : tolerances)
               for (int coarse : coarsest) {
-                if (solver == "cholmod" && (degree != degrees[0] || tolerance != tolerances[0] || coarse != coarsest[0]))
+                if (solver == "cholmod" &&
+                    (degree != degrees[0] || tolerance != tolerances[0] || coarse != coarsest[0]))
                   continue;  // the direct solver has none of these knobs
                 HomogenizationOptions o;
                 o.solver = solver;

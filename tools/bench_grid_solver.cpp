@@ -46,8 +46,10 @@ int main(int argc, char** argv) {
   std::string field = "uniform";
   double tolerance = 1e-8;
   for (int a = 5; a < argc; ++a) {
-    if (!std::strcmp(argv[a], "--tolerance") && a + 1 < argc) tolerance = std::atof(argv[++a]);
-    else field = argv[a];
+    if (!std::strcmp(argv[a], "--tolerance") && a + 1 < argc)
+      tolerance = std::atof(argv[++a]);
+    else
+      field = argv[a];
   }
   if (field != "uniform" && field != "random") {
     std::fprintf(stderr, "field must be uniform or random\n");

@@ -29,9 +29,7 @@ using namespace msfab;
 
 namespace {
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
 
 double cpu_seconds() {
   rusage usage{};
@@ -89,8 +87,8 @@ int main(int argc, char** argv) {
     else if (positional < 3)
       dims[positional++] = std::atoi(argv[a]);
   }
-  std::printf("grid %d x %d x %d voxels, threads %d, Chebyshev degree %d, coarse < %d unknowns\n",
-              dims[0], dims[1], dims[2], resolve_thread_count(0), degree, coarse);
+  std::printf("grid %d x %d x %d voxels, threads %d, Chebyshev degree %d, coarse < %d unknowns\n", dims[0], dims[1],
+              dims[2], resolve_thread_count(0), degree, coarse);
 
   Timer timer;
   const VoxelGrid grid = fibers_grid(dims[0], dims[1], dims[2]);
@@ -104,8 +102,7 @@ int main(int argc, char** argv) {
   const int n = mesh.num_dofs();
   std::vector<char> fixed(static_cast<std::size_t>(n), 0);
   for (int node = 0; node < mesh.num_nodes(); ++node) {
-    if (mesh.nodes(node, 1) < 1e-12)
-      fixed[3 * node] = fixed[3 * node + 1] = fixed[3 * node + 2] = 1;
+    if (mesh.nodes(node, 1) < 1e-12) fixed[3 * node] = fixed[3 * node + 1] = fixed[3 * node + 2] = 1;
   }
   double diagonal = 0.0;
   int free_count = 0;
@@ -130,8 +127,7 @@ int main(int argc, char** argv) {
     b[3 * node + 2] = -1.0;
     if (mesh.nodes(node, 1) > (dims[1] - 0.5) * grid.voxel_size) b[3 * node] += 50.0;
   }
-  std::printf("%d nodes, %d unknowns, %ld non-zeros\n", mesh.num_nodes(), n,
-              static_cast<long>(K.nonZeros()));
+  std::printf("%d nodes, %d unknowns, %ld non-zeros\n", mesh.num_nodes(), n, static_cast<long>(K.nonZeros()));
   timer.report("mesh + assembly");
 
   LinearSolverOptions options;
@@ -143,8 +139,7 @@ int main(int argc, char** argv) {
   solver.analyze(K);
   timer.report("pcg-mg analyze");
   std::printf("levels:");
-  for (int l = 0; l < solver.num_levels(); ++l)
-    std::printf(" %ld", static_cast<long>(solver.level_unknowns(l)));
+  for (int l = 0; l < solver.num_levels(); ++l) std::printf(" %ld", static_cast<long>(solver.level_unknowns(l)));
   std::printf(" unknowns\n");
   VecX x;
   for (int s = 0; s < solves; ++s) {
@@ -158,8 +153,7 @@ int main(int argc, char** argv) {
     std::snprintf(label, sizeof(label), "pcg-mg solve (%d it)", solver.stats().iterations);
     timer.report(label);
   }
-  std::printf("relative residual %.3e (checked: %.3e)\n", solver.stats().relative_residual,
-              relative_residual(K, x, b));
+  std::printf("relative residual %.3e (checked: %.3e)\n", solver.stats().relative_residual, relative_residual(K, x, b));
 
   if (with_cholmod) {
     CholmodSolver direct;
@@ -169,8 +163,7 @@ int main(int argc, char** argv) {
     timer.report("cholmod factorize");
     const VecX reference = direct.solve(b);
     timer.report("cholmod solve");
-    std::printf("relative difference pcg-mg vs cholmod %.3e\n",
-                (x - reference).norm() / reference.norm());
+    std::printf("relative difference pcg-mg vs cholmod %.3e\n", (x - reference).norm() / reference.norm());
   }
   return 0;
 }

@@ -109,14 +109,15 @@ ConfigGridSize config_grid_size(const Config& config, const std::string& key) {
   if (!config.has(key)) return size;
   size.counts = config.get<std::vector<int>>(key);
   size.cells = 1;
-  for (int n : size.counts) size.cells *= std::max(n, 1), size.text += (size.text.empty() ? "" : " x ") + std::to_string(n);
+  for (int n : size.counts)
+    size.cells *= std::max(n, 1), size.text += (size.text.empty() ? "" : " x ") + std::to_string(n);
   return size;
 }
 
 void StageContext::check_memory(double estimated_bytes, const std::string& what, const std::string& remedy) const {
   const bool given = !options.memory_limit.empty();
-  const double limit = given ? double(parse_memory_size(options.memory_limit, "--memory-limit"))
-                             : double(available_memory_bytes());
+  const double limit =
+      given ? double(parse_memory_size(options.memory_limit, "--memory-limit")) : double(available_memory_bytes());
   spdlog::debug("memory: {} needs about {} (limit {}, {})", what, format_bytes(estimated_bytes), format_bytes(limit),
                 given ? "--memory-limit" : "available now");
   if (limit <= 0 || estimated_bytes <= limit) return;
@@ -217,8 +218,8 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
 
     StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};
     if (!options_.out.empty()) check_output_path(cli_, options_.out);
-    spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, version(), git_revision(),
-                  omp_get_max_threads(), options_.seed);
+    spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, version(), git_revision(), omp_get_max_threads(),
+                  options_.seed);
     spdlog::debug("command line: {}", ctx.command_line);
     body(ctx);
     return kExitOk;

@@ -7,9 +7,9 @@ namespace msfab {
 
 enum ExitCode : int {
   kExitOk = 0,
-  kExitInternal = 1,      // a bug: an invariant of ours was violated
-  kExitBadInput = 2,      // bad usage or bad input: names file, field, problem
-  kExitNumerical = 3,     // a numerical method did not converge
+  kExitInternal = 1,   // a bug: an invariant of ours was violated
+  kExitBadInput = 2,   // bad usage or bad input: names file, field, problem
+  kExitNumerical = 3,  // a numerical method did not converge
 };
 
 // Bad usage or bad input. The message must say which file / field and what

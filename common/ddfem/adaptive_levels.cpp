@@ -20,7 +20,8 @@ double predicted_error(const std::vector<CellErrorModel>& cells, const LevelErro
                        const std::vector<int>& cell_level) {
   if (cell_level.size() != cells.size()) throw InputError("predicted_error: one level per cell expected");
   double sum = 0;
-  for (size_t c = 0; c < cells.size(); ++c) sum += cells[c].energy_share * errors[cell_level[c]] * errors[cell_level[c]];
+  for (size_t c = 0; c < cells.size(); ++c)
+    sum += cells[c].energy_share * errors[cell_level[c]] * errors[cell_level[c]];
   return std::sqrt(sum);
 }
 
@@ -63,9 +64,8 @@ LevelChoice choose_cell_levels(const std::vector<CellErrorModel>& cells, const L
   return out;
 }
 
-std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1,
-                                              const CoarseGrid& level2, const VoxelMesh& level1_mesh,
-                                              const std::vector<double>& level1_energy) {
+std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1, const CoarseGrid& level2,
+                                              const VoxelMesh& level1_mesh, const std::vector<double>& level1_energy) {
   if (level1.level != 1 || level2.level != 2 || level1_mesh.voxel_element.size() != size_t(level1.num_cells()))
     throw InputError("cell_error_models: the level-1 mesh and the grids do not belong together");
   if (level1_energy.size() != size_t(level1_mesh.mesh.num_elements()))

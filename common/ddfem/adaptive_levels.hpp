@@ -32,8 +32,8 @@
 namespace msfab {
 
 struct CellErrorModel {
-  double energy_share = 0;                // U_c / sum U
-  std::array<int, 3> elements{};          // elements the cell has at levels 0, 1, 2
+  double energy_share = 0;        // U_c / sum U
+  std::array<int, 3> elements{};  // elements the cell has at levels 0, 1, 2
 };
 
 // The uniform models' errors at levels 0, 1, 2 (level 0 is the fine model: 0).
@@ -43,8 +43,8 @@ using LevelErrors = std::array<double, 3>;
 LevelErrors level_errors_from_difference(double difference, double rate = 1.0);
 
 struct LevelChoice {
-  std::vector<int> cell_level;            // per level-2 cell
-  double predicted_error = 0;             // the estimate for these levels
+  std::vector<int> cell_level;  // per level-2 cell
+  double predicted_error = 0;   // the estimate for these levels
 };
 
 // The estimate for given levels.
@@ -59,9 +59,8 @@ LevelChoice choose_cell_levels(const std::vector<CellErrorModel>& cells, const L
 // from a solve on the level-1 mesh (`level1_energy` per element of
 // level1_mesh) and their element counts per level. All-void cells have no
 // elements and no share.
-std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1,
-                                              const CoarseGrid& level2, const VoxelMesh& level1_mesh,
-                                              const std::vector<double>& level1_energy);
+std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1, const CoarseGrid& level2,
+                                              const VoxelMesh& level1_mesh, const std::vector<double>& level1_energy);
 
 // Strain energy of every element of `mesh` at positions x (node-major).
 std::vector<double> element_energies(const HexMesh& mesh, const VecX& x);

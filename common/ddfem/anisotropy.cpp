@@ -5,8 +5,8 @@
 
 namespace msfab {
 
-std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coarse,
-                                                 const hex8::NodeMatrix& X, const Vec24& u) {
+std::vector<Mat3> coarse_deformation_gradients(const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
+                                               const Vec24& u) {
   hex8::NodeMatrix x = X;
   for (int c = 0; c < 8; ++c) x.row(c) += u.segment<3>(3 * c).transpose();
   std::vector<Mat3> F(coarse.size());

@@ -105,7 +105,8 @@ QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, cons
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;
   m.at_point.reserve(8 * ids.size());
-  for (int id : ids) m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material_checked(palette, id));
+  for (int id : ids)
+    m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material_checked(palette, id));
   return m;
 }
 
@@ -138,8 +139,8 @@ MaterialPtr homogenized_block_material(const Mat6& C) {
   lambda = std::max(lambda, 0.0);
   const Mat6 iso = lame_C(mu, lambda);
   // The largest t with C - t iso >= 0: the smallest generalized eigenvalue.
-  const double t =
-      std::clamp(Eigen::GeneralizedSelfAdjointEigenSolver<Mat6>(C, iso, Eigen::EigenvaluesOnly).eigenvalues()[0], 0.0, 1.0);
+  const double t = std::clamp(
+      Eigen::GeneralizedSelfAdjointEigenSolver<Mat6>(C, iso, Eigen::EigenvaluesOnly).eigenvalues()[0], 0.0, 1.0);
   Eigen::SelfAdjointEigenSolver<Mat6> rest(C - t * iso);
   const Mat6 remainder =
       rest.eigenvectors() * rest.eigenvalues().cwiseMax(0.0).asDiagonal() * rest.eigenvectors().transpose();

@@ -148,9 +148,10 @@ void write_level1(H5File& f, const std::string& prefix, const CoarseDatabase& db
   f.write_vector(g + "/orbit", db.orbit);
   f.write_vector(g + "/entry", db.entry_of);
   f.write_attribute(g, "void_children", int(db.void_children));
-  f.write_attribute(g, "order", db.void_children
-                                    ? "row = sum_c id_c (n + 1)^c, child c in hex8 order (id 0 void; row 0, all void, has entry -1)"
-                                    : "row = sum_c (id_c - 1) n^c, child c in hex8 order");
+  f.write_attribute(g, "order",
+                    db.void_children
+                        ? "row = sum_c id_c (n + 1)^c, child c in hex8 order (id 0 void; row 0, all void, has entry -1)"
+                        : "row = sum_c (id_c - 1) n^c, child c in hex8 order");
   f.write_attribute(g + "/entry", "meaning", "row of " + prefix + "/fit/* holding the combination's coarse material");
   write_fits(f, prefix, db.entries);
 }
@@ -230,8 +231,8 @@ void shape_ok(const std::string& path, const std::string& name, std::int64_t row
 // `<prefix>/fit/*` with P points per entry; material ids must be in
 // [min_id, max_id]. mu0 / lambda0 are left for the caller (they come from
 // the palette).
-std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& path, const std::string& prefix,
-                                         int P, int min_id, int max_id, std::int64_t max_rows) {
+std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& path, const std::string& prefix, int P,
+                                         int min_id, int max_id, std::int64_t max_rows) {
   const std::string g = prefix + "/fit";
   const auto entry_ids = f.read_matrix<int>(g + "/ids");
   const std::int64_t K = entry_ids.rows();
@@ -271,15 +272,15 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
     for (int k = 0; k < 8; ++k) {
       fit.material_ids[k] = entry_ids(e, k);
       if (fit.material_ids[k] < min_id || fit.material_ids[k] > max_id)
-        bad(path, g + "/ids row " + std::to_string(e) + " has id " + std::to_string(fit.material_ids[k]) +
-                      " outside " + std::to_string(min_id) + ".." + std::to_string(max_id));
+        bad(path, g + "/ids row " + std::to_string(e) + " has id " + std::to_string(fit.material_ids[k]) + " outside " +
+                      std::to_string(min_id) + ".." + std::to_string(max_id));
     }
     fit.fitted = fitted[e] != 0;
     for (int k = 0; k < P; ++k) {
       fit.mu[k] = mu(e, k), fit.lambda[k] = lambda(e, k), fit.C[k] = C(e, k);
       fit.v[k] = v.block<1, 3>(e, 3 * k).transpose();
-      if (fit.fitted && (!(fit.mu[k] >= 0) || !(fit.lambda[k] >= 0) || !(fit.C[k] >= 0) ||
-                         std::abs(fit.v[k].norm() - 1) > 1e-6))
+      if (fit.fitted &&
+          (!(fit.mu[k] >= 0) || !(fit.lambda[k] >= 0) || !(fit.C[k] >= 0) || std::abs(fit.v[k].norm() - 1) > 1e-6))
         bad(path, g + " row " + std::to_string(e) + " point " + std::to_string(k) +
                       ": parameters must be >= 0 and v a unit vector");
     }

@@ -12,10 +12,9 @@
 // "Blocks with void").
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
-
-#include <memory>
 
 #include "ddfem/coarse_fit.hpp"
 #include "ddfem/coarse_grid.hpp"
@@ -34,7 +33,7 @@ struct DbMaterial {
 
 struct CoarseDatabase {
   int level = 1;
-  std::vector<DbMaterial> materials;          // ids 1..n
+  std::vector<DbMaterial> materials;  // ids 1..n
   // Combinations include void children (id 0): codes in base n + 1, the
   // all-void code 0 has no entry. Otherwise base n over the solid ids.
   bool void_children = false;
@@ -44,7 +43,7 @@ struct CoarseDatabase {
   // Per combination code: the index of its entry (its own, or its
   // representative's), -1 if none.
   std::vector<int> entry_of;
-  std::vector<int> orbit;                     // per combination code: code of its symmetry orbit's representative
+  std::vector<int> orbit;  // per combination code: code of its symmetry orbit's representative
   int num_orbits = 0;
   // Level 2 only (§2.3.5): the level-1 database whose coarse materials are
   // this level's palette, and the pairing stages that look the level-1

@@ -172,7 +172,7 @@ void record_fit_errors(const std::vector<CoarseEnergyBasis>& basis, const std::v
 // energy), with their energy bases at zero bubble amplitudes.
 struct FitSamples {
   std::vector<CoarseEnergyBasis> basis;
-  std::vector<double> V0;             // fine energies
+  std::vector<double> V0;  // fine energies
   std::vector<ForceKind> kind;
   std::vector<const Vec24*> corners;  // coarse corner displacements, in `set`
 };
@@ -500,8 +500,7 @@ CoarseMaterialFit fit_coarse_material(const FineBlock& block, const CoarseFitOpt
   ForceSamplingOptions sampling = options.sampling;
   if (block.voxels_per_edge != 2)
     for (int k = 0; k < 5; ++k) sampling.kinds[k] = options.kind_weight[k] > 0;
-  const ForceSampleSet samples =
-      periodic ? sample_periodic(block, sampling) : sample_force_space(block, sampling);
+  const ForceSampleSet samples = periodic ? sample_periodic(block, sampling) : sample_force_space(block, sampling);
   std::vector<Vec3> directions(block.coarse_points(), Vec3::UnitX());
   if (options.anisotropic) {
     if (block.voxels_per_edge != 2) {

@@ -85,31 +85,31 @@ CoarseFitOptions::Residual parse_fit_residual(const std::string& name);
 
 struct CoarseMaterialFit {
   bool fitted = false;
-  std::string not_fitted_reason;   // why, when !fitted (e.g. a void child)
+  std::string not_fitted_reason;  // why, when !fitted (e.g. a void child)
   BlockMaterials material_ids{};
   // Per coarse quadrature point: 8 at level 1 (2 x 2 x 2 Gauss points),
   // 64 for a 4-point rule.
   std::vector<double> mu, lambda, C;
-  std::vector<Vec3> v;                        // spring directions (unit)
-  double mu_centre = 0, lambda_centre = 0;    // mu_c, lambda_c (energy densities), 0 without the centre point
-  bool enhanced = false;                      // fitted for (and used on) the element with bubble modes
-  int bubble_rounds = 0;                      // enhanced: alternations run
-  std::vector<double> mu0, lambda0;           // fine parameters at each point (Eq. 2.9's p^0)
+  std::vector<Vec3> v;                      // spring directions (unit)
+  double mu_centre = 0, lambda_centre = 0;  // mu_c, lambda_c (energy densities), 0 without the centre point
+  bool enhanced = false;                    // fitted for (and used on) the element with bubble modes
+  int bubble_rounds = 0;                    // enhanced: alternations run
+  std::vector<double> mu0, lambda0;         // fine parameters at each point (Eq. 2.9's p^0)
   // Relative energy errors (V1 - V0) / V0, RMS with the fit's kind weights.
-  double residual = 0;             // over the training samples
-  double objective = 0;            // Eq. 2.9 as minimized: weighted data term + regularizer (scaled units)
-  double heldout_error = 0;        // over the held-out samples
-  double heldout_energy_error = 0; // sum |V1 - V0| / sum V0 over the held-out samples
-  int samples_attempted = 0;       // fine solves run
-  int samples_dropped = 0;         // fine solves that did not converge
-  int samples_coarse_inverted = 0; // converged samples the coarse element cannot represent (det F <= 0)
+  double residual = 0;              // over the training samples
+  double objective = 0;             // Eq. 2.9 as minimized: weighted data term + regularizer (scaled units)
+  double heldout_error = 0;         // over the held-out samples
+  double heldout_energy_error = 0;  // sum |V1 - V0| / sum V0 over the held-out samples
+  int samples_attempted = 0;        // fine solves run
+  int samples_dropped = 0;          // fine solves that did not converge
+  int samples_coarse_inverted = 0;  // converged samples the coarse element cannot represent (det F <= 0)
   int samples_train = 0;
   int samples_heldout = 0;
-  double seconds = 0;              // sampling + directions + fit
+  double seconds = 0;  // sampling + directions + fit
 
   explicit CoarseMaterialFit(int points = 8) { resize(points); }
   int points() const { return static_cast<int>(mu.size()); }
-  void resize(int points);         // zero parameters, unit-x directions
+  void resize(int points);  // zero parameters, unit-x directions
 };
 
 // The per-point basis energies of V^1 for corner displacements u: a_k, b_k,
@@ -133,8 +133,8 @@ hex8::ElementGeometry coarse_fit_geometry(const hex8::NodeMatrix& X, int points,
 // enhanced fit the condensed energy min_A V^1(u, A). `coarse` must be
 // coarse_fit_geometry(X, fit.points(), fit.enhanced) (std::invalid_argument
 // if its bubble modes do not match the fit's).
-double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse,
-                     const hex8::NodeMatrix& X, const Vec24& u);
+double coarse_energy(const CoarseMaterialFit& fit, const hex8::ElementGeometry& coarse, const hex8::NodeMatrix& X,
+                     const Vec24& u);
 
 // True when the fit stores at least 1e-3 of the naive element's energy (the
 // block's fine materials at their points, void points empty) under each

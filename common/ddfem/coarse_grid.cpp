@@ -6,8 +6,8 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "material/neo_hookean.hpp"
 
 namespace msfab {
@@ -141,8 +141,8 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
   // The node lattice, elements and colouring are those of a voxel mesh of the
   // cell grid; a temporary palette is used for meshing and the lookups then set every element's materials.
   const MaterialPtr meshing_material = std::make_shared<NeoHookean>(1.0, 0.3);
-  VoxelMesh vm = build_voxel_mesh(grid.as_voxel_grid(),
-                                  std::vector<MaterialPtr>(grid.combinations.size() + 1, meshing_material));
+  VoxelMesh vm =
+      build_voxel_mesh(grid.as_voxel_grid(), std::vector<MaterialPtr>(grid.combinations.size() + 1, meshing_material));
   HexMesh& mesh = vm.mesh;
 
   mesh.materials.clear();
@@ -152,13 +152,15 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
     const int n = static_cast<int>(m.at_point.size());
     if (rule_of(n) == kRules) {
       std::ostringstream msg;
-      msg << "coarse mesh: the material lookup returned " << n << " materials for combination " << c
-          << "; expected 1, " << gauss.size() << " (one per quadrature point), " << gauss.size() + 1
-          << " (and one at the centre) or " << composite.size() << " (8 per fine voxel)";
+      msg << "coarse mesh: the material lookup returned " << n << " materials for combination " << c << "; expected 1, "
+          << gauss.size() << " (one per quadrature point), " << gauss.size() + 1 << " (and one at the centre) or "
+          << composite.size() << " (8 per fine voxel)";
       throw InputError(msg.str());
     }
     for (const MaterialPtr& p : m.at_point)
-      if (!p) throw InputError("coarse mesh: the material lookup returned a null material for combination " + std::to_string(c));
+      if (!p)
+        throw InputError("coarse mesh: the material lookup returned a null material for combination " +
+                         std::to_string(c));
     mesh.materials.push_back(std::move(m));
   }
   hex8::NodeMatrix cube;
@@ -175,7 +177,8 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
     const Rule r = rule_of(static_cast<int>(mesh.materials[m].at_point.size()));
     if (index[r] < 0) {
       index[r] = static_cast<int>(mesh.geometries.size());
-      mesh.geometries.push_back(r == kGaussCentre ? hex8::with_centre_point(mesh.geometries[0], cube) : geometry(composite));
+      mesh.geometries.push_back(r == kGaussCentre ? hex8::with_centre_point(mesh.geometries[0], cube)
+                                                  : geometry(composite));
     }
     mesh.element_geometry[e] = index[r];
   }
@@ -193,8 +196,9 @@ SpMat coarse_to_fine_interpolation(const VoxelGrid& fine_grid, const VoxelMesh& 
   const double tol = 1e-9 * fine_grid.voxel_size;
   if (fine_grid.nx != coarse.fine_nx || fine_grid.ny != coarse.fine_ny || fine_grid.nz != coarse.fine_nz ||
       std::abs(fine_grid.voxel_size - coarse.fine_voxel_size) > tol || (fine_grid.origin - coarse.origin).norm() > tol)
-    throw InputError("coarse-to-fine interpolation: the coarse grid was not built from this fine grid "
-                     "(sizes, voxel size or origin differ)");
+    throw InputError(
+        "coarse-to-fine interpolation: the coarse grid was not built from this fine grid "
+        "(sizes, voxel size or origin differ)");
   if (coarse_mesh.voxel_element.size() != size_t(coarse.num_cells()))
     throw InputError("coarse-to-fine interpolation: the coarse mesh does not belong to the coarse grid");
   const int f = coarse.fine_per_cell();
@@ -230,8 +234,8 @@ SpMat coarse_to_fine_interpolation(const VoxelGrid& fine_grid, const VoxelMesh& 
   return P;
 }
 
-StaticConditions coarse_static_conditions(const Scene& fine_scene, const VoxelMesh& fine_mesh,
-                                          const CoarseGrid& coarse, const VoxelMesh& coarse_mesh) {
+StaticConditions coarse_static_conditions(const Scene& fine_scene, const VoxelMesh& fine_mesh, const CoarseGrid& coarse,
+                                          const VoxelMesh& coarse_mesh) {
   const StaticConditions fine = build_static_conditions(fine_scene, fine_mesh);
 
   Scene cs;

@@ -28,11 +28,11 @@ namespace msfab {
 using ChildIds = std::array<int, 8>;
 
 struct CoarseGrid {
-  int level = 1;               // fine voxels per coarse edge: 2^level
-  int nx = 0, ny = 0, nz = 0;  // coarse cells per axis
+  int level = 1;                              // fine voxels per coarse edge: 2^level
+  int nx = 0, ny = 0, nz = 0;                 // coarse cells per axis
   int fine_nx = 0, fine_ny = 0, fine_nz = 0;  // the original voxel grid
   double fine_voxel_size = 0;
-  double cell_size = 0;        // 2^level * fine voxel size
+  double cell_size = 0;  // 2^level * fine voxel size
   Vec3 origin = Vec3::Zero();
   // Per cell (x fastest): index into `combinations`, -1 for an all-void block.
   std::vector<int> cell_combination;
@@ -40,7 +40,7 @@ struct CoarseGrid {
   // fine voxel material ids (0 = void). Level 2: level-1 combination index
   // + 1 (0 = an all-void level-1 child).
   std::vector<ChildIds> combinations;
-  double seconds = 0;          // wall time spent building this grid
+  double seconds = 0;  // wall time spent building this grid
 
   size_t index(int i, int j, int k) const { return size_t(i) + size_t(nx) * (size_t(j) + size_t(ny) * k); }
   // The first fine voxel (i, j, k) of cell c: the inverse of index, times 2^level.
@@ -112,7 +112,7 @@ SpMat coarse_to_fine_interpolation(const VoxelGrid& fine_grid, const VoxelMesh& 
 // padded axis moves to the padded boundary). Forces: the fine nodal forces
 // (loads and gravity) restricted by the transpose of the interpolation, which
 // keeps their total force and moment.
-StaticConditions coarse_static_conditions(const Scene& fine_scene, const VoxelMesh& fine_mesh,
-                                          const CoarseGrid& coarse, const VoxelMesh& coarse_mesh);
+StaticConditions coarse_static_conditions(const Scene& fine_scene, const VoxelMesh& fine_mesh, const CoarseGrid& coarse,
+                                          const VoxelMesh& coarse_mesh);
 
 }  // namespace msfab

@@ -17,8 +17,8 @@ using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 VecX interpolate_to_fine(const VoxelGrid& fine_grid, const VoxelMesh& fine_mesh, const CoarseGrid& coarse,
                          const VoxelMesh& coarse_mesh, const VecX& coarse_displacement) {
   if (coarse_displacement.size() != coarse_mesh.mesh.num_dofs())
-    throw InputError("coarse displacement has " + std::to_string(coarse_displacement.size()) + " entries, the coarse mesh " +
-                     std::to_string(coarse_mesh.mesh.num_dofs()) + " DOFs");
+    throw InputError("coarse displacement has " + std::to_string(coarse_displacement.size()) +
+                     " entries, the coarse mesh " + std::to_string(coarse_mesh.mesh.num_dofs()) + " DOFs");
   const SpMat P = coarse_to_fine_interpolation(fine_grid, fine_mesh, coarse, coarse_mesh);
   VecX out(fine_mesh.mesh.num_dofs());
   Eigen::Map<Rows3>(out.data(), fine_mesh.mesh.num_nodes(), 3) =
@@ -91,8 +91,7 @@ CoarseErrorFloor coarse_error_floor(const SpMat& P, const VoxelMesh& fine_mesh, 
     const double shift = 1e-14 * normal.diagonal().maxCoeff();
     for (int c = 0; c < normal.cols(); ++c) normal.coeffRef(c, c) += shift;
     if (it == 1) cholesky.analyze(normal);
-    if (!cholesky.factorize(normal))
-      throw NumericalError("coarse error floor: weighted normal equations not definite");
+    if (!cholesky.factorize(normal)) throw NumericalError("coarse error floor: weighted normal equations not definite");
     U = cholesky.solve_columns(MatX(Pt * (weight.asDiagonal() * F)));
     R = F - P * U;
     // Primal value, and the dual certificate L = W R, which satisfies

@@ -107,8 +107,8 @@ FarthestPointSet farthest_point_sampling(const MatX& features, int k, const std:
   return out;
 }
 
-CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
-                                 std::uint64_t seed, CompressionReport* report, bool corner_moves) {
+CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain, std::uint64_t seed,
+                                 CompressionReport* report, bool corner_moves) {
   if (full.compressed()) throw InputError("compression: the input database is already compressed");
   FineBlock unit;
   unit.voxel_size = 1e-3;

@@ -57,7 +57,7 @@ bool is_homogeneous(const BlockMaterials& ids);
 
 struct CompressionReport {
   double mean_distance = 0, max_distance = 0;  // combinations to their representative (Eq. 2.10)
-  double mean_energy_error = 0;               // mean |V_rep / V_own - 1| over combinations and deformations
+  double mean_energy_error = 0;                // mean |V_rep / V_own - 1| over combinations and deformations
 };
 
 // A database whose entries are k representatives of `full` (which must be
@@ -65,7 +65,7 @@ struct CompressionReport {
 // representative. The homogeneous combinations come first (if k allows),
 // then farthest-point sampling; `seed` draws the common deformations.
 // `corner_moves` appends corner_deformations to the common ones.
-CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain,
-                                 std::uint64_t seed, CompressionReport* report = nullptr, bool corner_moves = false);
+CoarseDatabase compress_database(const CoarseDatabase& full, int k, int deformations, double strain, std::uint64_t seed,
+                                 CompressionReport* report = nullptr, bool corner_moves = false);
 
 }  // namespace msfab

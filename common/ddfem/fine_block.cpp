@@ -56,8 +56,7 @@ int FineBlock::child_of_element(int e) const {
 
 hex8::NodeMatrix FineBlock::coarse_rest_positions() const {
   hex8::NodeMatrix X;
-  for (int c = 0; c < 8; ++c)
-    X.row(c) = edge() * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
+  for (int c = 0; c < 8; ++c) X.row(c) = edge() * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
   return X;
 }
 
@@ -88,8 +87,8 @@ int FineBlock::lattice_node(int i, int j, int k) const {
   return voxels.lattice_node[size_t(i + context) + n * (size_t(j + context) + n * size_t(k + context))];
 }
 
-FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size, int coarse_points_per_axis, int context) {
+FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette, double voxel_size,
+                          int coarse_points_per_axis, int context) {
   if (context < 0 || context > 4) {
     std::ostringstream os;
     os << "fine block: context must be 0 (isolated) to 4 voxels, got " << context;
@@ -112,8 +111,8 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
     const int id = ids[c];
     if (id < 0 || id >= static_cast<int>(palette.size())) {
       std::ostringstream os;
-      os << "fine block: material id " << id << " of child " << c << " is outside the palette (size "
-         << palette.size() << ")";
+      os << "fine block: material id " << id << " of child " << c << " is outside the palette (size " << palette.size()
+         << ")";
       throw InputError(os.str());
     }
     if (id == 0) continue;
@@ -169,8 +168,8 @@ FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<
     const int id = voxel_ids[v];
     if (id < 0 || id >= static_cast<int>(palette.size()) || (id != 0 && !palette[id])) {
       std::ostringstream os;
-      os << "voxel block: material id " << id << " of voxel " << v << " is not in the palette (size "
-         << palette.size() << ")";
+      os << "voxel block: material id " << id << " of voxel " << v << " is not in the palette (size " << palette.size()
+         << ")";
       throw InputError(os.str());
     }
     any_solid = any_solid || id != 0;

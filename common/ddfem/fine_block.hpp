@@ -19,12 +19,12 @@ bool is_all_solid(const BlockMaterials& ids);
 std::string block_name(const BlockMaterials& ids);
 
 struct FineBlock {
-  double voxel_size = 1.0;           // fine edge h; the coarse element has edge n h
+  double voxel_size = 1.0;  // fine edge h; the coarse element has edge n h
   // Voxels n along each edge of the block: 2 (one voxel per child, level 1)
   // or 4 (a level-2 block sampled on its fine voxels: each child is then
   // 2 x 2 x 2 voxels, see make_voxel_block).
   int voxels_per_edge = 2;
-  BlockMaterials material_ids{};     // palette ids per child, 0 = void
+  BlockMaterials material_ids{};            // palette ids per child, 0 = void
   std::vector<MaterialPtr> child_material;  // per child, null for void
   // Voxels of context around the block on every side (in-situ sampling,
   // docs/ddfem.md): 0 is the isolated block; r > 0 surrounds it with r
@@ -32,7 +32,7 @@ struct FineBlock {
   // and a fibre or layer that crosses the block continues through its faces
   // as it does in a body. The block itself always spans [0, 2h]^3.
   int context = 0;
-  VoxelMesh voxels;                  // mesh of the non-void voxels (block and context)
+  VoxelMesh voxels;  // mesh of the non-void voxels (block and context)
   // Elements inside the block (1) or in its context (0): a sample's energy
   // is the energy of the block's own elements.
   std::vector<char> core_element;
@@ -73,8 +73,8 @@ struct FineBlock {
 // `context` layers of periodic copies around it. Throws InputError if h is
 // not positive, an id is out of range, a non-void id has no material, every
 // child is void, or context is outside [0, 4].
-FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette,
-                          double voxel_size, int coarse_points_per_axis = 2, int context = 0);
+FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette, double voxel_size,
+                          int coarse_points_per_axis = 2, int context = 0);
 
 // A level-2 block on its fine voxels (docs/ddfem.md, "Level 2"): 4 x 4 x 4
 // voxels, `voxel_ids[i + 4 (j + 4 k)]` the palette id of voxel (i, j, k)

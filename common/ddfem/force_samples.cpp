@@ -1,13 +1,12 @@
 #include "ddfem/force_samples.hpp"
 
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <stdexcept>
-
-#include <Eigen/SparseCholesky>
 
 #include "core/errors.hpp"
 #include "ddfem/block_newton.hpp"
@@ -72,8 +71,8 @@ std::string sampling_mode_name(ForceSamplingOptions::Mode mode) {
 }
 
 ForceSamplingOptions::Mode parse_sampling_mode(const std::string& name) {
-  for (auto m : {ForceSamplingOptions::Mode::isolated, ForceSamplingOptions::Mode::patch,
-                 ForceSamplingOptions::Mode::periodic})
+  for (auto m :
+       {ForceSamplingOptions::Mode::isolated, ForceSamplingOptions::Mode::patch, ForceSamplingOptions::Mode::periodic})
     if (sampling_mode_name(m) == name) return m;
   throw InputError("unknown sampling mode '" + name + "' (isolated, patch or periodic)");
 }
@@ -270,9 +269,9 @@ constexpr double kRigidShift = 1e-8;
 // constraints.
 struct BlockSolver::SparseKkt {
   Eigen::SimplicialLDLT<SpMat> ldlt;
-  MatX Gt;                         // G^T
-  Eigen::LDLT<MatX> gram;          // G G^T, for the exact projection on G d = 0
-  MatX Y;                          // (K + sigma I)^{-1} G^T
+  MatX Gt;                 // G^T
+  Eigen::LDLT<MatX> gram;  // G G^T, for the exact projection on G d = 0
+  MatX Y;                  // (K + sigma I)^{-1} G^T
   Eigen::LDLT<MatX> schur;
   bool positive_on_null_space = false;
 

@@ -25,8 +25,8 @@ struct ForceSamplingOptions {
   // turned by a rotation drawn from `seed`.
   bool include_axes = true;
   int sphere_directions = 3;
-  int magnitudes = 5;          // per sign; magnitude m of n is m/n of the largest
-  double max_strain = 0.15;    // small-strain estimate of the largest local strain at the largest magnitude
+  int magnitudes = 5;        // per sign; magnitude m of n is m/n of the largest
+  double max_strain = 0.15;  // small-strain estimate of the largest local strain at the largest magnitude
   std::uint64_t seed = 1;
   double newton_tolerance = 1e-9;
   // Where the block is while it is sampled (docs/ddfem.md, "In-situ
@@ -58,10 +58,10 @@ struct ForcePattern {
 };
 
 struct ForceSample {
-  int pattern = 0;          // index into ForceSampleSet::patterns
-  double load = 0;          // signed multiple of the unit pattern applied
+  int pattern = 0;                            // index into ForceSampleSet::patterns
+  double load = 0;                            // signed multiple of the unit pattern applied
   Vec24 corner_displacement = Vec24::Zero();  // coarse u^1, node-major (3*corner + axis)
-  double energy = 0;        // fine elastic energy V^0 at equilibrium
+  double energy = 0;                          // fine elastic energy V^0 at equilibrium
   int newton_iterations = 0;
 };
 
@@ -69,8 +69,8 @@ struct ForceSampleSet {
   std::vector<ForcePattern> patterns;
   std::vector<ForceSample> samples;  // converged samples, in pattern, sign, magnitude order
   int attempted = 0;
-  int dropped = 0;                   // solves that did not converge
-  double seconds = 0;                // wall time of the solves
+  int dropped = 0;     // solves that did not converge
+  double seconds = 0;  // wall time of the solves
 };
 
 // The fine block's static problem with rigid motion removed by six linear
@@ -140,14 +140,14 @@ class BlockSolver {
 
   const FineBlock& block_;
   ElasticAssembler assembler_;
-  HexMesh core_mesh_;                   // the block's own elements (all nodes); empty when isolated
+  HexMesh core_mesh_;  // the block's own elements (all nodes); empty when isolated
   std::unique_ptr<ElasticAssembler> core_assembler_;
   double tolerance_;
   int max_iterations_ = 200;  // slow cases: a soft corner next to stiff children
   MatX G_, Z_;
   VecX rest_;
-  double stiffness_scale_ = 0;        // largest diagonal entry of the rest stiffness (projected when dense)
-  Eigen::LDLT<MatX> rest_stiffness_;  // dense path: Z^T K(X) Z
+  double stiffness_scale_ = 0;              // largest diagonal entry of the rest stiffness (projected when dense)
+  Eigen::LDLT<MatX> rest_stiffness_;        // dense path: Z^T K(X) Z
   std::unique_ptr<SparseKkt> sparse_;       // Newton iterations (refactored each step)
   std::unique_ptr<SparseKkt> sparse_rest_;  // the rest state, for linear_peak_strain
 };

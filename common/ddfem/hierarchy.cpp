@@ -53,7 +53,8 @@ std::vector<Mat24> level1_rest_stiffness(const std::vector<CoarseMaterialFit>& l
     const QuadratureMaterials m = coarse_quadrature_materials(level1[e]);
     const hex8::ElementGeometry& geo = level1[e].enhanced ? enhanced : trilinear;
     hex_evaluate(coarse_element_geometry(geo, X, m), m, X, nullptr, &K[e]);
-    if (!K[e].allFinite()) throw InputError("level 2: level-1 coarse material " + std::to_string(e) + " has a non-finite stiffness");
+    if (!K[e].allFinite())
+      throw InputError("level 2: level-1 coarse material " + std::to_string(e) + " has a non-finite stiffness");
   }
   return K;
 }
@@ -84,7 +85,8 @@ Mat24 condensed_stiffness(const Arrangement& arr, const std::vector<Mat24>& K1, 
     const Mat24& Ke = K1.at(arr[c]);
     for (int a = 0; a < 8; ++a)
       for (int b = 0; b < 8; ++b)
-        K.block<3, 3>(3 * dof_node[key(lattice(c, a))], 3 * dof_node[key(lattice(c, b))]) += Ke.block<3, 3>(3 * a, 3 * b);
+        K.block<3, 3>(3 * dof_node[key(lattice(c, a))], 3 * dof_node[key(lattice(c, b))]) +=
+            Ke.block<3, 3>(3 * a, 3 * b);
   }
   const int ni = 3 * (nodes - 8);
   if (ni == 0) return K.topLeftCorner<24, 24>();

@@ -37,9 +37,9 @@ using Arrangement = std::array<int, 8>;
 // inputs are the previous stage's representatives (level-1 entries for
 // stage 0).
 struct PairStage {
-  int inputs = 0;                          // size of the input alphabet
-  std::vector<int> table;                  // a * inputs + b -> representative (b at the +axis side)
-  std::vector<std::array<int, 2>> pairs;   // representative -> its (a, b)
+  int inputs = 0;                              // size of the input alphabet
+  std::vector<int> table;                      // a * inputs + b -> representative (b at the +axis side)
+  std::vector<std::array<int, 2>> pairs;       // representative -> its (a, b)
   double mean_distance = 0, max_distance = 0;  // candidates to their representative (Eq. 2.10)
   int outputs() const { return static_cast<int>(pairs.size()); }
 };
@@ -63,9 +63,9 @@ struct Level2Hierarchy {
 
 struct HierarchyOptions {
   std::array<int, 3> representatives{400, 400, 400};  // kx, ky, kz (the thesis: 400 each)
-  int deformations = 32;    // common deformations of the level-2 cell
-  double strain = 0.05;     // their strain magnitude
-  std::uint64_t seed = 5;   // draws the deformations and each stage's first representative
+  int deformations = 32;                              // common deformations of the level-2 cell
+  double strain = 0.05;                               // their strain magnitude
+  std::uint64_t seed = 5;                             // draws the deformations and each stage's first representative
   // Add the 24 single-corner moves of the candidate's box to its features
   // (the diagonal of its condensed stiffness): where in the cell its
   // stiffness sits, as msfab-ddfem-compress's corner_moves.

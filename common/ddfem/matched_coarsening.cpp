@@ -81,7 +81,8 @@ Mat6 element_uniform_response(const std::vector<Mat6>& C, int n, bool enhanced) 
   const hex8::QuadratureRule rule = hex8::gauss_rule(n);
   if (static_cast<int>(C.size()) != rule.size())
     throw std::invalid_argument("element_uniform_response: one stiffness per quadrature point expected");
-  return uniform_strain_response(enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule), C);
+  return uniform_strain_response(enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule),
+                                 C);
 }
 
 Mat6 fit_uniform_response(const CoarseMaterialFit& fit) {
@@ -199,11 +200,13 @@ namespace {
 std::vector<Mat6> matched_point_stiffness_to(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
                                              int n, bool enhanced, const Mat6* target, int* iterations,
                                              double* residual) {
-  if (static_cast<int>(ids.size()) != n * n * n) throw std::invalid_argument("matched_point_stiffness: n^3 ids expected");
+  if (static_cast<int>(ids.size()) != n * n * n)
+    throw std::invalid_argument("matched_point_stiffness: n^3 ids expected");
   std::vector<Mat6> C;
   for (int id : ids) {
     if (id <= 0 || id >= static_cast<int>(palette.size()) || !palette[id])
-      throw InputError("matched coarsening: fine material id " + std::to_string(id) + " is not a solid palette material");
+      throw InputError("matched coarsening: fine material id " + std::to_string(id) +
+                       " is not a solid palette material");
     C.push_back(lame_C(palette[id]->shear_modulus(), palette[id]->lame_lambda()));
   }
   const hex8::NodeMatrix X = unit_cube();
@@ -220,8 +223,8 @@ std::vector<Mat6> matched_point_stiffness(const std::vector<MaterialPtr>& palett
   return matched_point_stiffness_to(palette, ids, n, enhanced, nullptr, iterations, residual);
 }
 
-QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
-                                            int n, bool enhanced, const Mat6* target) {
+QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
+                                            bool enhanced, const Mat6* target) {
   if (!solid_mixed_block(ids)) return naive_block(palette, ids, n);
   int iterations = 0;
   const std::vector<Mat6> C = matched_point_stiffness_to(palette, ids, n, enhanced, target, &iterations, nullptr);

@@ -71,8 +71,8 @@ std::vector<Mat6> congruent_to_response(std::vector<Mat6> C, const hex8::Element
 // Matched materials of one block (fine ids laid out as block_level1, n per
 // edge) carried onto `target` instead of the block's C^H; naive materials
 // for a block with void or of one material.
-QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids,
-                                            int n, bool enhanced, const Mat6* target = nullptr);
+QuadratureMaterials matched_block_materials(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
+                                            bool enhanced, const Mat6* target = nullptr);
 
 // The stiffness of solid cell `cell` of `cells` (fine ids `ids`, laid out as
 // block_level1, n = cells.fine_per_cell() per edge) among `margin` voxels of

@@ -47,7 +47,6 @@ void check_mixed_level_inputs(const VoxelGrid& fine, const CoarseGrid& level1, c
   for (int l : cell_level)
     if (l < 0 || l > 2) throw InputError("mixed-level mesh: a cell level must be 0, 1 or 2, got " + std::to_string(l));
   if (!level1_materials || !level2_materials) throw InputError("mixed-level mesh: a material lookup is missing");
-
 }
 
 // Geometries per (level, rule), told apart by an element's number of
@@ -244,8 +243,7 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
             if (id == 0) continue;
             if (id < 0 || id >= static_cast<int>(palette.size()) || !palette[id])
               throw InputError("mixed-level mesh: voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
-                               std::to_string(k) + ") has material id " + std::to_string(id) +
-                               " outside the palette");
+                               std::to_string(k) + ") has material id " + std::to_string(id) + " outside the palette");
             const int slot = material(0, id, [&] { return QuadratureMaterials{{palette[id]}}; });
             add_element(0, {i, j, k}, slot, id);
           }

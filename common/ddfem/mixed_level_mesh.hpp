@@ -53,8 +53,7 @@ struct MixedLevelMesh {
 MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<MaterialPtr>& palette,
                                       const CoarseGrid& level1, const CoarseGrid& level2,
                                       const std::vector<int>& cell_level, const CoarseMaterialLookup& level1_materials,
-                                      const CoarseMaterialLookup& level2_materials,
-                                      bool enhanced_modes = false);
+                                      const CoarseMaterialLookup& level2_materials, bool enhanced_modes = false);
 
 // Displacements (or positions) of the unknowns interpolated to the fine
 // mesh's nodes: a (fine nodes) x (unknown nodes) matrix with rows summing to

@@ -8,8 +8,8 @@ namespace msfab {
 
 struct NnlsResult {
   VecX x;
-  double residual = 0;   // ||A x - b||
-  int iterations = 0;    // outer iterations (variables freed)
+  double residual = 0;  // ||A x - b||
+  int iterations = 0;   // outer iterations (variables freed)
   bool converged = false;
 };
 

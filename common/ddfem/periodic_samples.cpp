@@ -129,8 +129,7 @@ PeriodicBlockSolver::PeriodicBlockSolver(const FineBlock& block, double newton_t
     const MatX fit = N.completeOrthogonalDecomposition().pseudoInverse();  // nv x nodes
     MatX per_dof = MatX::Zero(3 * nv, 3 * mesh.num_nodes());
     for (int i = 0; i < nv; ++i)
-      for (int n = 0; n < mesh.num_nodes(); ++n)
-        per_dof.block<3, 3>(3 * i, 3 * n) = fit(i, n) * Mat3::Identity();
+      for (int n = 0; n < mesh.num_nodes(); ++n) per_dof.block<3, 3>(3 * i, 3 * n) = fit(i, n) * Mat3::Identity();
     extrapolate_ = per_dof * reduce_;
   }
 }
@@ -311,8 +310,8 @@ std::vector<Vec3> periodic_point_directions(const FineBlock& block, const Anisot
       if (e < 0) continue;
       hex8::NodeMatrix xe;
       for (int a = 0; a < 8; ++a) xe.row(a) = x.segment<3>(3 * mesh.elements[e][a]).transpose();
-      const double energy = hex_energy(mesh.geometries[mesh.element_geometry[e]],
-                                       mesh.materials[mesh.element_material[e]], xe);
+      const double energy =
+          hex_energy(mesh.geometries[mesh.element_geometry[e]], mesh.materials[mesh.element_material[e]], xe);
       if (!(energy > 0) || !std::isfinite(energy)) continue;
       const double l = 1.0 / std::sqrt(energy);
       cloud[q].push_back(l * d);

@@ -51,14 +51,14 @@ class PeriodicBlockSolver {
   const FineBlock& block_;
   ElasticAssembler assembler_;
   double tolerance_;
-  int free_ = 0;                        // 3 per periodic class with nodes, corners' class excepted
-  double force_round_off_;              // mu h^2 of the stiffest fine material: nodal forces' scale at round-off
+  int free_ = 0;            // 3 per periodic class with nodes, corners' class excepted
+  double force_round_off_;  // mu h^2 of the stiffest fine material: nodal forces' scale at round-off
   VecX rest_;
-  std::vector<int> node_class_;        // mesh node -> its periodic class's unknown, -1 at the corners
+  std::vector<int> node_class_;  // mesh node -> its periodic class's unknown, -1 at the corners
   std::vector<Eigen::Matrix<double, 8, 1>> node_weights_;  // trilinear weights of the corners at each node
-  MatX reduce_;                         // DOFs x free_: sums nodal forces over each free periodic class
-  std::vector<int> void_corners_;       // corners without a fine node
-  MatX extrapolate_;                    // (3 void corners) x 21: their least-squares correction from w
+  MatX reduce_;                    // DOFs x free_: sums nodal forces over each free periodic class
+  std::vector<int> void_corners_;  // corners without a fine node
+  MatX extrapolate_;               // (3 void corners) x 21: their least-squares correction from w
 };
 
 // Every pattern at options.magnitudes magnitudes in both signs, peak coarse

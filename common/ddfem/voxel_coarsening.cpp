@@ -33,19 +33,19 @@ const CoarseMaterialFit* database_fit(const CoarseDatabase& db, const std::vecto
 CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
                                     const CoarseGrid& level1, int level, double tolerance, bool enhanced,
                                     CoarseMaterialLookup database, CoarsenedVoxels* counts) {
-  return [&db, palette, combos = level1.combinations, level, tolerance, enhanced, database,
-          counts](const ChildIds& ids) {
-    const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
-    if (!fit) return database(ids);
-    const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
-    if (!solid_mixed_block(voxels)) return database(ids);
-    if (counts) ++counts->checked_blocks;
-    const int n = level == 2 ? 4 : 2;
-    const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
-    if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
-    if (counts) ++counts->replaced_blocks;
-    return matched_block_materials(palette, voxels, n, enhanced, &CH);
-  };
+  return
+      [&db, palette, combos = level1.combinations, level, tolerance, enhanced, database, counts](const ChildIds& ids) {
+        const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
+        if (!fit) return database(ids);
+        const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
+        if (!solid_mixed_block(voxels)) return database(ids);
+        if (counts) ++counts->checked_blocks;
+        const int n = level == 2 ? 4 : 2;
+        const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
+        if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
+        if (counts) ++counts->replaced_blocks;
+        return matched_block_materials(palette, voxels, n, enhanced, &CH);
+      };
 }
 
 // What deciding one cell's materials found. Per cell, so that cells can be
@@ -134,7 +134,8 @@ CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vec
   if (name == "averaged") return level1 ? averaged_coarsening(palette, *level1) : averaged_coarsening(palette);
   if (name == "galerkin") return level1 ? galerkin_coarsening(palette, *level1) : galerkin_coarsening(palette);
   if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
-  if (name == "matched") return level1 ? matched_coarsening(palette, *level1, enhanced) : matched_coarsening(palette, enhanced);
+  if (name == "matched")
+    return level1 ? matched_coarsening(palette, *level1, enhanced) : matched_coarsening(palette, enhanced);
   throw InputError("coarse materials: expected naive, averaged, galerkin, homogenized or matched, got '" + name + "'");
 }
 
@@ -171,7 +172,8 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   if (request.check_tolerance > 0 && request.material != "ddfem")
     throw InputError("--coarse-check: applies to --coarse-material ddfem only (got " + request.material + ")");
   if (request.window < 0) throw InputError("--coarse-window: the margin must be >= 0 voxels (0: off)");
-  if (request.window > 0 && request.material != "matched" && !(request.material == "ddfem" && request.check_tolerance > 0))
+  if (request.window > 0 && request.material != "matched" &&
+      !(request.material == "ddfem" && request.check_tolerance > 0))
     throw InputError("--coarse-window: applies to --coarse-material matched, or ddfem with --coarse-check (got " +
                      request.material + (request.material == "ddfem" ? " without --coarse-check)" : ")"));
   if (request.fallback != "naive" && request.material != "ddfem")
@@ -208,24 +210,31 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
   if (request.window > 0 && request.material == "matched") {
     const CoarseGrid cells = with_one_combination_per_cell(m.grid);
     const bool enhanced = m.element == "enhanced";
-    m.mesh = per_cell_mesh(grid, cells, request.window, [&](int cell, CellOutcome& o) {
-      return windowed_matched_cell(grid, palette, cells, level1, enhanced, request.window, cell, &o.unresolved);
-    }, enhanced, &m.stats, &m);
+    m.mesh = per_cell_mesh(
+        grid, cells, request.window,
+        [&](int cell, CellOutcome& o) {
+          return windowed_matched_cell(grid, palette, cells, level1, enhanced, request.window, cell, &o.unresolved);
+        },
+        enhanced, &m.stats, &m);
     m.grid = cells;
   } else if (request.window > 0) {  // ddfem, checked against each cell's windowed stiffness
     m.fallback = request.fallback;
     m.check_tolerance = request.check_tolerance;
     // Blocks without a fit are counted once per distinct block, as without a window.
-    for (const ChildIds& c : m.grid.combinations) m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
+    for (const ChildIds& c : m.grid.combinations)
+      m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
     CoarsenedVoxels unchecked = m;
     unchecked.check_tolerance = 0;
     const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
     const CoarseGrid cells = with_one_combination_per_cell(m.grid);
     const bool enhanced = m.element == "enhanced";
-    m.mesh = per_cell_mesh(grid, cells, request.window, [&](int cell, CellOutcome& o) {
-      return windowed_checked_cell(grid, palette, *m.database, m.level1, request.level, cells, lookup, enhanced,
-                                   request.window, request.check_tolerance, cell, o);
-    }, enhanced, &m.stats, &m);
+    m.mesh = per_cell_mesh(
+        grid, cells, request.window,
+        [&](int cell, CellOutcome& o) {
+          return windowed_checked_cell(grid, palette, *m.database, m.level1, request.level, cells, lookup, enhanced,
+                                       request.window, request.check_tolerance, cell, o);
+        },
+        enhanced, &m.stats, &m);
     m.grid = cells;
   } else {
     CoarseMaterialLookup lookup;

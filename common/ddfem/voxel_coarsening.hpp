@@ -14,9 +14,9 @@
 namespace msfab {
 
 struct CoarseningRequest {
-  int level = 0;                     // 0 = fine, 1, 2
-  std::string material = "ddfem";    // ddfem | naive | averaged | homogenized | galerkin | matched
-  std::string database;              // coarse_db path (ddfem)
+  int level = 0;                   // 0 = fine, 1, 2
+  std::string material = "ddfem";  // ddfem | naive | averaged | homogenized | galerkin | matched
+  std::string database;            // coarse_db path (ddfem)
   // ddfem: how blocks without a fit in the database are coarsened (naive |
   // galerkin | matched); blocks with void children are the usual ones.
   std::string fallback = "naive";
@@ -34,19 +34,19 @@ struct CoarseningRequest {
 };
 
 struct CoarsenedVoxels {
-  CoarseGrid level1, grid;           // grid = the level requested
+  CoarseGrid level1, grid;  // grid = the level requested
   VoxelMesh mesh;
   CoarseMeshStats stats;
-  double seconds = 0;                // grid + lookups + mesh (the online coarsening time)
-  int fallback_blocks = 0;           // ddfem: distinct combinations without a fit (coarsened by request.fallback)
+  double seconds = 0;       // grid + lookups + mesh (the online coarsening time)
+  int fallback_blocks = 0;  // ddfem: distinct combinations without a fit (coarsened by request.fallback)
   std::shared_ptr<CoarseDatabase> database;
-  std::string element = "trilinear"; // the coarse element used (request resolved)
-  std::string fallback = "naive";    // ddfem: how blocks without a fit were coarsened
-  double check_tolerance = 0;        // ddfem: the checked lookup's tolerance (request resolved; 0: off)
-  int checked_blocks = 0;            // ddfem with a check: distinct solid mixed blocks whose fit was checked
-  int replaced_blocks = 0;           // ... and of those, coarsened by the matched model instead
-  int unresolved_windows = 0;        // with a window: cells whose window gave no stiffness (own C^H used)
-  int distinct_windows = 0;          // with a window: distinct windows among the solid cells (each computed once)
+  std::string element = "trilinear";  // the coarse element used (request resolved)
+  std::string fallback = "naive";     // ddfem: how blocks without a fit were coarsened
+  double check_tolerance = 0;         // ddfem: the checked lookup's tolerance (request resolved; 0: off)
+  int checked_blocks = 0;             // ddfem with a check: distinct solid mixed blocks whose fit was checked
+  int replaced_blocks = 0;            // ... and of those, coarsened by the matched model instead
+  int unresolved_windows = 0;         // with a window: cells whose window gave no stiffness (own C^H used)
+  int distinct_windows = 0;           // with a window: distinct windows among the solid cells (each computed once)
 };
 
 // A baseline by name (naive, averaged, galerkin, homogenized of

@@ -68,7 +68,8 @@ void check_fine_reference(const DynamicsScene& scene, const Trajectory& fine, co
                      " rest nodes; the fine mesh of this scene has " + std::to_string(nf) +
                      " (not a fine run of this scene)");
   if ((fine.rest_nodes - fine_mesh.nodes).cwiseAbs().maxCoeff() > 1e-9 * scene.grid.voxel_size)
-    throw InputError(fine_path + ": dataset '/mesh/nodes' differs from this scene's fine mesh (not a fine run of "
+    throw InputError(fine_path +
+                     ": dataset '/mesh/nodes' differs from this scene's fine mesh (not a fine run of "
                      "this scene, or one with other scene parameters)");
   if (fine.frames.empty()) throw InputError(fine_path + ": holds no output frame");
   const double time_step = scene.newmark.time_step;
@@ -127,7 +128,8 @@ TrajectoryDifference compare_with_fine(const DynamicsScene& scene, const Traject
   if (model.frames.empty()) throw InputError("this run: holds no output frame");
   if (fine.frames.size() != model.frames.size())
     throw InputError(fine_path + ": the reference has " + std::to_string(fine.frames.size()) + " frames, this run " +
-                     std::to_string(model.frames.size()) + " (simulation.time_step, duration and output_every must "
+                     std::to_string(model.frames.size()) +
+                     " (simulation.time_step, duration and output_every must "
                      "be the same)");
   const double step = std::max(fine.time_step, model.time_step);
   for (size_t i = 0; i < fine.frames.size(); ++i)
@@ -151,7 +153,8 @@ TrajectoryDifference compare_with_fine(const DynamicsScene& scene, const Traject
     VecX interpolated = um;
     if (P) {
       interpolated.resize(3 * nf);
-      Eigen::Map<NodeRowsMap>(interpolated.data(), nf, 3) = *P * Eigen::Map<const NodeRowsMap>(um.data(), d.model_nodes, 3);
+      Eigen::Map<NodeRowsMap>(interpolated.data(), nf, 3) =
+          *P * Eigen::Map<const NodeRowsMap>(um.data(), d.model_nodes, 3);
     }
     const double e = mean_vertex_error(fine_mesh, uf, interpolated);
     d.time.push_back(fine.frames[i].time);
@@ -163,9 +166,8 @@ TrajectoryDifference compare_with_fine(const DynamicsScene& scene, const Traject
   const size_t samples = std::min(fine.samples.size(), model.samples.size());
   for (size_t i = 0; i < samples; ++i)
     if (std::abs(fine.samples[i].time - model.samples[i].time) <= 1e-6 * step)
-      d.max_center_of_mass_distance =
-          std::max(d.max_center_of_mass_distance,
-                   (fine.samples[i].center_of_mass - model.samples[i].center_of_mass).norm());
+      d.max_center_of_mass_distance = std::max(
+          d.max_center_of_mass_distance, (fine.samples[i].center_of_mass - model.samples[i].center_of_mass).norm());
   seconds_per_elastic_step(fine, d.fine_seconds_per_step, d.fine_steps);
   seconds_per_elastic_step(model, d.model_seconds_per_step, d.model_steps);
   return d;

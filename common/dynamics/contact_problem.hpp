@@ -40,7 +40,7 @@ struct ContactSolveOptions {
 };
 
 struct ContactSolveResult {
-  VecX p;            // 3m impulses (scaled by h^2/2)
+  VecX p;  // 3m impulses (scaled by h^2/2)
   int sweeps = 0;
   bool converged = false;
   double max_change = 0;  // relative change of the last sweep

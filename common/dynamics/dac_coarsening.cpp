@@ -102,8 +102,8 @@ DacResult dac_geometric_coarsening(const DacLevelBuilder& build, const DacOption
     if (!result.levels.empty()) {
       const VecX& previous = result.levels.back().frequencies;
       for (int i = 0; i < k; ++i)
-        report.frequency_change = std::max(
-            report.frequency_change, std::abs(report.frequencies(i) - previous(i)) / report.frequencies(i));
+        report.frequency_change =
+            std::max(report.frequency_change, std::abs(report.frequencies(i) - previous(i)) / report.frequencies(i));
     }
     result.levels.push_back(std::move(report));
     if (result.levels.size() > 1 && result.levels.back().frequency_change < options.convergence_tolerance) {
@@ -117,8 +117,8 @@ DacResult dac_geometric_coarsening(const DacLevelBuilder& build, const DacOption
   bool chosen = false;
   for (size_t l = 0; l < result.levels.size(); ++l) {
     DacLevelReport& report = result.levels[l];
-    report.matches = match_modes(surfaces[reference], modes[reference].modes, surfaces[l],
-                                 modes[l].modes.leftCols(k), options.match_window, options.distance);
+    report.matches = match_modes(surfaces[reference], modes[reference].modes, surfaces[l], modes[l].modes.leftCols(k),
+                                 options.match_window, options.distance);
     report.max_distance = 0;
     for (const ModeMatch& m : report.matches) report.max_distance = std::max(report.max_distance, m.distance);
     report.within_tolerance = report.max_distance <= options.shape_tolerance;

@@ -36,8 +36,8 @@ using DacLevelBuilder = std::function<DacLevel(int level)>;
 // the finest value is returned with `monotone` false. InputError unless
 // the sizes decrease and every value is finite.
 struct FrequencyLimit {
-  double limit = 0.0;   // estimated converged frequency
-  double order = 0.0;   // observed order p; 0 when not monotone
+  double limit = 0.0;  // estimated converged frequency
+  double order = 0.0;  // observed order p; 0 when not monotone
   bool monotone = false;
 };
 FrequencyLimit extrapolate_frequency(const std::array<double, 3>& f, const std::array<double, 3>& h);
@@ -45,7 +45,7 @@ FrequencyLimit extrapolate_frequency(const std::array<double, 3>& f, const std::
 struct DacOptions {
   int first_level = 0;
   int max_level = 6;
-  int num_modes = 4;                   // modes whose shapes and frequencies must match
+  int num_modes = 4;                    // modes whose shapes and frequencies must match
   double convergence_tolerance = 0.01;  // max relative frequency change between levels
   double shape_tolerance = 0.05;        // max relative Hausdorff distance per mode
   int match_window = 2;                 // see match_modes; extra modes are computed for it
@@ -63,9 +63,9 @@ struct DacLevelReport {
   int elements = 0;
   int dofs = 0;
   double element_size = 0.0;
-  VecX frequencies;              // first num_modes + match_window, Hz
-  double frequency_change = 0.0;  // max_i |f_i - f_i(previous)| / f_i over num_modes (0 at the first level)
-  std::vector<ModeMatch> matches; // mode i -> convergent mode and its relative Hausdorff distance
+  VecX frequencies;                // first num_modes + match_window, Hz
+  double frequency_change = 0.0;   // max_i |f_i - f_i(previous)| / f_i over num_modes (0 at the first level)
+  std::vector<ModeMatch> matches;  // mode i -> convergent mode and its relative Hausdorff distance
   double max_distance = 0.0;
   bool within_tolerance = false;  // every distance <= shape_tolerance
   // Relative distance of the first num_modes frequencies from their
@@ -76,10 +76,10 @@ struct DacLevelReport {
 
 struct DacResult {
   std::vector<DacLevelReport> levels;  // first_level .. convergent level, in order
-  bool converged = false;  // false: max_level reached first; the finest level is the reference
+  bool converged = false;              // false: max_level reached first; the finest level is the reference
   int convergent_level = -1;
-  int chosen_level = -1;   // coarsest level within the shape tolerance
-  size_t chosen_index = 0; // its position in `levels`
+  int chosen_level = -1;    // coarsest level within the shape tolerance
+  size_t chosen_index = 0;  // its position in `levels`
   // Converged frequency of each of the first num_modes modes (of the
   // reference level, tracked through coarser levels by shape): Richardson
   // extrapolation over the three finest levels where the mode converges

@@ -12,14 +12,14 @@ namespace msfab {
 
 struct DacModel {
   std::string material;
-  double reference_modulus = 0;   // E_m used for the coarse modes
-  double youngs_modulus = 0;      // E_n
+  double reference_modulus = 0;  // E_m used for the coarse modes
+  double youngs_modulus = 0;     // E_n
   double damping_a = 0, damping_b = 0;
   double target_frequency = 0, target_decay = 0, target_eigenvalue = 0;
-  VecX coarse_eigenvalues;        // with E_m
-  double voxel_size = 0;          // of the coarse mesh the fit holds for
+  VecX coarse_eigenvalues;  // with E_m
+  double voxel_size = 0;    // of the coarse mesh the fit holds for
   int elements = 0;
-  double marker_rms = 0;          // harmonic-inversion residual (0 if the target was given)
+  double marker_rms = 0;  // harmonic-inversion residual (0 if the target was given)
 };
 
 void write_dac_model_artifact(const std::string& path, const DacModel& model, const std::string& executable,

@@ -33,15 +33,18 @@ double clearance(const DynamicsModel& model, const std::vector<int>& nodes, cons
   double worst = std::numeric_limits<double>::infinity();
   for (int node : nodes)
     for (const Obstacle& o : model.obstacles)
-      worst = std::min(worst, signed_distance(o, q.segment<3>(3 * node), nullptr) -
-                                  horizon * v.segment<3>(3 * node).norm());
+      worst = std::min(worst,
+                       signed_distance(o, q.segment<3>(3 * node), nullptr) - horizon * v.segment<3>(3 * node).norm());
   return worst;
 }
 
 class Recorder {
  public:
   Recorder(const DynamicsScene& scene, const NewmarkIntegrator& sim, Trajectory& out)
-      : scene_(scene), sim_(sim), out_(out), body_(make_rigid_body(sim.scalar_mass_matrix(), sim.assembler().rest_positions())) {
+      : scene_(scene),
+        sim_(sim),
+        out_(out),
+        body_(make_rigid_body(sim.scalar_mass_matrix(), sim.assembler().rest_positions())) {
     R0_ = project_to_rigid(body_, scene.initial_positions, scene.initial_velocities).R;
     if (scene.body_names.size() > 1) {
       // Lumped nodal masses per body, for each body's centre of mass.
@@ -129,10 +132,10 @@ class PreloadFoldCheck {
     const NodeFaceContact& c = through.front();
     const HexMesh& mesh = scene_.model.mesh;
     std::ostringstream msg;
-    msg << (scene_.preload == Preload::kStaticPluck ? "pluck" : "press") << ": the preload folds the body through itself ("
-        << through.size() << " boundary nodes end behind a face; node at rest (" << mesh.nodes(c.node, 0) << ", "
-        << mesh.nodes(c.node, 1) << ", " << mesh.nodes(c.node, 2) << ") ends " << -c.gap_end * 1e3
-        << " mm deep); "
+    msg << (scene_.preload == Preload::kStaticPluck ? "pluck" : "press")
+        << ": the preload folds the body through itself (" << through.size()
+        << " boundary nodes end behind a face; node at rest (" << mesh.nodes(c.node, 0) << ", " << mesh.nodes(c.node, 1)
+        << ", " << mesh.nodes(c.node, 2) << ") ends " << -c.gap_end * 1e3 << " mm deep); "
         << (scene_.preload == Preload::kQuasistaticPress
                 ? "set press.self_contact (the parts then rest on each other), press.stop_at_touch, or reduce the force"
                 : "the pluck has no self-contact: reduce the force");
@@ -169,8 +172,7 @@ QuasistaticResult press_until_touch(const DynamicsScene& scene, const NewmarkInt
   if (!fold.folded(r.x)) return r;
   double lo = 0, hi = 1;
   QuasistaticResult best = press_at(scene, sim, load, 0.0);
-  if (fold.folded(best.x))
-    throw InputError("press: the body folds through itself under gravity alone");
+  if (fold.folded(best.x)) throw InputError("press: the body folds through itself under gravity alone");
   while (hi - lo > 0.01) {
     const double mid = 0.5 * (lo + hi);
     QuasistaticResult m = press_at(scene, sim, load, mid);

@@ -131,8 +131,8 @@ VoxelGrid paint_geometry(const Config& g, const std::vector<SceneMaterial>& mate
     paint_box(mine, b.lo, b.hi, 1);
     for (size_t v = 0; v < mine.size(); ++v)
       if (mine.ids[v] && body.ids[v] && body.ids[v] != b.body + 1)
-        g.fail("boxes[" + std::to_string(k) + "]", "overlaps a box of body '" + body_names[body.ids[v] - 1] +
-                                                       "' (bodies may touch, not overlap)");
+        g.fail("boxes[" + std::to_string(k) + "]",
+               "overlaps a box of body '" + body_names[body.ids[v] - 1] + "' (bodies may touch, not overlap)");
     paint_box(grid, b.lo, b.hi, b.id);
     paint_box(body, b.lo, b.hi, b.body + 1);
   }
@@ -184,7 +184,8 @@ FrictionTable read_friction(const Config& c, const std::vector<SceneMaterial>& m
       const std::string material = materials[material_index(p, "material", materials)].name;
       const std::string surface = p.get<std::string>("surface");
       const double mu = p.get<double>("mu");
-      if (!(mu >= 0) || !std::isfinite(mu)) p.fail("mu", "friction coefficient must be >= 0 (got " + std::to_string(mu) + ")");
+      if (!(mu >= 0) || !std::isfinite(mu))
+        p.fail("mu", "friction coefficient must be >= 0 (got " + std::to_string(mu) + ")");
       t.pairs[{material, surface}] = mu;
     }
   return t;
@@ -213,7 +214,8 @@ VecX region_force(const DynamicsScene& s, const RegionLoad& load, const std::str
   std::vector<int> inside;
   for (int i = 0; i < nodes; ++i) {
     const Vec3 x = positions.segment<3>(3 * i);
-    if ((x.array() >= load.lo.array() - 1e-12).all() && (x.array() <= load.hi.array() + 1e-12).all()) inside.push_back(i);
+    if ((x.array() >= load.lo.array() - 1e-12).all() && (x.array() <= load.hi.array() + 1e-12).all())
+      inside.push_back(i);
   }
   if (inside.empty()) throw InputError(what + ": the region holds no node of the body");
   VecX f = VecX::Zero(3 * nodes);
@@ -247,8 +249,8 @@ void read_simulation_settings(const Config& sim, bool has_friction_table, Dynami
   constexpr double kMaxTimeSteps = 1e8;
   if (s.duration / s.newmark.time_step > kMaxTimeSteps) {
     std::ostringstream msg;
-    msg << "gives " << s.duration / s.newmark.time_step << " steps over duration " << s.duration
-        << " s; at most " << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
+    msg << "gives " << s.duration / s.newmark.time_step << " steps over duration " << s.duration << " s; at most "
+        << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
     sim.fail("time_step", msg.str());
   }
   s.output_every = sim.get_or<int>("output_every", 10);
@@ -273,7 +275,6 @@ void read_simulation_settings(const Config& sim, bool has_friction_table, Dynami
       r.fail("enabled", "rigid flight projects the whole mesh to one rigid body; the scene has " +
                             std::to_string(s.body_names.size()) + " bodies");
   }
-
 }
 
 // The preload: a static pluck or a press (quasistatic or dynamic).
@@ -294,15 +295,17 @@ void read_preload(const Config& c, DynamicsScene& s) {
     s.stop_at_touch = press.get_or<bool>("stop_at_touch", false);
     s.press_self_contact = press.get_or<bool>("self_contact", false);
     if (s.press_self_contact && s.stop_at_touch)
-      press.fail("self_contact", "and stop_at_touch exclude each other (with self-contact the press carries the load "
-                                 "on through the parts that touch)");
+      press.fail("self_contact",
+                 "and stop_at_touch exclude each other (with self-contact the press carries the load "
+                 "on through the parts that touch)");
     if (model.obstacles.empty()) c.fail("press", "needs obstacles to press against");
     if (dynamic) {
       s.press_ramp_time = press.require_positive<double>("ramp_time", "seconds from zero to the full load");
       if (s.stop_at_touch) press.fail("stop_at_touch", "belongs to the quasistatic press (mode: quasistatic)");
       if (s.press_self_contact)
         press.fail("self_contact", "belongs to the quasistatic press (a dynamic press uses simulation.body_contact)");
-      if (s.rigid.enabled) c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
+      if (s.rigid.enabled)
+        c.fail("simulation.rigid_flight.enabled", "a body under a dynamic press is not in free flight");
     } else if (press.has("ramp_time")) {
       press.fail("ramp_time", "belongs to mode: dynamic (the quasistatic press steps its load with press.steps)");
     }
@@ -346,15 +349,17 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
       throw InputError("--coarsen: the scene has " + std::to_string(s.body_names.size()) +
                        " bodies; coarse blocks would join them (coarsen scenes of one body)");
     if (!morph.is_identity())
-      throw InputError("--coarsen: the scene's parameters move its geometry; coarse fits hold for the reference "
-                       "geometry only (coarsen a scene without geometry parameters)");
+      throw InputError(
+          "--coarsen: the scene's parameters move its geometry; coarse fits hold for the reference "
+          "geometry only (coarsen a scene without geometry parameters)");
     coarse_state = coarsen_dynamics_design(s.grid, s.materials, palette, coarsening, model);
     s.element_body.assign(model.mesh.num_elements(), 0);
     s.coarsening = coarse_state;
   } else {
     const VoxelMesh voxels = build_voxel_mesh(s.grid, palette);
     model.mesh = voxels.mesh;
-    for (int e = 0; e < model.mesh.num_elements(); ++e) s.element_body.push_back(body_grid.ids[voxels.element_voxel[e]]);
+    for (int e = 0; e < model.mesh.num_elements(); ++e)
+      s.element_body.push_back(body_grid.ids[voxels.element_voxel[e]]);
     if (s.body_names.size() > 1) separate_bodies(model.mesh, s.element_body);
     morph.apply(model.mesh);
     for (int e = 0; e < model.mesh.num_elements(); ++e) {
@@ -404,9 +409,10 @@ DynamicsScene read_dynamics_scene(const Config& c, const CoarseningRequest& coar
       }
     }
     if (count == 0)
-      c.child("clamp").fail("min", s.coarsening ? "the clamp box holds no node of the coarse mesh (its nodes lie every " +
-                                                      std::to_string(s.coarsening->coarse.grid.fine_per_cell()) + " voxels)"
-                                                : "the clamp box holds no node of the body");
+      c.child("clamp").fail("min", s.coarsening
+                                       ? "the clamp box holds no node of the coarse mesh (its nodes lie every " +
+                                             std::to_string(s.coarsening->coarse.grid.fine_per_cell()) + " voxels)"
+                                       : "the clamp box holds no node of the body");
   }
 
   model.obstacles = read_obstacles(c);

@@ -33,13 +33,13 @@ std::string field(const char* name, double value) {
 }
 
 void validate(const VecX& y, double dt, const HarmonicInversionOptions& opt) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(field("sample_interval", dt) + ": must be positive and finite");
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw InputError(field("sample_interval", dt) + ": must be positive and finite");
   if (y.size() < kMinSamples)
     throw InputError("harmonic_inversion: " + std::to_string(y.size()) + " samples: need at least " +
                      std::to_string(kMinSamples));
   for (Eigen::Index k = 0; k < y.size(); ++k)
-    if (!std::isfinite(y[k]))
-      throw InputError("harmonic_inversion: sample " + std::to_string(k) + " is not finite");
+    if (!std::isfinite(y[k])) throw InputError("harmonic_inversion: sample " + std::to_string(k) + " is not finite");
   if (opt.num_modes < 0) throw InputError(field("num_modes", opt.num_modes) + ": must be >= 0");
   if (opt.max_modes < 1) throw InputError(field("max_modes", opt.max_modes) + ": must be >= 1");
   if (!(opt.pencil_fraction > 0.0 && opt.pencil_fraction < 1.0))

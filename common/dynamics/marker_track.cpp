@@ -110,8 +110,8 @@ MarkerTrack read_marker_track(const std::string& path, const std::string& column
         throw error(line_no, where + ": '" + cell + "' is not a finite number");
     }
     if (!t.empty() && !(parsed[0] > t.back()))
-      throw error(line_no, "time " + cells[time_col] + " does not increase (previous row " +
-                               std::to_string(lines.back()) + ")");
+      throw error(line_no,
+                  "time " + cells[time_col] + " does not increase (previous row " + std::to_string(lines.back()) + ")");
     t.push_back(parsed[0]);
     v.push_back(parsed[1]);
     lines.push_back(line_no);

@@ -26,10 +26,10 @@ struct MarkerTrackOptions {
 };
 
 struct MarkerTrack {
-  std::string source;  // the file read
-  std::string column;  // the coordinate column selected
-  VecX times;          // s, as in the file
-  VecX values;         // the selected coordinate
+  std::string source;            // the file read
+  std::string column;            // the coordinate column selected
+  VecX times;                    // s, as in the file
+  VecX values;                   // the selected coordinate
   double sample_interval = 0.0;  // mean time step
 };
 

@@ -1,12 +1,11 @@
 #include "dynamics/modal_analysis.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <sstream>
 #include <string>
-
-#include <Eigen/Eigenvalues>
 
 #include "core/errors.hpp"
 #include "dynamics/mass_matrix.hpp"
@@ -51,8 +50,8 @@ MatX start_block(Eigen::Index n, Eigen::Index columns, std::uint64_t salt) {
   MatX X(n, columns);
   for (Eigen::Index c = 0; c < columns; ++c)
     for (Eigen::Index i = 0; i < n; ++i) {
-      std::uint64_t z = (static_cast<std::uint64_t>(c) << 40) ^ static_cast<std::uint64_t>(i) ^
-                        (salt * 0x9E3779B97F4A7C15ull);
+      std::uint64_t z =
+          (static_cast<std::uint64_t>(c) << 40) ^ static_cast<std::uint64_t>(i) ^ (salt * 0x9E3779B97F4A7C15ull);
       z += 0x9E3779B97F4A7C15ull;
       z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
       z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
@@ -66,8 +65,7 @@ MatX start_block(Eigen::Index n, Eigen::Index columns, std::uint64_t salt) {
 // a time by two passes of classical Gram-Schmidt in the M inner product.
 class MBasis {
  public:
-  MBasis(const SpMat& M, Eigen::Index n, Eigen::Index capacity)
-      : M_(M), V_(n, capacity), MV_(n, capacity) {}
+  MBasis(const SpMat& M, Eigen::Index n, Eigen::Index capacity) : M_(M), V_(n, capacity), MV_(n, capacity) {}
 
   Eigen::Index size() const { return size_; }
   Eigen::Index capacity() const { return V_.cols(); }
@@ -165,8 +163,7 @@ void check_options(const ModalOptions& o) {
   if (o.max_cycles < 1) bad("max_cycles must be at least 1");
   if (o.block_size < 0) bad("block_size must be >= 0 (0 = automatic)");
   if (o.krylov_blocks < 2) bad("krylov_blocks must be at least 2");
-  if (!(o.repeated_tolerance >= 0) || !(o.repeated_tolerance < 1))
-    bad("repeated_tolerance must be in [0, 1)");
+  if (!(o.repeated_tolerance >= 0) || !(o.repeated_tolerance < 1)) bad("repeated_tolerance must be in [0, 1)");
 }
 
 void check_system(const SpMat& K, const SpMat& M, const std::vector<char>& fixed, const NodeArray* rest_positions) {
@@ -180,8 +177,8 @@ void check_system(const SpMat& K, const SpMat& M, const std::vector<char>& fixed
     throw InputError("modal analysis: " + std::to_string(rest_positions->rows()) + " node positions for " +
                      std::to_string(n) + " DOFs");
   if (!fixed.empty() && static_cast<Eigen::Index>(fixed.size()) != n)
-    throw InputError("modal analysis: " + std::to_string(fixed.size()) + " fixed-DOF flags for " +
-                     std::to_string(n) + " DOFs");
+    throw InputError("modal analysis: " + std::to_string(fixed.size()) + " fixed-DOF flags for " + std::to_string(n) +
+                     " DOFs");
 }
 
 // Factorizes A = K - sigma M into `solver` and returns sigma: the given
@@ -345,8 +342,8 @@ void canonicalize_repeated(const SpMat& Kf, const SpMat& Mf, const std::vector<i
 
 }  // namespace
 
-ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<char>& fixed,
-                           const ModalOptions& options, const NodeArray* rest_positions) {
+ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<char>& fixed, const ModalOptions& options,
+                           const NodeArray* rest_positions) {
   check_options(options);
   check_system(K, M, fixed, rest_positions);
   const Eigen::Index n = K.rows();
@@ -442,8 +439,8 @@ ModalResult modal_analysis(const SpMat& K, const SpMat& M, const std::vector<cha
   }
   if (!converged) {
     std::ostringstream msg;
-    msg << "modal analysis did not reach relative residual " << options.tolerance << " in "
-        << options.max_cycles << " cycles (block " << p << ", shift " << sigma << "):";
+    msg << "modal analysis did not reach relative residual " << options.tolerance << " in " << options.max_cycles
+        << " cycles (block " << p << ", shift " << sigma << "):";
     const size_t from = history.size() > 5 ? history.size() - 5 : 0;
     for (size_t i = from; i < history.size(); ++i) msg << (i > from ? "; " : " ") << history[i];
     throw NumericalError(msg.str());
@@ -463,8 +460,8 @@ double modal_analysis_peak_bytes(double elements, double dofs, const ModalOption
          8.0 * dofs * (3.0 * options.krylov_blocks + 6.0) * width;
 }
 
-ModalResult modal_analysis(const HexMesh& mesh, const std::vector<double>& density,
-                           const std::vector<char>& fixed, const ModalOptions& options) {
+ModalResult modal_analysis(const HexMesh& mesh, const std::vector<double>& density, const std::vector<char>& fixed,
+                           const ModalOptions& options) {
   ElasticAssembler assembler(mesh);
   SpMat K = assembler.pattern();
   const double energy = assembler.evaluate(assembler.rest_positions(), nullptr, &K);

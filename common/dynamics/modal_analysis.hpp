@@ -65,8 +65,8 @@ struct ModalOptions {
 };
 
 struct ModalResult {
-  VecX eigenvalues;   // lambda_i ascending (rad^2/s^2)
-  VecX frequencies;   // f_i = sqrt(max(lambda_i, 0)) / (2 pi), Hz
+  VecX eigenvalues;  // lambda_i ascending (rad^2/s^2)
+  VecX frequencies;  // f_i = sqrt(max(lambda_i, 0)) / (2 pi), Hz
   // One column per mode, full DOF length (node-major 3 n + a), zero at fixed
   // DOFs, M-orthonormal: modes^T M modes = I. Sign: the entry of largest
   // magnitude (first such) is positive.
@@ -76,11 +76,11 @@ struct ModalResult {
   // (lambda below the rigid threshold) the denominator is
   // stiffness_scale * ||M x|| because K x vanishes.
   VecX residuals;
-  int cycles = 0;             // restart cycles of the block Krylov iteration
+  int cycles = 0;                 // restart cycles of the block Krylov iteration
   int operator_applications = 0;  // solves with K - sigma M
   int rigid_modes_skipped = 0;
-  double shift = 0.0;             // sigma actually used
-  double stiffness_scale = 0.0;   // tr(K_free) / tr(M_free)
+  double shift = 0.0;            // sigma actually used
+  double stiffness_scale = 0.0;  // tr(K_free) / tr(M_free)
 };
 
 // K and M are symmetric with both triangles stored (as ElasticAssembler and
@@ -103,7 +103,7 @@ double modal_analysis_peak_bytes(double elements, double dofs, const ModalOption
 
 // Assembles K at the rest positions and the consistent mass from per-element
 // densities, then calls the function above.
-ModalResult modal_analysis(const HexMesh& mesh, const std::vector<double>& density,
-                           const std::vector<char>& fixed, const ModalOptions& options = {});
+ModalResult modal_analysis(const HexMesh& mesh, const std::vector<double>& density, const std::vector<char>& fixed,
+                           const ModalOptions& options = {});
 
 }  // namespace msfab

@@ -33,8 +33,7 @@ Vec3 closest_point(const Vec3& p, const Triangle& t) {
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + (d2 / (d2 - d6)) * ac;
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (t.c - t.b);
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (t.c - t.b);
   const double sum = va + vb + vc;
   if (!(sum > 0)) return t.a;  // degenerate (zero-area) triangle
   return t.a + (vb / sum) * ab + (vc / sum) * ac;
@@ -302,8 +301,8 @@ std::vector<ModeMatch> match_modes(const ModeShapeSurface& ref, const MatX& ref_
         m.reference_mode = static_cast<int>(j);
       }
     }
-    if (m.reference_mode < 0) throw InputError("mode matching: no reference mode within the window of mode " +
-                                               std::to_string(i));
+    if (m.reference_mode < 0)
+      throw InputError("mode matching: no reference mode within the window of mode " + std::to_string(i));
   }
   return matches;
 }

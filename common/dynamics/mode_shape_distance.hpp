@@ -19,9 +19,9 @@ namespace msfab {
 // Each quad is split into four triangles around its centre, so the surface
 // displaced by a nodal field is piecewise linear and exactly reproducible.
 struct ModeShapeSurface {
-  NodeArray rest;                            // rest positions of every mesh node
-  std::vector<std::array<int, 4>> faces;     // boundary quads, corners in cyclic order
-  double diagonal = 0.0;                     // bounding-box diagonal of the rest mesh
+  NodeArray rest;                         // rest positions of every mesh node
+  std::vector<std::array<int, 4>> faces;  // boundary quads, corners in cyclic order
+  double diagonal = 0.0;                  // bounding-box diagonal of the rest mesh
 };
 ModeShapeSurface mode_shape_surface(const HexMesh& mesh);
 
@@ -35,9 +35,8 @@ ModeShapeSurface mode_shape_surface(const HexMesh& mesh);
 // With a finite upper_bound the result is exact when it is <= upper_bound
 // and +inf otherwise, which lets comparisons against a best-so-far stop
 // early.
-double hausdorff_distance(const ModeShapeSurface& a, const VecX& ua, const ModeShapeSurface& b,
-                          const VecX& ub, int samples = 2,
-                          double upper_bound = std::numeric_limits<double>::infinity());
+double hausdorff_distance(const ModeShapeSurface& a, const VecX& ua, const ModeShapeSurface& b, const VecX& ub,
+                          int samples = 2, double upper_bound = std::numeric_limits<double>::infinity());
 
 struct ModeDistanceOptions {
   // Each mode is scaled so that its largest nodal displacement is this
@@ -62,8 +61,7 @@ struct ModeMatch {
   int reference_mode = -1;
   double distance = 0.0;  // relative Hausdorff distance to it
 };
-std::vector<ModeMatch> match_modes(const ModeShapeSurface& ref, const MatX& ref_modes,
-                                   const ModeShapeSurface& other, const MatX& other_modes, int window,
-                                   const ModeDistanceOptions& options = {});
+std::vector<ModeMatch> match_modes(const ModeShapeSurface& ref, const MatX& ref_modes, const ModeShapeSurface& other,
+                                   const MatX& other_modes, int window, const ModeDistanceOptions& options = {});
 
 }  // namespace msfab

@@ -138,7 +138,8 @@ NewmarkIntegrator::NewmarkIntegrator(const DynamicsModel& model, const NewmarkOp
     for (int node : mesh.elements[e])
       if (node_material_[node].empty()) node_material_[node] = model.element_material_name[e];
   dx_ = smallest_edge(mesh);
-  if (model.contact && model.body_contact) surface_ = std::make_unique<BoundarySurface>(hex_boundary(mesh), boundary_nodes_);
+  if (model.contact && model.body_contact)
+    surface_ = std::make_unique<BoundarySurface>(hex_boundary(mesh), boundary_nodes_);
 
   // The factorization runs on one thread. A step's Jacobian is small enough
   // that threaded BLAS gains nothing (the 432-element plant: 48 ms per step
@@ -211,7 +212,8 @@ void NewmarkIntegrator::assemble_jacobian(const SpMat& K) {
   for (int i : fixed_diagonal_index_) H[i] = 1;
 }
 
-NewmarkIntegrator::Contact NewmarkIntegrator::obstacle_contact(int node, int obstacle, const ContactPlane& plane) const {
+NewmarkIntegrator::Contact NewmarkIntegrator::obstacle_contact(int node, int obstacle,
+                                                               const ContactPlane& plane) const {
   Contact c;
   c.key = {node, obstacle};
   c.nodes[0] = node;
@@ -227,7 +229,9 @@ void NewmarkIntegrator::add_surface_contacts(const VecX& delta, double margin, s
   std::vector<std::pair<int, int>> present;
   for (const Contact& c : contacts) present.push_back(c.key);
   std::sort(present.begin(), present.end());
-  auto absent = [&](const std::pair<int, int>& key) { return !std::binary_search(present.begin(), present.end(), key); };
+  auto absent = [&](const std::pair<int, int>& key) {
+    return !std::binary_search(present.begin(), present.end(), key);
+  };
   auto material = [&](int face) { return model_.element_material_name[surface_->boundary().face_element[face]]; };
   auto friction = [&](const std::string& a, const std::string& b) {
     return model_.friction ? model_.friction_table.mu_between(a, b) : 0.0;
@@ -355,8 +359,7 @@ StepReport NewmarkIntegrator::step() {
   // remaining h/2 D delta lives in inertia_.
   step_rhs_ = h * (mass_ * v_) + h * h / 4 * force_t;
   apply_fixed(step_rhs_);
-  force_scale_ = std::max({(mass_ * v_).norm() * h, h * h / 4 * end_force_.norm(), h * h / 4 * grad_t.norm(),
-                           1e-300});
+  force_scale_ = std::max({(mass_ * v_).norm() * h, h * h / 4 * end_force_.norm(), h * h / 4 * grad_t.norm(), 1e-300});
 
   // Predicted path for collision detection: free flight under gravity.
   VecX delta = h * v_;
@@ -377,8 +380,9 @@ StepReport NewmarkIntegrator::step() {
     add_penetrating_contacts(delta, contacts);
     if (contacts.size() == before) break;
     if (round == options_.max_contact_rounds)
-      throw NumericalError("dynamics: step at t = " + std::to_string(time_) + " s still finds new penetrating nodes after " +
-                           std::to_string(round) + " contact rounds; reduce the time step");
+      throw NumericalError("dynamics: step at t = " + std::to_string(time_) +
+                           " s still finds new penetrating nodes after " + std::to_string(round) +
+                           " contact rounds; reduce the time step");
   }
 
   const VecX v_new = impact_velocity(delta, contacts, impulses);
@@ -386,7 +390,8 @@ StepReport NewmarkIntegrator::step() {
   for (size_t k = 0; k < contacts.size(); ++k) {
     if (impulses(3 * k) > 0) ++report.active_contacts;
     if (!contacts[k].on_obstacle())
-      report.max_penetration = std::max(report.max_penetration, -(contacts[k].gap0 + contacts[k].frame.col(0).dot(contacts[k].relative(delta))));
+      report.max_penetration = std::max(
+          report.max_penetration, -(contacts[k].gap0 + contacts[k].frame.col(0).dot(contacts[k].relative(delta))));
   }
   q_ += delta;
   v_ = v_new;
@@ -394,12 +399,14 @@ StepReport NewmarkIntegrator::step() {
   for (int node : boundary_nodes_)
     for (const Obstacle& o : model_.obstacles)
       if (model_.contact)
-        report.max_penetration = std::max(report.max_penetration, -signed_distance(o, q_.segment<3>(3 * node), nullptr));
+        report.max_penetration =
+            std::max(report.max_penetration, -signed_distance(o, q_.segment<3>(3 * node), nullptr));
   report.seconds = seconds_since(t0);
   return report;
 }
 
-int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses, StepReport& report) {
+int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& contacts, VecX& impulses,
+                                  StepReport& report) {
   const double h = options_.time_step;
   const int n = model_.mesh.num_dofs();
   const int m = static_cast<int>(contacts.size());
@@ -421,8 +428,10 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
   // plate has hundreds of contacts (solve/cholmod_solver.hpp).
   const std::vector<int> contact_dofs = contact_unknowns(contacts);
   if (contact_dofs != solver_->last_unknowns()) {
-    if (contact_dofs.empty()) solver_->analyze(jacobian_);
-    else solver_->analyze_with_last(jacobian_, contact_dofs);
+    if (contact_dofs.empty())
+      solver_->analyze(jacobian_);
+    else
+      solver_->analyze_with_last(jacobian_, contact_dofs);
   }
   const MatX G_contact = contact_columns(contacts, contact_dofs);
 
@@ -448,7 +457,8 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     while (!solver_->factorize(jacobian_, shift)) {
       shift = shift == 0 ? 1e-10 * jacobian_.diagonal().cwiseAbs().maxCoeff() : 10 * shift;
       if (shift > jacobian_.diagonal().cwiseAbs().maxCoeff())
-        throw NumericalError("dynamics: the Newmark Jacobian is not positive definite at t = " + std::to_string(time_) + " s; reduce the time step");
+        throw NumericalError("dynamics: the Newmark Jacobian is not positive definite at t = " + std::to_string(time_) +
+                             " s; reduce the time step");
     }
     const VecX delta_free = delta - solver_->solve(f);
     VecX candidate = delta_free;
@@ -474,8 +484,9 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
       const ContactSolveResult solved = solve_contact_problem(problem, impulses, gs);
       report.gauss_seidel_sweeps += solved.sweeps;
       if (!solved.converged && solved.max_change > 1e-2)
-        throw NumericalError("dynamics: contact Gauss-Seidel did not converge at t = " + std::to_string(time_) + " s (" +
-                             std::to_string(m) + " contacts, last relative change " + std::to_string(solved.max_change) + ")");
+        throw NumericalError("dynamics: contact Gauss-Seidel did not converge at t = " + std::to_string(time_) +
+                             " s (" + std::to_string(m) + " contacts, last relative change " +
+                             std::to_string(solved.max_change) + ")");
       impulses = solved.p;
       delassus_ = std::move(problem.W);
       candidate += solver_->solve(contact_force(impulses));

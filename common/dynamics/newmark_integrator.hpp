@@ -75,8 +75,8 @@ struct StepReport {
   int contacts = 0;         // in the contact set
   int active_contacts = 0;  // carrying a normal impulse at the end
   int gauss_seidel_sweeps = 0;
-  double residual = 0;        // final relative residual
-  double max_penetration = 0; // deepest node below an obstacle surface at the end (m, >= 0)
+  double residual = 0;         // final relative residual
+  double max_penetration = 0;  // deepest node below an obstacle surface at the end (m, >= 0)
   double seconds = 0;
 };
 
@@ -161,8 +161,8 @@ class NewmarkIntegrator {
   double dx_ = 0;
   VecX q_, v_, q0_;
   double time_ = 0;
-  VecX step_rhs_;          // b^t of the current step
-  double force_scale_ = 1; // what the current step's residual is relative to
+  VecX step_rhs_;           // b^t of the current step
+  double force_scale_ = 1;  // what the current step's residual is relative to
   // The last Newton iterate's Delassus matrix, reused by BBI with the
   // factorization it came from.
   MatX delassus_;

@@ -14,10 +14,10 @@ namespace msfab {
 struct Obstacle {
   enum class Kind { kGround, kBox };
   Kind kind = Kind::kGround;
-  std::string name;       // as in the scene, for messages and outputs
-  double ground_z = 0.0;  // kGround: the plane z = ground_z, solid below
+  std::string name;                           // as in the scene, for messages and outputs
+  double ground_z = 0.0;                      // kGround: the plane z = ground_z, solid below
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // kBox: solid between lo and hi
-  std::string surface;    // surface material, for the friction table
+  std::string surface;                        // surface material, for the friction table
 };
 
 // The face plane of a contact: admissible side n . x >= offset.

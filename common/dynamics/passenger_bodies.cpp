@@ -62,7 +62,8 @@ VecX carry_passengers(const DynamicsScene& scene, const std::vector<char>& passe
     const std::string name = scene.body_names.empty() ? "body" : scene.body_names[b];
     // A line of support nodes fixes no rotation.
     NodeArray from(static_cast<Eigen::Index>(support.size()), 3);
-    for (size_t k = 0; k < support.size(); ++k) from.row(Eigen::Index(k)) = initial.segment<3>(3 * support[k]).transpose();
+    for (size_t k = 0; k < support.size(); ++k)
+      from.row(Eigen::Index(k)) = initial.segment<3>(3 * support[k]).transpose();
     bool planar_or_solid = support.size() >= 3;
     if (planar_or_solid) {
       const Vec3 c = from.colwise().mean().transpose();

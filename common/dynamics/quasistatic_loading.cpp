@@ -95,7 +95,8 @@ void validate(const ElasticAssembler& assembler, const std::vector<Obstacle>& ob
   for (const Obstacle& o : obstacles) {
     if (o.kind == Obstacle::Kind::kGround && !std::isfinite(o.ground_z))
       fail("obstacle '" + o.name + "': ground height is not finite");
-    if (o.kind == Obstacle::Kind::kBox && !(o.lo.allFinite() && o.hi.allFinite() && (o.lo.array() < o.hi.array()).all()))
+    if (o.kind == Obstacle::Kind::kBox &&
+        !(o.lo.allFinite() && o.hi.allFinite() && (o.lo.array() < o.hi.array()).all()))
       fail("obstacle '" + o.name + "': box needs finite corners with lo < hi");
   }
   if (!(opt.relative_tolerance > 0)) fail("option relative_tolerance must be > 0");
@@ -132,8 +133,14 @@ class Press {
         // side, not touching it (surface_contact.hpp).
         tie_depth_limit_(0.25 * dx_),
         active_{std::vector<int>(nodes_, kFree), std::vector<ContactPlane>(nodes_)},
-        g_(n_), g_trial_(n_), rhs_(n_), step_(n_), trial_(n_), r_(n_),
-        fixed_(n_, 0), held_(n_, 0) {
+        g_(n_),
+        g_trial_(n_),
+        rhs_(n_),
+        step_(n_),
+        trial_(n_),
+        r_(n_),
+        fixed_(n_, 0),
+        held_(n_, 0) {
     result_.characteristic_size = dx_;
     result_.x = x0.size() == n_ ? x0 : X_;
   }
@@ -171,7 +178,8 @@ class Press {
   bool tied(int d) const { return ties_ && ties_->is_slave(d / 3); }
   VecX reduced_gradient(const VecX& grad) const { return ties_ ? ties_->reduce(grad) : grad; }
   void update_fixed() {
-    for (int i = 0; i < nodes_; ++i) fixed_[3 * i] = fixed_[3 * i + 1] = fixed_[3 * i + 2] = active_.obstacle[i] != kFree;
+    for (int i = 0; i < nodes_; ++i)
+      fixed_[3 * i] = fixed_[3 * i + 1] = fixed_[3 * i + 2] = active_.obstacle[i] != kFree;
   }
   Scales scales(const VecX& fs) const;
   int release_pulling_contacts(double scale);
@@ -207,8 +215,8 @@ void Press::start() {
     if (c.obstacle == kFree || c.distance > touch_) continue;
     if (c.distance < -max_depth_) {
       std::ostringstream msg;
-      msg << "quasistatic loading: initial positions: node " << i << " lies " << -c.distance
-          << " m inside obstacle '" << obstacles_[c.obstacle].name << "' (tolerance " << max_depth_
+      msg << "quasistatic loading: initial positions: node " << i << " lies " << -c.distance << " m inside obstacle '"
+          << obstacles_[c.obstacle].name << "' (tolerance " << max_depth_
           << " m = penetration_tolerance * element size)";
       throw InputError(msg.str());
     }
@@ -371,8 +379,8 @@ int Press::project_penetrations() {
     }
   }
   if (ties_)
-    activated += ties_->activate(q(), trial_, 0.0, tie_depth_limit_,
-                                 [&](int node) { return active_.obstacle[node] != kFree; });
+    activated +=
+        ties_->activate(q(), trial_, 0.0, tie_depth_limit_, [&](int node) { return active_.obstacle[node] != kFree; });
   return activated;
 }
 

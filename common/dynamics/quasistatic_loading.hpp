@@ -28,9 +28,9 @@ struct QuasistaticOptions {
   // Convergence: ||free residual|| <= relative_tolerance * force scale (the
   // applied load and the contact reactions), with an unchanged active set.
   double relative_tolerance = 1e-9;
-  int max_iterations = 60;     // per load increment, counted from the last change of the active set
-  int load_steps = 4;          // initial number of equal load increments
-  int max_step_halvings = 6;   // adaptive cuts of a failing increment
+  int max_iterations = 60;    // per load increment, counted from the last change of the active set
+  int load_steps = 4;         // initial number of equal load increments
+  int max_step_halvings = 6;  // adaptive cuts of a failing increment
   double armijo = 1e-4;
   int max_line_search = 40;
   // Depth a free vertex may reach inside an obstacle within one step, in
@@ -52,7 +52,7 @@ struct QuasistaticOptions {
 // One vertex held by an obstacle.
 struct ContactVertex {
   int node = 0;
-  int obstacle = 0;         // index into the obstacle list
+  int obstacle = 0;  // index into the obstacle list
   // Face it rests on (admissible side normal . x >= offset); on an edge or
   // corner, the touching face that pushes hardest.
   ContactPlane plane;
@@ -73,13 +73,13 @@ struct QuasistaticIteration {
 };
 
 struct QuasistaticResult {
-  VecX x;                              // equilibrium positions (3N, node-major)
-  std::vector<ContactVertex> contacts;  // active vertices, ascending node order
+  VecX x;                                     // equilibrium positions (3N, node-major)
+  std::vector<ContactVertex> contacts;        // active vertices, ascending node order
   std::vector<SelfContactTie> self_contacts;  // nodes tied to faces, with their reactions
-  int iterations = 0;                  // Newton steps taken, all increments
-  int load_steps = 0;                  // increments attempted (including cut ones)
-  double elastic_energy = 0;           // E(x)
-  double characteristic_size = 0;      // dx used for the tolerances
+  int iterations = 0;                         // Newton steps taken, all increments
+  int load_steps = 0;                         // increments attempted (including cut ones)
+  double elastic_energy = 0;                  // E(x)
+  double characteristic_size = 0;             // dx used for the tolerances
   std::vector<QuasistaticIteration> history;
 };
 

@@ -25,11 +25,11 @@ PrincipalFrame principal_frame(const Mat3& inertia);
 
 struct RigidBody {
   double mass = 0;
-  Vec3 rest_center = Vec3::Zero();     // c0
+  Vec3 rest_center = Vec3::Zero();         // c0
   Mat3 principal_axes = Mat3::Identity();  // A, det +1
-  Vec3 inertia = Vec3::Zero();          // body-frame diagonal inertia, ascending
-  SpMat scalar_mass;                    // N x N consistent mass (m_ij)
-  NodeArray body_positions;             // rest nodes in the body frame, A^T (X_i - c0)
+  Vec3 inertia = Vec3::Zero();             // body-frame diagonal inertia, ascending
+  SpMat scalar_mass;                       // N x N consistent mass (m_ij)
+  NodeArray body_positions;                // rest nodes in the body frame, A^T (X_i - c0)
   int num_nodes() const { return static_cast<int>(body_positions.rows()); }
 };
 
@@ -84,8 +84,7 @@ struct DmvOptions {
 // J_d = tr(I)/2 Id - I, for principal moments I and body angular momentum m;
 // the step is R <- R Omega, m <- Omega^T m. NumericalError when Newton fails
 // or the step would turn the body by half a turn or more (h far too large).
-Mat3 moser_veselov_increment(const Vec3& inertia, const Vec3& body_momentum, double h,
-                             const DmvOptions& options = {});
+Mat3 moser_veselov_increment(const Vec3& inertia, const Vec3& body_momentum, double h, const DmvOptions& options = {});
 
 // One DMV step of length h under uniform gravity g acting at the centre of
 // mass. Translation is the exact parabola; the rotation is the Moser-Veselov
@@ -93,7 +92,6 @@ Mat3 moser_veselov_increment(const Vec3& inertia, const Vec3& body_momentum, dou
 // torque about t) and conserves the rotational kinetic energy to round-off
 // at any step size; it is second-order accurate in the pose. Uses only
 // body.mass and body.inertia.
-void dmv_step(const RigidBody& body, const Vec3& gravity, double h, RigidState* state,
-              const DmvOptions& options = {});
+void dmv_step(const RigidBody& body, const Vec3& gravity, double h, RigidState* state, const DmvOptions& options = {});
 
 }  // namespace msfab

@@ -70,7 +70,8 @@ namespace {
 
 bool is_name(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
 ParameterValues read_values(const Config& c, const std::string& key) {
@@ -99,7 +100,8 @@ std::string number_text(double x) {
 }
 
 // Every scalar of the document with its override-style key path.
-void collect_scalars(const YAML::Node& node, const std::string& path, std::vector<std::pair<std::string, YAML::Node>>& out) {
+void collect_scalars(const YAML::Node& node, const std::string& path,
+                     std::vector<std::pair<std::string, YAML::Node>>& out) {
   if (node.IsScalar()) {
     out.emplace_back(path, node);
   } else if (node.IsSequence()) {
@@ -185,7 +187,8 @@ GeometryMorph build_morph(const Substitution& sub, const std::vector<Scalar>& fa
           throw InputError(sub.config().source() + ": " + f.source->path + " and " + group->source->path +
                            ": these box faces coincide at the reference parameters (" + axis_name[a] + " = " +
                            number_text(f.ref) + ") but not at the current ones (" + number_text(group->cur) + " vs " +
-                           number_text(f.cur) + "); the voxel mesh is built at the reference values and moved, so "
+                           number_text(f.cur) +
+                           "); the voxel mesh is built at the reference values and moved, so "
                            "faces that meet there must stay together");
         continue;
       }

@@ -32,9 +32,7 @@ Vec3 SelfContactTie::face_normal(const VecX& x) const {
 }
 
 SelfContactTies::SelfContactTies(const HexMesh& mesh)
-    : surface_(whole_boundary(mesh)),
-      slave_(mesh.num_nodes(), 0),
-      master_count_(mesh.num_nodes(), 0) {}
+    : surface_(whole_boundary(mesh)), slave_(mesh.num_nodes(), 0), master_count_(mesh.num_nodes(), 0) {}
 
 bool SelfContactTies::tie(const NodeFaceContact& c, VecX& trial) {
   if (slave_[c.node] || master_count_[c.node] > 0) return false;

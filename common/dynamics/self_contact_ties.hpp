@@ -28,10 +28,10 @@ namespace msfab {
 
 struct SelfContactTie {
   int node = 0;
-  int face = 0;                   // index into the boundary's faces
+  int face = 0;  // index into the boundary's faces
   std::array<int, 4> face_nodes{};
   std::array<double, 4> weight{};  // bilinear weights of the point the node is tied to
-  Vec3 reaction = Vec3::Zero();   // force the face exerts on the node (set by the solver)
+  Vec3 reaction = Vec3::Zero();    // force the face exerts on the node (set by the solver)
 
   // The face's outward unit normal at the tied point, face corners at `x`.
   Vec3 face_normal(const VecX& x) const;
@@ -89,7 +89,7 @@ class SelfContactTies {
   std::vector<SelfContactTie> ties_;
   std::vector<char> slave_;
   std::vector<int> master_count_;  // ties each node is a face corner of
-  int version_ = 0;  // only grows, so no two sets share a version
+  int version_ = 0;                // only grows, so no two sets share a version
 };
 
 }  // namespace msfab

@@ -38,8 +38,7 @@ class BoxGrid {
     }
     origin_ = all_lo;
     size_ = std::max(largest, 1e-300);
-    for (int a = 0; a < 3; ++a)
-      dims_(a) = std::max(1, static_cast<int>(std::ceil((all_hi(a) - all_lo(a)) / size_)));
+    for (int a = 0; a < 3; ++a) dims_(a) = std::max(1, static_cast<int>(std::ceil((all_hi(a) - all_lo(a)) / size_)));
     for (size_t i = 0; i < lo.size(); ++i)
       for_cells(lo[i], hi[i], [&](long long c) { cells_.emplace_back(c, static_cast<int>(i)); });
     std::sort(cells_.begin(), cells_.end());
@@ -216,8 +215,9 @@ std::vector<NodeFaceContact> BoundarySurface::find(const VecX& start, const VecX
     }
     // Nearest first; a face whose normal repeats a kept one adds no new
     // direction (a node over the edge between two coplanar faces).
-    std::stable_sort(for_node.begin(), for_node.end(),
-                     [](const NodeFaceContact& l, const NodeFaceContact& r) { return std::abs(l.gap_end) < std::abs(r.gap_end); });
+    std::stable_sort(for_node.begin(), for_node.end(), [](const NodeFaceContact& l, const NodeFaceContact& r) {
+      return std::abs(l.gap_end) < std::abs(r.gap_end);
+    });
     const size_t first = found.size();
     for (const NodeFaceContact& c : for_node) {
       bool repeated = false;
@@ -246,7 +246,8 @@ std::vector<EdgeEdgeContact> BoundarySurface::find_edges(const VecX& start, cons
   // Outward unit edge normals at `end`: along the sum of the bordering
   // faces' unit normals.
   std::vector<Vec3> face_normal(boundary_.faces.size());
-  for (size_t f = 0; f < boundary_.faces.size(); ++f) face_normal[f] = face_area_normal(boundary_.faces[f], end).normalized();
+  for (size_t f = 0; f < boundary_.faces.size(); ++f)
+    face_normal[f] = face_area_normal(boundary_.faces[f], end).normalized();
   std::vector<Vec3> edge_normal(num_edges, Vec3::Zero());
   for (int e = 0; e < num_edges; ++e)
     for (int f : edges_[e].faces) edge_normal[e] += face_normal[f];

@@ -47,7 +47,7 @@ namespace msfab {
 
 struct NodeFaceContact {
   int node = 0;
-  int face = 0;  // index into HexBoundary::faces
+  int face = 0;                     // index into HexBoundary::faces
   std::array<double, 4> weights{};  // bilinear weights of the closest point
   Vec3 normal = Vec3::UnitZ();      // outward unit normal of the face there
   double gap_start = 0;             // the linearized gap at the start positions
@@ -67,11 +67,11 @@ QuadProjection project_to_quad(const std::array<Vec3, 4>& x, const Vec3& p, doub
 Vec3 quad_normal(const std::array<Vec3, 4>& x, double s, double t);
 
 struct EdgeEdgeContact {
-  int edge_a = 0, edge_b = 0;  // indices into BoundarySurface::edges(), edge_a < edge_b
-  double alpha = 0, beta = 0;  // closest points' parameters along a and b
-  Vec3 normal = Vec3::UnitZ(); // unit, from edge b towards edge a
-  double gap_start = 0;        // the linearized gap at the start positions
-  double gap_end = 0;          // ... at the end positions (same n, alpha, beta)
+  int edge_a = 0, edge_b = 0;   // indices into BoundarySurface::edges(), edge_a < edge_b
+  double alpha = 0, beta = 0;   // closest points' parameters along a and b
+  Vec3 normal = Vec3::UnitZ();  // unit, from edge b towards edge a
+  double gap_start = 0;         // the linearized gap at the start positions
+  double gap_end = 0;           // ... at the end positions (same n, alpha, beta)
 };
 
 // A boundary edge: two nodes, and the boundary faces it borders (two on a

@@ -40,9 +40,12 @@ std::string join_lines(const std::vector<std::string>& items) {
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (i > 0) out += '\n';
     for (char c : items[i]) {
-      if (c == '\\') out += "\\\\";
-      else if (c == '\n') out += "\\n";
-      else out += c;
+      if (c == '\\')
+        out += "\\\\";
+      else if (c == '\n')
+        out += "\\n";
+      else
+        out += c;
     }
   }
   return out;
@@ -61,9 +64,12 @@ bool split_lines(const std::string& text, std::size_t count, std::vector<std::st
     } else if (c == '\\') {
       if (i + 1 >= text.size()) return false;
       const char next = text[++i];
-      if (next == '\\') items.back() += '\\';
-      else if (next == 'n') items.back() += '\n';
-      else return false;
+      if (next == '\\')
+        items.back() += '\\';
+      else if (next == 'n')
+        items.back() += '\n';
+      else
+        return false;
     } else {
       items.back() += c;
     }
@@ -126,26 +132,37 @@ void write_sample_vec3(H5File& f, const std::string& name, const std::vector<Tra
 void write_samples(H5File& f, const std::vector<TrajectorySample>& samples) {
   f.create_group("/samples");
   using S = TrajectorySample;
-  write_sample_column<double>(f, "time", samples, [](const S& s) { return s.time; }, "s");
-  write_sample_column<std::int32_t>(f, "phase", samples, [](const S& s) { return static_cast<int>(s.phase); },
-                                    nullptr);
+  write_sample_column<double>(
+      f, "time", samples, [](const S& s) { return s.time; }, "s");
+  write_sample_column<std::int32_t>(
+      f, "phase", samples, [](const S& s) { return static_cast<int>(s.phase); }, nullptr);
   std::vector<std::string> names;
   for (SimulationPhase p : kPhases) names.push_back(phase_name(p));
   f.write_attribute("/samples/phase", "names", format_name_list(names));
-  write_sample_column<double>(f, "kinetic", samples, [](const S& s) { return s.kinetic; }, "J");
-  write_sample_column<double>(f, "elastic", samples, [](const S& s) { return s.elastic; }, "J");
-  write_sample_column<double>(f, "gravity", samples, [](const S& s) { return s.gravity; }, "J");
-  write_sample_column<double>(f, "total", samples, [](const S& s) { return s.total(); }, "J");
-  write_sample_vec3(f, "center_of_mass", samples, [](const S& s) { return s.center_of_mass; }, "m");
-  write_sample_vec3(f, "com_velocity", samples, [](const S& s) { return s.com_velocity; }, "m/s");
-  write_sample_vec3(f, "rotation", samples, [](const S& s) { return s.rotation; }, "rad");
-  write_sample_column<std::int32_t>(f, "contacts", samples, [](const S& s) { return s.contacts; }, nullptr);
-  write_sample_column<std::int32_t>(f, "active_contacts", samples, [](const S& s) { return s.active_contacts; },
-                                    nullptr);
-  write_sample_column<std::int32_t>(f, "newton_iterations", samples,
-                                    [](const S& s) { return s.newton_iterations; }, nullptr);
-  write_sample_column<double>(f, "max_penetration", samples, [](const S& s) { return s.max_penetration; }, "m");
-  write_sample_column<double>(f, "seconds", samples, [](const S& s) { return s.seconds; }, "s");
+  write_sample_column<double>(
+      f, "kinetic", samples, [](const S& s) { return s.kinetic; }, "J");
+  write_sample_column<double>(
+      f, "elastic", samples, [](const S& s) { return s.elastic; }, "J");
+  write_sample_column<double>(
+      f, "gravity", samples, [](const S& s) { return s.gravity; }, "J");
+  write_sample_column<double>(
+      f, "total", samples, [](const S& s) { return s.total(); }, "J");
+  write_sample_vec3(
+      f, "center_of_mass", samples, [](const S& s) { return s.center_of_mass; }, "m");
+  write_sample_vec3(
+      f, "com_velocity", samples, [](const S& s) { return s.com_velocity; }, "m/s");
+  write_sample_vec3(
+      f, "rotation", samples, [](const S& s) { return s.rotation; }, "rad");
+  write_sample_column<std::int32_t>(
+      f, "contacts", samples, [](const S& s) { return s.contacts; }, nullptr);
+  write_sample_column<std::int32_t>(
+      f, "active_contacts", samples, [](const S& s) { return s.active_contacts; }, nullptr);
+  write_sample_column<std::int32_t>(
+      f, "newton_iterations", samples, [](const S& s) { return s.newton_iterations; }, nullptr);
+  write_sample_column<double>(
+      f, "max_penetration", samples, [](const S& s) { return s.max_penetration; }, "m");
+  write_sample_column<double>(
+      f, "seconds", samples, [](const S& s) { return s.seconds; }, "s");
 }
 
 // Only for scenes with several bodies: one row per sample, x y z per body.
@@ -303,8 +320,8 @@ void read_frames(const H5File& f, Trajectory& t) {
   for (std::size_t k = 0; k < time.size(); ++k) {
     const std::string g = frame_group(k);
     if (!f.is_group(g))
-      throw InputError(f.path() + ": group '" + g + "' not found (/frames/time lists " +
-                       std::to_string(time.size()) + " frames)");
+      throw InputError(f.path() + ": group '" + g + "' not found (/frames/time lists " + std::to_string(time.size()) +
+                       " frames)");
     TrajectoryFrame& frame = t.frames[k];
     frame.time = time[k];
     frame.positions = as_vector(read_rows3(f, g + "/positions", n, per_node));
@@ -313,8 +330,7 @@ void read_frames(const H5File& f, Trajectory& t) {
     // wrong motion in ParaView, so its shape is checked too.
     const std::vector<hsize_t> shape = f.dataset_shape(g + "/displacement");
     if (shape.size() != 2 || shape[0] != hsize_t(n) || shape[1] != 3)
-      throw InputError(f.path() + ": dataset '" + g + "/displacement' must have shape (" + std::to_string(n) +
-                       ", 3)");
+      throw InputError(f.path() + ": dataset '" + g + "/displacement' must have shape (" + std::to_string(n) + ", 3)");
   }
 }
 
@@ -346,8 +362,8 @@ const char* phase_name(SimulationPhase phase) {
 std::string write_trajectory_artifact(const std::string& path, const Trajectory& t,
                                       const TrajectoryProvenance& provenance) {
   check_trajectory(t);
-  ArtifactWriter writer(path, kSchema, kSchemaVersion, provenance.executable, provenance.config_text,
-                        provenance.inputs, provenance.seed);
+  ArtifactWriter writer(path, kSchema, kSchemaVersion, provenance.executable, provenance.config_text, provenance.inputs,
+                        provenance.seed);
   H5File& f = writer.file();
   f.write_attribute("/", "scene", t.scene);
   f.write_attribute("/", "impact_model", t.impact_model);

@@ -62,7 +62,7 @@ struct TrajectoryCoarsening {
   // stiffness (their own C^H was used).
   int window = 0, unresolved_windows = 0;
   int fine_elements = 0;
-  double seconds = 0;       // online coarsening time
+  double seconds = 0;  // online coarsening time
 };
 
 // The run against a fine run of the same scene (msfab-dynamics --reference):
@@ -76,13 +76,13 @@ struct TrajectoryComparison {
 
 struct Trajectory {
   std::string scene;
-  NodeArray rest_nodes;                       // rest positions
-  std::vector<std::array<int, 8>> elements;   // toolkit node order
-  std::vector<int> element_tag;               // material index per element
-  std::vector<std::string> material_names;    // tag -> name
-  std::vector<std::string> body_names;        // empty or one name per body
-  std::vector<TrajectorySample> samples;      // one per step (and the initial state)
-  std::vector<TrajectoryFrame> frames;        // at output times
+  NodeArray rest_nodes;                      // rest positions
+  std::vector<std::array<int, 8>> elements;  // toolkit node order
+  std::vector<int> element_tag;              // material index per element
+  std::vector<std::string> material_names;   // tag -> name
+  std::vector<std::string> body_names;       // empty or one name per body
+  std::vector<TrajectorySample> samples;     // one per step (and the initial state)
+  std::vector<TrajectoryFrame> frames;       // at output times
   std::vector<TrajectoryEvent> events;
   // Wall time by phase (s) and in total.
   double seconds_quasistatic = 0, seconds_elastic = 0, seconds_rigid = 0, seconds_total = 0;

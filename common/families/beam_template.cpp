@@ -124,8 +124,10 @@ std::vector<PlacedBeam> images_near_domain(const Beam& beam, bool caps, double m
 // `where` names the caller and the beam, ending in ": ".
 void check_beam(const Beam& b, const std::string& where) {
   if (!b.a.allFinite() || !b.b.allFinite()) throw InputError(where + "end points must be finite");
-  if (!(b.r0 >= 0) || !std::isfinite(b.r0)) throw InputError(where + "r0 must be finite and >= 0, got " + std::to_string(b.r0));
-  if (!(b.r1 >= 0) || !std::isfinite(b.r1)) throw InputError(where + "r1 must be finite and >= 0, got " + std::to_string(b.r1));
+  if (!(b.r0 >= 0) || !std::isfinite(b.r0))
+    throw InputError(where + "r0 must be finite and >= 0, got " + std::to_string(b.r0));
+  if (!(b.r1 >= 0) || !std::isfinite(b.r1))
+    throw InputError(where + "r1 must be finite and >= 0, got " + std::to_string(b.r1));
   if (!std::isfinite(b.theta)) throw InputError(where + "theta must be finite");
 }
 
@@ -147,7 +149,8 @@ std::vector<double> template_distance(const BeamTemplate& tpl, const Fundamental
 }  // namespace
 
 void check_template(const BeamTemplate& tpl, const std::string& context) {
-  for (std::size_t i = 0; i < tpl.beams.size(); ++i) check_beam(tpl.beams[i], context + ": beam " + std::to_string(i) + ": ");
+  for (std::size_t i = 0; i < tpl.beams.size(); ++i)
+    check_beam(tpl.beams[i], context + ": beam " + std::to_string(i) + ": ");
 }
 
 BeamFrame beam_frame(const Beam& beam) {

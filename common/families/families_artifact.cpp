@@ -106,8 +106,9 @@ FamiliesResult read_families_artifact(const std::string& path) {
     throw InputError(path + ": /clusters/label and /clusters/family must have one entry per selected structure");
   for (int k = 0; k < families; ++k) {
     const std::string g = family_group(std::size_t(k));
-    if (!f.is_group(g)) throw InputError(path + ": attribute 'families' is " + std::to_string(families) +
-                                         " but group " + g + " is missing");
+    if (!f.is_group(g))
+      throw InputError(path + ": attribute 'families' is " + std::to_string(families) + " but group " + g +
+                       " is missing");
     FamilyRecord fam;
     fam.members = f.read_vector<std::int64_t>(g + "/members");
     fam.representative = f.read_attribute<std::int64_t>(g, "representative");

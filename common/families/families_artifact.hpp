@@ -20,11 +20,11 @@ inline constexpr const char* kFamiliesSchema = "msfab.families";
 inline constexpr int kFamiliesSchemaVersion = 1;
 
 struct FamilyRecord {
-  std::vector<std::int64_t> members;   // indices into the input set
-  std::int64_t representative = -1;    // index into the input set
-  bool caps = true;                    // the template's beams carry dome caps
-  VecX representative_template;        // 9 per beam, fitted to the representative
-  double representative_difference = 0;  // its voxel difference
+  std::vector<std::int64_t> members;      // indices into the input set
+  std::int64_t representative = -1;       // index into the input set
+  bool caps = true;                       // the template's beams carry dome caps
+  VecX representative_template;           // 9 per beam, fitted to the representative
+  double representative_difference = 0;   // its voxel difference
   std::vector<double> member_difference;  // per member: voxel difference of the refitted template (NaN: not fitted)
   std::vector<char> member_kept;          // per member: used for the reduction
   MatX member_parameters;                 // members x parameters (rows of unfitted members: NaN)
@@ -35,19 +35,19 @@ struct FamilyRecord {
 };
 
 struct FamiliesResult {
-  int resolution = 0;                       // voxels per cell edge of the input set
-  double E_stiff = 0, decades = 4;          // the input set's normalization
-  double stiff_E = 0, stiff_nu = 0;         // its stiff base material (generated structures are made of it)
-  std::vector<std::int64_t> selection;      // indices of the selected structures
-  MatX embedding;                           // selection x dimensions (rows of left-out structures: NaN)
-  std::vector<int> labels;                  // per selected structure: its mixture cluster, -1 left out
-  std::vector<int> family_of;               // per selected structure: its family, -1 none
-  VecX eigenvalues;                         // of the MDS
+  int resolution = 0;                   // voxels per cell edge of the input set
+  double E_stiff = 0, decades = 4;      // the input set's normalization
+  double stiff_E = 0, stiff_nu = 0;     // its stiff base material (generated structures are made of it)
+  std::vector<std::int64_t> selection;  // indices of the selected structures
+  MatX embedding;                       // selection x dimensions (rows of left-out structures: NaN)
+  std::vector<int> labels;              // per selected structure: its mixture cluster, -1 left out
+  std::vector<int> family_of;           // per selected structure: its family, -1 none
+  VecX eigenvalues;                     // of the MDS
   double residual_variance = 0;
-  std::vector<int> bic_components;          // mixture sizes tried
-  std::vector<double> bic;                  // their BIC
-  int clusters = 0;                         // mixture size chosen
-  std::vector<FamilyRecord> families;       // by decreasing member count
+  std::vector<int> bic_components;     // mixture sizes tried
+  std::vector<double> bic;             // their BIC
+  int clusters = 0;                    // mixture size chosen
+  std::vector<FamilyRecord> families;  // by decreasing member count
 };
 
 void write_families_artifact(const std::string& path, const FamiliesResult& result, const std::string& executable,

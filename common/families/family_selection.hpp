@@ -13,8 +13,8 @@
 namespace msfab {
 
 struct PropertyWindow {
-  double nu_min = -1.0, nu_max = 0.5;   // Poisson's ratio
-  double E_min = 0.0, E_max = 1.0;      // Young's modulus relative to the stiff material
+  double nu_min = -1.0, nu_max = 0.5;  // Poisson's ratio
+  double E_min = 0.0, E_max = 1.0;     // Young's modulus relative to the stiff material
   double density_min = 0.0, density_max = 1.0;
 };
 

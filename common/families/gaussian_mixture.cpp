@@ -1,7 +1,6 @@
 #include "families/gaussian_mixture.hpp"
 
 #include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -167,8 +166,8 @@ void require_points(const MatX& X, int components) {
   if (X.rows() < 1 || X.cols() < 1) throw InputError("gaussian mixture: no points");
   if (!X.allFinite()) throw InputError("gaussian mixture: a point has a non-finite coordinate");
   if (components < 1 || components > X.rows())
-    throw InputError("gaussian mixture: " + std::to_string(components) + " components for " +
-                     std::to_string(X.rows()) + " points (need 1 <= K <= N)");
+    throw InputError("gaussian mixture: " + std::to_string(components) + " components for " + std::to_string(X.rows()) +
+                     " points (need 1 <= K <= N)");
 }
 
 }  // namespace

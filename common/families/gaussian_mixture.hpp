@@ -33,15 +33,15 @@ struct GaussianMixture {
   std::vector<MatX> covariances;  // K matrices d x d
   double log_likelihood = 0.0;    // sum over points of ln p(x)
   double bic = 0.0;
-  int iterations = 0;             // M-steps of the winning start
+  int iterations = 0;  // M-steps of the winning start
   bool converged = false;
-  int restart = 0;                // which start won
+  int restart = 0;  // which start won
   // ln-likelihood after every E-step of the winning start, the first from
   // the k-means++ initialization; the last equals log_likelihood.
   std::vector<double> log_likelihood_history;
-  MatX responsibilities;          // N x K, rows summing to 1
-  std::vector<int> labels;        // N: argmax responsibility (lowest index on ties)
-  std::vector<int> sizes;         // K: number of points per label
+  MatX responsibilities;    // N x K, rows summing to 1
+  std::vector<int> labels;  // N: argmax responsibility (lowest index on ties)
+  std::vector<int> sizes;   // K: number of points per label
 };
 
 // Free parameters of a K-component full-covariance mixture in d dimensions:

@@ -1,7 +1,6 @@
 #include "families/isomap.hpp"
 
 #include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -103,7 +102,7 @@ MatX geodesic_distances(const NeighborGraph& graph) {
       if (e.target < 0 || e.target >= n || !(e.length >= 0))
         throw InputError("isomap: graph edge to node " + std::to_string(e.target) + " with length " +
                          std::to_string(e.length) + " (nodes 0.." + std::to_string(n - 1) + ", lengths >= 0)");
-  // Column s of the column-major G is contiguous: the rows of source s.
+        // Column s of the column-major G is contiguous: the rows of source s.
 #pragma omp parallel for schedule(dynamic)
   for (int s = 0; s < n; ++s) dijkstra(graph, s, G.col(s).data());
   return 0.5 * (G + G.transpose());
@@ -169,7 +168,10 @@ int connect_components(NeighborGraph& graph, const MatX& D) {
   if (ncomp <= 1) return 0;
   // The shortest edge between every pair of components (ties: smallest
   // indices, from the scan order), then Kruskal over the components.
-  struct Link { double length; int i, j; };
+  struct Link {
+    double length;
+    int i, j;
+  };
   std::vector<Link> best(std::size_t(ncomp) * ncomp, {std::numeric_limits<double>::infinity(), -1, -1});
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) {
@@ -190,8 +192,8 @@ int connect_components(NeighborGraph& graph, const MatX& D) {
   };
   const auto insert = [&](int from, int to, double length) {
     std::vector<GraphEdge>& edges = graph[from];
-    const auto at = std::lower_bound(edges.begin(), edges.end(), to,
-                                     [](const GraphEdge& e, int t) { return e.target < t; });
+    const auto at =
+        std::lower_bound(edges.begin(), edges.end(), to, [](const GraphEdge& e, int t) { return e.target < t; });
     edges.insert(at, GraphEdge{to, length});
   };
   int added = 0;

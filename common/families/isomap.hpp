@@ -72,13 +72,13 @@ struct IsomapOptions {
 };
 
 struct IsomapResult {
-  MatX coordinates;            // kept.size() x dimensions; row r is point kept[r]
-  std::vector<int> kept;       // input indices embedded, ascending
-  std::vector<int> left_out;   // input indices outside the largest component
-  int components = 1;          // of the neighbour graph (before joining)
-  VecX eigenvalues;            // descending
+  MatX coordinates;              // kept.size() x dimensions; row r is point kept[r]
+  std::vector<int> kept;         // input indices embedded, ascending
+  std::vector<int> left_out;     // input indices outside the largest component
+  int components = 1;            // of the neighbour graph (before joining)
+  VecX eigenvalues;              // descending
   double residual_variance = 0;  // of the embedding against the geodesic distances
-  MatX geodesic;               // kept x kept
+  MatX geodesic;                 // kept x kept
 };
 // The largest component (ties: the one with the smallest index) is
 // embedded. InputError for a bad matrix or options, for a component with

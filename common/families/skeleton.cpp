@@ -177,7 +177,8 @@ int wrapped_step(int a, int b, int n) {
 std::array<int, 3> voxel_step(const SkeletonGraph& g, int u, int w) {
   const int n = g.n;
   const int a = g.voxel[u], b = g.voxel[w];
-  return {wrapped_step(a % n, b % n, n), wrapped_step(a / n % n, b / n % n, n), wrapped_step(a / (n * n), b / (n * n), n)};
+  return {wrapped_step(a % n, b % n, n), wrapped_step(a / n % n, b / n % n, n),
+          wrapped_step(a / (n * n), b / (n * n), n)};
 }
 
 Vec3 step_vector(const SkeletonGraph& g, int u, int w) {
@@ -503,7 +504,8 @@ std::vector<SkeletonPath> skeleton_paths(const SkeletonGraph& graph) {
 std::vector<int> simplify_polyline(const std::vector<Vec3>& points, double tolerance) {
   if (points.size() < 2)
     throw InputError("simplify_polyline: a polyline needs at least 2 points, got " + std::to_string(points.size()));
-  if (!(tolerance >= 0)) throw InputError("simplify_polyline: tolerance must be >= 0, got " + std::to_string(tolerance));
+  if (!(tolerance >= 0))
+    throw InputError("simplify_polyline: tolerance must be >= 0, got " + std::to_string(tolerance));
   std::vector<int> kept{0, static_cast<int>(points.size()) - 1};
   while (true) {
     double worst = -1;

@@ -38,9 +38,9 @@ int count_void_components(const VoxelGrid& cell);
 // of a junction blob are not separate branches.
 struct SkeletonGraph {
   int n = 0;
-  std::vector<int> voxel;                   // vertex -> voxel index (x fastest)
-  std::vector<Vec3> position;               // vertex -> voxel centre, unit-cell coordinates in [0, 1)
-  std::vector<std::vector<int>> neighbours; // sorted
+  std::vector<int> voxel;                    // vertex -> voxel index (x fastest)
+  std::vector<Vec3> position;                // vertex -> voxel centre, unit-cell coordinates in [0, 1)
+  std::vector<std::vector<int>> neighbours;  // sorted
 };
 // InputError unless the cell is cubic with n >= 3.
 SkeletonGraph skeleton_graph(const VoxelGrid& skeleton);

@@ -1,11 +1,10 @@
 #include "families/structure_distance.hpp"
 
-#include <unsupported/Eigen/FFT>
-
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <string>
+#include <unsupported/Eigen/FFT>
 
 #include "core/errors.hpp"
 

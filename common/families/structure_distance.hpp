@@ -23,7 +23,9 @@ struct VoxelField {
 
   VoxelField() = default;
   explicit VoxelField(int n_, double fill = 0.0) : n(n_), values(VecX::Constant(Eigen::Index(n_) * n_ * n_, fill)) {}
-  Eigen::Index index(int i, int j, int k) const { return Eigen::Index(i) + Eigen::Index(n) * (j + Eigen::Index(n) * k); }
+  Eigen::Index index(int i, int j, int k) const {
+    return Eigen::Index(i) + Eigen::Index(n) * (j + Eigen::Index(n) * k);
+  }
   double& at(int i, int j, int k) { return values[index(i, j, k)]; }
   double at(int i, int j, int k) const { return values[index(i, j, k)]; }
 };

@@ -238,8 +238,10 @@ BeamTemplate refine(const FitProblem& P, const BeamTemplate& start, const Templa
       clamp_sizes(trial);
       trial_d = occupancies(trial);
       trial_value = P.objective(combined(trial_d, -1));
-      if (trial_value <= value - 1e-4 * alpha * g.squaredNorm()) accepted = true;
-      else alpha *= 0.5;
+      if (trial_value <= value - 1e-4 * alpha * g.squaredNorm())
+        accepted = true;
+      else
+        alpha *= 0.5;
     }
     if (!accepted) {
       // Near a kink of the objective (a dome switching sides, images
@@ -311,8 +313,8 @@ TemplateFit refine_in_stages(const VoxelGrid& target, const BeamTemplate& start,
 // lattice whose beams start one or two voxels off the corner). A restart
 // moves one end of such a beam kRestartOffset voxels along a coordinate
 // axis across it, one axis of each set the symmetries turn into one another.
-constexpr double kRestartOffset = 1.5;     // voxels
-constexpr double kSymmetryTolerance = 0.5; // voxels: thinning places a junction to within half a voxel
+constexpr double kRestartOffset = 1.5;      // voxels
+constexpr double kSymmetryTolerance = 0.5;  // voxels: thinning places a junction to within half a voxel
 
 std::vector<BeamTemplate> restart_templates(const BeamTemplate& tpl, int n) {
   std::vector<BeamTemplate> out;
@@ -379,7 +381,8 @@ double voxel_difference(const VoxelGrid& target, const BeamTemplate& tpl) {
   return double(differ) / double(model.size());
 }
 
-BeamTemplate initialize_sections(const VoxelGrid& target, const BeamTemplate& start, const TemplateFitOptions& options) {
+BeamTemplate initialize_sections(const VoxelGrid& target, const BeamTemplate& start,
+                                 const TemplateFitOptions& options) {
   check_target(target, "initialize_sections");
   check_options(options, "initialize_sections");
   check_template(start, "initialize_sections");

@@ -28,17 +28,18 @@ namespace msfab {
 inline constexpr double kFitSharpening = 4.0;
 
 struct TemplateFitOptions {
-  double width = 1.0;               // voxels: Gaussian sigma of the target, blur of the template
-  int max_iterations = 200;         // gradients computed, at most, over all stages of one descent
-  double relative_tolerance = 1e-6; // stop when a step lowers the objective by less than this fraction
-                                    // (the earlier stages: 1000x and 100x this, by their last five steps)
-  double difference_step = 0.25;    // central-difference step, voxels (theta: the angle that moves the section corner that far)
-  double initial_step = 1.0;        // voxels: the first trial step's largest parameter change
-  SkeletonOptions skeleton;         // segments for fit_template
-  double merge_tolerance = 0.05;    // fundamental_segments
-  bool caps = true;                 // the template fit_template builds
-  double restart_difference = 0.01; // fit_template restarts while its voxel difference is above this
-  int max_restarts = 4;             // fit_template: restarts tried, at most
+  double width = 1.0;                // voxels: Gaussian sigma of the target, blur of the template
+  int max_iterations = 200;          // gradients computed, at most, over all stages of one descent
+  double relative_tolerance = 1e-6;  // stop when a step lowers the objective by less than this fraction
+                                     // (the earlier stages: 1000x and 100x this, by their last five steps)
+  double difference_step =
+      0.25;  // central-difference step, voxels (theta: the angle that moves the section corner that far)
+  double initial_step = 1.0;         // voxels: the first trial step's largest parameter change
+  SkeletonOptions skeleton;          // segments for fit_template
+  double merge_tolerance = 0.05;     // fundamental_segments
+  bool caps = true;                  // the template fit_template builds
+  double restart_difference = 0.01;  // fit_template restarts while its voxel difference is above this
+  int max_restarts = 4;              // fit_template: restarts tried, at most
 };
 
 struct TemplateFit {

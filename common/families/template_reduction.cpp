@@ -41,7 +41,7 @@ ReducedTemplate reduce_template_parameters(const MatX& parameters, const MatX& p
   out.components = q;
   out.explained_variance = total > 0 ? kept / total : 1.0;
   const MatX V = svd.matrixV().leftCols(q);  // p x q
-  const MatX T = P * V;                     // m x q scores
+  const MatX T = P * V;                      // m x q scores
 
   // Least squares on the scores: y ≈ T B.
   const MatX B = T.colPivHouseholderQr().solve(Y);  // q x 2

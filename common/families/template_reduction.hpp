@@ -25,14 +25,14 @@
 namespace msfab {
 
 struct ReducedTemplate {
-  VecX base;                 // mean fitted parameters (r = 0)
-  std::vector<VecX> plus;    // parameters at r_j = +1
-  std::vector<VecX> minus;   // parameters at r_j = -1
+  VecX base;                // mean fitted parameters (r = 0)
+  std::vector<VecX> plus;   // parameters at r_j = +1
+  std::vector<VecX> minus;  // parameters at r_j = -1
   // Predicted change of (log10 E, ν) per unit r_j by the regression
   // (column j): the direction the properties move along.
-  MatX property_slope;       // 2 x reduced
-  int components = 0;        // principal components kept
-  double explained_variance = 0;  // fraction of the parameter spread they hold
+  MatX property_slope;               // 2 x reduced
+  int components = 0;                // principal components kept
+  double explained_variance = 0;     // fraction of the parameter spread they hold
   double regression_r2[2] = {0, 0};  // R^2 of log10 E and of ν on the kept scores
 };
 

@@ -90,9 +90,7 @@ const NodeArray& ElasticAssembler::unknown_rest_nodes() const {
   return constraints_ ? constraints_->unknown_rest : mesh_.nodes;
 }
 
-SpMat ElasticAssembler::pattern() const {
-  return constraints_ ? reduced_pattern_ : mesh_pattern();
-}
+SpMat ElasticAssembler::pattern() const { return constraints_ ? reduced_pattern_ : mesh_pattern(); }
 
 SpMat ElasticAssembler::mesh_pattern() const {
   const int n = mesh_.num_dofs();
@@ -111,9 +109,7 @@ VecX ElasticAssembler::rest_positions() const {
   return x;
 }
 
-VecX ElasticAssembler::mesh_positions(const VecX& x) const {
-  return constraints_ ? VecX(dof_map_ * x) : x;
-}
+VecX ElasticAssembler::mesh_positions(const VecX& x) const { return constraints_ ? VecX(dof_map_ * x) : x; }
 
 hex8::NodeMatrix ElasticAssembler::gather(const VecX& x, int e) const {
   hex8::NodeMatrix xe;
@@ -121,9 +117,7 @@ hex8::NodeMatrix ElasticAssembler::gather(const VecX& x, int e) const {
   return xe;
 }
 
-double ElasticAssembler::energy(const VecX& x) const {
-  return evaluate(x, nullptr, nullptr);
-}
+double ElasticAssembler::energy(const VecX& x) const { return evaluate(x, nullptr, nullptr); }
 
 double ElasticAssembler::evaluate(const VecX& x, VecX* gradient, SpMat* hessian) const {
   if (!constraints_) return evaluate_mesh(x, gradient, hessian);

@@ -21,8 +21,8 @@ namespace msfab {
 // the larger element whose face or edge they lie on, which keeps the
 // displacement field continuous.
 struct NodeConstraints {
-  SpMat node_map;         // (mesh nodes) x (unknown nodes); rows sum to 1
-  NodeArray unknown_rest; // rest positions of the unknown nodes
+  SpMat node_map;          // (mesh nodes) x (unknown nodes); rows sum to 1
+  NodeArray unknown_rest;  // rest positions of the unknown nodes
 };
 
 class ElasticAssembler {
@@ -65,8 +65,8 @@ class ElasticAssembler {
   double evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hessian) const;
 
   const HexMesh& mesh_;
-  std::vector<int> col_ptr_;   // CSC column starts, size 3N + 1
-  std::vector<int> row_idx_;   // CSC row indices
+  std::vector<int> col_ptr_;  // CSC column starts, size 3N + 1
+  std::vector<int> row_idx_;  // CSC row indices
   // For element e, node pair (i, j): the offset of node i's 3-row block in
   // the columns of node j, relative to the column start.
   std::vector<std::array<uint16_t, 64>> block_offset_;

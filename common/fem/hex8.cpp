@@ -8,9 +8,7 @@
 
 namespace msfab::hex8 {
 
-Vec3 natural_node(int i) {
-  return Vec3((i & 4) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 1) ? 1.0 : -1.0);
-}
+Vec3 natural_node(int i) { return Vec3((i & 4) ? 1.0 : -1.0, (i & 2) ? 1.0 : -1.0, (i & 1) ? 1.0 : -1.0); }
 
 double shape(int i, const Vec3& chi) {
   const Vec3 c = natural_node(i);
@@ -38,8 +36,14 @@ NodeMatrix shape_gradients(const Vec3& chi) {
 QuadratureRule gauss_rule(int n) {
   std::vector<double> x, w;
   switch (n) {
-    case 1: x = {0.0}; w = {2.0}; break;
-    case 2: x = {-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}; w = {1.0, 1.0}; break;
+    case 1:
+      x = {0.0};
+      w = {2.0};
+      break;
+    case 2:
+      x = {-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)};
+      w = {1.0, 1.0};
+      break;
     case 3: {
       const double a = std::sqrt(0.6);
       x = {-a, 0.0, a};
@@ -117,8 +121,7 @@ ElementGeometry enhanced_element_geometry(const NodeMatrix& X, const QuadratureR
   for (int q = 0; q < rule.size(); ++q) {
     const double detJ = (X.transpose() * shape_gradients(rule.points[q])).determinant();
     // d(1 - chi_k^2)/dchi = -2 chi_k e_k; spatial: J0^-T of it, row k.
-    for (int k = 0; k < 3; ++k)
-      g.enhanced[q].row(k) = (det0 / detJ) * (-2.0 * rule.points[q][k]) * J0_inverse.row(k);
+    for (int k = 0; k < 3; ++k) g.enhanced[q].row(k) = (det0 / detJ) * (-2.0 * rule.points[q][k]) * J0_inverse.row(k);
   }
   return g;
 }

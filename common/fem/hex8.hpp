@@ -70,8 +70,6 @@ ElementGeometry enhanced_element_geometry(const NodeMatrix& X, const QuadratureR
 ElementGeometry with_centre_point(const ElementGeometry& geo, const NodeMatrix& X);
 
 // F = sum_i x_i (dN_i/dX)^T (Eq. 2.4 written for positions x = X + u).
-inline Mat3 deformation_gradient(const NodeMatrix& x, const NodeMatrix& dNdX) {
-  return x.transpose() * dNdX;
-}
+inline Mat3 deformation_gradient(const NodeMatrix& x, const NodeMatrix& dNdX) { return x.transpose() * dNdX; }
 
 }  // namespace msfab::hex8

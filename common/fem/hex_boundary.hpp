@@ -12,7 +12,7 @@ struct HexBoundary {
   // Each face's four nodes, counter-clockwise seen from outside.
   std::vector<std::array<int, 4>> faces;
   std::vector<int> face_element;  // the element each face belongs to
-  std::vector<int> nodes;  // sorted
+  std::vector<int> nodes;         // sorted
 };
 
 HexBoundary hex_boundary(const HexMesh& mesh);

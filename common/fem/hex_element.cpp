@@ -93,8 +93,7 @@ double evaluate_with(const hex8::ElementGeometry& geo, const QuadratureMaterials
     if (hessian)
       for (int j = 0; j < 8; ++j) {
         const double d0 = w * D(j, 0), d1 = w * D(j, 1), d2 = w * D(j, 2);
-        for (int b = 0; b < 3; ++b)
-          hessian->row(3 * j + b) += d0 * HB.row(b) + d1 * HB.row(b + 3) + d2 * HB.row(b + 6);
+        for (int b = 0; b < 3; ++b) hessian->row(3 * j + b) += d0 * HB.row(b) + d1 * HB.row(b + 3) + d2 * HB.row(b + 6);
       }
     if (coupling) bubbles->K_Au.noalias() += w * bubble_map_transpose_times<24>(geo.enhanced[q], HB);
   }
@@ -106,9 +105,8 @@ double evaluate_with(const hex8::ElementGeometry& geo, const QuadratureMaterials
 Eigen::LDLT<Mat9> definite_factor(const Mat9& K) {
   Eigen::LDLT<Mat9> f(K);
   const double scale = std::max(K.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-  for (double shift = 1e-10 * scale; f.info() != Eigen::Success || !f.isPositive() ||
-                                     f.vectorD().minCoeff() <= 1e-14 * scale;
-       shift *= 10) {
+  for (double shift = 1e-10 * scale;
+       f.info() != Eigen::Success || !f.isPositive() || f.vectorD().minCoeff() <= 1e-14 * scale; shift *= 10) {
     f.compute(K + shift * Mat9::Identity());
     if (shift > scale) break;
   }
@@ -159,8 +157,7 @@ bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterial
 
 }  // namespace
 
-double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                  const hex8::NodeMatrix& x) {
+double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x) {
   if (geo.has_enhanced_modes()) return hex_evaluate(geo, mat, x, nullptr, nullptr);
   double e = 0;
   for (int q = 0; q < geo.size(); ++q) {
@@ -172,8 +169,8 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
   return e;
 }
 
-double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                    const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian, Mat3* bubbles) {
+double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                    Vec24* gradient, Mat24* hessian, Mat3* bubbles) {
   if (!geo.has_enhanced_modes()) return evaluate_with(geo, mat, x, Mat3::Zero(), gradient, hessian, nullptr);
   Mat3 A = bubbles ? *bubbles : Mat3::Zero();
   double energy;
@@ -191,8 +188,8 @@ double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials&
   return energy;
 }
 
-bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                           const hex8::NodeMatrix& x, Mat3& A) {
+bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                           Mat3& A) {
   A.setZero();
   if (!geo.has_enhanced_modes()) return std::isfinite(hex_energy(geo, mat, x));
   double energy;

@@ -13,15 +13,12 @@ namespace msfab {
 // to every point.
 struct QuadratureMaterials {
   std::vector<MaterialPtr> at_point;
-  const Material& operator[](int q) const {
-    return *at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)];
-  }
+  const Material& operator[](int q) const { return *at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)]; }
 };
 
 // Element energy for deformed node positions x (rows = nodes). Returns +inf
 // as soon as one quadrature point is inverted.
-double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                  const hex8::NodeMatrix& x);
+double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x);
 
 // Energy, gradient (24, node-major: 3*i + a) and Hessian (24x24) in one pass;
 // pass nullptr for what is not needed. Returns the energy (+inf if inverted,
@@ -33,8 +30,8 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
 // evaluations this saves about 40% of the bubbles' Newton iterations; the
 // energy differs from a cold start by less than 1e-14 of itself
 // (hex_element.cpp).
-double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                    const hex8::NodeMatrix& x, Vec24* gradient, Mat24* hessian, Mat3* bubbles = nullptr);
+double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                    Vec24* gradient, Mat24* hessian, Mat3* bubbles = nullptr);
 
 // For an element with bubble modes (geo.has_enhanced_modes()): the 3 x 3
 // amplitudes A (row i: displacement component i, column k: bubble
@@ -42,7 +39,7 @@ double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials&
 // hex_evaluate finds them. False if the element is inverted at A = 0. The
 // DDFEM fit on the enhanced element holds A fixed while it solves for the
 // material parameters (ddfem/coarse_fit.hpp).
-bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat,
-                           const hex8::NodeMatrix& x, Mat3& A);
+bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
+                           Mat3& A);
 
 }  // namespace msfab

@@ -12,7 +12,7 @@ namespace msfab {
 using NodeArray = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 struct HexMesh {
-  NodeArray nodes;                          // rest positions X, one row per node
+  NodeArray nodes;                           // rest positions X, one row per node
   std::vector<std::array<int, 8>> elements;  // node indices in hex8 order
   // Elements of identical shape share one geometry (a voxel mesh has one).
   std::vector<hex8::ElementGeometry> geometries;

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <utility>
 
 namespace msfab {
@@ -46,8 +46,8 @@ TriangleSurface merge_equal_vertices(const TriangleSurface& surface) {
   std::vector<int> remap(surface.vertices.size());
   for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
     const Vec3& p = surface.vertices[v];
-    const auto [it, added] = index_of.emplace(std::array<double, 3>{p.x(), p.y(), p.z()},
-                                              static_cast<int>(out.vertices.size()));
+    const auto [it, added] =
+        index_of.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(out.vertices.size()));
     if (added) out.vertices.push_back(p);
     remap[v] = it->second;
   }

@@ -38,8 +38,8 @@ TriangleSurface merge_equal_vertices(const TriangleSurface& surface);
 // number is the same along any ray. Edges are compared by vertex index, so
 // a surface read from STL needs merge_equal_vertices first.
 struct SurfaceClosure {
-  long long unmatched_edges = 0;      // directed edges without a reverse partner
-  long long degenerate_triangles = 0; // triangles with a repeated vertex (ignored)
+  long long unmatched_edges = 0;            // directed edges without a reverse partner
+  long long degenerate_triangles = 0;       // triangles with a repeated vertex (ignored)
   std::array<int, 2> example_edge{-1, -1};  // one unmatched edge, vertex indices
   bool closed() const { return unmatched_edges == 0; }
 };

@@ -12,8 +12,7 @@ size_t VoxelGrid::count_solid() const {
 }
 
 VoxelMesh build_voxel_mesh(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette) {
-  if (grid.nx <= 0 || grid.ny <= 0 || grid.nz <= 0)
-    throw InputError("voxel grid has a non-positive dimension");
+  if (grid.nx <= 0 || grid.ny <= 0 || grid.nz <= 0) throw InputError("voxel grid has a non-positive dimension");
   if (!(grid.voxel_size > 0)) throw InputError("voxel size must be positive");
   if (grid.count_solid() == 0) throw InputError("voxel grid is empty: every voxel is void (id 0)");
 

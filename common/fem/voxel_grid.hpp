@@ -22,9 +22,7 @@ struct VoxelGrid {
   int& at(int i, int j, int k) { return ids[index(i, j, k)]; }
   int at(int i, int j, int k) const { return ids[index(i, j, k)]; }
   size_t size() const { return ids.size(); }
-  Vec3 voxel_center(int i, int j, int k) const {
-    return origin + voxel_size * Vec3(i + 0.5, j + 0.5, k + 0.5);
-  }
+  Vec3 voxel_center(int i, int j, int k) const { return origin + voxel_size * Vec3(i + 0.5, j + 0.5, k + 0.5); }
   Vec3 extent() const { return voxel_size * Vec3(nx, ny, nz); }
   size_t count_solid() const;
 };
@@ -35,9 +33,9 @@ struct VoxelGrid {
 // is identical for identical grids.
 struct VoxelMesh {
   HexMesh mesh;
-  std::vector<int> element_voxel;   // element -> voxel index
-  std::vector<int> voxel_element;   // voxel -> element or -1
-  std::vector<int> lattice_node;    // lattice node (nx+1)(ny+1)(nz+1) -> mesh node or -1
+  std::vector<int> element_voxel;  // element -> voxel index
+  std::vector<int> voxel_element;  // voxel -> element or -1
+  std::vector<int> lattice_node;   // lattice node (nx+1)(ny+1)(nz+1) -> mesh node or -1
 };
 VoxelMesh build_voxel_mesh(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette);
 

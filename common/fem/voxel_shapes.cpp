@@ -23,9 +23,8 @@ void check_axis(int axis) {
 }  // namespace
 
 void paint_box(VoxelGrid& grid, const Vec3& lo, const Vec3& hi, int id) {
-  paint_where(grid, id, [&](const Vec3& p) {
-    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
-  });
+  paint_where(grid, id,
+              [&](const Vec3& p) { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); });
 }
 
 void paint_layers(VoxelGrid& grid, int axis, const std::vector<double>& thickness, const std::vector<int>& ids) {

@@ -42,8 +42,7 @@ void validate_field(const VoxelStiffnessField& field, const std::string& what) {
   if (field.basis.empty()) throw InputError(what + ": no element stiffness matrices");
   if (field.weights.size() != std::size_t(field.voxels()) * field.basis.size())
     throw InputError(what + ": " + std::to_string(field.weights.size()) + " element weights for " +
-                     std::to_string(field.voxels()) + " voxels x " + std::to_string(field.basis.size()) +
-                     " matrices");
+                     std::to_string(field.voxels()) + " voxels x " + std::to_string(field.basis.size()) + " matrices");
   for (double w : field.weights)
     if (!std::isfinite(w)) throw InputError(what + ": a non-finite element weight");
 }

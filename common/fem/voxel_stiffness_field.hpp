@@ -18,9 +18,9 @@ namespace msfab {
 
 struct VoxelStiffnessField {
   int nx = 0, ny = 0, nz = 0;
-  double h = 1.0;              // voxel edge length
-  std::vector<Mat24> basis;    // corner a at (a>>2&1, a>>1&1, a&1) h; 3 unknowns per corner
-  std::vector<double> weights; // basis.size() per voxel, voxel v = i + nx (j + ny k)
+  double h = 1.0;               // voxel edge length
+  std::vector<Mat24> basis;     // corner a at (a>>2&1, a>>1&1, a&1) h; 3 unknowns per corner
+  std::vector<double> weights;  // basis.size() per voxel, voxel v = i + nx (j + ny k)
 
   std::int64_t voxels() const { return std::int64_t(nx) * ny * nz; }
   int basis_size() const { return static_cast<int>(basis.size()); }

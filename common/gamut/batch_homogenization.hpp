@@ -21,11 +21,11 @@ struct BatchOptions {
 
 struct BatchReport {
   int structures = 0;
-  int outside = 0;                    // properties now outside the space's box (unit coordinates clamped)
-  double max_relative_change = 0;     // max over structures of |C_new - C_old| / |C_old|
+  int outside = 0;                 // properties now outside the space's box (unit coordinates clamped)
+  double max_relative_change = 0;  // max over structures of |C_new - C_old| / |C_old|
   double median_relative_change = 0;
-  std::string solver;                 // solver of the (refined) cells
-  long long iterations = 0;           // multigrid CG iterations, all structures
+  std::string solver;        // solver of the (refined) cells
+  long long iterations = 0;  // multigrid CG iterations, all structures
   double seconds = 0;
 };
 

@@ -1,11 +1,10 @@
 #include "gamut/continuous_refinement.hpp"
 
-#include <nlopt.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
+#include <nlopt.hpp>
 
 #include "core/errors.hpp"
 #include "homog/periodic_homogenization.hpp"
@@ -24,9 +23,9 @@ struct ContinuousCellProblem::Evaluation {
   std::vector<double> x, xt;
   std::vector<double> xp, dxp;  // projected densities and dxp/dxt (xp = xt without projection)
   HomogenizationResult r;
-  MatX C;                 // the plane block (2D) or the 6 x 6 tensor
+  MatX C;  // the plane block (2D) or the 6 x 6 tensor
   double rho = 0;
-  std::vector<Mat6> dC;   // per voxel: dC^H / d(x~^p), filled on demand
+  std::vector<Mat6> dC;  // per voxel: dC^H / d(x~^p), filled on demand
 };
 
 namespace {
@@ -36,7 +35,8 @@ void check_options(int nx, int ny, int nz, double h, const MaterialPtr& stiff, c
   if (!stiff) throw InputError("continuous step: no stiff material");
   if (options.max_iterations < 1 || !(options.penalty >= 1) || !(options.filter_radius >= 0) ||
       !(options.density_weight >= 0) || !(options.start_offset >= 0 && options.start_offset < 0.5) ||
-      !(options.void_stiffness > 0) || !(options.projection_beta >= 0 && options.projection_beta <= 1024) || options.min_feature < 1)
+      !(options.void_stiffness > 0) || !(options.projection_beta >= 0 && options.projection_beta <= 1024) ||
+      options.min_feature < 1)
     throw InputError(
         "continuous step: need max_iterations >= 1, penalty >= 1, filter_radius >= 0, density_weight >= 0, "
         "0 <= start_offset < 0.5, void_stiffness > 0, 0 <= projection_beta <= 1024, min_feature >= 1");
@@ -136,8 +136,10 @@ void ContinuousCellProblem::setup_cell(MaterialPtr stiff, MaterialPtr soft) {
         const double w = reach == 0 ? (d == 0 ? 1.0 : 0.0) : std::max(0.0, R - d);
         if (w <= 0) continue;
         auto [it, added] = tap_of_offset.emplace(std::array<int, 3>{a, b, c}, filter_.size());
-        if (added) filter_.push_back({a, b, c, w});
-        else filter_[it->second].weight = std::max(filter_[it->second].weight, w);
+        if (added)
+          filter_.push_back({a, b, c, w});
+        else
+          filter_[it->second].weight = std::max(filter_[it->second].weight, w);
       }
   for (const FilterTap& t : filter_) sum += t.weight;
   for (FilterTap& t : filter_) t.weight /= sum;
@@ -248,7 +250,7 @@ double ContinuousCellProblem::floor_violation(const VecX& u) const {
 }
 
 const ContinuousCellProblem::Evaluation& ContinuousCellProblem::evaluate(const std::vector<double>& x,
-                                                                          bool with_sensitivities) const {
+                                                                         bool with_sensitivities) const {
   if (!last_ || last_->x != x) {
     auto e = std::make_shared<Evaluation>();
     e->x = x;
@@ -326,8 +328,7 @@ double ContinuousCellProblem::objective(const std::vector<double>& x, std::vecto
   const MatX E = W_ * (G - target_.G) * W_;
   const double f = target_objective(e);
   // df/dG = 2 W E W; df/dC = -G (df/dG) G (all symmetric).
-  if (gradient)
-    chain(e, -2.0 * G * (W_ * E * W_) * G, 2.0 * options_.density_weight * (e.rho - target_.rho), gradient);
+  if (gradient) chain(e, -2.0 * G * (W_ * E * W_) * G, 2.0 * options_.density_weight * (e.rho - target_.rho), gradient);
   return f;
 }
 
@@ -338,8 +339,10 @@ double ContinuousCellProblem::constraint(int c, const std::vector<double>& x, st
   std::vector<MatX> dudC;
   const VecX u = properties_and_gradients(e, gradient ? &dudC : nullptr);
   if (gradient) {
-    if (i + 1 == u.size()) chain(e, MatX::Zero(e.C.rows(), e.C.cols()), -1.0, gradient);
-    else chain(e, -dudC[i], 0.0, gradient);
+    if (i + 1 == u.size())
+      chain(e, MatX::Zero(e.C.rows(), e.C.cols()), -1.0, gradient);
+    else
+      chain(e, -dudC[i], 0.0, gradient);
   }
   return floor - u[i];
 }
@@ -449,7 +452,8 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
       VoxelGrid g = printable(level);
       if (g.count_solid() == 0 || thin_feature_voxels(g, options.min_feature) > 0) continue;
       const double score = problem.structure_objective(g, stiff_id);
-      if (score < best_score) best_score = score, result.structure = std::move(g), result.threshold = level, result.found = true;
+      if (score < best_score)
+        best_score = score, result.structure = std::move(g), result.threshold = level, result.found = true;
     }
   } else {
     // The grey optimum is not the printable one: face-disconnected pieces
@@ -464,8 +468,8 @@ ContinuousResult run_mma(ContinuousCellProblem& problem, const VoxelGrid& struct
       if (g.count_solid() == 0 || thin_feature_voxels(g, options.min_feature) > 0) continue;
       const VecX u = problem.structure_unit_properties(g, stiff_id);
       const double violation = problem.floor_violation(u), score = problem.directed_objective(u);
-      const bool better = violation <= kFeasible ? (best_violation > kFeasible || score < best_score)
-                                                 : violation < best_violation;
+      const bool better =
+          violation <= kFeasible ? (best_violation > kFeasible || score < best_score) : violation < best_violation;
       if (better) {
         best_score = score, best_violation = violation;
         result.structure = std::move(g), result.threshold = level, result.found = true;

@@ -40,12 +40,12 @@
 namespace msfab {
 
 struct ContinuousOptions {
-  int max_iterations = 50;      // objective evaluations
-  double penalty = 3.0;         // SIMP exponent p
-  double filter_radius = 1.5;   // voxels; <= 1: no filtering
-  double density_weight = 1.0;  // w_rho
-  double start_offset = 0.3;    // stiff voxels start at 0.5 + offset, others at 0.5 - offset
-  double void_stiffness = 1e-6; // when the soft phase is void
+  int max_iterations = 50;       // objective evaluations
+  double penalty = 3.0;          // SIMP exponent p
+  double filter_radius = 1.5;    // voxels; <= 1: no filtering
+  double density_weight = 1.0;   // w_rho
+  double start_offset = 0.3;     // stiff voxels start at 0.5 + offset, others at 0.5 - offset
+  double void_stiffness = 1e-6;  // when the soft phase is void
   // Heaviside projection with continuation: beta = 1, 2, 4, ... up to
   // projection_beta, the evaluations split evenly over the stages, so the
   // last stage optimizes a nearly black-and-white design and the
@@ -165,8 +165,8 @@ class ContinuousCellProblem {
 
   double project(double xt, double* derivative) const;
   void setup_cell(MaterialPtr stiff, MaterialPtr soft);
-  void homogenize_densities(Evaluation& e) const;  // e.xp -> e.r, e.C, e.rho
-  double target_objective(const Evaluation& e) const;  // f of a target problem
+  void homogenize_densities(Evaluation& e) const;                                   // e.xp -> e.r, e.C, e.rho
+  double target_objective(const Evaluation& e) const;                               // f of a target problem
   Evaluation homogenize_structure(const VoxelGrid& structure, int stiff_id) const;  // black and white
   const Evaluation& evaluate(const std::vector<double>& x, bool with_sensitivities) const;
   // d(property)/dC of the plane block or the 6 x 6 tensor, and the unit-cube properties.
@@ -176,12 +176,12 @@ class ContinuousCellProblem {
 };
 
 struct ContinuousResult {
-  VoxelGrid structure;               // thresholded, mirrored and cleaned
+  VoxelGrid structure;  // thresholded, mirrored and cleaned
   double start_objective = 0, best_objective = 0;
   int evaluations = 0;
-  double threshold = 0.5;            // the level x~ was thresholded at
-  bool found = true;                 // false when no level gave a printable structure (directed, or several target levels)
-  std::vector<double> history;       // f per evaluation
+  double threshold = 0.5;       // the level x~ was thresholded at
+  bool found = true;            // false when no level gave a printable structure (directed, or several target levels)
+  std::vector<double> history;  // f per evaluation
 };
 
 // Runs MMA from `structure` towards `target`. Deterministic.

@@ -1,6 +1,5 @@
 #include "gamut/gamut_artifact.hpp"
 
-
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
 
@@ -48,8 +47,9 @@ void write_gamut(H5File& f, const Gamut& g) {
   f.write_attribute("/level_set", "lower", ls.lower());
   f.write_attribute("/level_set", "spacing", ls.spacing());
   f.write_attribute("/level_set", "padding", ls.padding());
-  f.write_attribute("/level_set", "meaning",
-                    "signed distance in normalized property space, negative inside; node i at lower + (i + 1/2) spacing");
+  f.write_attribute(
+      "/level_set", "meaning",
+      "signed distance in normalized property space, negative inside; node i at lower + (i + 1/2) spacing");
   if (g.bound_stiff.size() > 0) {
     f.write_matrix("/bound/stiff", g.bound_stiff);
     f.write_matrix("/bound/soft", g.bound_soft);
@@ -108,10 +108,9 @@ Gamut read_gamut_artifact(const std::string& path) {
     throw InputError(path + ": /level_set dimension " + std::to_string(d) + " differs from the " +
                      std::to_string(g.property_names.size()) + " property names");
   const NdArray<double> phi = f.read_dataset<double>("/level_set/phi");
-  g.level_set = GamutLevelSet::from_values(d, f.read_attribute<std::int32_t>("/level_set", "cells"),
-                                           f.read_attribute<double>("/level_set", "lower"),
-                                           f.read_attribute<double>("/level_set", "spacing"), phi.values,
-                                           read_padding(f, path));
+  g.level_set = GamutLevelSet::from_values(
+      d, f.read_attribute<std::int32_t>("/level_set", "cells"), f.read_attribute<double>("/level_set", "lower"),
+      f.read_attribute<double>("/level_set", "spacing"), phi.values, read_padding(f, path));
   if (f.exists("/bound/stiff")) {
     const int m = g.space == "cubic3d" ? 6 : 3;
     g.bound_stiff = read_bound_tensor(f, path, "/bound/stiff", m);

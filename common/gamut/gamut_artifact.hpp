@@ -18,14 +18,14 @@ inline constexpr int kGamutSchemaVersion = 1;
 
 struct GamutCycle {
   int cycle = 0;
-  int samples = 0;             // structures in the set after the cycle
+  int samples = 0;                               // structures in the set after the cycle
   int discrete_added = 0, continuous_added = 0;  // continuous: the level-set pushes and the directed ones
-  double coverage = 0;         // fraction of the unit cube inside the gamut (coverage())
-  double seconds = 0;          // wall time of the cycle
+  double coverage = 0;                           // fraction of the unit cube inside the gamut (coverage())
+  double seconds = 0;                            // wall time of the cycle
 };
 
 struct Gamut {
-  std::string space;           // MaterialSpace kind name
+  std::string space;  // MaterialSpace kind name
   std::vector<std::string> property_names;
   double E_stiff = 0, decades = 4;
   GamutLevelSet level_set;

@@ -1,8 +1,7 @@
 #include "gamut/level_set.hpp"
 
-#include <array>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -212,8 +211,8 @@ GamutLevelSet GamutLevelSet::from_values(int d, int cells, double lower, double 
   ls.stride_.assign(d, 1);
   for (int a = 1; a < d; ++a) ls.stride_[a] = ls.stride_[a - 1] * cells;
   if (static_cast<long long>(values.size()) != ls.stride_[d - 1] * cells)
-    throw InputError("gamut level set: " + std::to_string(values.size()) + " node values for " +
-                     std::to_string(cells) + "^" + std::to_string(d) + " nodes");
+    throw InputError("gamut level set: " + std::to_string(values.size()) + " node values for " + std::to_string(cells) +
+                     "^" + std::to_string(d) + " nodes");
   for (double v : values)
     if (!std::isfinite(v)) throw InputError("gamut level set: a node value is not finite");
   ls.phi_ = std::move(values);

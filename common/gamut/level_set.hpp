@@ -21,10 +21,10 @@
 namespace msfab {
 
 struct LevelSetOptions {
-  int cells = 32;              // grid cells per axis
-  double margin = 0.1;         // the grid covers [-margin, 1 + margin] per axis
-  double radius = 0.0;         // r of the implicit function; 0: 1.5 grid cells
-  int smoothing_steps = 2;     // explicit Laplacian steps (dt = h^2 / (4 d))
+  int cells = 32;           // grid cells per axis
+  double margin = 0.1;      // the grid covers [-margin, 1 + margin] per axis
+  double radius = 0.0;      // r of the implicit function; 0: 1.5 grid cells
+  int smoothing_steps = 2;  // explicit Laplacian steps (dt = h^2 / (4 d))
 };
 
 class GamutLevelSet {

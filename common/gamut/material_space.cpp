@@ -70,7 +70,8 @@ VecX MaterialSpace::properties_2d(const Mat3& C, double rho) const {
 
 VecX MaterialSpace::properties_with_gradient(const MatX& C, double rho, std::vector<MatX>* dC) const {
   const int m = kind_ == MaterialSpaceKind::cubic3d ? 6 : 3;
-  if (C.rows() != m || C.cols() != m) throw std::invalid_argument("MaterialSpace::properties_with_gradient: wrong size");
+  if (C.rows() != m || C.cols() != m)
+    throw std::invalid_argument("MaterialSpace::properties_with_gradient: wrong size");
   // The values come from the readers above, so the two cannot drift apart.
   const VecX p = m == 6 ? properties(Mat6(C), rho) : properties_2d(Mat3(C), rho);
   if (!dC) return p;
@@ -111,9 +112,12 @@ VecX MaterialSpace::unit_derivative(const VecX& raw) const {
   if (raw.size() != dimension()) throw std::invalid_argument("MaterialSpace::unit_derivative: wrong dimension");
   VecX d(raw.size());
   for (int i = 0; i < raw.size(); ++i) {
-    if (i == raw.size() - 1) d[i] = 1;
-    else if (is_modulus(i)) d[i] = 1 / (raw[i] * std::log(10.0) * decades_);
-    else d[i] = 1 / (nu_high() - nu_low());
+    if (i == raw.size() - 1)
+      d[i] = 1;
+    else if (is_modulus(i))
+      d[i] = 1 / (raw[i] * std::log(10.0) * decades_);
+    else
+      d[i] = 1 / (nu_high() - nu_low());
   }
   return d;
 }

@@ -1,13 +1,12 @@
 #include "gamut/microstructure_set.hpp"
 
-#include "material/linear_isotropic.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "material/linear_isotropic.hpp"
 
 namespace msfab {
 namespace {
@@ -48,8 +47,9 @@ StructureGrid read_grid(const H5File& f, const std::string& g, std::size_t items
     grid.axes.push_back(std::move(axis));
   }
   if (grid.points() != items)
-    bad(f, gg, "the grid has " + std::to_string(grid.points()) + " points but the set " + std::to_string(items) +
-                   " structures");
+    bad(f, gg,
+        "the grid has " + std::to_string(grid.points()) + " points but the set " + std::to_string(items) +
+            " structures");
   return grid;
 }
 
@@ -166,8 +166,9 @@ void write_microstructure_set(H5File& f, const std::string& g, const Microstruct
   f.write_vector(at(g, "size"), std::vector<std::int32_t>{set.nx, set.ny, set.nz});
   f.write_dataset(at(g, "voxels"), packed, {hsize_t(n), hsize_t(row)});
   f.write_attribute(at(g, "voxels"), "bits_per_voxel", static_cast<std::int32_t>(bits));
-  f.write_attribute(at(g, "voxels"), "order",
-                    "per structure: ids x fastest (i + nx (j + ny k)), bits_per_voxel bits each, least significant first");
+  f.write_attribute(
+      at(g, "voxels"), "order",
+      "per structure: ids x fastest (i + nx (j + ny k)), bits_per_voxel bits each, least significant first");
   f.write_attribute(at(g, "voxels"), "ids", set.soft_is_void ? "0 void, 1 stiff" : "0 void, 1 stiff, 2 soft");
   f.write_dataset(at(g, "properties"), props, {hsize_t(n), hsize_t(d)});
   f.write_dataset(at(g, "unit_properties"), unit, {hsize_t(n), hsize_t(d)});
@@ -175,7 +176,8 @@ void write_microstructure_set(H5File& f, const std::string& g, const Microstruct
   f.write_attribute(at(g, "C"), "order", "Voigt xx, yy, zz, yz, xz, xy; engineering shear; 2D cells: plane strain");
   f.write_vector(at(g, "cycle"), cycle);
   f.write_vector(at(g, "step"), step);
-  f.write_attribute(at(g, "step"), "meaning", "0 initial, 1 discrete, 2 continuous, 3 void variant, 4 directed, 5 targeted");
+  f.write_attribute(at(g, "step"), "meaning",
+                    "0 initial, 1 discrete, 2 continuous, 3 void variant, 4 directed, 5 targeted");
   f.write_vector(at(g, "parent"), parent);
   if (!set.grid.empty()) write_grid(f, g, set.grid, n);
 }

@@ -46,8 +46,8 @@ struct BaseMaterial {
 // family's own parameters (topopt space family3d) instead of a level set
 // around its members. Empty for a set that is not such a grid.
 struct StructureGrid {
-  std::vector<std::string> names;          // one per axis
-  std::vector<std::vector<double>> axes;   // per axis: the parameter values, strictly increasing
+  std::vector<std::string> names;         // one per axis
+  std::vector<std::vector<double>> axes;  // per axis: the parameter values, strictly increasing
   bool empty() const { return axes.empty(); }
   std::size_t points() const;
   // The item of the grid point with these indices (one per axis).
@@ -55,15 +55,15 @@ struct StructureGrid {
 };
 
 struct MicrostructureSet {
-  std::string space;                 // MaterialSpace kind name: cubic3d | cubic2d | orthotropic2d
+  std::string space;  // MaterialSpace kind name: cubic3d | cubic2d | orthotropic2d
   std::vector<std::string> property_names;
-  double E_stiff = 0, decades = 4;   // the normalization (MaterialSpace)
+  double E_stiff = 0, decades = 4;  // the normalization (MaterialSpace)
   int nx = 0, ny = 0, nz = 0;
-  BaseMaterial stiff, soft;          // ids 1 and 2
-  bool soft_is_void = true;          // no id 2; cuts leave void
+  BaseMaterial stiff, soft;  // ids 1 and 2
+  bool soft_is_void = true;  // no id 2; cuts leave void
   std::vector<Microstructure> items;
-  StructureGrid grid;                // empty unless the items are a parameter grid (a stage that adds
-                                     // or removes items must clear it)
+  StructureGrid grid;  // empty unless the items are a parameter grid (a stage that adds
+                       // or removes items must clear it)
 };
 
 // The set's base materials as a palette: [0] void, [1] stiff, [2] soft

@@ -10,11 +10,11 @@
 namespace msfab {
 
 struct BeamMoveOptions {
-  int max_beams = 3;            // 1..max_beams beams per move
-  double min_radius = 0.5;      // beam radius range, voxels
+  int max_beams = 3;        // 1..max_beams beams per move
+  double min_radius = 0.5;  // beam radius range, voxels
   double max_radius = 2.0;
-  int materials = 1;            // added beams take a solid id in 1..materials
-  int cut_id = 0;               // what a cut leaves: void, or the soft base material
+  int materials = 1;  // added beams take a solid id in 1..materials
+  int cut_id = 0;     // what a cut leaves: void, or the soft base material
   CellSymmetry symmetry = CellSymmetry::cubic;
 };
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <string>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -26,7 +26,7 @@ void require_symmetric_shape(const VoxelGrid& c) {
 // inside the cell (what a cell next to another structure keeps); no piece
 // then wraps.
 struct Pieces {
-  std::vector<int> piece;                 // per voxel, -1 if not a member
+  std::vector<int> piece;                  // per voxel, -1 if not a member
   std::vector<std::array<bool, 3>> wraps;  // per piece
   std::vector<int> size;
 };
@@ -178,7 +178,8 @@ int add_axis_backbone(VoxelGrid& c, int half_width) {
   // another structure, so material joined to the backbone only through the
   // cell's own periodic image would float there. The three beams cross at
   // the centre, so they are one piece.
-  const Pieces solid = face_pieces(c, [](int id) { return id != 0; }, false);
+  const Pieces solid = face_pieces(
+      c, [](int id) { return id != 0; }, false);
   const int backbone = solid.piece[a_beam_voxel];
   for (std::size_t v = 0; v < c.size(); ++v)
     if (solid.piece[v] >= 0 && solid.piece[v] != backbone) c.ids[v] = 0, ++changed;
@@ -248,14 +249,14 @@ std::int64_t thin_feature_voxels(const VoxelGrid& c, int width) {
         for (int dk = 0; dk < wz && uniform; ++dk)
           for (int dj = 0; dj < width && uniform; ++dj)
             for (int di = 0; di < width && uniform; ++di)
-              uniform = (c.at(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny),
-                              wrap_periodic(k + dk, c.nz)) != 0) == solid;
+              uniform = (c.at(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny), wrap_periodic(k + dk, c.nz)) !=
+                         0) == solid;
         if (!uniform) continue;
         for (int dk = 0; dk < wz; ++dk)
           for (int dj = 0; dj < width; ++dj)
             for (int di = 0; di < width; ++di)
-              covered[c.index(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny),
-                              wrap_periodic(k + dk, c.nz))] = 1;
+              covered[c.index(wrap_periodic(i + di, c.nx), wrap_periodic(j + dj, c.ny), wrap_periodic(k + dk, c.nz))] =
+                  1;
       }
   std::int64_t thin = 0;
   for (std::uint8_t v : covered) thin += v == 0;

@@ -36,8 +36,8 @@ std::array<bool, 3> spans_periodically(const VoxelGrid& cell) {
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const std::array<int, 3> q = {p[0] + dx, p[1] + dy, p[2] + dz};
-          const std::size_t v = cell.index(((q[0] % n[0]) + n[0]) % n[0], ((q[1] % n[1]) + n[1]) % n[1],
-                                           ((q[2] % n[2]) + n[2]) % n[2]);
+          const std::size_t v =
+              cell.index(((q[0] % n[0]) + n[0]) % n[0], ((q[1] % n[1]) + n[1]) % n[1], ((q[2] % n[2]) + n[2]) % n[2]);
           if (cell.ids[v] == 0) continue;
           if (!seen[v]) {
             seen[v] = 1, position[v] = q, queue.push_back(v);
@@ -125,8 +125,7 @@ Vec3 PeriodicFiniteStrainCell::stretches(double s, const VecX& z) const {
   return S;
 }
 
-double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient, SpMat* hessian,
-                                        double* dE_ds) const {
+double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient, SpMat* hessian, double* dE_ds) const {
   const int n = unknowns(), l0 = n - 2, l1 = n - 1;
   const Vec3 S = stretches(s, z);
   const double h = cell_.voxel_size;
@@ -142,7 +141,8 @@ double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient,
   mat.at_point.resize(1);
   for (std::size_t el = 0; el < solid_.size(); ++el) {
     const std::size_t v = solid_[el];
-    const int i = static_cast<int>(v % nx), j = static_cast<int>((v / nx) % ny), k = static_cast<int>(v / (std::size_t(nx) * ny));
+    const int i = static_cast<int>(v % nx), j = static_cast<int>((v / nx) % ny),
+              k = static_cast<int>(v / (std::size_t(nx) * ny));
     const std::array<int, 8>& unknown = element_unknowns_[el];
     hex8::NodeMatrix X, x;
     for (int a = 0; a < 8; ++a) {
@@ -155,7 +155,8 @@ double PeriodicFiniteStrainCell::energy(double s, const VecX& z, VecX* gradient,
     total += e;
     // dx/d(lateral stretch c) is X's c column on component c.
     Vec24 t0 = Vec24::Zero(), t1 = Vec24::Zero();
-    for (int a = 0; a < 8; ++a) t0[3 * a + lateral_[0]] = X(a, lateral_[0]), t1[3 * a + lateral_[1]] = X(a, lateral_[1]);
+    for (int a = 0; a < 8; ++a)
+      t0[3 * a + lateral_[0]] = X(a, lateral_[0]), t1[3 * a + lateral_[1]] = X(a, lateral_[1]);
     if (gradient) {
       for (int a = 0; a < 8; ++a)
         if (unknown[a] >= 0)
@@ -279,13 +280,15 @@ std::vector<UniaxialStrainPoint> uniaxial_finite_strain(const VoxelGrid& cell, c
     std::vector<std::size_t> order;
     for (std::size_t p = 0; p < strains.size(); ++p)
       if (strains[p] * sign > 0) order.push_back(p);
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return std::abs(strains[a]) < std::abs(strains[b]); });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return std::abs(strains[a]) < std::abs(strains[b]); });
     VecX z = model.rest(), z_previous = z;
     double reached = 0, step_before = 0;
     int iterations = 0, shifted = 0;
     for (const std::size_t p : order) {
       const double target = strains[p];
-      const int increments = std::max(1, static_cast<int>(std::ceil(std::abs(target - reached) / options.max_step - 1e-9)));
+      const int increments =
+          std::max(1, static_cast<int>(std::ceil(std::abs(target - reached) / options.max_step - 1e-9)));
       const double step = (target - reached) / increments;
       for (int inc = 0; inc < increments; ++inc) {
         // Start from the secant extrapolation of the last two states.

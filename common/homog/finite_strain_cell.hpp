@@ -62,25 +62,25 @@ class PeriodicFiniteStrainCell {
   std::vector<std::size_t> solid_;  // voxel indices with material
   // Per solid voxel, its corners' first unknowns (-1: the held node).
   std::vector<std::array<int, 8>> element_unknowns_;
-  hex8::NodeMatrix corners_;       // one voxel's corners at the origin
+  hex8::NodeMatrix corners_;  // one voxel's corners at the origin
   hex8::ElementGeometry geometry_;
   double volume_ = 0, energy_scale_ = 0;
 };
 
 struct FiniteStrainOptions {
-  double max_step = 0.01;            // largest strain increment of the continuation
-  int max_newton_iterations = 50;    // per increment
+  double max_step = 0.01;          // largest strain increment of the continuation
+  int max_newton_iterations = 50;  // per increment
   // Newton stops when its decrement -g.dz falls below this times the
   // energy scale (mu h^3 of the stiffest material times the solid voxels).
   double newton_tolerance = 1e-14;
 };
 
 struct UniaxialStrainPoint {
-  double strain = 0;              // engineering strain along the axis, s - 1
+  double strain = 0;  // engineering strain along the axis, s - 1
   Vec3 stretch = Vec3::Ones();
-  double nu[2] = {0, 0};          // secant Poisson ratios -(lateral stretch - 1) / strain, lateral axes in order
-  double nominal_stress = 0;      // axial force per reference cross-section (first Piola-Kirchhoff)
-  int newton_iterations = 0;      // over the increments that reached this strain
+  double nu[2] = {0, 0};      // secant Poisson ratios -(lateral stretch - 1) / strain, lateral axes in order
+  double nominal_stress = 0;  // axial force per reference cross-section (first Piola-Kirchhoff)
+  int newton_iterations = 0;  // over the increments that reached this strain
   // Of those iterations, how many needed a shifted Hessian: the solid has
   // a zero-energy mechanism (voxels hinged at a shared node or edge), or
   // it buckled on the way to this strain.

@@ -35,18 +35,18 @@ namespace msfab {
 bool mirror_invariant(const VoxelStiffnessField& field);
 
 struct OctantSolverOptions {
-  std::string solver = "auto";  // auto | cholmod | matrix-free (Dirichlet grid multigrid on the octant)
-  double tolerance = 1e-6;      // matrix-free: relative residual
-  int max_iterations = 2000;    // matrix-free: CG iterations before it fails
+  std::string solver = "auto";     // auto | cholmod | matrix-free (Dirichlet grid multigrid on the octant)
+  double tolerance = 1e-6;         // matrix-free: relative residual
+  int max_iterations = 2000;       // matrix-free: CG iterations before it fails
   std::string max_iterations_key;  // the config key of max_iterations, for messages
   int smoother_degree = 2;
   int threads = 0;
 };
 
 struct OctantSolveReport {
-  std::string solver;        // "cholmod" or "matrix-free"
-  std::int64_t unknowns = 0; // free octant unknowns, largest over the case groups
-  int iterations = 0;        // multigrid: CG iterations over the cases solved
+  std::string solver;         // "cholmod" or "matrix-free"
+  std::int64_t unknowns = 0;  // free octant unknowns, largest over the case groups
+  int iterations = 0;         // multigrid: CG iterations over the cases solved
 };
 
 // "auto" solves octants of up to this many voxels directly (a 16^3 cell),

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "fem/hex8.hpp"
 #include "fem/voxel_grid.hpp"
 #include "fem/voxel_stiffness_field.hpp"
-#include "fem/hex8.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "solve/periodic_grid_multigrid.hpp"
 
@@ -70,15 +70,15 @@ bool cyclic_invariant(const VoxelStiffnessField& field);
 inline constexpr std::int64_t kAutoMultigridVoxels = 12 * 12 * 12;
 
 struct HomogenizationResult {
-  Mat6 C = Mat6::Zero();          // C^H, Voigt (elastic_tensor.hpp)
-  Mat6 G = Mat6::Zero();          // harmonic displacements: strains under unit stresses, (C^H)^-1
+  Mat6 C = Mat6::Zero();                // C^H, Voigt (elastic_tensor.hpp)
+  Mat6 G = Mat6::Zero();                // harmonic displacements: strains under unit stresses, (C^H)^-1
   std::vector<double> volume_fraction;  // per palette id, [0] = void
-  int pieces = 0;                 // connected solid pieces (voxels sharing a node, periodically)
-  std::int64_t unknowns = 0;      // 3 per lattice node (direct: less the 3 pinned ones)
-  std::string solver;             // "cholmod" or "matrix-free"
-  int iterations = 0;             // multigrid: CG iterations over the strain cases solved
-  bool symmetric_cases = false;   // two cases solved, four carried by the cyclic permutation
-  bool octant = false;            // solved on one octant (mirror symmetry); unknowns are the octant's
+  int pieces = 0;                       // connected solid pieces (voxels sharing a node, periodically)
+  std::int64_t unknowns = 0;            // 3 per lattice node (direct: less the 3 pinned ones)
+  std::string solver;                   // "cholmod" or "matrix-free"
+  int iterations = 0;                   // multigrid: CG iterations over the strain cases solved
+  bool symmetric_cases = false;         // two cases solved, four carried by the cyclic permutation
+  bool octant = false;                  // solved on one octant (mirror symmetry); unknowns are the octant's
   // Per Voigt strain: the periodic fluctuation at the nx*ny*nz lattice
   // nodes (3 per node, x fastest), zero at node 0.
   std::array<VecX, 6> fluctuation;
@@ -130,8 +130,8 @@ Eigen::Matrix<double, 24, 6> total_element_displacements(const HomogenizationRes
 // is exactly the plane-strain problem of bilinear quadrilaterals (plus a
 // decoupled anti-plane one). Voigt order xx, yy, xy (engineering shear).
 struct PlaneStrainResult {
-  Mat3 C = Mat3::Zero();   // in-plane block (xx, yy, xy) of the 3D C^H
-  Mat3 G = Mat3::Zero();   // C^-1
+  Mat3 C = Mat3::Zero();  // in-plane block (xx, yy, xy) of the 3D C^H
+  Mat3 G = Mat3::Zero();  // C^-1
   HomogenizationResult full;
 };
 PlaneStrainResult homogenize_plane_strain(const VoxelGrid& cell, const std::vector<MaterialPtr>& palette,

@@ -94,15 +94,14 @@ std::vector<ArtifactInput> hash_inputs(const std::string& output, const std::vec
 }
 }  // namespace
 
-ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
-                               const std::string& executable, const std::string& config_text,
-                               const std::vector<std::string>& input_paths, std::uint64_t seed)
+ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version, const std::string& executable,
+                               const std::string& config_text, const std::vector<std::string>& input_paths,
+                               std::uint64_t seed)
     : ArtifactWriter(path, std::move(schema), schema_version, executable, config_text,
                      HashedInputs(hash_inputs(path, input_paths)), seed) {}
 
-ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version,
-                               const std::string& executable, const std::string& config_text,
-                               HashedInputs inputs, std::uint64_t seed)
+ArtifactWriter::ArtifactWriter(std::string path, std::string schema, int schema_version, const std::string& executable,
+                               const std::string& config_text, HashedInputs inputs, std::uint64_t seed)
     : path_(std::move(path)) {
   for (const ArtifactInput& input : inputs.list) refuse_output_as_input(path_, input.path);
   tmp_ = std::make_unique<AtomicFile>(path_);
@@ -175,23 +174,20 @@ H5File open_finished(const std::string& path) {
 }
 }  // namespace
 
-ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
-                               int supported_version)
+ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema, int supported_version)
     : ArtifactReader(path, expected_schema, supported_version, supported_version) {}
 
-ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema,
-                               int min_version, int max_version)
+ArtifactReader::ArtifactReader(const std::string& path, const std::string& expected_schema, int min_version,
+                               int max_version)
     : file_(open_finished(path)) {
-  const std::string expected =
-      "expected schema '" + expected_schema + "' " + versions_text(min_version, max_version);
+  const std::string expected = "expected schema '" + expected_schema + "' " + versions_text(min_version, max_version);
   if (!file_.has_attribute("/", "schema") || !file_.has_attribute("/", "schema_version")) {
     throw InputError(path + ": " + expected +
                      ", found no schema/schema_version root attributes (not an msfab artifact)");
   }
   schema_ = file_.read_string_attribute("/", "schema");
   schema_version_ = int(file_.read_attribute<std::int64_t>("/", "schema_version"));
-  if (schema_ != expected_schema || schema_version_ < min_version ||
-      schema_version_ > max_version) {
+  if (schema_ != expected_schema || schema_version_ < min_version || schema_version_ > max_version) {
     throw InputError(path + ": " + expected + ", found schema '" + schema_ + "' version " +
                      std::to_string(schema_version_));
   }

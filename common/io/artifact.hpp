@@ -50,18 +50,16 @@ class ArtifactWriter {
   // missing or not writable, or the path is a folder) and writes the root
   // attributes. `executable` is the program name; the version and
   // git revision are added here.
-  ArtifactWriter(std::string path, std::string schema, int schema_version,
-                 const std::string& executable, const std::string& config_text,
-                 const std::vector<std::string>& input_paths, std::uint64_t seed);
+  ArtifactWriter(std::string path, std::string schema, int schema_version, const std::string& executable,
+                 const std::string& config_text, const std::vector<std::string>& input_paths, std::uint64_t seed);
   // The same with inputs already hashed (an artifact of the same commit
   // group, io/commit_group.hpp, whose final path does not hold it yet).
   struct HashedInputs {
     explicit HashedInputs(std::vector<ArtifactInput> inputs) : list(std::move(inputs)) {}
     std::vector<ArtifactInput> list;
   };
-  ArtifactWriter(std::string path, std::string schema, int schema_version,
-                 const std::string& executable, const std::string& config_text,
-                 HashedInputs inputs, std::uint64_t seed);
+  ArtifactWriter(std::string path, std::string schema, int schema_version, const std::string& executable,
+                 const std::string& config_text, HashedInputs inputs, std::uint64_t seed);
   ArtifactWriter(const ArtifactWriter&) = delete;
   ArtifactWriter& operator=(const ArtifactWriter&) = delete;
   ~ArtifactWriter();
@@ -97,11 +95,9 @@ class ArtifactWriter {
 // was found.
 class ArtifactReader {
  public:
-  ArtifactReader(const std::string& path, const std::string& expected_schema,
-                 int supported_version);
+  ArtifactReader(const std::string& path, const std::string& expected_schema, int supported_version);
   // Accepts schema_version in [min_version, max_version].
-  ArtifactReader(const std::string& path, const std::string& expected_schema, int min_version,
-                 int max_version);
+  ArtifactReader(const std::string& path, const std::string& expected_schema, int min_version, int max_version);
 
   const H5File& file() const { return file_; }
   const std::string& path() const { return file_.path(); }

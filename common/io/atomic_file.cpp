@@ -55,7 +55,7 @@ std::string parent_directory(const std::string& path) {
 AtomicFile::AtomicFile(std::string final_path) : path_(std::move(final_path)) {
   if (path_.empty()) throw InputError("empty output path");
   const std::string directory = parent_directory(path_);
-  struct stat st{};
+  struct stat st {};
   if (::lstat(path_.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
     throw InputError(path_ + ": is a folder, expected the path of a file to write");
   if (fs::path(path_).filename().empty())
@@ -68,17 +68,15 @@ AtomicFile::AtomicFile(std::string final_path) : path_(std::move(final_path)) {
     if (err == EEXIST || err == EINTR) continue;  // taken (or planted): draw another name
     tmp_path_.clear();
     switch (err) {
-      case ENOENT:
-        throw InputError(path_ + ": output folder does not exist (" + directory + ")");
-      case ENOTDIR:
-        throw InputError(path_ + ": '" + directory + "' is not a folder");
+      case ENOENT: throw InputError(path_ + ": output folder does not exist (" + directory + ")");
+      case ENOTDIR: throw InputError(path_ + ": '" + directory + "' is not a folder");
       case EACCES:
       case EPERM:
       case EROFS:
         throw InputError(path_ + ": output folder is not writable (" + directory + ": " + error_text(err) + ")");
       default:
-        throw std::runtime_error(path_ + ": cannot create a temporary file in '" + directory + "' (" +
-                                 error_text(err) + ")");
+        throw std::runtime_error(path_ + ": cannot create a temporary file in '" + directory + "' (" + error_text(err) +
+                                 ")");
     }
   }
   tmp_path_.clear();
@@ -119,7 +117,8 @@ void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t si
 }
 
 void AtomicFile::check_is_this_file(int other_fd) const {
-  struct stat mine{}, theirs{};
+  struct stat mine {
+  }, theirs{};
   if (fd_ < 0 || ::fstat(fd_, &mine) != 0 || ::fstat(other_fd, &theirs) != 0 || mine.st_dev != theirs.st_dev ||
       mine.st_ino != theirs.st_ino)
     throw std::runtime_error(path_ + ": the temporary " + tmp_path_ + " was replaced while it was being opened");
@@ -133,8 +132,7 @@ void AtomicFile::sync() {
     throw std::runtime_error(path_ + ": fsync of " + tmp_path_ + " failed (" + error_text(errno) + ")");
   const int status = ::close(fd_);
   fd_ = -1;
-  if (status != 0)
-    throw std::runtime_error(path_ + ": closing " + tmp_path_ + " failed (" + error_text(errno) + ")");
+  if (status != 0) throw std::runtime_error(path_ + ": closing " + tmp_path_ + " failed (" + error_text(errno) + ")");
   synced_ = true;
 }
 

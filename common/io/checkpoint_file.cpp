@@ -26,8 +26,9 @@ H5File open_checkpoint_file(const std::string& path, const std::string& schema, 
   if (!f.has_attribute("/", "schema") || f.read_string_attribute("/", "schema") != schema)
     throw InputError(path + ": not a " + what + " checkpoint");
   if (!f.has_attribute("/", "config") || f.read_string_attribute("/", "config") != run_text)
-    throw InputError(path + ": checkpoint was written with a different configuration or seed; delete it or rerun "
-                            "without --resume");
+    throw InputError(path +
+                     ": checkpoint was written with a different configuration or seed; delete it or rerun "
+                     "without --resume");
   return f;
 }
 

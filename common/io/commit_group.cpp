@@ -63,7 +63,7 @@ std::vector<JournalEntry> parse_journal(const std::string& journal, const std::s
 }
 
 bool is_plain_file(const std::string& path) {
-  struct stat st{};
+  struct stat st {};
   return ::lstat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
@@ -126,7 +126,7 @@ void CommitGroup::run_commit(std::size_t stop_after) {
 
 void complete_interrupted_commit(const std::string& path) {
   const std::string journal = pending_journal_path(path);
-  struct stat st{};
+  struct stat st {};
   if (::lstat(journal.c_str(), &st) != 0) return;
   if (!S_ISREG(st.st_mode)) throw InputError(journal + ": not a regular file; remove it if no commit is running");
   const std::vector<JournalEntry> entries = parse_journal(journal, path);

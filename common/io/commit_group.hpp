@@ -44,8 +44,8 @@ class CommitGroup {
   // A new member (the ArtifactWriter constructor's arguments). InputError if
   // another member has the same path.
   ArtifactWriter& add(const std::string& path, const std::string& schema, int schema_version,
-                      const std::string& executable, const std::string& config_text,
-                      std::vector<ArtifactInput> inputs, std::uint64_t seed);
+                      const std::string& executable, const std::string& config_text, std::vector<ArtifactInput> inputs,
+                      std::uint64_t seed);
   // Finishes `member` (nothing more can be written to it) and returns it as
   // an input of a later member: its final path and the hash of its content.
   ArtifactInput as_input(ArtifactWriter& member);

@@ -1,9 +1,9 @@
 #include "io/config.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -206,7 +206,8 @@ struct Reader<double> {
     // modulus of 1e308 overflows the first product it enters.
     if (!std::isfinite(v)) throw InputError(where + ": " + path + " = " + node.Scalar() + ": expected a finite number");
     if (std::abs(v) > kLargestConfigNumber)
-      throw InputError(where + ": " + path + " = " + node.Scalar() + ": beyond ±" + format_number(kLargestConfigNumber) +
+      throw InputError(where + ": " + path + " = " + node.Scalar() + ": beyond ±" +
+                       format_number(kLargestConfigNumber) +
                        "; no quantity read from a config needs such a value, and its products overflow");
     return v;
   }
@@ -320,8 +321,7 @@ struct ExpansionBudget {
   void spend(const YAML::Node& node) {
     const std::uint64_t cost = 1 + (node.IsScalar() ? node.Scalar().size() : 0);
     if (cost > left)
-      throw InputError(source + ": YAML aliases expand the document to more than " +
-                       std::to_string(limit) +
+      throw InputError(source + ": YAML aliases expand the document to more than " + std::to_string(limit) +
                        " nodes and characters; refusing it (nested anchors and aliases, an 'alias bomb'?)");
     left -= cost;
   }

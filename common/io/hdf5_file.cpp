@@ -62,9 +62,7 @@ hid_t memory_type_of(H5Dtype dtype) {
   throw std::logic_error("unknown H5Dtype");
 }
 
-std::size_t size_of(H5Dtype dtype) {
-  return dtype == H5Dtype::kUInt8 ? 1 : dtype == H5Dtype::kInt32 ? 4 : 8;
-}
+std::size_t size_of(H5Dtype dtype) { return dtype == H5Dtype::kUInt8 ? 1 : dtype == H5Dtype::kInt32 ? 4 : 8; }
 
 // Describes a stored type the way numpy names dtypes.
 std::string describe_type(hid_t type) {
@@ -72,8 +70,7 @@ std::string describe_type(hid_t type) {
   const std::size_t bits = 8 * H5Tget_size(type);
   switch (type_class) {
     case H5T_FLOAT: return "float" + std::to_string(bits);
-    case H5T_INTEGER:
-      return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(bits);
+    case H5T_INTEGER: return (H5Tget_sign(type) == H5T_SGN_NONE ? "uint" : "int") + std::to_string(bits);
     case H5T_STRING: return "string";
     case H5T_COMPOUND: return "compound";
     default: return "an unsupported type";
@@ -321,8 +318,7 @@ std::size_t H5File::element_count(const std::vector<hsize_t>& shape) {
   return count;
 }
 
-void H5File::check_element_count(const std::string& path, std::size_t count,
-                                 const std::vector<hsize_t>& shape) const {
+void H5File::check_element_count(const std::string& path, std::size_t count, const std::vector<hsize_t>& shape) const {
   if (count != element_count(shape)) {
     throw std::runtime_error(path_ + ": dataset '" + path + "' given " + std::to_string(count) +
                              " values but its shape holds " + std::to_string(element_count(shape)));
@@ -339,28 +335,25 @@ std::string shape_text(const std::vector<hsize_t>& shape) {
 }
 }  // namespace
 
-void H5File::check_rank(const std::string& path, const std::vector<hsize_t>& shape,
-                        std::size_t rank) const {
+void H5File::check_rank(const std::string& path, const std::vector<hsize_t>& shape, std::size_t rank) const {
   if (shape.size() != rank) {
-    throw InputError(path_ + ": dataset '" + path + "' has shape " + shape_text(shape) +
-                     ", expected rank " + std::to_string(rank));
+    throw InputError(path_ + ": dataset '" + path + "' has shape " + shape_text(shape) + ", expected rank " +
+                     std::to_string(rank));
   }
 }
 
-void H5File::check_cols(const std::string& path, const std::vector<hsize_t>& shape,
-                        Eigen::Index expected_cols) const {
+void H5File::check_cols(const std::string& path, const std::vector<hsize_t>& shape, Eigen::Index expected_cols) const {
   if (shape[1] != hsize_t(expected_cols)) {
-    throw InputError(path_ + ": dataset '" + path + "' has shape " + shape_text(shape) +
-                     ", expected " + std::to_string(expected_cols) + " columns");
+    throw InputError(path_ + ": dataset '" + path + "' has shape " + shape_text(shape) + ", expected " +
+                     std::to_string(expected_cols) + " columns");
   }
 }
 
-void H5File::write_raw(const std::string& path, H5Dtype dtype, const void* data,
-                       const std::vector<hsize_t>& shape, const H5WriteOptions& options) {
+void H5File::write_raw(const std::string& path, H5Dtype dtype, const void* data, const std::vector<hsize_t>& shape,
+                       const H5WriteOptions& options) {
   require_open();
   if (exists(path)) throw std::runtime_error(path_ + ": '" + path + "' already exists");
-  H5Id space(shape.empty() ? H5Screate(H5S_SCALAR)
-                           : H5Screate_simple(int(shape.size()), shape.data(), nullptr),
+  H5Id space(shape.empty() ? H5Screate(H5S_SCALAR) : H5Screate_simple(int(shape.size()), shape.data(), nullptr),
              H5Sclose);
   if (!space.valid()) {
     throw std::runtime_error(path_ + ": bad shape " + shape_text(shape) + " for '" + path + "'");
@@ -375,21 +368,17 @@ void H5File::write_raw(const std::string& path, H5Dtype dtype, const void* data,
     H5Pset_deflate(create.get(), unsigned(std::min(options.gzip_level, 9)));
   }
   H5Id lcpl = link_creation_with_parents();
-  H5Id dataset(H5Dcreate2(file_.get(), path.c_str(), file_type_of(dtype), space.get(), lcpl.get(),
-                          create.get(), H5P_DEFAULT),
-               H5Dclose);
+  H5Id dataset(
+      H5Dcreate2(file_.get(), path.c_str(), file_type_of(dtype), space.get(), lcpl.get(), create.get(), H5P_DEFAULT),
+      H5Dclose);
   if (!dataset.valid()) {
-    throw std::runtime_error(path_ + ": cannot create dataset '" + path + "' (" +
-                             hdf5_error_detail() + ")");
+    throw std::runtime_error(path_ + ": cannot create dataset '" + path + "' (" + hdf5_error_detail() + ")");
   }
-  if (count > 0 &&
-      H5Dwrite(dataset.get(), memory_type_of(dtype), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
-    throw std::runtime_error(path_ + ": writing dataset '" + path + "' failed (" +
-                             hdf5_error_detail() + ")");
+  if (count > 0 && H5Dwrite(dataset.get(), memory_type_of(dtype), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    throw std::runtime_error(path_ + ": writing dataset '" + path + "' failed (" + hdf5_error_detail() + ")");
   }
   if (dataset.close() < 0) {
-    throw std::runtime_error(path_ + ": closing dataset '" + path + "' failed (" +
-                             hdf5_error_detail() + ")");
+    throw std::runtime_error(path_ + ": closing dataset '" + path + "' failed (" + hdf5_error_detail() + ")");
   }
 }
 
@@ -400,8 +389,7 @@ std::vector<hsize_t> H5File::dataset_shape(const std::string& path) const {
   H5Id space(H5Dget_space(dataset.get()), H5Sclose);
   const int rank = H5Sget_simple_extent_ndims(space.get());
   if (rank < 0) {
-    throw InputError(path_ + ": dataset '" + path + "' has an unreadable shape (" +
-                     hdf5_error_detail() + ")");
+    throw InputError(path_ + ": dataset '" + path + "' has an unreadable shape (" + hdf5_error_detail() + ")");
   }
   std::vector<hsize_t> shape(std::size_t(rank), 0);
   if (rank > 0) H5Sget_simple_extent_dims(space.get(), shape.data(), nullptr);
@@ -420,13 +408,11 @@ void H5File::read_raw(const std::string& path, H5Dtype dtype, void* data, std::s
   H5Id space(H5Dget_space(dataset.get()), H5Sclose);
   const hssize_t stored_count = H5Sget_simple_extent_npoints(space.get());
   if (stored_count < 0 || std::size_t(stored_count) != count) {
-    throw InputError(path_ + ": dataset '" + path + "' holds " + std::to_string(stored_count) +
-                     " values, expected " + std::to_string(count));
+    throw InputError(path_ + ": dataset '" + path + "' holds " + std::to_string(stored_count) + " values, expected " +
+                     std::to_string(count));
   }
-  if (count > 0 &&
-      H5Dread(dataset.get(), memory_type_of(dtype), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
-    throw InputError(path_ + ": reading dataset '" + path + "' failed (file corrupt? " +
-                     hdf5_error_detail() + ")");
+  if (count > 0 && H5Dread(dataset.get(), memory_type_of(dtype), H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    throw InputError(path_ + ": reading dataset '" + path + "' failed (file corrupt? " + hdf5_error_detail() + ")");
   }
 }
 
@@ -467,9 +453,9 @@ void H5File::create_chunked_raw(const std::string& path, H5Dtype dtype, const st
     H5Pset_deflate(create.get(), unsigned(std::min(gzip_level, 9)));
   }
   H5Id lcpl = link_creation_with_parents();
-  H5Id dataset(H5Dcreate2(file_.get(), path.c_str(), file_type_of(dtype), space.get(), lcpl.get(), create.get(),
-                          H5P_DEFAULT),
-               H5Dclose);
+  H5Id dataset(
+      H5Dcreate2(file_.get(), path.c_str(), file_type_of(dtype), space.get(), lcpl.get(), create.get(), H5P_DEFAULT),
+      H5Dclose);
   if (!dataset.valid())
     throw std::runtime_error(path_ + ": cannot create dataset '" + path + "' (" + hdf5_error_detail() + ")");
   if (dataset.close() < 0)
@@ -552,8 +538,7 @@ H5Id H5File::open_attribute_for_reading(const std::string& object, const std::st
   }
   H5Id attribute(H5Aopen(target.get(), name.c_str(), H5P_DEFAULT), H5Aclose);
   if (!attribute.valid()) {
-    throw InputError(path_ + ": cannot open " + on_object(name, object) + " (" +
-                     hdf5_error_detail() + ")");
+    throw InputError(path_ + ": cannot open " + on_object(name, object) + " (" + hdf5_error_detail() + ")");
   }
   return attribute;
 }
@@ -574,19 +559,17 @@ H5Id open_for_attribute_write(hid_t file, const std::string& file_path, const st
                               const std::string& name) {
   H5Id target(H5Oopen(file, object.c_str(), H5P_DEFAULT), H5Oclose);
   if (!target.valid()) {
-    throw std::runtime_error(file_path + ": cannot write " + on_object(name, object) +
-                             ", the object does not exist");
+    throw std::runtime_error(file_path + ": cannot write " + on_object(name, object) + ", the object does not exist");
   }
   if (H5Aexists(target.get(), name.c_str()) > 0 && H5Adelete(target.get(), name.c_str()) < 0) {
-    throw std::runtime_error(file_path + ": cannot replace " + on_object(name, object) + " (" +
-                             hdf5_error_detail() + ")");
+    throw std::runtime_error(file_path + ": cannot replace " + on_object(name, object) + " (" + hdf5_error_detail() +
+                             ")");
   }
   return target;
 }
 }  // namespace
 
-void H5File::write_attribute(const std::string& object, const std::string& name,
-                             const std::string& value) {
+void H5File::write_attribute(const std::string& object, const std::string& name, const std::string& value) {
   require_open();
   H5Id target = open_for_attribute_write(file_.get(), path_, object, name);
   // Variable-length UTF-8: the text lives in the global heap, so long
@@ -596,29 +579,23 @@ void H5File::write_attribute(const std::string& object, const std::string& name,
   H5Tset_size(type.get(), H5T_VARIABLE);
   H5Tset_cset(type.get(), H5T_CSET_UTF8);
   H5Id space(H5Screate(H5S_SCALAR), H5Sclose);
-  H5Id attribute(H5Acreate2(target.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT,
-                            H5P_DEFAULT),
-                 H5Aclose);
+  H5Id attribute(H5Acreate2(target.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   const char* text = value.c_str();
   if (!attribute.valid() || H5Awrite(attribute.get(), type.get(), &text) < 0) {
-    throw std::runtime_error(path_ + ": writing " + on_object(name, object) + " failed (" +
-                             hdf5_error_detail() + ")");
+    throw std::runtime_error(path_ + ": writing " + on_object(name, object) + " failed (" + hdf5_error_detail() + ")");
   }
 }
 
-void H5File::write_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,
-                                 const void* data, std::size_t count, bool scalar) {
+void H5File::write_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype, const void* data,
+                                 std::size_t count, bool scalar) {
   require_open();
   H5Id target = open_for_attribute_write(file_.get(), path_, object, name);
   const hsize_t extent = count;
   H5Id space(scalar ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &extent, nullptr), H5Sclose);
-  H5Id attribute(H5Acreate2(target.get(), name.c_str(), file_type_of(dtype), space.get(),
-                            H5P_DEFAULT, H5P_DEFAULT),
+  H5Id attribute(H5Acreate2(target.get(), name.c_str(), file_type_of(dtype), space.get(), H5P_DEFAULT, H5P_DEFAULT),
                  H5Aclose);
-  if (!attribute.valid() ||
-      (count > 0 && H5Awrite(attribute.get(), memory_type_of(dtype), data) < 0)) {
-    throw std::runtime_error(path_ + ": writing " + on_object(name, object) + " failed (" +
-                             hdf5_error_detail() + ")");
+  if (!attribute.valid() || (count > 0 && H5Awrite(attribute.get(), memory_type_of(dtype), data) < 0)) {
+    throw std::runtime_error(path_ + ": writing " + on_object(name, object) + " failed (" + hdf5_error_detail() + ")");
   }
 }
 
@@ -632,24 +609,22 @@ std::size_t H5File::attribute_size(const std::string& object, const std::string&
   return std::size_t(count);
 }
 
-void H5File::read_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,
-                                void* data, std::size_t count, bool scalar) const {
+void H5File::read_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype, void* data,
+                                std::size_t count, bool scalar) const {
   H5Id attribute = open_attribute_for_reading(object, name);
   H5Id stored_type(H5Aget_type(attribute.get()), H5Tclose);
   if (!converts_losslessly(stored_type.get(), dtype)) {
-    throw InputError(path_ + ": " + on_object(name, object) + " holds " +
-                     describe_type(stored_type.get()) + ", expected " + dtype_name(dtype));
+    throw InputError(path_ + ": " + on_object(name, object) + " holds " + describe_type(stored_type.get()) +
+                     ", expected " + dtype_name(dtype));
   }
   H5Id space(H5Aget_space(attribute.get()), H5Sclose);
   const hssize_t stored_count = H5Sget_simple_extent_npoints(space.get());
   if (stored_count < 0 || std::size_t(stored_count) != count) {
-    throw InputError(path_ + ": " + on_object(name, object) + " holds " +
-                     std::to_string(stored_count) + " values, expected " +
-                     (scalar ? std::string("a single value") : std::to_string(count)));
+    throw InputError(path_ + ": " + on_object(name, object) + " holds " + std::to_string(stored_count) +
+                     " values, expected " + (scalar ? std::string("a single value") : std::to_string(count)));
   }
   if (count > 0 && H5Aread(attribute.get(), memory_type_of(dtype), data) < 0) {
-    throw InputError(path_ + ": reading " + on_object(name, object) + " failed (" +
-                     hdf5_error_detail() + ")");
+    throw InputError(path_ + ": reading " + on_object(name, object) + " failed (" + hdf5_error_detail() + ")");
   }
 }
 
@@ -657,16 +632,15 @@ std::string H5File::read_string_attribute(const std::string& object, const std::
   H5Id attribute = open_attribute_for_reading(object, name);
   H5Id stored_type(H5Aget_type(attribute.get()), H5Tclose);
   if (H5Tget_class(stored_type.get()) != H5T_STRING) {
-    throw InputError(path_ + ": " + on_object(name, object) + " holds " +
-                     describe_type(stored_type.get()) + ", expected a string");
+    throw InputError(path_ + ": " + on_object(name, object) + " holds " + describe_type(stored_type.get()) +
+                     ", expected a string");
   }
   H5Id space(H5Aget_space(attribute.get()), H5Sclose);
   if (H5Sget_simple_extent_npoints(space.get()) != 1) {
     throw InputError(path_ + ": " + on_object(name, object) + " is an array, expected one string");
   }
   const auto fail = [&] {
-    return InputError(path_ + ": reading " + on_object(name, object) + " failed (" +
-                      hdf5_error_detail() + ")");
+    return InputError(path_ + ": reading " + on_object(name, object) + " failed (" + hdf5_error_detail() + ")");
   };
   if (H5Tis_variable_str(stored_type.get()) > 0) {
     H5Id memory_type(H5Tcopy(H5T_C_S1), H5Tclose);

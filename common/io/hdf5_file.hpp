@@ -32,12 +32,28 @@ class AtomicFile;
 // The element types a dataset or numeric attribute may have.
 enum class H5Dtype { kFloat64, kInt32, kInt64, kUInt8, kUInt64 };
 
-template <class T> struct H5DtypeOf;  // undefined: T is not a supported element type
-template <> struct H5DtypeOf<double> { static constexpr H5Dtype value = H5Dtype::kFloat64; };
-template <> struct H5DtypeOf<std::int32_t> { static constexpr H5Dtype value = H5Dtype::kInt32; };
-template <> struct H5DtypeOf<std::int64_t> { static constexpr H5Dtype value = H5Dtype::kInt64; };
-template <> struct H5DtypeOf<std::uint8_t> { static constexpr H5Dtype value = H5Dtype::kUInt8; };
-template <> struct H5DtypeOf<std::uint64_t> { static constexpr H5Dtype value = H5Dtype::kUInt64; };
+template <class T>
+struct H5DtypeOf;  // undefined: T is not a supported element type
+template <>
+struct H5DtypeOf<double> {
+  static constexpr H5Dtype value = H5Dtype::kFloat64;
+};
+template <>
+struct H5DtypeOf<std::int32_t> {
+  static constexpr H5Dtype value = H5Dtype::kInt32;
+};
+template <>
+struct H5DtypeOf<std::int64_t> {
+  static constexpr H5Dtype value = H5Dtype::kInt64;
+};
+template <>
+struct H5DtypeOf<std::uint8_t> {
+  static constexpr H5Dtype value = H5Dtype::kUInt8;
+};
+template <>
+struct H5DtypeOf<std::uint64_t> {
+  static constexpr H5Dtype value = H5Dtype::kUInt64;
+};
 
 const char* dtype_name(H5Dtype dtype);  // "float64", "int32", ...
 
@@ -120,15 +136,14 @@ class H5File {
     write_raw(path, H5DtypeOf<T>::value, data, shape, options);
   }
   template <class T>
-  void write_dataset(const std::string& path, const std::vector<T>& values,
-                     const std::vector<hsize_t>& shape, const H5WriteOptions& options = {}) {
+  void write_dataset(const std::string& path, const std::vector<T>& values, const std::vector<hsize_t>& shape,
+                     const H5WriteOptions& options = {}) {
     check_element_count(path, values.size(), shape);
     write_raw(path, H5DtypeOf<T>::value, values.data(), shape, options);
   }
   // Rank-1 dataset of shape (n).
   template <class T>
-  void write_vector(const std::string& path, const std::vector<T>& values,
-                    const H5WriteOptions& options = {}) {
+  void write_vector(const std::string& path, const std::vector<T>& values, const H5WriteOptions& options = {}) {
     write_raw(path, H5DtypeOf<T>::value, values.data(), {hsize_t(values.size())}, options);
   }
   template <class Derived>
@@ -146,8 +161,7 @@ class H5File {
     using Scalar = typename Derived::Scalar;
     using RowMajor = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
     const RowMajor copy = matrix.derived();
-    write_raw(path, H5DtypeOf<Scalar>::value, copy.data(),
-              {hsize_t(copy.rows()), hsize_t(copy.cols())}, options);
+    write_raw(path, H5DtypeOf<Scalar>::value, copy.data(), {hsize_t(copy.rows()), hsize_t(copy.cols())}, options);
   }
 
   // --- datasets written piece by piece (larger than memory) -------------
@@ -206,13 +220,13 @@ class H5File {
   }
   // Requires rank 2 and, when expected_cols >= 0, that many columns.
   template <class T>
-  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_matrix(
-      const std::string& path, Eigen::Index expected_cols = -1, Finite finite = Finite::required) const {
+  Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic> read_matrix(const std::string& path, Eigen::Index expected_cols = -1,
+                                                               Finite finite = Finite::required) const {
     const std::vector<hsize_t> shape = dataset_shape(path);
     check_rank(path, shape, 2);
     if (expected_cols >= 0) check_cols(path, shape, expected_cols);
-    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major(
-        static_cast<Eigen::Index>(shape[0]), static_cast<Eigen::Index>(shape[1]));
+    Eigen::Matrix<T, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major(static_cast<Eigen::Index>(shape[0]),
+                                                                                static_cast<Eigen::Index>(shape[1]));
     read_raw(path, H5DtypeOf<T>::value, row_major.data(), std::size_t(row_major.size()));
     check_finite(path, {}, H5DtypeOf<T>::value, row_major.data(), std::size_t(row_major.size()), finite);
     return row_major;
@@ -228,8 +242,7 @@ class H5File {
     write_attribute_raw(object, name, H5DtypeOf<T>::value, &value, 1, true);
   }
   template <class T>
-  void write_attribute(const std::string& object, const std::string& name,
-                       const std::vector<T>& values) {
+  void write_attribute(const std::string& object, const std::string& name, const std::vector<T>& values) {
     write_attribute_raw(object, name, H5DtypeOf<T>::value, values.data(), values.size(), false);
   }
 
@@ -256,13 +269,11 @@ class H5File {
   H5File(std::string path, H5Id file) : path_(std::move(path)), file_(std::move(file)) {}
 
   static std::size_t element_count(const std::vector<hsize_t>& shape);
-  void check_element_count(const std::string& path, std::size_t count,
-                           const std::vector<hsize_t>& shape) const;
+  void check_element_count(const std::string& path, std::size_t count, const std::vector<hsize_t>& shape) const;
   void check_rank(const std::string& path, const std::vector<hsize_t>& shape, std::size_t rank) const;
-  void check_cols(const std::string& path, const std::vector<hsize_t>& shape,
-                  Eigen::Index expected_cols) const;
-  void write_raw(const std::string& path, H5Dtype dtype, const void* data,
-                 const std::vector<hsize_t>& shape, const H5WriteOptions& options);
+  void check_cols(const std::string& path, const std::vector<hsize_t>& shape, Eigen::Index expected_cols) const;
+  void write_raw(const std::string& path, H5Dtype dtype, const void* data, const std::vector<hsize_t>& shape,
+                 const H5WriteOptions& options);
   void read_raw(const std::string& path, H5Dtype dtype, void* data, std::size_t count) const;
   // InputError naming the file, the dataset (or the attribute `attribute` on
   // `object`) and the first bad index unless every float64 value is finite
@@ -271,14 +282,14 @@ class H5File {
                     std::size_t count, Finite finite) const;
   void create_chunked_raw(const std::string& path, H5Dtype dtype, const std::vector<hsize_t>& shape,
                           const std::vector<hsize_t>& chunk, int gzip_level);
-  void write_slab_raw(const std::string& path, H5Dtype dtype, const void* data,
-                      const std::vector<hsize_t>& offset, const std::vector<hsize_t>& count);
+  void write_slab_raw(const std::string& path, H5Dtype dtype, const void* data, const std::vector<hsize_t>& offset,
+                      const std::vector<hsize_t>& count);
   void read_slab_raw(const std::string& path, H5Dtype dtype, void* data, const std::vector<hsize_t>& offset,
                      const std::vector<hsize_t>& count) const;
-  void write_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,
-                           const void* data, std::size_t count, bool scalar);
-  void read_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype,
-                          void* data, std::size_t count, bool scalar) const;
+  void write_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype, const void* data,
+                           std::size_t count, bool scalar);
+  void read_attribute_raw(const std::string& object, const std::string& name, H5Dtype dtype, void* data,
+                          std::size_t count, bool scalar) const;
   std::size_t attribute_size(const std::string& object, const std::string& name) const;
   H5Id open_object_for_reading(const std::string& object) const;
   H5Id open_attribute_for_reading(const std::string& object, const std::string& name) const;

@@ -40,7 +40,7 @@ int open_regular(const std::string& path, std::uint64_t max_bytes, std::uint64_t
     if (err == ENOENT) throw InputError(path + ": no such file");
     throw InputError(path + ": cannot open for reading (" + std::strerror(err) + ")");
   }
-  struct stat st{};
+  struct stat st {};
   if (::fstat(fd, &st) != 0) {
     const int err = errno;
     ::close(fd);
@@ -94,14 +94,16 @@ std::string read_text_file(const std::string& path, std::uint64_t max_bytes) {
 }
 
 bool same_file(const std::string& a, const std::string& b) {
-  struct stat sa{}, sb{};
+  struct stat sa {
+  }, sb{};
   const bool a_exists = ::stat(a.c_str(), &sa) == 0, b_exists = ::stat(b.c_str(), &sb) == 0;
   if (a_exists && b_exists) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
   if (a_exists != b_exists) return false;
   std::error_code ec_a, ec_b;
   const std::filesystem::path ca = std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec_a);
   const std::filesystem::path cb = std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec_b);
-  if (ec_a || ec_b) return std::filesystem::absolute(a).lexically_normal() == std::filesystem::absolute(b).lexically_normal();
+  if (ec_a || ec_b)
+    return std::filesystem::absolute(a).lexically_normal() == std::filesystem::absolute(b).lexically_normal();
   return ca == cb;
 }
 

@@ -22,7 +22,8 @@ std::string joined(const std::vector<std::string>& names) {
 // a warning) when only that is given.
 std::string present_key(const Config& config, const std::string& key, const std::string& legacy) {
   if (legacy.empty() || !config.has(legacy)) return key;
-  if (config.has(key)) config.fail(legacy, "is the earlier name of " + config.key_path(key) + "; give only one of them");
+  if (config.has(key))
+    config.fail(legacy, "is the earlier name of " + config.key_path(key) + "; give only one of them");
   spdlog::warn("{}: {} is an earlier name; write {}", config.source(), config.key_path(legacy), config.key_path(key));
   return legacy;
 }
@@ -50,7 +51,8 @@ LinearSolverChoice read_linear_solver_choice(const Config& config, const std::ve
   c.kind = current_kind_name(given);
   if (c.kind != given)
     spdlog::warn("{}: {} = {} is an earlier name; write {}", config.source(), c.kind_key, given, c.kind);
-  if (!is_offered(c.kind, offered)) config.fail(kind_key, "linear solver '" + given + "' is unknown here; choose one of " + joined(offered));
+  if (!is_offered(c.kind, offered))
+    config.fail(kind_key, "linear solver '" + given + "' is unknown here; choose one of " + joined(offered));
 
   const std::string tolerance_key = present_key(config, keys.tolerance, keys.legacy_tolerance);
   c.tolerance_key = config.key_path(tolerance_key);

@@ -11,10 +11,14 @@ double read_poissons_ratio(const Config& m, PoissonRange range) {
 
 ElasticConstants read_elastic_constants(const Config& m, PoissonRange range, std::optional<ElasticConstants> fallback) {
   ElasticConstants c;
-  if (fallback && !m.has("E")) c.E = m.get_or<double>("E", fallback->E);
-  else c.E = read_youngs_modulus(m);
-  if (fallback && !m.has("nu")) c.nu = m.get_or<double>("nu", fallback->nu);
-  else c.nu = read_poissons_ratio(m, range);
+  if (fallback && !m.has("E"))
+    c.E = m.get_or<double>("E", fallback->E);
+  else
+    c.E = read_youngs_modulus(m);
+  if (fallback && !m.has("nu"))
+    c.nu = m.get_or<double>("nu", fallback->nu);
+  else
+    c.nu = read_poissons_ratio(m, range);
   return c;
 }
 

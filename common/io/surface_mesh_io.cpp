@@ -153,7 +153,8 @@ TriangleSurface parse_obj(const std::string& text, const std::string& source) {
         corners.push_back(static_cast<int>(zero_based));
       }
       if (corners.size() < 3) throw InputError(where + ": a face needs at least three vertices");
-      for (std::size_t c = 1; c + 1 < corners.size(); ++c) s.triangles.push_back({corners[0], corners[c], corners[c + 1]});
+      for (std::size_t c = 1; c + 1 < corners.size(); ++c)
+        s.triangles.push_back({corners[0], corners[c], corners[c + 1]});
     }
     // vt, vn, g, o, s, l, usemtl, mtllib, ...: not geometry of the volume.
   }

@@ -9,11 +9,11 @@
 #include "io/input_file.hpp"
 
 #ifdef MSFAB_WITH_OPENVDB
-#include <mutex>
-
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
+
+#include <mutex>
 #endif
 
 namespace msfab {
@@ -37,8 +37,9 @@ openvdb::GridBase::Ptr read_named_grid(const std::string& path, const std::strin
     if (names.empty()) throw InputError(path + ": the file holds no grid");
     std::string chosen = name;
     if (chosen.empty()) {
-      if (names.size() > 1) throw InputError(path + ": the file holds " + std::to_string(names.size()) +
-                                             " grids (" + list + "); name one with `grid`");
+      if (names.size() > 1)
+        throw InputError(path + ": the file holds " + std::to_string(names.size()) + " grids (" + list +
+                         "); name one with `grid`");
       chosen = names.front();
     } else if (std::find(names.begin(), names.end(), chosen) == names.end()) {
       throw InputError(path + ": no grid named '" + chosen + "'; the file holds " + list);
@@ -133,7 +134,8 @@ class TypedVolume final : public VolumeView {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     if (inside.empty()) return {lo, hi};
     // Voxel centres sit on integer index coordinates: a voxel spans +-1/2.
-    const openvdb::Vec3d a = inside.min().asVec3d() - openvdb::Vec3d(0.5), b = inside.max().asVec3d() + openvdb::Vec3d(0.5);
+    const openvdb::Vec3d a = inside.min().asVec3d() - openvdb::Vec3d(0.5),
+                         b = inside.max().asVec3d() + openvdb::Vec3d(0.5);
     for (int corner = 0; corner < 8; ++corner) {
       const openvdb::Vec3d q((corner & 1) ? b.x() : a.x(), (corner & 2) ? b.y() : a.y(), (corner & 4) ? b.z() : a.z());
       const openvdb::Vec3d w = grid_->transform().indexToWorld(q);
@@ -216,8 +218,9 @@ std::string VdbVolume::describe() const {
 
 namespace {
 [[noreturn]] void no_openvdb(const std::string& path) {
-  throw InputError(path + ": this build of msfab reads no .vdb files; install libopenvdb-dev and "
-                          "libboost-iostreams-dev (make -f Makefile.pipeline deps) and build again");
+  throw InputError(path +
+                   ": this build of msfab reads no .vdb files; install libopenvdb-dev and "
+                   "libboost-iostreams-dev (make -f Makefile.pipeline deps) and build again");
 }
 }  // namespace
 

@@ -132,7 +132,8 @@ std::vector<int> parse_npy_voxel_ids(const std::string& bytes, const std::string
   if (bytes.size() < 10 || bytes.compare(0, 6, "\x93NUMPY") != 0)
     throw InputError(source + ": not a .npy file (no \\x93NUMPY magic)");
   const int major = static_cast<unsigned char>(bytes[6]);
-  if (major < 1 || major > 3) throw InputError(source + ": .npy format version " + std::to_string(major) + " is not supported");
+  if (major < 1 || major > 3)
+    throw InputError(source + ": .npy format version " + std::to_string(major) + " is not supported");
   std::size_t header_length = 0, header_start = 0;
   if (major == 1) {
     header_length = static_cast<unsigned char>(bytes[8]) | (std::size_t(static_cast<unsigned char>(bytes[9])) << 8);
@@ -149,7 +150,8 @@ std::vector<int> parse_npy_voxel_ids(const std::string& bytes, const std::string
   const std::string descr = descr_text.size() >= 2 ? descr_text.substr(1, descr_text.size() - 2) : descr_text;
   ElementType type;
   if (!parse_descr(descr, type))
-    throw InputError(source + ": dtype '" + descr + "' is not supported (integer or bool ids: u1, i1, b1, u2, i2, u4, i4, u8, i8)");
+    throw InputError(source + ": dtype '" + descr +
+                     "' is not supported (integer or bool ids: u1, i1, b1, u2, i2, u4, i4, u8, i8)");
   const std::string order = dictionary_value(header, "fortran_order", source);
   if (order != "True" && order != "False") throw InputError(source + ": malformed fortran_order '" + order + "'");
   const std::vector<long long> shape = parse_shape(dictionary_value(header, "shape", source), source);

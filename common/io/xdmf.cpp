@@ -63,44 +63,41 @@ const char* attribute_type(const XdmfField& field) {
     case 6: return "Tensor6";
     case 9: return "Tensor";
   }
-  throw std::invalid_argument("XDMF field '" + field.name + "' has " +
-                              std::to_string(field.components) +
+  throw std::invalid_argument("XDMF field '" + field.name + "' has " + std::to_string(field.components) +
                               " components; supported are 1, 3, 6 and 9");
 }
 
-void data_item(std::ostream& out, const std::string& indent, const std::string& dimensions,
-               H5Dtype dtype, const std::string& h5_file, const std::string& dataset) {
-  out << indent << "<DataItem Dimensions=\"" << dimensions << "\" " << number_type(dtype)
-      << " Format=\"HDF\">" << xml_escape(h5_file) << ":" << xml_escape(dataset)
-      << "</DataItem>\n";
+void data_item(std::ostream& out, const std::string& indent, const std::string& dimensions, H5Dtype dtype,
+               const std::string& h5_file, const std::string& dataset) {
+  out << indent << "<DataItem Dimensions=\"" << dimensions << "\" " << number_type(dtype) << " Format=\"HDF\">"
+      << xml_escape(h5_file) << ":" << xml_escape(dataset) << "</DataItem>\n";
 }
 
 void mesh_elements(std::ostream& out, const std::string& indent, const XdmfHexMesh& mesh) {
   out << indent << "<Topology TopologyType=\"Hexahedron\" NumberOfElements=\"" << mesh.n_elems
       << "\" NodesPerElement=\"8\">\n";
-  data_item(out, indent + "  ", std::to_string(mesh.n_elems) + " 8", mesh.connectivity_dtype,
-            mesh.h5_file, mesh.connectivity_dataset);
+  data_item(out, indent + "  ", std::to_string(mesh.n_elems) + " 8", mesh.connectivity_dtype, mesh.h5_file,
+            mesh.connectivity_dataset);
   out << indent << "</Topology>\n";
   out << indent << "<Geometry GeometryType=\"XYZ\">\n";
-  data_item(out, indent + "  ", std::to_string(mesh.n_nodes) + " 3", H5Dtype::kFloat64,
-            mesh.h5_file, mesh.nodes_dataset);
+  data_item(out, indent + "  ", std::to_string(mesh.n_nodes) + " 3", H5Dtype::kFloat64, mesh.h5_file,
+            mesh.nodes_dataset);
   out << indent << "</Geometry>\n";
 }
 
-void field(std::ostream& out, const std::string& indent, const XdmfField& f, const char* center,
-           std::size_t count, const std::string& h5_file) {
+void field(std::ostream& out, const std::string& indent, const XdmfField& f, const char* center, std::size_t count,
+           const std::string& h5_file) {
   const char* type = attribute_type(f);
   std::string dimensions = std::to_string(count);
   if (f.components > 1) dimensions += " " + std::to_string(f.components);
-  out << indent << "<Attribute Name=\"" << xml_escape(f.name) << "\" AttributeType=\"" << type
-      << "\" Center=\"" << center << "\">\n";
+  out << indent << "<Attribute Name=\"" << xml_escape(f.name) << "\" AttributeType=\"" << type << "\" Center=\""
+      << center << "\">\n";
   data_item(out, indent + "  ", dimensions, f.dtype, h5_file, f.dataset);
   out << indent << "</Attribute>\n";
 }
 
-void uniform_grid(std::ostream& out, const std::string& indent, const std::string& name,
-                  const XdmfHexMesh& mesh, const double* time,
-                  const std::vector<XdmfField>& node_fields,
+void uniform_grid(std::ostream& out, const std::string& indent, const std::string& name, const XdmfHexMesh& mesh,
+                  const double* time, const std::vector<XdmfField>& node_fields,
                   const std::vector<XdmfField>& cell_fields) {
   out << indent << "<Grid Name=\"" << xml_escape(name) << "\" GridType=\"Uniform\">\n";
   const std::string inner = indent + "  ";
@@ -123,8 +120,7 @@ const char* kFooter =
 }  // namespace
 
 void write_hex_mesh_xdmf(const std::string& xmf_path, const XdmfHexMesh& mesh,
-                         const std::vector<XdmfField>& node_fields,
-                         const std::vector<XdmfField>& cell_fields) {
+                         const std::vector<XdmfField>& node_fields, const std::vector<XdmfField>& cell_fields) {
   std::ostringstream out;
   out << kHeader;
   uniform_grid(out, "    ", "mesh", mesh, nullptr, node_fields, cell_fields);
@@ -138,8 +134,8 @@ void write_hex_mesh_time_series_xdmf(const std::string& xmf_path, const XdmfHexM
   out << kHeader;
   out << "    <Grid Name=\"time_series\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   for (std::size_t i = 0; i < steps.size(); ++i) {
-    uniform_grid(out, "      ", "step_" + std::to_string(i), mesh, &steps[i].time,
-                 steps[i].node_fields, steps[i].cell_fields);
+    uniform_grid(out, "      ", "step_" + std::to_string(i), mesh, &steps[i].time, steps[i].node_fields,
+                 steps[i].cell_fields);
   }
   out << "    </Grid>\n";
   out << kFooter;

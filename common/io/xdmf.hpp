@@ -24,8 +24,7 @@ inline constexpr std::array<int, 8> kToolkitNodeAtVtkCorner = {0, 4, 6, 2, 1, 5,
 template <class Derived>
 typename Derived::PlainObject hex_connectivity_to_vtk_order(const Eigen::MatrixBase<Derived>& toolkit) {
   if (toolkit.cols() != 8) {
-    throw std::invalid_argument("hex connectivity needs 8 columns, got " +
-                                std::to_string(toolkit.cols()));
+    throw std::invalid_argument("hex connectivity needs 8 columns, got " + std::to_string(toolkit.cols()));
   }
   typename Derived::PlainObject vtk(toolkit.rows(), toolkit.cols());
   for (int v = 0; v < 8; ++v) vtk.col(v) = toolkit.col(kToolkitNodeAtVtkCorner[v]);
@@ -59,8 +58,7 @@ struct XdmfHexMesh {
 // (io/atomic_file.hpp); throws std::runtime_error on I/O failure and
 // std::invalid_argument for an unsupported component count.
 void write_hex_mesh_xdmf(const std::string& xmf_path, const XdmfHexMesh& mesh,
-                         const std::vector<XdmfField>& node_fields,
-                         const std::vector<XdmfField>& cell_fields);
+                         const std::vector<XdmfField>& node_fields, const std::vector<XdmfField>& cell_fields);
 
 struct XdmfTimeStep {
   double time = 0.0;

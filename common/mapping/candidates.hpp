@@ -45,8 +45,8 @@ class KdTree {
   void search_within(int node, const double* q, double r2, std::vector<Neighbour>& out) const;
 
   int n_ = 0, d_ = 0;
-  std::vector<double> xyz_;     // points, row-major
-  std::vector<int> order_;      // point indices, grouped by leaf
+  std::vector<double> xyz_;  // points, row-major
+  std::vector<int> order_;   // point indices, grouped by leaf
   std::vector<Node> nodes_;
 };
 
@@ -55,8 +55,8 @@ std::vector<Neighbour> brute_force_nearest(const MatX& points, const double* q, 
 std::vector<Neighbour> brute_force_within(const MatX& points, const double* q, double radius);
 
 struct CandidateOptions {
-  int k = 16;           // nearest structures per cell (>= 1)
-  double radius = 0;    // > 0: also every structure within this distance
+  int k = 16;         // nearest structures per cell (>= 1)
+  double radius = 0;  // > 0: also every structure within this distance
   // Distances over the moduli and Poisson ratios only, the density (the
   // space's last coordinate) left out: a cell then gets the structures
   // whose stiffness matches, whatever their mass (design_candidates).
@@ -74,7 +74,7 @@ struct CandidateOptions {
 struct CellCandidates {
   std::vector<std::int64_t> offsets;  // cells + 1
   std::vector<std::int32_t> structure;
-  std::vector<double> distance;       // Euclidean, normalized units
+  std::vector<double> distance;  // Euclidean, normalized units
 
   std::int64_t cells() const { return std::int64_t(offsets.size()) - 1; }
   std::int64_t count(std::int64_t c) const { return offsets[c + 1] - offsets[c]; }

@@ -15,17 +15,14 @@ std::vector<std::int32_t> pattern_structures(const CellGrid& grid, const std::ve
   if (pattern.axis < 0 || pattern.axis >= grid.dimension())
     throw std::invalid_argument("pattern_structures: axis outside the grid's dimension");
   if (pattern.thickness < 1) throw std::invalid_argument("pattern_structures: thickness must be >= 1");
-  if (std::int64_t(roles.size()) != grid.cells())
-    throw std::invalid_argument("pattern_structures: one role per cell");
+  if (std::int64_t(roles.size()) != grid.cells()) throw std::invalid_argument("pattern_structures: one role per cell");
   const std::int64_t count = std::int64_t(pattern.structures.size());
   std::vector<std::int32_t> out(std::size_t(grid.cells()), -1);
   for (std::int64_t c = 0; c < grid.cells(); ++c) {
     if (roles[std::size_t(c)] != CellRole::design) continue;
     std::int64_t pick = 0;
     switch (pattern.kind) {
-      case PatternKind::uniform:
-        pick = 0;
-        break;
+      case PatternKind::uniform: pick = 0; break;
       case PatternKind::layers:
         pick = (grid.cell_coords(c)[std::size_t(pattern.axis)] / pattern.thickness) % count;
         break;

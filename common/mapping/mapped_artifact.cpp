@@ -36,8 +36,7 @@ std::string size_problem(const MappedDesign& m) {
 }  // namespace
 
 void write_mapped_artifact(const std::string& path, const MappedDesign& m, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed) {
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
   if (const std::string problem = size_problem(m); !problem.empty())
     throw std::invalid_argument("write_mapped_artifact: " + problem);
   ArtifactWriter out(path, kMappedSchema, kMappedSchemaVersion, executable, config_text, inputs, seed);

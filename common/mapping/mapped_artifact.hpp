@@ -19,21 +19,21 @@ inline constexpr int kMappedSchemaVersion = 1;
 inline constexpr int kMaxTiling = 16;  // copies of a structure per cell edge
 
 struct MappedDesign {
-  std::string space;                       // the design's (and the set's) material space
+  std::string space;  // the design's (and the set's) material space
   std::vector<std::string> property_names;
   int dimension = 2;
-  int nx = 0, ny = 0, nz = 1;              // cells
-  double cell_size = 1.0;                  // cell edge (m)
-  int vx = 0, vy = 0, vz = 1;              // voxels per structure (the structures' size)
+  int nx = 0, ny = 0, nz = 1;  // cells
+  double cell_size = 1.0;      // cell edge (m)
+  int vx = 0, vy = 0, vz = 1;  // voxels per structure (the structures' size)
   // Copies of its structure per cell edge (thesis §3.6: a cell replaced by
   // a tiling of its microstructure, which shrinks the boundary layers the
   // periodic homogenization leaves out): a cell is tiling x vx voxels wide
   // (and tiling x vz high in 3D; a 2D model stays one voxel thick).
   int tiling = 1;
-  std::vector<CellRole> roles;             // per cell, from the design
-  std::vector<std::int32_t> structure;     // per cell, index into the set; -1 for forced empty / solid cells
-  std::vector<std::uint8_t> shift;         // per cell, 1: the half-shifted exemplar
-  std::vector<double> distance;            // per cell, |unit(structure) - unit(target)|; 0 for fixed cells
+  std::vector<CellRole> roles;          // per cell, from the design
+  std::vector<std::int32_t> structure;  // per cell, index into the set; -1 for forced empty / solid cells
+  std::vector<std::uint8_t> shift;      // per cell, 1: the half-shifted exemplar
+  std::vector<double> distance;         // per cell, |unit(structure) - unit(target)|; 0 for fixed cells
   // Per cell, |C(structure) - C(target)|_F / |C(target)|_F with C the
   // space's stiffness tensor of the raw properties: the property gap the
   // printed cell has against what the optimizer used; 0 for fixed cells.
@@ -58,8 +58,7 @@ struct MappedDesign {
 
 // Throws std::invalid_argument for inconsistent sizes (a bug of the caller).
 void write_mapped_artifact(const std::string& path, const MappedDesign& mapped, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed);
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
 // InputError naming the file and field on anything missing or inconsistent.
 MappedDesign read_mapped_artifact(const std::string& path);
 

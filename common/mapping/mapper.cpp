@@ -88,11 +88,11 @@ void check_mapping_inputs(const Design& design, const std::string& design_path, 
       throw InputError(structures_path + ": structure " + std::to_string(i) + " has no finite unit properties");
 }
 
-CellCandidates design_candidates(const Design& design, const MicrostructureSet& set,
-                                 const CandidateOptions& options) {
+CellCandidates design_candidates(const Design& design, const MicrostructureSet& set, const CandidateOptions& options) {
   const Eigen::Index d = design.unit.cols() - (options.stiffness_only ? 1 : 0);
   MatX points(Eigen::Index(set.items.size()), d);
-  for (std::size_t i = 0; i < set.items.size(); ++i) points.row(Eigen::Index(i)) = set.items[i].unit.head(d).transpose();
+  for (std::size_t i = 0; i < set.items.size(); ++i)
+    points.row(Eigen::Index(i)) = set.items[i].unit.head(d).transpose();
   std::vector<bool> wanted(std::size_t(design.cells()));
   for (std::size_t c = 0; c < wanted.size(); ++c) wanted[c] = design.roles[c] == CellRole::design;
   CellCandidates found = find_candidates(design.unit.leftCols(d), wanted, points, options);
@@ -134,8 +134,7 @@ MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& 
 }
 
 MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
-                           const MismatchProblem& problem, const DescentReport& report,
-                           const MapperOptions& options) {
+                           const MismatchProblem& problem, const DescentReport& report, const MapperOptions& options) {
   const int variants = options.half_shift ? 2 : 1;
   MappedDesign m;
   m.space = design.space;
@@ -193,8 +192,7 @@ double relative_stiffness_gap(const MaterialSpace& ms, const VecX& a, const VecX
   return (ms.tensor_2d(a) - Cb).norm() / Cb.norm();
 }
 
-DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped,
-                                    double max_distance) {
+DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped, double max_distance) {
   DistanceSummary s;
   for (std::int64_t c = 0; c < mapped.cells(); ++c) {
     if (mapped.roles[std::size_t(c)] != CellRole::design) continue;

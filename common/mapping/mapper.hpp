@@ -12,8 +12,8 @@
 #include <string>
 
 #include "gamut/material_space.hpp"
-#include "io/config.hpp"
 #include "gamut/microstructure_set.hpp"
+#include "io/config.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapped_artifact.hpp"
 #include "mapping/mismatch.hpp"
@@ -50,8 +50,7 @@ double mapping_peak_bytes(const Design& design, const MicrostructureSet& set, co
 
 // Step 1: the candidates of every design cell (forced empty / solid cells
 // get none), by the cells' `unit` rows against the structures' `unit` rows.
-CellCandidates design_candidates(const Design& design, const MicrostructureSet& set,
-                                 const CandidateOptions& options);
+CellCandidates design_candidates(const Design& design, const MicrostructureSet& set, const CandidateOptions& options);
 
 // Steps 1-2: every cell's options as entries of a face table. Design cell c's
 // option o is candidate o / v of c, half-shifted when o % v == 1, where
@@ -63,22 +62,20 @@ MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& 
 
 // Step 4: the chosen structure, exemplar and distance of every cell.
 MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
-                           const MismatchProblem& problem, const DescentReport& report,
-                           const MapperOptions& options);
+                           const MismatchProblem& problem, const DescentReport& report, const MapperOptions& options);
 
 // How far the candidates are from the targets, over design cells.
 struct DistanceSummary {
   std::int64_t design_cells = 0;
-  std::int64_t far_cells = 0;  // nearest candidate farther than max_distance
-  double max_nearest = 0;      // largest distance to the nearest candidate
-  double max_chosen = 0;       // largest distance to the structure chosen
+  std::int64_t far_cells = 0;        // nearest candidate farther than max_distance
+  double max_nearest = 0;            // largest distance to the nearest candidate
+  double max_chosen = 0;             // largest distance to the structure chosen
   double max_gap = 0, mean_gap = 0;  // property gap (MappedDesign::property_gap) of the chosen structures
 };
 // |C(a) - C(b)|_F / |C(b)|_F for raw properties a (a structure's) and b (a
 // target) of a gamut space (MaterialSpace::tensor_2d / tensor_3d).
 double relative_stiffness_gap(const MaterialSpace& space, const VecX& a, const VecX& b);
 
-DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped,
-                                    double max_distance);
+DistanceSummary summarize_distances(const CellCandidates& candidates, const MappedDesign& mapped, double max_distance);
 
 }  // namespace msfab

@@ -78,9 +78,7 @@ int FaceTable::add(const std::vector<int>& ids) {
   return entries_++;
 }
 
-int FaceTable::add_uniform(int id) {
-  return add(std::vector<int>(std::size_t(vx_) * vy_ * vz_, id));
-}
+int FaceTable::add_uniform(int id) { return add(std::vector<int>(std::size_t(vx_) * vy_ * vz_, id)); }
 
 std::int64_t FaceTable::mismatch(int lower, int upper, int axis) const {
   const std::uint8_t* a = face(lower, 2 * axis + 1);

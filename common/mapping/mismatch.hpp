@@ -57,9 +57,7 @@ class FaceTable {
   int entries() const { return entries_; }
   int dimension() const { return dimension_; }
   int face_size(int axis) const { return face_size_[axis]; }
-  const std::uint8_t* face(int entry, int f) const {
-    return &data_[std::size_t(entry) * stride_ + face_offset_[f]];
-  }
+  const std::uint8_t* face(int entry, int f) const { return &data_[std::size_t(entry) * stride_ + face_offset_[f]]; }
   // Differing voxel pairs between `lower`'s upper face and `upper`'s lower
   // face along `axis`.
   std::int64_t mismatch(int lower, int upper, int axis) const;
@@ -76,8 +74,8 @@ class FaceTable {
 // The total mismatch after each accepted move, [0] the initial value.
 struct DescentReport {
   std::int64_t initial = 0, final = 0;
-  std::int64_t moves = 0;        // accepted changes
-  std::int64_t evaluations = 0;  // cells whose options were all tried
+  std::int64_t moves = 0;             // accepted changes
+  std::int64_t evaluations = 0;       // cells whose options were all tried
   std::vector<std::int64_t> history;  // moves + 1 totals, strictly decreasing
   std::vector<std::int64_t> changed;  // moves + 1 cells, [0] = -1
   double seconds = 0;
@@ -88,8 +86,7 @@ struct DescentReport {
 // at least one per cell; a cell with one option is fixed.
 class MismatchProblem {
  public:
-  MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
-                  std::vector<std::int32_t> options);
+  MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets, std::vector<std::int32_t> options);
 
   const FaceGrid& grid() const { return grid_; }
   const FaceTable& table() const { return table_; }

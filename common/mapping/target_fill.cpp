@@ -6,9 +6,9 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "gamut/material_space.hpp"
 #include "gamut/structure_ops.hpp"
-#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "mapping/candidates.hpp"
 #include "mapping/mapper.hpp"
@@ -27,7 +27,8 @@ Eigen::Index search_columns(const MicrostructureSet& set, const CandidateOptions
 
 MatX unit_points(const MicrostructureSet& set, Eigen::Index columns) {
   MatX points(Eigen::Index(set.items.size()), columns);
-  for (std::size_t i = 0; i < set.items.size(); ++i) points.row(Eigen::Index(i)) = set.items[i].unit.head(columns).transpose();
+  for (std::size_t i = 0; i < set.items.size(); ++i)
+    points.row(Eigen::Index(i)) = set.items[i].unit.head(columns).transpose();
   return points;
 }
 
@@ -116,7 +117,8 @@ std::vector<FillTarget> plan_targets(const Design& design, const MicrostructureS
     for (const Neighbour& n : tree.nearest(query.data(), options.candidates.k)) near.push_back(n.index);
     const auto ranked = by_gap(space, set, near, t.raw);
     t.gap = ranked.front().first;
-    for (int s = 0; s < options.starts && s < int(ranked.size()); ++s) t.starts.push_back(ranked[std::size_t(s)].second);
+    for (int s = 0; s < options.starts && s < int(ranked.size()); ++s)
+      t.starts.push_back(ranked[std::size_t(s)].second);
     targets.push_back(std::move(t));
   }
   return targets;

@@ -47,10 +47,10 @@ struct FillPlanOptions {
 // (the worst uncovered cell and every uncovered cell within
 // cluster_radius of it), and where to start.
 struct FillTarget {
-  VecX unit, raw;                      // the target's properties (raw: MaterialSpace order, moduli in Pa)
-  std::vector<std::int64_t> cells;     // the cells it serves, worst first
-  double gap = 0;                      // the set's best gap for the target itself
-  std::vector<std::int32_t> starts;    // structures of smallest gap to the target, best first
+  VecX unit, raw;                    // the target's properties (raw: MaterialSpace order, moduli in Pa)
+  std::vector<std::int64_t> cells;   // the cells it serves, worst first
+  double gap = 0;                    // the set's best gap for the target itself
+  std::vector<std::int32_t> starts;  // structures of smallest gap to the target, best first
 };
 // Groups are formed worst cell first (ties: lower index), so the plan is
 // one well-defined list. InputError for bad options.
@@ -58,11 +58,11 @@ std::vector<FillTarget> plan_targets(const Design& design, const MicrostructureS
                                      const FillPlanOptions& options);
 
 struct GeneratedStructure {
-  bool found = false;      // a printable structure came out of some start
-  std::vector<int> ids;    // voxel ids, the set's layout
+  bool found = false;    // a printable structure came out of some start
+  std::vector<int> ids;  // voxel ids, the set's layout
   Mat6 C = Mat6::Zero();
-  double rho = 0;          // stiff volume fraction
-  double gap = 0;          // to the target
+  double rho = 0;  // stiff volume fraction
+  double gap = 0;  // to the target
   std::int32_t parent = -1;
 };
 

@@ -29,8 +29,7 @@ VoxelModel::VoxelModel(const MappedDesign& mapped, const MicrostructureSet& set)
       std::int64_t(m_.roles.size()) != m_.cells())
     throw std::invalid_argument("VoxelModel: per-cell arrays of the wrong size");
   for (std::size_t c = 0; c < m_.structure.size(); ++c)
-    if (m_.roles[c] == CellRole::design &&
-        (m_.structure[c] < 0 || std::size_t(m_.structure[c]) >= set.items.size()))
+    if (m_.roles[c] == CellRole::design && (m_.structure[c] < 0 || std::size_t(m_.structure[c]) >= set.items.size()))
       throw InputError("cell " + std::to_string(c) + " maps to structure " + std::to_string(m_.structure[c]) +
                        ", the set holds " + std::to_string(set.items.size()));
 }
@@ -72,8 +71,7 @@ void VoxelModel::layer(std::int64_t z, std::vector<int>& ids) const {
 // Voxel artifact
 
 void write_voxels_artifact(const std::string& path, const VoxelModel& model, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed) {
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
   const MappedDesign& m = model.mapping();
   const int bits = bits_per_voxel(model.max_id());
   const std::size_t layer_voxels = std::size_t(model.nx() * model.ny());
@@ -235,9 +233,12 @@ StlExport write_material_stls(const std::string& stem, const VoxelModel& model) 
         const std::size_t v = std::size_t(X + NX * Y);
         const int id = here[v];
         if (id <= 0) continue;
-        const int across[6] = {X > 0 ? here[v - 1] : 0,       X + 1 < NX ? here[v + 1] : 0,
-                               Y > 0 ? here[v - NX] : 0,      Y + 1 < NY ? here[v + NX] : 0,
-                               below[v],                      above[v]};
+        const int across[6] = {X > 0 ? here[v - 1] : 0,
+                               X + 1 < NX ? here[v + 1] : 0,
+                               Y > 0 ? here[v - NX] : 0,
+                               Y + 1 < NY ? here[v + NX] : 0,
+                               below[v],
+                               above[v]};
         const std::int64_t p[3] = {X, Y, Z};
         for (int f = 0; f < 6; ++f)
           if (across[f] != id) files[std::size_t(id - 1)]->quad(f / 2, f % 2, p, h);

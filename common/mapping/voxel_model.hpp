@@ -65,8 +65,7 @@ inline constexpr int kVoxelsSchemaVersion = 1;
 // first, each layer padded to whole bytes), in gzip chunks, one layer of
 // cells at a time.
 void write_voxels_artifact(const std::string& path, const VoxelModel& model, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed);
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
 
 // Reads a voxel artifact layer by layer.
 class VoxelsReader {

@@ -18,8 +18,8 @@ AnisotropicSpring::AnisotropicSpring(double C, const Vec3& v) : C_(C) {
   if (!v.allFinite() || !(n > 0.0)) {
     std::ostringstream os;
     os.precision(10);
-    os << "anisotropic spring direction v must be finite and nonzero, got (" << v(0) << ", "
-       << v(1) << ", " << v(2) << ")";
+    os << "anisotropic spring direction v must be finite and nonzero, got (" << v(0) << ", " << v(1) << ", " << v(2)
+       << ")";
     throw InputError(os.str());
   }
   v_ = v / n;

@@ -4,7 +4,6 @@
 #include <sstream>
 
 #include "core/errors.hpp"
-
 #include "material/voigt.hpp"
 
 namespace msfab {

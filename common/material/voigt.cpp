@@ -26,8 +26,7 @@ std::string num(double v) {
 
 Vec6 strain_to_voigt(const Mat3& eps) {
   Vec6 e;
-  e << eps(0, 0), eps(1, 1), eps(2, 2), eps(0, 1) + eps(1, 0), eps(1, 2) + eps(2, 1),
-      eps(2, 0) + eps(0, 2);
+  e << eps(0, 0), eps(1, 1), eps(2, 2), eps(0, 1) + eps(1, 0), eps(1, 2) + eps(2, 1), eps(2, 0) + eps(0, 2);
   return e;
 }
 
@@ -41,8 +40,8 @@ Mat3 voigt_to_strain(const Vec6& e) {
 
 Vec6 stress_to_voigt(const Mat3& sigma) {
   Vec6 s;
-  s << sigma(0, 0), sigma(1, 1), sigma(2, 2), 0.5 * (sigma(0, 1) + sigma(1, 0)),
-      0.5 * (sigma(1, 2) + sigma(2, 1)), 0.5 * (sigma(2, 0) + sigma(0, 2));
+  s << sigma(0, 0), sigma(1, 1), sigma(2, 2), 0.5 * (sigma(0, 1) + sigma(1, 0)), 0.5 * (sigma(1, 2) + sigma(2, 1)),
+      0.5 * (sigma(2, 0) + sigma(0, 2));
   return s;
 }
 
@@ -66,16 +65,14 @@ Eigen::Matrix<double, 6, 9> voigt_strain_operator() {
 }
 
 void check_elastic_constants(double E, double nu) {
-  if (!std::isfinite(E) || E <= 0.0)
-    throw InputError("Young's modulus E must be positive and finite, got " + num(E));
+  if (!std::isfinite(E) || E <= 0.0) throw InputError("Young's modulus E must be positive and finite, got " + num(E));
   if (!std::isfinite(nu) || nu <= -1.0 || nu >= 0.5)
     throw InputError("Poisson's ratio nu must lie in (-1, 0.5), got " + num(nu));
 }
 
 Mat6 cubic_C(double E, double nu, double G) {
   check_elastic_constants(E, nu);
-  if (!std::isfinite(G) || G <= 0.0)
-    throw InputError("shear modulus G must be positive and finite, got " + num(G));
+  if (!std::isfinite(G) || G <= 0.0) throw InputError("shear modulus G must be positive and finite, got " + num(G));
   const double Ehat = E / ((1.0 - 2.0 * nu) * (1.0 + nu));
   Mat6 C = Mat6::Zero();
   for (int i = 0; i < 3; ++i) {
@@ -103,14 +100,14 @@ Mat6 orthotropic_C(const OrthotropicConstants& k) {
   const char* names[6] = {"Ex", "Ey", "Ez", "Gxy", "Gyz", "Gzx"};
   for (int i = 0; i < 6; ++i)
     if (!std::isfinite(moduli[i]) || moduli[i] <= 0.0)
-      throw InputError(std::string("orthotropic modulus ") + names[i] +
-                       " must be positive and finite, got " + num(moduli[i]));
+      throw InputError(std::string("orthotropic modulus ") + names[i] + " must be positive and finite, got " +
+                       num(moduli[i]));
   const double ratios[3] = {k.nu_xy, k.nu_yz, k.nu_zx};
   const char* ratio_names[3] = {"nu_xy", "nu_yz", "nu_zx"};
   for (int i = 0; i < 3; ++i)
     if (!std::isfinite(ratios[i]))
-      throw InputError(std::string("orthotropic Poisson's ratio ") + ratio_names[i] +
-                       " must be finite, got " + num(ratios[i]));
+      throw InputError(std::string("orthotropic Poisson's ratio ") + ratio_names[i] + " must be finite, got " +
+                       num(ratios[i]));
   Mat6 S = Mat6::Zero();
   S(0, 0) = 1.0 / k.Ex;
   S(1, 1) = 1.0 / k.Ey;
@@ -125,9 +122,8 @@ Mat6 orthotropic_C(const OrthotropicConstants& k) {
   // check on C below would catch it too, but this message names the cause.
   const Mat3 S_normal = S.topLeftCorner<3, 3>();
   if (!(S_normal.ldlt().vectorD().minCoeff() > 0.0))
-    throw InputError("orthotropic Poisson's ratios (nu_xy=" + num(k.nu_xy) + ", nu_yz=" +
-                     num(k.nu_yz) + ", nu_zx=" + num(k.nu_zx) +
-                     ") give a compliance that is not positive definite");
+    throw InputError("orthotropic Poisson's ratios (nu_xy=" + num(k.nu_xy) + ", nu_yz=" + num(k.nu_yz) +
+                     ", nu_zx=" + num(k.nu_zx) + ") give a compliance that is not positive definite");
   Mat6 C = S.ldlt().solve(Mat6::Identity());
   C = 0.5 * (C + C.transpose());
   check_stiffness(C, "orthotropic stiffness");
@@ -138,8 +134,7 @@ void check_stiffness(const Mat6& C, const std::string& what) {
   if (!C.allFinite()) throw InputError(what + " has a non-finite entry");
   const double scale = C.cwiseAbs().maxCoeff();
   const double asym = (C - C.transpose()).cwiseAbs().maxCoeff();
-  if (asym > 1e-10 * scale)
-    throw InputError(what + " is not symmetric (largest |C_ij - C_ji| = " + num(asym) + ")");
+  if (asym > 1e-10 * scale) throw InputError(what + " is not symmetric (largest |C_ij - C_ji| = " + num(asym) + ")");
   // Pivoted LDL^T: C is positive definite iff every pivot is positive.
   const Mat6 sym = 0.5 * (C + C.transpose());
   const double lo = sym.ldlt().vectorD().minCoeff();

@@ -1,9 +1,9 @@
-#include "parallel/fan_out.hpp"
-
 #include <mpi.h>
 #include <spdlog/spdlog.h>
 
 #include <exception>
+
+#include "parallel/fan_out.hpp"
 
 namespace msfab {
 

@@ -1,8 +1,7 @@
-#include "parallel/mpi_session.hpp"
-
 #include <mpi.h>
 
 #include "parallel/fan_out.hpp"
+#include "parallel/mpi_session.hpp"
 
 namespace msfab {
 

@@ -1,5 +1,9 @@
 #include "scene/scene.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,10 +11,6 @@
 #include <map>
 #include <numeric>
 #include <sstream>
-
-#include <Eigen/Eigenvalues>
-#include <Eigen/Geometry>
-#include <spdlog/spdlog.h>
 
 #include "core/errors.hpp"
 #include "fem/surface_voxelizer.hpp"
@@ -101,9 +101,10 @@ std::string paint_voxel_file(const Config& c, VoxelGrid& grid, const std::vector
     }
     VdbVoxelIds read = read_vdb_voxel_ids(path, c.get_or<std::string>("grid", ""), grid.nx, grid.ny, grid.nz, origin);
     if (read.active_outside > 0)
-      spdlog::warn("{}: {} active voxels lie outside the grid's {} x {} x {} voxels from index ({}, {}, {}) and are "
-                   "cut off",
-                   path, read.active_outside, grid.nx, grid.ny, grid.nz, origin[0], origin[1], origin[2]);
+      spdlog::warn(
+          "{}: {} active voxels lie outside the grid's {} x {} x {} voxels from index ({}, {}, {}) and are "
+          "cut off",
+          path, read.active_outside, grid.nx, grid.ny, grid.nz, origin[0], origin[1], origin[2]);
     ids = std::move(read.ids);
   } else {
     for (const char* key : {"grid", "origin"})
@@ -316,8 +317,8 @@ std::vector<std::string> paint_layout(const Config& config, VoxelGrid& grid,
     } else if (item.has("cylinder")) {
       const Config c = item.child("cylinder");
       const int axis = read_axis(c, "axis");
-      paint_cylinder(grid, axis, read_vec3(c, "center"), c.require_positive("radius"),
-                     c.get_or<double>("from", -1e300), c.get_or<double>("to", 1e300), id_of("id"));
+      paint_cylinder(grid, axis, read_vec3(c, "center"), c.require_positive("radius"), c.get_or<double>("from", -1e300),
+                     c.get_or<double>("to", 1e300), id_of("id"));
     } else if (item.has("helical_fibers")) {
       const Config c = item.child("helical_fibers");
       paint_helical_fibers(grid, read_axis(c, "axis"), read_vec3(c, "center"), c.require_positive("helix_radius"),
@@ -340,13 +341,13 @@ std::vector<std::string> paint_layout(const Config& config, VoxelGrid& grid,
     } else if (item.has("vdb")) {
       files.push_back(paint_vdb_file(item, grid, id_of("id")));
     } else {
-      item.fail("", "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field, "
-                    "voxels, mesh, vdb");
+      item.fail("",
+                "a layout item needs one of: fill, box, layers, cylinder, helical_fibers, checker, random_field, "
+                "voxels, mesh, vdb");
     }
   }
   return files;
 }
-
 
 std::string Region::describe() const {
   std::ostringstream o;
@@ -443,7 +444,8 @@ Scene read_scene(const Config& config) {
     LinearSolverKeys keys;
     keys.legacy_tolerance = "pcg_tolerance";
     keys.legacy_max_iterations = "pcg_max_iterations";
-    const LinearSolverChoice linear = read_linear_solver_choice(c, {"auto", "cholmod", "pcg", "pcg-mg"}, defaults, keys);
+    const LinearSolverChoice linear =
+        read_linear_solver_choice(c, {"auto", "cholmod", "pcg", "pcg-mg"}, defaults, keys);
     o.linear_solver = linear.kind;
     o.linear.pcg_tolerance = linear.tolerance;
     o.linear.pcg_max_iterations = linear.max_iterations;
@@ -566,8 +568,9 @@ StaticConditions build_static_conditions(const Scene& scene, const VoxelMesh& vm
     }
   }
   if (sc.dirichlet.count_fixed() == 0)
-    throw InputError("the scene has no boundary condition: without fixed nodes the stiffness matrix is singular "
-                     "(add a 'boundary' entry with 'fix' or 'displacement')");
+    throw InputError(
+        "the scene has no boundary condition: without fixed nodes the stiffness matrix is singular "
+        "(add a 'boundary' entry with 'fix' or 'displacement')");
   check_rigid_motion_fixed(mesh, sc.dirichlet);
 
   for (const auto& load : scene.loads) {

@@ -23,8 +23,8 @@ struct PaletteEntry {
 // axis-aligned box (physical coordinates, boundaries included).
 struct Region {
   enum class Kind { Face, Box } kind = Kind::Face;
-  int axis = 0;      // face: 0/1/2 for x/y/z
-  bool upper = false;  // face: max side
+  int axis = 0;                               // face: 0/1/2 for x/y/z
+  bool upper = false;                         // face: max side
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // box
   std::string describe() const;
 };
@@ -55,7 +55,7 @@ struct Scene {
   std::vector<Load> loads;
   Vec3 gravity = Vec3::Zero();
   NewtonOptions newton;
-  bool nonlinear = true;  // false when every material is linear
+  bool nonlinear = true;                    // false when every material is linear
   std::vector<std::string> geometry_files;  // voxel arrays and surface meshes the layout read
 };
 

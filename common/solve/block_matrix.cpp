@@ -13,8 +13,7 @@ namespace {
 // Entries of column j occupy [outer[j], column_end(A, j)); uncompressed
 // matrices leave gaps after each column.
 inline Eigen::Index column_end(const SpMat& A, Eigen::Index j) {
-  return A.isCompressed() ? A.outerIndexPtr()[j + 1]
-                          : A.outerIndexPtr()[j] + A.innerNonZeroPtr()[j];
+  return A.isCompressed() ? A.outerIndexPtr()[j + 1] : A.outerIndexPtr()[j] + A.innerNonZeroPtr()[j];
 }
 
 }  // namespace
@@ -46,8 +45,7 @@ BlockMatrix block_pattern(const SpMat& A) {
       }
     }
     std::sort(row.begin(), row.end());
-    M.diagonal[i] = M.row_start[i] +
-                    static_cast<int>(std::lower_bound(row.begin(), row.end(), i) - row.begin());
+    M.diagonal[i] = M.row_start[i] + static_cast<int>(std::lower_bound(row.begin(), row.end(), i) - row.begin());
     M.column.insert(M.column.end(), row.begin(), row.end());
     M.row_start[i + 1] = static_cast<int>(M.column.size());
   }
@@ -71,8 +69,7 @@ void copy_block_values(const SpMat& A, double shift, BlockMatrix& M, int threads
           const int j = inner[k] / 3;
           while (M.column[slot] < j) ++slot;
           // Entry (3j + b, 3i + a) of A is entry (a, b) of block (i, j) by symmetry.
-          M.values[9 * std::size_t(slot) + 3 * std::size_t(a) + std::size_t(inner[k] % 3)] =
-              source[k];
+          M.values[9 * std::size_t(slot) + 3 * std::size_t(a) + std::size_t(inner[k] % 3)] = source[k];
         }
       }
       double* diagonal = M.values.data() + 9 * std::size_t(M.diagonal[i]);

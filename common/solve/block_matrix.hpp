@@ -44,8 +44,7 @@ void parallel_row_ranges(int n, int team, RangeBody&& body) {
 // Block row i of M times x: out[a] = sum_j M_ij(a, :) x_j, with the values
 // taken from `values` (laid out like M.values; float for a compact copy).
 template <class Value>
-inline void block_row_product(const BlockMatrix& M, const Value* values, int i, const double* x,
-                              double out[3]) {
+inline void block_row_product(const BlockMatrix& M, const Value* values, int i, const double* x, double out[3]) {
   double y0 = 0.0, y1 = 0.0, y2 = 0.0;
   const int* column = M.column.data();
   for (int slot = M.row_start[i]; slot < M.row_start[i + 1]; ++slot) {

@@ -49,8 +49,7 @@ inline double start_entry(Eigen::Index i) {
 // inverse[9 i ..] = D_i^-1 for the blocks diagonal[9 i ..]. Returns the
 // number of blocks that are not positive definite (an exact count, so the
 // outcome does not depend on the thread count).
-inline int invert_diagonal_blocks(int rows, const double* diagonal, std::vector<double>& inverse,
-                                  int threads) {
+inline int invert_diagonal_blocks(int rows, const double* diagonal, std::vector<double>& inverse, int threads) {
   inverse.resize(9 * std::size_t(rows));
   const double bad = chunked_reduce(rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
     double count = 0.0;
@@ -58,8 +57,7 @@ inline int invert_diagonal_blocks(int rows, const double* diagonal, std::vector<
       const Mat3 block = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(diagonal + 9 * i);
       const Eigen::LLT<Mat3> llt(block);
       if (llt.info() != Eigen::Success || !block.allFinite()) count += 1.0;
-      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(inverse.data() + 9 * i) =
-          llt.solve(Mat3::Identity());
+      Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(inverse.data() + 9 * i) = llt.solve(Mat3::Identity());
     }
     return count;
   });
@@ -69,23 +67,22 @@ inline int invert_diagonal_blocks(int rows, const double* diagonal, std::vector<
 // Largest eigenvalue of D^-1 A by Lanczos in the D inner product (D^-1 A is
 // self-adjoint there). before_pass(v) runs before each product, as in smooth().
 template <class RowProduct, class BeforePass>
-double estimate_max_eigenvalue(int rows, const double* diagonal, const double* inverse,
-                               RowProduct&& row_product, BeforePass&& before_pass, int threads) {
+double estimate_max_eigenvalue(int rows, const double* diagonal, const double* inverse, RowProduct&& row_product,
+                               BeforePass&& before_pass, int threads) {
   const Eigen::Index n = 3 * Eigen::Index(rows);
   auto d_norm_part = [&](const VecX& u, Eigen::Index begin, Eigen::Index end) {
     double sum = 0.0;
     for (Eigen::Index i = begin; i < end; ++i) {
       const double* m = diagonal + 9 * i;
       const double* x = u.data() + 3 * i;
-      for (int a = 0; a < 3; ++a)
-        sum += x[a] * (m[3 * a] * x[0] + m[3 * a + 1] * x[1] + m[3 * a + 2] * x[2]);
+      for (int a = 0; a < 3; ++a) sum += x[a] * (m[3 * a] * x[0] + m[3 * a + 1] * x[1] + m[3 * a + 2] * x[2]);
     }
     return sum;
   };
   VecX v(n), previous = VecX::Zero(n), w(n);
   for (Eigen::Index i = 0; i < n; ++i) v[i] = start_entry(i);
-  const double norm = std::sqrt(chunked_reduce(
-      rows, threads, [&](Eigen::Index begin, Eigen::Index end) { return d_norm_part(v, begin, end); }));
+  const double norm = std::sqrt(
+      chunked_reduce(rows, threads, [&](Eigen::Index begin, Eigen::Index end) { return d_norm_part(v, begin, end); }));
   if (!(norm > 0.0)) return 1.0;
   v /= norm;
 
@@ -150,8 +147,7 @@ void residual(int rows, RowProduct&& row_product, const VecX& b, const VecX& x, 
 // there and row_product reads it back.
 template <class InverseScalar, class RowProduct, class BeforePass>
 void smooth(int rows, const InverseScalar* inverse, double max_eigenvalue, int degree, RowProduct&& row_product,
-            BeforePass&& before_pass, const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next,
-            int threads) {
+            BeforePass&& before_pass, const VecX& b, VecX& x, bool zero_start, VecX& step, VecX& next, int threads) {
   const double upper = kSafety * max_eigenvalue;
   const double lower = upper / kSmoothingRange;
   const double theta = 0.5 * (upper + lower);

@@ -84,21 +84,22 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
   });
   if (chebyshev::invert_diagonal_blocks(A.rows, diagonal_.data(), inverse_, threads) != 0) return false;
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      A.rows, diagonal_.data(), inverse_.data(),
-      [&](int i, const double* x, double out[3]) { row_product(i, x, out); }, [](const VecX&) {}, threads);
+      A.rows, diagonal_.data(), inverse_.data(), [&](int i, const double* x, double out[3]) { row_product(i, x, out); },
+      [](const VecX&) {}, threads);
   std::vector<double>().swap(diagonal_);  // the smoothing uses the inverses only
   return std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0;
 }
 
 void ChebyshevSmoother::residual(const VecX& b, const VecX& x, VecX& r) const {
-  chebyshev::residual(pattern_->rows, [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, b,
-                      x, r, threads_);
+  chebyshev::residual(
+      pattern_->rows, [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, b, x, r, threads_);
 }
 
 void ChebyshevSmoother::smooth(const VecX& b, VecX& x, bool zero_start) {
-  chebyshev::smooth(pattern_->rows, inverse_.data(), max_eigenvalue_, degree_,
-                    [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, [](const VecX&) {}, b, x,
-                    zero_start, step_, next_, threads_);
+  chebyshev::smooth(
+      pattern_->rows, inverse_.data(), max_eigenvalue_, degree_,
+      [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, [](const VecX&) {}, b, x, zero_start,
+      step_, next_, threads_);
 }
 
 }  // namespace msfab

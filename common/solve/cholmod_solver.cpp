@@ -3,16 +3,16 @@
 #include <cholmod.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <algorithm>
 #include <cstring>
-#include <stdexcept>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/blas_threads.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
@@ -61,8 +61,7 @@ cholmod_sparse lower_triangle_view(const SpMat& A) {
   std::memset(&view, 0, sizeof(view));
   view.nrow = static_cast<size_t>(A.rows());
   view.ncol = static_cast<size_t>(A.cols());
-  view.nzmax = static_cast<size_t>(A.isCompressed() ? A.nonZeros()
-                                                    : A.outerIndexPtr()[A.cols()]);
+  view.nzmax = static_cast<size_t>(A.isCompressed() ? A.nonZeros() : A.outerIndexPtr()[A.cols()]);
   view.p = const_cast<int*>(A.outerIndexPtr());
   view.i = const_cast<int*>(A.innerIndexPtr());
   view.nz = A.isCompressed() ? nullptr : const_cast<int*>(A.innerNonZeroPtr());
@@ -194,9 +193,7 @@ void CholmodSolver::analyze(const SpMat& A) {
                                 ? "; use the 'pcg' linear solver for systems this large"
                                 : ""));
     }
-    ordering_ = c.factor->ordering == CHOLMOD_METIS ? "metis"
-                : c.factor->ordering == CHOLMOD_AMD ? "amd"
-                                                    : "other";
+    ordering_ = c.factor->ordering == CHOLMOD_METIS ? "metis" : c.factor->ordering == CHOLMOD_AMD ? "amd" : "other";
     c.factor_nonzeros = c.common.lnz;
   } else {
     ordering_ = "none";
@@ -243,8 +240,9 @@ void CholmodSolver::analyze_with_last(const SpMat& A, const std::vector<int>& la
     std::vector<int> interior_perm(static_cast<std::size_t>(m));
     int ok = cholmod_metis(&view, nullptr, 0, 1, interior_perm.data(), &c.common);
     if (!ok) ok = cholmod_amd(&view, nullptr, 0, interior_perm.data(), &c.common);
-    if (!ok) throw NumericalError("CHOLMOD ordering of a " + std::to_string(m) + "-unknown block failed: " +
-                                  status_text(c.common.status));
+    if (!ok)
+      throw NumericalError("CHOLMOD ordering of a " + std::to_string(m) +
+                           "-unknown block failed: " + status_text(c.common.status));
     for (int k : interior_perm) perm.push_back(others[std::size_t(k)]);
   }
   perm.insert(perm.end(), last.begin(), last.end());
@@ -352,8 +350,7 @@ VecX CholmodSolver::solve(const VecX& b) {
   if (c.n > 0) {
     cholmod_dense rhs = dense_view(b.data(), b.size(), 1);
     const CholmodThreadScope one_thread;
-    if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e,
-                        &c.common)) {
+    if (!cholmod_solve2(CHOLMOD_A, c.factor, &rhs, nullptr, &c.x, nullptr, &c.y, &c.e, &c.common)) {
       throw NumericalError("CHOLMOD triangular solves failed: " + status_text(c.common.status));
     }
     x = Eigen::Map<const VecX>(static_cast<const double*>(c.x->x), c.n);
@@ -374,8 +371,8 @@ MatX CholmodSolver::solve_columns(const MatX& B) {
   if (!c.factor_ready)
     throw NumericalError("CHOLMOD solve without a valid factorization; factorize with a larger shift first");
   if (B.rows() != c.n)
-    throw std::invalid_argument("CholmodSolver: right-hand sides have " + std::to_string(B.rows()) + " rows, expected " +
-                                std::to_string(c.n));
+    throw std::invalid_argument("CholmodSolver: right-hand sides have " + std::to_string(B.rows()) +
+                                " rows, expected " + std::to_string(c.n));
   MatX X = MatX::Zero(c.n, B.cols());
   if (c.n > 0 && B.cols() > 0) {
     cholmod_dense rhs = dense_view(B.data(), B.rows(), B.cols());

@@ -49,7 +49,7 @@ class CholmodSolver final : public LinearSolver {
 
  private:
   void reset_analysis();  // frees the factor and forgets the analysis
-  struct Cholmod;  // CHOLMOD workspace and factor; keeps cholmod.h out of this header
+  struct Cholmod;         // CHOLMOD workspace and factor; keeps cholmod.h out of this header
   std::unique_ptr<Cholmod> cholmod_;
   LinearSolverOptions options_;
   LinearSolveStats stats_;

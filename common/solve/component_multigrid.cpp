@@ -5,8 +5,8 @@
 #include <stdexcept>
 
 #include "solve/hex_lattice.hpp"
-#include "solve/sparse_ops.hpp"
 #include "solve/multigrid_cycle.hpp"
+#include "solve/sparse_ops.hpp"
 
 namespace msfab {
 namespace {
@@ -71,7 +71,8 @@ std::vector<RowRange> by_ranges(int n, int threads, Body&& body) {
   std::vector<RowRange> ranges(static_cast<std::size_t>(team));
 #pragma omp parallel for schedule(static, 1) num_threads(team)
   for (int t = 0; t < team; ++t) {
-    const int begin = static_cast<int>(std::int64_t(n) * t / team), end = static_cast<int>(std::int64_t(n) * (t + 1) / team);
+    const int begin = static_cast<int>(std::int64_t(n) * t / team),
+              end = static_cast<int>(std::int64_t(n) * (t + 1) / team);
     body(ranges[std::size_t(t)], begin, end);
   }
   return ranges;
@@ -224,12 +225,13 @@ bool ComponentMultigrid::factorize() {
     Level& level = *levels_[l];
     level.decoupled = decoupled_unknowns(level.matrix, threads_);
     if (l + 1 == levels_.size()) break;
-    component_galerkin_product(level.matrix, level.decoupled, components_->transfers()[l + 1],
-                               levels_[l + 1]->matrix, threads_);
+    component_galerkin_product(level.matrix, level.decoupled, components_->transfers()[l + 1], levels_[l + 1]->matrix,
+                               threads_);
     const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * smoother_degree_;
     // A level too large to keep in double is stored by its upper blocks.
     const bool large = level.matrix.num_blocks() > kKeepLevelBlocks;
-    if (!level.smoother.setup(level.matrix, degree, threads_, large ? SmootherValues::single_upper : SmootherValues::single))
+    if (!level.smoother.setup(level.matrix, degree, threads_,
+                              large ? SmootherValues::single_upper : SmootherValues::single))
       return false;
     if (large) std::vector<double>().swap(level.matrix.values);
   }

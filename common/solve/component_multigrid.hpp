@@ -10,7 +10,6 @@
 // factorization on the coarsest level; a fixed symmetric positive definite
 // operator, bitwise deterministic for any thread count.
 #include <Eigen/SparseCholesky>
-
 #include <memory>
 #include <vector>
 

@@ -73,14 +73,13 @@ CgSetup multigrid_cg_setup(std::function<void(const VecX&, VecX&)> multiply,
   return cg;
 }
 
-VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b,
-                        const CgSettings& settings, LinearSolveStats& stats) {
+VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const VecX& b, const CgSettings& settings,
+                        LinearSolveStats& stats) {
   const auto start = std::chrono::steady_clock::now();
   auto record = [&](int iterations, double relative_residual) {
     stats.iterations = iterations;
     stats.relative_residual = relative_residual;
-    stats.solve_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   const int threads = settings.threads;
   const Eigen::Index n = b.size();
@@ -102,11 +101,10 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
   };
   auto not_definite = [&](const std::string& what, double value) {
     stats.positive_definite = false;
-    fail(settings.curvature_label + " met " + what + " = " + format_number(value) +
-         " at iteration " + std::to_string(iteration) +
-         (settings.curvature_message_has_residual
-              ? " (relative residual " + format_number(r_norm / b_norm) + ")"
-              : std::string()) +
+    fail(settings.curvature_label + " met " + what + " = " + format_number(value) + " at iteration " +
+         std::to_string(iteration) +
+         (settings.curvature_message_has_residual ? " (relative residual " + format_number(r_norm / b_norm) + ")"
+                                                  : std::string()) +
          ": the matrix is not positive definite; factorize with a larger shift");
   };
   auto precondition = [&](const VecX& residual, VecX& z) {
@@ -140,13 +138,11 @@ VecX conjugate_gradient(const CgOperator& A, const CgPreconditioner& M, const Ve
       p = z;
     }
     if (iteration >= max_iterations) {
-      fail(settings.label + " did not converge: relative residual " +
-           format_number(r_norm / b_norm) + " after " + std::to_string(iteration) +
-           " iterations (tolerance " + format_number(settings.tolerance) +
+      fail(settings.label + " did not converge: relative residual " + format_number(r_norm / b_norm) + " after " +
+           std::to_string(iteration) + " iterations (tolerance " + format_number(settings.tolerance) +
            ", iteration limit " + std::to_string(max_iterations) +
            (settings.max_iterations_key.empty() ? std::string() : " set by " + settings.max_iterations_key) +
-           "); relative residual every " + std::to_string(history_stride) +
-           " iterations: " + history);
+           "); relative residual every " + std::to_string(history_stride) + " iterations: " + history);
     }
     const double curvature = A.multiply_dot(p, q);
     if (!(curvature > 0.0) || !std::isfinite(curvature)) {

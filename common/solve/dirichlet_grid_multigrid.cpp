@@ -9,13 +9,13 @@
 #include <string>
 #include <utility>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/chebyshev_kernels.hpp"
 #include "solve/component_multigrid.hpp"
-#include "solve/material_components.hpp"
-#include "solve/hex_lattice.hpp"
 #include "solve/conjugate_gradient.hpp"
+#include "solve/hex_lattice.hpp"
+#include "solve/material_components.hpp"
 #include "solve/multigrid_solver.hpp"
 #include "solve/sparse_ops.hpp"
 
@@ -36,8 +36,8 @@ Mat24 interpolation(int pos) {
   for (int c = 0; c < 8; ++c) {
     const double xi[3] = {0.5 * (p[0] + corner_x(c)), 0.5 * (p[1] + corner_y(c)), 0.5 * (p[2] + corner_z(c))};
     for (int A = 0; A < 8; ++A) {
-      const double phi = (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) *
-                         (corner_z(A) ? xi[2] : 1 - xi[2]);
+      const double phi =
+          (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) * (corner_z(A) ? xi[2] : 1 - xi[2]);
       for (int d = 0; d < 3; ++d) P(3 * c + d, 3 * A + d) = phi;
     }
   }
@@ -84,8 +84,7 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
   if (options_.smoother_degree < 1 || options_.smoother_degree > 10)
     throw InputError("matrix-free multigrid: smoother_degree must lie in 1..10");
   const std::int64_t nodes = fine_.nodes();
-  if (nodes > (std::int64_t(1) << 31) / 3)
-    throw InputError("matrix-free multigrid: more than 2^31 unknowns");
+  if (nodes > (std::int64_t(1) << 31) / 3) throw InputError("matrix-free multigrid: more than 2^31 unknowns");
   if (std::int64_t(fixed_.size()) != 3 * nodes)
     throw std::invalid_argument("DirichletGridMultigrid: one fixed flag per unknown");
   coarse_.n[0] = nx / 2, coarse_.n[1] = ny / 2, coarse_.n[2] = nz / 2;
@@ -152,8 +151,7 @@ void DirichletGridMultigrid::set_field(VoxelStiffnessField field) {
     throw InputError("matrix-free multigrid: a field of " + std::to_string(field.nx) + " x " +
                      std::to_string(field.ny) + " x " + std::to_string(field.nz) + " elements for a " +
                      dims_text(fine_.n) + " grid");
-  if (fixed_count_ == 3 * fine_.nodes())
-    throw InputError("every unknown of the grid is fixed: nothing to solve");
+  if (fixed_count_ == 3 * fine_.nodes()) throw InputError("every unknown of the grid is fixed: nothing to solve");
   field_ = std::move(field);
   has_field_ = false;
   if (options_.material_coarse_space) build_material_components();
@@ -353,8 +351,7 @@ void DirichletGridMultigrid::assemble_coarse() {
     options.mg_coarse_unknowns = options_.coarse_unknowns;
     options.mg_smoother_degree = options_.smoother_degree;
     const int NX = coarse_.n[0], NY = coarse_.n[1], NZ = coarse_.n[2];
-    auto positions =
-        std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(coarse_.nodes(), 3);
+    auto positions = std::make_shared<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(coarse_.nodes(), 3);
     for (int k = 0; k <= NZ; ++k)
       for (int j = 0; j <= NY; ++j)
         for (int i = 0; i <= NX; ++i) positions->row(coarse_.node(i, j, k)) << i, j, k;
@@ -433,8 +430,8 @@ void DirichletGridMultigrid::assemble_material_coarse() {
         }
   });
   if (!component_solver_->factorize())
-    throw NumericalError("matrix-free multigrid: a coarse operator that follows the material (" +
-                         dims_text(coarse_.n) + " elements and below) is not positive definite: part of the body "
+    throw NumericalError("matrix-free multigrid: a coarse operator that follows the material (" + dims_text(coarse_.n) +
+                         " elements and below) is not positive definite: part of the body "
                          "is not held by a support");
 }
 
@@ -566,8 +563,8 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
     out[0] = y[0], out[1] = y[1], out[2] = y[2];
   };
   const auto apply = [this](const VecX& x) { multiply_rows(x, product_); };
-  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
-                    true, step_, next_, threads);
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z, true,
+                    step_, next_, threads);
   apply(z);
   // r - A z into product_ itself (each row is read before it is written).
   chebyshev::residual(rows, row_product, r, z, product_, threads);
@@ -577,8 +574,8 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
   else
     coarse_solution_ = coarse_solver_->apply_preconditioner(coarse_rhs_);
   add_prolongation(coarse_solution_, z);
-  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z,
-                    false, step_, next_, threads);
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z, false,
+                    step_, next_, threads);
 }
 
 VecX DirichletGridMultigrid::apply_preconditioner(const VecX& r) {
@@ -630,11 +627,13 @@ SpMat DirichletGridMultigrid::fine_operator() const {
   const int nx = fine_.n[0], ny = fine_.n[1];
   std::vector<Eigen::Triplet<double>> triplets;
   for (std::int64_t e = 0; e < field_.voxels(); ++e) {
-    const int i = static_cast<int>(e % nx), j = static_cast<int>((e / nx) % ny), k = static_cast<int>(e / (std::int64_t(nx) * ny));
+    const int i = static_cast<int>(e % nx), j = static_cast<int>((e / nx) % ny),
+              k = static_cast<int>(e / (std::int64_t(nx) * ny));
     const Mat24 K = field_.element(e);
     std::int64_t dof[24];
     for (int a = 0; a < 8; ++a)
-      for (int d = 0; d < 3; ++d) dof[3 * a + d] = 3 * fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)) + d;
+      for (int d = 0; d < 3; ++d)
+        dof[3 * a + d] = 3 * fine_.node(i + corner_x(a), j + corner_y(a), k + corner_z(a)) + d;
     for (int r = 0; r < 24; ++r)
       for (int c = 0; c < 24; ++c)
         if (!is_fixed(dof[r]) && !is_fixed(dof[c])) triplets.emplace_back(int(dof[r]), int(dof[c]), K(r, c));

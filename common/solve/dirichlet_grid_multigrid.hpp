@@ -44,12 +44,12 @@ class MaterialComponents;
 class MultigridSolver;
 
 struct DirichletMultigridOptions {
-  double tolerance = 1e-8;   // stop when ||b - A x|| <= tolerance ||b||
+  double tolerance = 1e-8;  // stop when ||b - A x|| <= tolerance ||b||
   int max_iterations = 2000;
   std::string max_iterations_key;  // the config key that sets max_iterations, for messages (empty: none)
-  int smoother_degree = 2;   // Chebyshev degree on the grid (matrix products per smoothing)
-  int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
-  int threads = 0;           // 0: the OpenMP default
+  int smoother_degree = 2;         // Chebyshev degree on the grid (matrix products per smoothing)
+  int coarse_unknowns = 3000;      // the assembled hierarchy factors its first level with fewer unknowns
+  int threads = 0;                 // 0: the OpenMP default
   // Coarse spaces that follow the material (solve/material_components.hpp):
   // one copy of a coarse node per connected piece of material in its
   // support, from level 1 down. For voxel models of printed structures
@@ -106,7 +106,9 @@ class DirichletGridMultigrid {
   struct Grid {
     int n[3]{0, 0, 0};  // elements per axis; nodes n + 1
     std::int64_t nodes() const { return std::int64_t(n[0] + 1) * (n[1] + 1) * (n[2] + 1); }
-    std::int64_t node(int i, int j, int k) const { return i + std::int64_t(n[0] + 1) * (j + std::int64_t(n[1] + 1) * k); }
+    std::int64_t node(int i, int j, int k) const {
+      return i + std::int64_t(n[0] + 1) * (j + std::int64_t(n[1] + 1) * k);
+    }
     std::int64_t element(int i, int j, int k) const { return i + std::int64_t(n[0]) * (j + std::int64_t(n[1]) * k); }
   };
   void build_fine_smoother();
@@ -120,8 +122,8 @@ class DirichletGridMultigrid {
   void galerkin_tables(std::vector<Mat24>& P, std::vector<Mat24>& galerkin) const;
   // Adds fine voxel (i, j, k)'s share of its coarse element's matrix,
   // P_pos^T D K_e D P_pos (D: its corners' free unknowns).
-  void add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P,
-                          const std::vector<Mat24>& galerkin, Mat24& KE) const;
+  void add_voxel_galerkin(int i, int j, int k, int pos, const std::vector<Mat24>& P, const std::vector<Mat24>& galerkin,
+                          Mat24& KE) const;
   // Rows from a numbering of the nodes (first[p + 1] > first[p]: node p
   // has row first[p]): the per-row masks and fixed list. NumericalError if
   // a node without a row has a free unknown.
@@ -149,13 +151,13 @@ class DirichletGridMultigrid {
   bool is_fixed(std::int64_t unknown) const { return fixed_[std::size_t(unknown)] != 0; }
 
   Grid fine_, coarse_;
-  std::vector<char> fixed_;                // per grid unknown
+  std::vector<char> fixed_;  // per grid unknown
   std::int64_t fixed_count_ = 0;
-  std::vector<int> own_first_;             // the numbering of every node (lattice coarse space)
+  std::vector<int> own_first_;               // the numbering of every node (lattice coarse space)
   const std::vector<int>* first_ = nullptr;  // own_first_ or the material components' level 0
-  std::vector<std::uint8_t> row_mask_;     // per row: bit d set if component d is fixed
-  std::vector<std::int64_t> fixed_list_;   // the rows' fixed unknowns (3 row + d), ascending
-  std::vector<char> coarse_reached_;       // per coarse unknown: some free fine unknown interpolates it
+  std::vector<std::uint8_t> row_mask_;       // per row: bit d set if component d is fixed
+  std::vector<std::int64_t> fixed_list_;     // the rows' fixed unknowns (3 row + d), ascending
+  std::vector<char> coarse_reached_;         // per coarse unknown: some free fine unknown interpolates it
   DirichletMultigridOptions options_;
   VoxelStiffnessField field_;
   bool has_field_ = false;

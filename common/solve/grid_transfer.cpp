@@ -16,16 +16,12 @@ namespace {
 // lattice order (x fastest), a code >= 13 means a column node >= the row node.
 constexpr int kCenter = 13;
 
-int offset_component(int code, int axis) {
-  return (axis == 0 ? code : axis == 1 ? code / 3 : code / 9) % 3 - 1;
-}
+int offset_component(int code, int axis) { return (axis == 0 ? code : axis == 1 ? code / 3 : code / 9) % 3 - 1; }
 
 // A fine node's box of coarse columns in A P: coarse points floor((c-1)/2)
 // onward, 3 per axis for an even coordinate c and 2 for an odd one.
 int box_extent(int parity_bit) { return parity_bit ? 2 : 3; }
-int box_size(int parity) {
-  return box_extent(parity & 1) * box_extent(parity >> 1 & 1) * box_extent(parity >> 2 & 1);
-}
+int box_size(int parity) { return box_extent(parity & 1) * box_extent(parity >> 1 & 1) * box_extent(parity >> 2 & 1); }
 
 struct EntryList {
   int count = 0;
@@ -50,8 +46,7 @@ const std::array<std::array<EntryList, 27>, 8>& parent_box_entries() {
         for (int w = first[pz][oz]; w <= last[pz][oz]; ++w) {
           for (int v = first[py][oy]; v <= last[py][oy]; ++v) {
             for (int u = first[px][ox]; u <= last[px][ox]; ++u) {
-              list.entry[static_cast<std::size_t>(list.count++)] =
-                  static_cast<std::uint8_t>(u + ex * (v + ey * w));
+              list.entry[static_cast<std::size_t>(list.count++)] = static_cast<std::uint8_t>(u + ex * (v + ey * w));
             }
           }
         }
@@ -92,14 +87,12 @@ const std::array<EntryList, 27>& box_entry_offsets() {
 
 }  // namespace
 
-GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
-                           const BlockMatrix& fine_operator) {
+GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator) {
   const int fine_count = fine.num_nodes();
   const int coarse_count = coarse.num_nodes();
   if (fine_operator.rows != fine_count) {
-    throw std::invalid_argument("GridTransfer: the fine operator has " +
-                                std::to_string(fine_operator.rows) + " block rows for " +
-                                std::to_string(fine_count) + " lattice nodes");
+    throw std::invalid_argument("GridTransfer: the fine operator has " + std::to_string(fine_operator.rows) +
+                                " block rows for " + std::to_string(fine_count) + " lattice nodes");
   }
 
   // Parents and coordinate parities of the fine nodes; offsets of the fine blocks.
@@ -112,8 +105,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
     fine_parity_[f] = static_cast<std::uint8_t>(parity);
     for (int k = c[2] / 2; k <= (c[2] + 1) / 2; ++k) {
       for (int j = c[1] / 2; j <= (c[1] + 1) / 2; ++j) {
-        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i)
-          parent_node_.push_back(coarse.node(i, j, k));
+        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i) parent_node_.push_back(coarse.node(i, j, k));
       }
     }
     parent_start_[f + 1] = static_cast<int>(parent_node_.size());
@@ -127,8 +119,8 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
       const std::array<int, 3>& d = fine.coords[g];
       const int dx = d[0] - c[0], dy = d[1] - c[1], dz = d[2] - c[2];
       if (std::abs(dx) > 1 || std::abs(dy) > 1 || std::abs(dz) > 1) {
-        throw InputError("pcg-mg needs a voxel mesh: the matrix couples nodes " +
-                         std::to_string(f) + " and " + std::to_string(g) +
+        throw InputError("pcg-mg needs a voxel mesh: the matrix couples nodes " + std::to_string(f) + " and " +
+                         std::to_string(g) +
                          ", which are not neighbours on the node lattice (is node_positions "
                          "the rest configuration of this mesh?)");
       }
@@ -142,8 +134,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
   for (int p = 0; p < coarse_count; ++p) {
     const std::array<int, 3>& c = coarse.coords[p];
     for (int code = 0; code < 27; ++code) {
-      const int dx = offset_component(code, 0), dy = offset_component(code, 1),
-                dz = offset_component(code, 2);
+      const int dx = offset_component(code, 0), dy = offset_component(code, 1), dz = offset_component(code, 2);
       const int f = fine.node(2 * c[0] + dx, 2 * c[1] + dy, 2 * c[2] + dz);
       if (f < 0) continue;
       child_node_.push_back(f);
@@ -191,8 +182,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
   for (int p = 0; p < coarse_count; ++p) {
     for (int slot = coarse_.row_start[p]; slot < coarse_.row_start[p + 1]; ++slot) {
       const int q = coarse_.column[slot];
-      const int mirror =
-          slot_of_offset[q][static_cast<std::size_t>(26 - coarse_block_offset_[slot])];
+      const int mirror = slot_of_offset[q][static_cast<std::size_t>(26 - coarse_block_offset_[slot])];
       if (mirror < 0) throw std::logic_error("GridTransfer: the coarse pattern is not symmetric");
       mirror_slot_[slot] = mirror;
     }
@@ -205,9 +195,8 @@ BlockMatrix GridTransfer::coarse_pattern() const {
   return pattern;
 }
 
-void GridTransfer::galerkin_product(const BlockMatrix& fine,
-                                    const std::vector<char>& fine_decoupled, BlockMatrix& coarse,
-                                    int threads) {
+void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
+                                    BlockMatrix& coarse, int threads) {
   const int team = resolve_thread_count(threads);
   const auto& parents = parent_box_entries();
   const auto& box_offsets = box_entry_offsets();
@@ -250,8 +239,7 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
       for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
         const int f = child_node_[k];
         const double weight = child_weight_[k];
-        for (int a = 0; a < 3; ++a)
-          reached[a] = reached[a] || !fine_decoupled[3 * std::size_t(f) + std::size_t(a)];
+        for (int a = 0; a < 3; ++a) reached[a] = reached[a] || !fine_decoupled[3 * std::size_t(f) + std::size_t(a)];
         const EntryList& to_code = box_offsets[child_offset_[k]];
         const double* box = fine_times_p_.data() + 9 * std::size_t(box_start_[f]);
         for (int e = 0; e < to_code.count; ++e) {
@@ -296,8 +284,8 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine,
   });
 }
 
-void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled,
-                                      VecX& coarse, int threads) const {
+void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled, VecX& coarse,
+                                      int threads) const {
   coarse.resize(3 * Eigen::Index(coarse_nodes()));
   parallel_row_ranges(coarse_nodes(), resolve_thread_count(threads), [&](int begin, int end) {
     for (int p = begin; p < end; ++p) {
@@ -306,8 +294,7 @@ void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>&
         const std::size_t f = static_cast<std::size_t>(child_node_[k]);
         const double weight = child_weight_[k];
         for (int a = 0; a < 3; ++a) {
-          if (!fine_decoupled[3 * f + std::size_t(a)])
-            sum[a] += weight * fine[Eigen::Index(3 * f) + a];
+          if (!fine_decoupled[3 * f + std::size_t(a)]) sum[a] += weight * fine[Eigen::Index(3 * f) + a];
         }
       }
       for (int a = 0; a < 3; ++a) coarse[3 * Eigen::Index(p) + a] = sum[a];
@@ -315,8 +302,8 @@ void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>&
   });
 }
 
-void GridTransfer::add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled,
-                                    VecX& fine, int threads) const {
+void GridTransfer::add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled, VecX& fine,
+                                    int threads) const {
   parallel_row_ranges(fine_nodes(), resolve_thread_count(threads), [&](int begin, int end) {
     for (int f = begin; f < end; ++f) {
       const int first = parent_start_[f];
@@ -328,8 +315,7 @@ void GridTransfer::add_prolongation(const VecX& coarse, const std::vector<char>&
         for (int a = 0; a < 3; ++a) sum[a] += coarse[p + a];
       }
       for (int a = 0; a < 3; ++a) {
-        if (!fine_decoupled[3 * std::size_t(f) + std::size_t(a)])
-          fine[3 * Eigen::Index(f) + a] += weight * sum[a];
+        if (!fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) fine[3 * Eigen::Index(f) + a] += weight * sum[a];
       }
     }
   });

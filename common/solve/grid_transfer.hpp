@@ -24,8 +24,7 @@ class GridTransfer {
   // the index tables of the triple product. Throws InputError if the fine
   // pattern couples nodes that are not lattice neighbours (the matrix is not
   // that of a trilinear hex mesh on this lattice).
-  GridTransfer(const NodeLattice& fine, const NodeLattice& coarse,
-               const BlockMatrix& fine_operator);
+  GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator);
 
   // The coarse operator's block pattern (values zero).
   BlockMatrix coarse_pattern() const;
@@ -34,15 +33,13 @@ class GridTransfer {
   // Coarse unknowns that P does not reach at all get a unit diagonal (their
   // rows and columns are zero otherwise). `coarse` must have the coarse
   // pattern. Exactly symmetric; deterministic for any thread count.
-  void galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
-                        BlockMatrix& coarse, int threads);
+  void galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled, BlockMatrix& coarse,
+                        int threads);
 
   // coarse = P^T fine.
-  void restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled, VecX& coarse,
-                          int threads) const;
+  void restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled, VecX& coarse, int threads) const;
   // fine += P coarse.
-  void add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled, VecX& fine,
-                        int threads) const;
+  void add_prolongation(const VecX& coarse, const std::vector<char>& fine_decoupled, VecX& fine, int threads) const;
 
   // P as a sparse matrix (fine unknowns x coarse unknowns), for checks.
   SpMat prolongation(const std::vector<char>& fine_decoupled) const;

@@ -19,8 +19,8 @@ void validate_linear_solver_options(const LinearSolverOptions& options) {
                      std::to_string(options.pcg_max_iterations));
   }
   if (options.pcg_preconditioner != "jacobi" && options.pcg_preconditioner != "block-jacobi3") {
-    throw InputError("linear solver option pcg_preconditioner is '" +
-                     options.pcg_preconditioner + "'; valid: jacobi, block-jacobi3");
+    throw InputError("linear solver option pcg_preconditioner is '" + options.pcg_preconditioner +
+                     "'; valid: jacobi, block-jacobi3");
   }
   if (options.threads < 0) {
     throw InputError("linear solver option threads must be >= 0 (0: OpenMP default), got " +
@@ -30,8 +30,7 @@ void validate_linear_solver_options(const LinearSolverOptions& options) {
 
 std::vector<std::string> linear_solver_names() { return {"cholmod", "pcg", "pcg-mg"}; }
 
-std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name,
-                                                 const LinearSolverOptions& options) {
+std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name, const LinearSolverOptions& options) {
   if (name == "cholmod") return std::make_unique<CholmodSolver>(options);
   if (name == "pcg") return std::make_unique<PcgSolver>(options);
   if (name == "pcg-mg") return std::make_unique<MultigridSolver>(options);

@@ -38,12 +38,12 @@ struct LinearSolverOptions {
 };
 
 struct LinearSolveStats {
-  int iterations = 0;               // CG iterations of the last solve (0 for direct)
-  double relative_residual = 0.0;   // ||b - (A + shift I) x|| / ||b|| of the last solve
-  double analyze_seconds = 0.0;     // last analyze()
-  double factorize_seconds = 0.0;   // last factorize()
-  double solve_seconds = 0.0;       // last solve()
-  bool positive_definite = false;   // last factorize() (PCG: also its last solve)
+  int iterations = 0;              // CG iterations of the last solve (0 for direct)
+  double relative_residual = 0.0;  // ||b - (A + shift I) x|| / ||b|| of the last solve
+  double analyze_seconds = 0.0;    // last analyze()
+  double factorize_seconds = 0.0;  // last factorize()
+  double solve_seconds = 0.0;      // last solve()
+  bool positive_definite = false;  // last factorize() (PCG: also its last solve)
 };
 
 // Usage: analyze(A) once per sparsity pattern, factorize(A, shift) whenever
@@ -79,7 +79,6 @@ std::vector<std::string> linear_solver_names();
 
 // name: "cholmod" | "pcg" | "pcg-mg". Throws InputError for an unknown name or an
 // invalid option, naming the field and the valid choices.
-std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name,
-                                                 const LinearSolverOptions& options = {});
+std::unique_ptr<LinearSolver> make_linear_solver(const std::string& name, const LinearSolverOptions& options = {});
 
 }  // namespace msfab

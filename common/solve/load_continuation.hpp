@@ -16,18 +16,18 @@ struct LoadContinuation {
   // Solves at load factor s (load_step counts attempts from 1); false with
   // `why` set when it did not converge.
   std::function<bool(double s, int load_step, std::string& why)> solve_at;
-  std::function<void()> save;     // the state before an increment
-  std::function<void()> restore;  // back to it after a failure
-  std::function<void(double s)> on_converged;                      // optional
+  std::function<void()> save;                                        // the state before an increment
+  std::function<void()> restore;                                     // back to it after a failure
+  std::function<void(double s)> on_converged;                        // optional
   std::function<void(double s, const std::string& why)> on_halving;  // optional
 };
 
 struct LoadContinuationResult {
   bool converged = false;
-  int load_steps = 0;      // increments tried, failed ones included
-  double failed_at = 0;    // the load factor that failed last (when not converged)
-  int halvings = 0;        // consecutive halvings before the final failure
-  std::string why;         // the final failure's reason
+  int load_steps = 0;    // increments tried, failed ones included
+  double failed_at = 0;  // the load factor that failed last (when not converged)
+  int halvings = 0;      // consecutive halvings before the final failure
+  std::string why;       // the final failure's reason
 };
 
 // When it does not converge, the state is restored to the last converged

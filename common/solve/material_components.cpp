@@ -74,7 +74,8 @@ void coarsen(const int n[3], const std::vector<char>& solid, const ComponentLeve
              ComponentLevel& coarse, ComponentTransfer& transfer) {
   const int s = fine.spacing;
   coarse.spacing = 2 * s;
-  for (int a = 0; a < 3; ++a) coarse.points[a] = fine.points[a] / 2 + 1;  // up to the first even point at or beyond the last
+  for (int a = 0; a < 3; ++a)
+    coarse.points[a] = fine.points[a] / 2 + 1;  // up to the first even point at or beyond the last
   const std::int64_t points = coarse.num_points();
   std::vector<PointPieces> pieces(static_cast<std::size_t>(points));
   const int team = resolve_thread_count(threads);
@@ -135,7 +136,8 @@ void coarsen(const int n[3], const std::vector<char>& solid, const ComponentLeve
     const PointPieces& p = pieces[std::size_t(P)];
     std::copy(p.representative.begin(), p.representative.end(),
               coarse.representative.begin() + coarse.first[std::size_t(P)]);
-    for (const auto& child : p.children) ++transfer.child_start[std::size_t(coarse.first[std::size_t(P)] + child.piece) + 1];
+    for (const auto& child : p.children)
+      ++transfer.child_start[std::size_t(coarse.first[std::size_t(P)] + child.piece) + 1];
   }
   for (int c = 0; c < copies; ++c) transfer.child_start[std::size_t(c) + 1] += transfer.child_start[std::size_t(c)];
   transfer.child.resize(std::size_t(transfer.child_start.back()));
@@ -153,7 +155,8 @@ void coarsen(const int n[3], const std::vector<char>& solid, const ComponentLeve
   const int fine_copies = fine.copies();
   transfer.parent_start.assign(std::size_t(fine_copies) + 1, 0);
   for (int c : transfer.child) ++transfer.parent_start[std::size_t(c) + 1];
-  for (int f = 0; f < fine_copies; ++f) transfer.parent_start[std::size_t(f) + 1] += transfer.parent_start[std::size_t(f)];
+  for (int f = 0; f < fine_copies; ++f)
+    transfer.parent_start[std::size_t(f) + 1] += transfer.parent_start[std::size_t(f)];
   transfer.parent.resize(transfer.child.size());
   transfer.parent_weight.resize(transfer.child.size());
   std::vector<int> cursor(transfer.parent_start.begin(), transfer.parent_start.end() - 1);

@@ -28,11 +28,13 @@ namespace msfab {
 struct ComponentLevel {
   int spacing = 1;
   int points[3]{0, 0, 0};
-  std::vector<int> first;                      // per lattice point (x fastest): its first copy; size points + 1
-  std::vector<std::int64_t> representative;    // per copy: one voxel of its piece
+  std::vector<int> first;                    // per lattice point (x fastest): its first copy; size points + 1
+  std::vector<std::int64_t> representative;  // per copy: one voxel of its piece
 
   int copies() const { return first.empty() ? 0 : first.back(); }
-  std::int64_t point(int i, int j, int k) const { return i + std::int64_t(points[0]) * (j + std::int64_t(points[1]) * k); }
+  std::int64_t point(int i, int j, int k) const {
+    return i + std::int64_t(points[0]) * (j + std::int64_t(points[1]) * k);
+  }
   std::int64_t num_points() const { return std::int64_t(points[0]) * points[1] * points[2]; }
 };
 
@@ -45,7 +47,7 @@ struct ComponentLevel {
 struct ComponentTransfer {
   std::vector<int> parent_start, parent;  // per fine row
   std::vector<float> parent_weight;
-  std::vector<int> child_start, child;    // per coarse copy
+  std::vector<int> child_start, child;  // per coarse copy
   std::vector<float> child_weight;
 
   int fine_rows() const { return static_cast<int>(parent_start.size()) - 1; }

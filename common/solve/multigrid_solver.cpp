@@ -4,16 +4,16 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_smoother.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/grid_transfer.hpp"
+#include "solve/multigrid_cycle.hpp"
 #include "solve/node_lattice.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
-#include "solve/multigrid_cycle.hpp"
 
 namespace msfab {
 
@@ -68,9 +68,8 @@ void MultigridSolver::analyze(const SpMat& A) {
   }
   const Eigen::Index nodes = options_.node_positions->rows();
   if (3 * nodes != A.rows()) {
-    throw InputError("pcg-mg needs a voxel mesh: node_positions has " + std::to_string(nodes) +
-                     " nodes (" + std::to_string(3 * nodes) + " unknowns) but the matrix has " +
-                     std::to_string(A.rows()) + " rows");
+    throw InputError("pcg-mg needs a voxel mesh: node_positions has " + std::to_string(nodes) + " nodes (" +
+                     std::to_string(3 * nodes) + " unknowns) but the matrix has " + std::to_string(A.rows()) + " rows");
   }
 
   auto fine = std::make_unique<Level>();
@@ -82,8 +81,7 @@ void MultigridSolver::analyze(const SpMat& A) {
     Level& level = *levels_.back();
     NodeLattice coarse_lattice = coarsen_lattice(level.lattice);
     // A lattice only one or two points thick in every direction stops shrinking.
-    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes()))
-      break;
+    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes())) break;
     level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix);
     auto coarse = std::make_unique<Level>();
     coarse->matrix = level.to_coarse->coarse_pattern();
@@ -116,8 +114,7 @@ bool MultigridSolver::factorize(const SpMat& A, double shift) {
     Level& level = *levels_[l];
     level.decoupled = decoupled_unknowns(level.matrix, threads);
     if (!level.to_coarse) break;
-    level.to_coarse->galerkin_product(level.matrix, level.decoupled, levels_[l + 1]->matrix,
-                                      threads);
+    level.to_coarse->galerkin_product(level.matrix, level.decoupled, levels_[l + 1]->matrix, threads);
     // Coarse levels are small: smoothing them harder costs little and keeps
     // the under-resolved high-contrast coarse operators from slowing CG down.
     const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * options_.mg_smoother_degree;
@@ -165,9 +162,8 @@ VecX MultigridSolver::apply_preconditioner(const VecX& r) {
     throw NumericalError("pcg-mg preconditioner applied without a successful factorize()");
   }
   if (r.size() != n_) {
-    throw std::invalid_argument("MultigridSolver::apply_preconditioner: vector has " +
-                                std::to_string(r.size()) + " entries, matrix has " +
-                                std::to_string(n_) + " rows");
+    throw std::invalid_argument("MultigridSolver::apply_preconditioner: vector has " + std::to_string(r.size()) +
+                                " entries, matrix has " + std::to_string(n_) + " rows");
   }
   VecX z;
   cycle(0, r, z);
@@ -182,8 +178,9 @@ VecX MultigridSolver::solve(const VecX& b) {
   }
   require_rhs_size(b, n_, "MultigridSolver");
   const int threads = options_.threads;
-  CgSetup cg = multigrid_cg_setup(nullptr, [this](const VecX& r, VecX& z) { cycle(0, r, z); }, options_.pcg_tolerance,
-                                  options_.pcg_max_iterations, threads, "pcg-mg");
+  CgSetup cg = multigrid_cg_setup(
+      nullptr, [this](const VecX& r, VecX& z) { cycle(0, r, z); }, options_.pcg_tolerance, options_.pcg_max_iterations,
+      threads, "pcg-mg");
   cg.settings.max_iterations_key = options_.pcg_max_iterations_key;
   if (n_ > 0) {
     const BlockMatrix& A = levels_.front()->matrix;  // A + shift I
@@ -218,8 +215,7 @@ SpMat MultigridSolver::level_operator(int level) const {
 SpMat MultigridSolver::prolongation(int level) const {
   const Level& fine = *levels_.at(static_cast<std::size_t>(level));
   if (!fine.to_coarse) {
-    throw std::invalid_argument("MultigridSolver::prolongation: level " + std::to_string(level) +
-                                " is the coarsest");
+    throw std::invalid_argument("MultigridSolver::prolongation: level " + std::to_string(level) + " is the coarsest");
   }
   return fine.to_coarse->prolongation(fine.decoupled);
 }

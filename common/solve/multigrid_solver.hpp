@@ -14,7 +14,6 @@
 // operator, so plain CG applies. Every kernel is OpenMP-parallel and
 // bitwise deterministic for any thread count.
 #include <Eigen/SparseCholesky>
-
 #include <cstdint>
 #include <memory>
 #include <vector>

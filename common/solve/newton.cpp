@@ -7,8 +7,8 @@
 #include <memory>
 #include <sstream>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/load_continuation.hpp"
 #include "solve/regularized_step.hpp"
 
@@ -75,8 +75,7 @@ std::string static_linear_solver(double dofs, const NewtonOptions& options) {
 
 double static_solve_peak_bytes(double elements, double dofs, const NewtonOptions& options) {
   const double assembled = 10e3 * elements;
-  return static_linear_solver(dofs, options) == "cholmod" ? assembled + 1e3 * std::pow(elements, 4.0 / 3.0)
-                                                          : assembled;
+  return static_linear_solver(dofs, options) == "cholmod" ? assembled + 1e3 * std::pow(elements, 4.0 / 3.0) : assembled;
 }
 
 namespace {
@@ -97,11 +96,18 @@ class StaticNewton {
         X_(assembler.rest_positions()),
         length_scale_((assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm()),
         K_(assembler.pattern()),
-        g_(n_), gap_(n_), rhs_(n_), dx_(n_), Kgap_(n_), g_trial_(n_), trial_(n_) {
+        g_(n_),
+        gap_(n_),
+        rhs_(n_),
+        dx_(n_),
+        Kgap_(n_),
+        g_trial_(n_),
+        trial_(n_) {
     LinearSolverOptions linear = options.linear;
     const std::string solver_name = static_linear_solver(n_, options);
     if (solver_name == "pcg-mg" && !linear.node_positions)
-      linear.node_positions = std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
+      linear.node_positions =
+          std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
     solver_ = make_linear_solver(solver_name, linear);
     spdlog::debug("linear solver: {}", solver_->name());
     const auto t0 = Clock::now();
@@ -244,9 +250,10 @@ bool StaticNewton::at(double s, int step, std::string& why) {
     // solution, and more iterations only redraw the noise.
     if (gap_closed && stagnant_steps >= 2) {
       add_record(rec);
-      spdlog::warn("Newton: the residual stagnates at {:.2e}, the round-off level of this problem, above the "
-                   "tolerance {:.1e}; accepted as converged",
-                   residual, options_.relative_tolerance);
+      spdlog::warn(
+          "Newton: the residual stagnates at {:.2e}, the round-off level of this problem, above the "
+          "tolerance {:.1e}; accepted as converged",
+          residual, options_.relative_tolerance);
       return true;
     }
     if (it == options_.max_iterations) {
@@ -263,7 +270,8 @@ bool StaticNewton::at(double s, int step, std::string& why) {
     const RegularizedStep regularized = solve_regularized_step(
         *solver_, K_, diag,
         [&](double shift, VecX& b) {
-          for (int i = 0; i < n_; ++i) b[i] = fixed_[i] ? (diag + shift) * gap_[i] : -g_[i] - (gap_norm > 0 ? Kgap_[i] : 0.0);
+          for (int i = 0; i < n_; ++i)
+            b[i] = fixed_[i] ? (diag + shift) * gap_[i] : -g_[i] - (gap_norm > 0 ? Kgap_[i] : 0.0);
         },
         [&](VecX& candidate) {
           double slope = 0;
@@ -308,11 +316,10 @@ bool StaticNewton::at(double s, int step, std::string& why) {
   return false;
 }
 
-
 }  // namespace
 
-NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
-                          const VecX& force, const NewtonOptions& options, const VecX& x0) {
+NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet, const VecX& force,
+                          const NewtonOptions& options, const VecX& x0) {
   const auto t_start = Clock::now();
   const int n = assembler.num_dofs();
   if (static_cast<int>(dirichlet.fixed.size()) != n || dirichlet.displacement.size() != n || force.size() != n)

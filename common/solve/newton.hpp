@@ -20,9 +20,7 @@ struct DirichletConditions {
   std::vector<char> fixed;  // per DOF: 1 if prescribed
   VecX displacement;        // per DOF: displacement at full load (read where fixed)
 
-  static DirichletConditions none(int num_dofs) {
-    return {std::vector<char>(num_dofs, 0), VecX::Zero(num_dofs)};
-  }
+  static DirichletConditions none(int num_dofs) { return {std::vector<char>(num_dofs, 0), VecX::Zero(num_dofs)}; }
   int count_fixed() const;
 };
 
@@ -51,10 +49,10 @@ struct NewtonIteration {
   int load_step = 0;
   double load_factor = 0;
   int iteration = 0;
-  double residual = 0;           // ||free residual|| / force scale
-  double energy = 0;             // total potential
-  double step_length = 0;        // accepted line-search step
-  double shift = 0;              // diagonal regularization used (0 if none)
+  double residual = 0;     // ||free residual|| / force scale
+  double energy = 0;       // total potential
+  double step_length = 0;  // accepted line-search step
+  double shift = 0;        // diagonal regularization used (0 if none)
   int linear_iterations = 0;
 };
 
@@ -66,21 +64,21 @@ struct NewtonTimings {
 };
 
 struct NewtonResult {
-  VecX x;                      // final positions
+  VecX x;  // final positions
   bool converged = false;
   int iterations = 0;
   int load_steps = 0;
   std::vector<NewtonIteration> history;
   NewtonTimings timings;
-  std::string failure;         // why it stopped, when not converged
+  std::string failure;  // why it stopped, when not converged
 };
 
 // Solves for equilibrium under external nodal forces `force` (full load)
 // and `dirichlet`. Starts from x0 (rest positions if empty). Never throws
 // on non-convergence: the result says converged = false with the reason
 // and the residual history, and callers decide (stages exit with code 3).
-NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
-                          const VecX& force, const NewtonOptions& options, const VecX& x0 = VecX());
+NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet, const VecX& force,
+                          const NewtonOptions& options, const VecX& x0 = VecX());
 
 // The linear solver solve_static runs for `dofs` unknowns: options'
 // linear_solver with "auto" resolved by auto_iterative_dofs.

@@ -11,14 +11,11 @@ namespace msfab {
 
 namespace {
 
-[[noreturn]] void not_a_lattice(const std::string& why) {
-  throw InputError("pcg-mg needs a voxel mesh: " + why);
-}
+[[noreturn]] void not_a_lattice(const std::string& why) { throw InputError("pcg-mg needs a voxel mesh: " + why); }
 
 std::string format_point(const NodePositions& positions, Eigen::Index node) {
   char text[96];
-  std::snprintf(text, sizeof(text), "(%.9g, %.9g, %.9g)", positions(node, 0), positions(node, 1),
-                positions(node, 2));
+  std::snprintf(text, sizeof(text), "(%.9g, %.9g, %.9g)", positions(node, 0), positions(node, 1), positions(node, 2));
   return text;
 }
 
@@ -56,14 +53,12 @@ NodeLattice lattice_from_positions(const NodePositions& positions) {
     const double points = std::round((high[axis] - low[axis]) / spacing[axis]) + 1.0;
     lattice.dims[axis] = static_cast<int>(std::min(points, 2e9));
   }
-  const double lattice_points =
-      double(lattice.dims[0]) * double(lattice.dims[1]) * double(lattice.dims[2]);
+  const double lattice_points = double(lattice.dims[0]) * double(lattice.dims[1]) * double(lattice.dims[2]);
   // A voxel mesh fills a good part of its bounding box; a scattered point
   // set would make the dense point -> node map (and the hierarchy) useless.
   if (lattice_points > 64.0 * double(n) + 1e6) {
-    not_a_lattice("the " + std::to_string(n) + " nodes would need a lattice of " +
-                  std::to_string(lattice.dims[0]) + " x " + std::to_string(lattice.dims[1]) +
-                  " x " + std::to_string(lattice.dims[2]) +
+    not_a_lattice("the " + std::to_string(n) + " nodes would need a lattice of " + std::to_string(lattice.dims[0]) +
+                  " x " + std::to_string(lattice.dims[1]) + " x " + std::to_string(lattice.dims[2]) +
                   " points (their smallest coordinate gaps are not a common spacing)");
   }
 
@@ -76,19 +71,18 @@ NodeLattice lattice_from_positions(const NodePositions& positions) {
       const double rounded = std::round(t);
       if (std::abs(t - rounded) > 1e-6) {
         not_a_lattice("node " + std::to_string(node) + " at " + format_point(positions, node) +
-                      " is off the regular lattice of spacing (" + std::to_string(spacing[0]) +
-                      ", " + std::to_string(spacing[1]) + ", " + std::to_string(spacing[2]) + ")");
+                      " is off the regular lattice of spacing (" + std::to_string(spacing[0]) + ", " +
+                      std::to_string(spacing[1]) + ", " + std::to_string(spacing[2]) + ")");
       }
       c[axis] = static_cast<int>(rounded);
     }
-    const std::size_t point =
-        static_cast<std::size_t>(c[0]) +
-        static_cast<std::size_t>(lattice.dims[0]) *
-            (static_cast<std::size_t>(c[1]) + static_cast<std::size_t>(lattice.dims[1]) * c[2]);
+    const std::size_t point = static_cast<std::size_t>(c[0]) +
+                              static_cast<std::size_t>(lattice.dims[0]) *
+                                  (static_cast<std::size_t>(c[1]) + static_cast<std::size_t>(lattice.dims[1]) * c[2]);
     int& slot = lattice.node_at[point];
     if (slot >= 0) {
-      not_a_lattice("nodes " + std::to_string(slot) + " and " + std::to_string(node) +
-                    " share the position " + format_point(positions, node));
+      not_a_lattice("nodes " + std::to_string(slot) + " and " + std::to_string(node) + " share the position " +
+                    format_point(positions, node));
     }
     slot = static_cast<int>(node);
   }
@@ -101,8 +95,7 @@ NodeLattice coarsen_lattice(const NodeLattice& fine) {
     // Fine coordinate m needs coarse points floor(m/2) and ceil(m/2).
     coarse.dims[axis] = fine.dims[axis] / 2 + 1;
   }
-  const std::size_t points =
-      static_cast<std::size_t>(coarse.dims[0]) * coarse.dims[1] * coarse.dims[2];
+  const std::size_t points = static_cast<std::size_t>(coarse.dims[0]) * coarse.dims[1] * coarse.dims[2];
   coarse.node_at.assign(points, -1);
   auto point_index = [&](int i, int j, int k) {
     return static_cast<std::size_t>(i) +

@@ -1,13 +1,12 @@
 #include "solve/pcg_solver.hpp"
 
 #include <Eigen/Cholesky>
-
 #include <chrono>
 #include <cmath>
 #include <string>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/conjugate_gradient.hpp"
 #include "solve/solver_checks.hpp"
 #include "solve/sparse_ops.hpp"
@@ -17,9 +16,7 @@ namespace msfab {
 // Chunks hold whole 3x3 node blocks, so block-Jacobi can work chunk by chunk.
 static_assert(kReductionChunk % 3 == 0, "reduction chunks must hold whole node blocks");
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 PcgSolver::PcgSolver(const LinearSolverOptions& options)
     : options_(options), block_jacobi_(options.pcg_preconditioner == "block-jacobi3") {
@@ -31,8 +28,10 @@ void PcgSolver::analyze(const SpMat& A) {
   require_square(A, "PcgSolver");
   const Eigen::Index n = A.rows();
   if (block_jacobi_ && n % 3 != 0) {
-    throw InputError("linear solver option pcg_preconditioner 'block-jacobi3' needs a multiple "
-                     "of 3 unknowns (3 per node), but the system has " + std::to_string(n));
+    throw InputError(
+        "linear solver option pcg_preconditioner 'block-jacobi3' needs a multiple "
+        "of 3 unknowns (3 per node), but the system has " +
+        std::to_string(n));
   }
   stats_ = LinearSolveStats{};
   matrix_ = nullptr;
@@ -66,28 +65,27 @@ bool PcgSolver::factorize(const SpMat& A, double shift) {
   const int block = block_jacobi_ ? 3 : 1;
   // Count of blocks that are not positive definite; an integer sum is exact,
   // so the outcome does not depend on the thread count.
-  const double bad_blocks =
-      chunked_reduce(n_ / block, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
-        double bad = 0.0;
-        for (Eigen::Index k = begin; k < end; ++k) {
-          if (!block_jacobi_) {
-            const double d = entry(static_cast<std::size_t>(k)) + shift;
-            if (!(d > 0.0) || !std::isfinite(d)) bad += 1.0;
-            inverse_[static_cast<std::size_t>(k)] = 1.0 / d;
-            continue;
-          }
-          Mat3 diagonal_block;
-          for (int a = 0; a < 9; ++a) {
-            diagonal_block(a) = entry(static_cast<std::size_t>(9 * k + a));
-          }
-          diagonal_block.diagonal().array() += shift;
-          const Eigen::LLT<Mat3> llt(diagonal_block);
-          if (llt.info() != Eigen::Success || !diagonal_block.allFinite()) bad += 1.0;
-          const Mat3 inverse = llt.solve(Mat3::Identity());
-          for (int a = 0; a < 9; ++a) inverse_[static_cast<std::size_t>(9 * k + a)] = inverse(a);
-        }
-        return bad;
-      });
+  const double bad_blocks = chunked_reduce(n_ / block, options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
+    double bad = 0.0;
+    for (Eigen::Index k = begin; k < end; ++k) {
+      if (!block_jacobi_) {
+        const double d = entry(static_cast<std::size_t>(k)) + shift;
+        if (!(d > 0.0) || !std::isfinite(d)) bad += 1.0;
+        inverse_[static_cast<std::size_t>(k)] = 1.0 / d;
+        continue;
+      }
+      Mat3 diagonal_block;
+      for (int a = 0; a < 9; ++a) {
+        diagonal_block(a) = entry(static_cast<std::size_t>(9 * k + a));
+      }
+      diagonal_block.diagonal().array() += shift;
+      const Eigen::LLT<Mat3> llt(diagonal_block);
+      if (llt.info() != Eigen::Success || !diagonal_block.allFinite()) bad += 1.0;
+      const Mat3 inverse = llt.solve(Mat3::Identity());
+      for (int a = 0; a < 9; ++a) inverse_[static_cast<std::size_t>(9 * k + a)] = inverse(a);
+    }
+    return bad;
+  });
   stats_.positive_definite = bad_blocks == 0.0;
   stats_.factorize_seconds = seconds_since(start);
   if (!stats_.positive_definite) return false;
@@ -96,8 +94,7 @@ bool PcgSolver::factorize(const SpMat& A, double shift) {
   return true;
 }
 
-double PcgSolver::precondition(const double* r, double* z, Eigen::Index begin,
-                               Eigen::Index end) const {
+double PcgSolver::precondition(const double* r, double* z, Eigen::Index begin, Eigen::Index end) const {
   const double* inverse = inverse_.data();
   double rz = 0.0;
   if (!block_jacobi_) {
@@ -135,13 +132,10 @@ VecX PcgSolver::solve(const VecX& b) {
   const int threads = options_.threads;
   CgOperator op;
   op.multiply = [&](const VecX& x, VecX& y) { symmetric_spmv(A, x, y, shift_, threads); };
-  op.multiply_dot = [&](const VecX& x, VecX& y) {
-    return symmetric_spmv_dot(A, x, y, shift_, threads);
-  };
+  op.multiply_dot = [&](const VecX& x, VecX& y) { return symmetric_spmv_dot(A, x, y, shift_, threads); };
   CgPreconditioner preconditioner;
   preconditioner.apply = [this](const VecX& r, VecX& z) { return apply_preconditioner(r, z); };
-  preconditioner.apply_chunk = [this](const double* r, double* z, Eigen::Index begin,
-                                      Eigen::Index end) {
+  preconditioner.apply_chunk = [this](const double* r, double* z, Eigen::Index begin, Eigen::Index end) {
     return precondition(r, z, begin, end);
   };
   CgSettings settings;

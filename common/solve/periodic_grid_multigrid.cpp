@@ -1,22 +1,22 @@
 #include "solve/periodic_grid_multigrid.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
 #include <utility>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/block_matrix.hpp"
 #include "solve/chebyshev_kernels.hpp"
-#include "solve/hex_lattice.hpp"
 #include "solve/chebyshev_smoother.hpp"
 #include "solve/conjugate_gradient.hpp"
-#include "solve/sparse_ops.hpp"
+#include "solve/hex_lattice.hpp"
 #include "solve/multigrid_cycle.hpp"
-
-#include <spdlog/spdlog.h>
+#include "solve/sparse_ops.hpp"
 
 namespace msfab {
 namespace {
@@ -25,7 +25,6 @@ namespace {
 // W-cycle below the finest level) costs little and keeps the high-contrast
 // coarse operators from slowing CG down.
 using namespace multigrid_cycle;
-
 
 using namespace hex_lattice;
 
@@ -54,10 +53,10 @@ struct PeriodicGridMultigrid::Level {
   std::array<int, 3> n{0, 0, 0};  // nodes = elements per axis
   int scale = 1;                  // voxels per element edge
   bool coarsest = false;
-  BlockMatrix matrix;             // assembled operator (levels between the finest and the coarsest)
-  std::vector<int> slot;          // 27 per node: slot of the block at each lattice offset
+  BlockMatrix matrix;     // assembled operator (levels between the finest and the coarsest)
+  std::vector<int> slot;  // 27 per node: slot of the block at each lattice offset
   ChebyshevSmoother smoother;
-  VecX rhs, solution, residual;   // cycle workspace
+  VecX rhs, solution, residual;  // cycle workspace
 
   int nodes() const { return n[0] * n[1] * n[2]; }
   int node(int i, int j, int k) const {
@@ -123,8 +122,8 @@ PeriodicGridMultigrid::PeriodicGridMultigrid(VoxelStiffnessField field, const Pe
   if (chebyshev::invert_diagonal_blocks(nodes, fine_diagonal_.data(), fine_inverse_, options_.threads) != 0)
     throw NumericalError("periodic multigrid: a node's diagonal stiffness block is not positive definite");
   fine_max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
-      nodes, fine_diagonal_.data(), fine_inverse_.data(), fine_rows(), [this](const VecX& x) { multiply(x, fine_product_); },
-      options_.threads);
+      nodes, fine_diagonal_.data(), fine_inverse_.data(), fine_rows(),
+      [this](const VecX& x) { multiply(x, fine_product_); }, options_.threads);
   if (!(fine_max_eigenvalue_ > 0) || !std::isfinite(fine_max_eigenvalue_))
     throw NumericalError("periodic multigrid: no usable eigenvalue bound for the smoother");
 
@@ -146,8 +145,8 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
     for (int c = 0; c < 8; ++c) {
       const double xi[3] = {double(pi + corner_x(c)) / s, double(pj + corner_y(c)) / s, double(pk + corner_z(c)) / s};
       for (int A = 0; A < 8; ++A) {
-        const double phi = (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) *
-                           (corner_z(A) ? xi[2] : 1 - xi[2]);
+        const double phi =
+            (corner_x(A) ? xi[0] : 1 - xi[0]) * (corner_y(A) ? xi[1] : 1 - xi[1]) * (corner_z(A) ? xi[2] : 1 - xi[2]);
         for (int d = 0; d < 3; ++d) P(3 * c + d, 3 * A + d) = phi;
       }
     }
@@ -164,7 +163,8 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
       const Mat24 K = coarse_element(l, e, galerkin);
       const auto c = level.coords(e);
       int corner_node[8];
-      for (int a = 0; a < 8; ++a) corner_node[a] = level.node(c[0] + corner_x(a), c[1] + corner_y(a), c[2] + corner_z(a));
+      for (int a = 0; a < 8; ++a)
+        corner_node[a] = level.node(c[0] + corner_x(a), c[1] + corner_y(a), c[2] + corner_z(a));
       for (int a = 0; a < 8; ++a)
         for (int b = 0; b < 8; ++b)
           for (int r = 0; r < 3; ++r)
@@ -229,7 +229,7 @@ void PeriodicGridMultigrid::build_level(std::size_t l) {
     }
   }
   if (!level.smoother.setup(M, kCoarseDegreeFactor * options_.smoother_degree, options_.threads,
-                              single_precision_smoothers_ ? SmootherValues::single : SmootherValues::double_values))
+                            single_precision_smoothers_ ? SmootherValues::single : SmootherValues::double_values))
     throw NumericalError("periodic multigrid: a diagonal block of level " + std::to_string(l) + " (" +
                          dims_text(level.n) + ") is not positive definite");
 }
@@ -243,7 +243,8 @@ Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element,
   for (int pk = 0; pk < s; ++pk)
     for (int pj = 0; pj < s; ++pj)
       for (int pi = 0; pi < s; ++pi) {
-        const std::int64_t v = (s * c[0] + pi) + std::int64_t(field_.nx) * ((s * c[1] + pj) + std::int64_t(field_.ny) * (s * c[2] + pk));
+        const std::int64_t v =
+            (s * c[0] + pi) + std::int64_t(field_.nx) * ((s * c[1] + pj) + std::int64_t(field_.ny) * (s * c[2] + pk));
         const std::size_t pos = std::size_t(pi + s * (pj + s * pk));
         for (int b = 0; b < B; ++b)
           if (const double w = field_.weight(v, b); w != 0.0) K.noalias() += w * galerkin[pos * B + b];
@@ -288,7 +289,6 @@ void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
   }
 }
 
-
 void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
   Level& level = *levels_[index];
   const int threads = options_.threads;
@@ -320,8 +320,7 @@ void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solu
     if (index == 0) {
       apply_fine(solution);
       chebyshev::residual(level.nodes(), fine_product, rhs, solution, level.residual, threads);
-    }
-    else
+    } else
       level.smoother.residual(rhs, solution, level.residual);
     // Restriction P^T r: each coarse node gathers the fine nodes within one
     // fine spacing of its point, weight 1 or 1/2 per axis.
@@ -379,9 +378,10 @@ VecX PeriodicGridMultigrid::solve(const VecX& b) {
     if (stats_.positive_definite || !single_precision_smoothers_) throw;
     // The fine operator is exact (double, matrix-free), so an indefinite
     // preconditioner comes from the rounded coarse operators.
-    spdlog::warn("periodic multigrid: the preconditioner is indefinite with single-precision smoothers ({}); "
-                 "retrying with double precision",
-                 e.what());
+    spdlog::warn(
+        "periodic multigrid: the preconditioner is indefinite with single-precision smoothers ({}); "
+        "retrying with double precision",
+        e.what());
     single_precision_smoothers_ = false;
     for (std::size_t l = 1; l < levels_.size(); ++l)
       if (!levels_[l]->coarsest) build_level(l);

@@ -28,7 +28,6 @@
 // Every kernel gathers per output row, so results are bitwise identical for
 // any thread count.
 #include <Eigen/SparseCholesky>
-
 #include <array>
 #include <memory>
 #include <string>
@@ -43,14 +42,14 @@ struct PeriodicMultigridOptions {
   double tolerance = 1e-8;  // stop when ||b - K x|| <= tolerance ||b|| (b projected)
   int max_iterations = 1000;
   std::string max_iterations_key;  // the config key that sets max_iterations, for messages (empty: none)
-  int smoother_degree = 2;   // Chebyshev degree on the finest level (twice that below)
-  int coarsest_nodes = 64;  // coarsening stops at the first level with at most this many nodes
+  int smoother_degree = 2;         // Chebyshev degree on the finest level (twice that below)
+  int coarsest_nodes = 64;         // coarsening stops at the first level with at most this many nodes
   // Coarse levels' smoothers in single precision (ChebyshevSmoother). A
   // stiffness contrast beyond what single precision resolves (e.g. void at
   // 1e-9 of the solid) can make the rounded operators indefinite; solve()
   // detects that (r . M^-1 r <= 0) and switches to double precision once.
   bool single_precision_smoothers = true;
-  int threads = 0;           // 0: the OpenMP default
+  int threads = 0;  // 0: the OpenMP default
 };
 
 class PeriodicGridMultigrid {

@@ -13,8 +13,8 @@ namespace msfab {
 
 struct RegularizedStep {
   bool ok = false;
-  double shift = 0;                // the shift of the last factorization tried
-  std::string last_linear_error;   // what the last failed solve reported (iterative solvers), if any
+  double shift = 0;               // the shift of the last factorization tried
+  std::string last_linear_error;  // what the last failed solve reported (iterative solvers), if any
 };
 
 // At most 12 factorizations. `right_hand_side(shift, rhs)` fills the system's

@@ -14,22 +14,20 @@ namespace {
 // Entries of column j occupy [outer[j], column_end(A, j)) of the index and
 // value arrays; uncompressed matrices leave gaps after each column.
 inline Eigen::Index column_end(const SpMat& A, Eigen::Index j) {
-  return A.isCompressed() ? A.outerIndexPtr()[j + 1]
-                          : A.outerIndexPtr()[j] + A.innerNonZeroPtr()[j];
+  return A.isCompressed() ? A.outerIndexPtr()[j + 1] : A.outerIndexPtr()[j] + A.innerNonZeroPtr()[j];
 }
 
 void require_square_match(const SpMat& A, const VecX& x, const char* what) {
   if (A.rows() != A.cols() || x.size() != A.cols()) {
-    throw std::invalid_argument(std::string(what) + ": matrix is " +
-                                std::to_string(A.rows()) + "x" + std::to_string(A.cols()) +
-                                " but the vector has " + std::to_string(x.size()) +
+    throw std::invalid_argument(std::string(what) + ": matrix is " + std::to_string(A.rows()) + "x" +
+                                std::to_string(A.cols()) + " but the vector has " + std::to_string(x.size()) +
                                 " entries");
   }
 }
 
 // Rows [begin, end) of y = (A + shift I) x, returning their contribution to x . y.
-inline double spmv_rows(const SpMat& A, const double* x, double* y, double shift,
-                        Eigen::Index begin, Eigen::Index end) {
+inline double spmv_rows(const SpMat& A, const double* x, double* y, double shift, Eigen::Index begin,
+                        Eigen::Index end) {
   const int* outer = A.outerIndexPtr();
   const int* inner = A.innerIndexPtr();
   const double* values = A.valuePtr();
@@ -46,15 +44,12 @@ inline double spmv_rows(const SpMat& A, const double* x, double* y, double shift
 
 }  // namespace
 
-int resolve_thread_count(int threads) {
-  return threads > 0 ? threads : omp_get_max_threads();
-}
+int resolve_thread_count(int threads) { return threads > 0 ? threads : omp_get_max_threads(); }
 
 double parallel_dot(const VecX& a, const VecX& b, int threads) {
   if (a.size() != b.size()) {
-    throw std::invalid_argument("parallel_dot: vector sizes differ (" +
-                                std::to_string(a.size()) + " vs " + std::to_string(b.size()) +
-                                ")");
+    throw std::invalid_argument("parallel_dot: vector sizes differ (" + std::to_string(a.size()) + " vs " +
+                                std::to_string(b.size()) + ")");
   }
   return chunked_reduce(a.size(), threads, [&](Eigen::Index begin, Eigen::Index end) {
     return a.segment(begin, end - begin).dot(b.segment(begin, end - begin));
@@ -66,17 +61,15 @@ double symmetric_spmv_dot(const SpMat& A, const VecX& x, VecX& y, double shift, 
   y.resize(A.rows());
   const double* xp = x.data();
   double* yp = y.data();
-  return chunked_reduce(A.cols(), threads, [&](Eigen::Index begin, Eigen::Index end) {
-    return spmv_rows(A, xp, yp, shift, begin, end);
-  });
+  return chunked_reduce(A.cols(), threads,
+                        [&](Eigen::Index begin, Eigen::Index end) { return spmv_rows(A, xp, yp, shift, begin, end); });
 }
 
 void symmetric_spmv(const SpMat& A, const VecX& x, VecX& y, double shift, int threads) {
   symmetric_spmv_dot(A, x, y, shift, threads);
 }
 
-double relative_residual(const SpMat& A, const VecX& x, const VecX& b, double shift,
-                         int threads) {
+double relative_residual(const SpMat& A, const VecX& x, const VecX& b, double shift, int threads) {
   require_square_match(A, b, "relative_residual");
   VecX residual;
   symmetric_spmv(A, x, residual, shift, threads);

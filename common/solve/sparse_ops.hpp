@@ -61,17 +61,14 @@ double parallel_dot(const VecX& a, const VecX& b, int threads = 0);
 // y = (A + shift*I) x for a symmetric A stored with both triangles. Column j
 // of A equals row j, so y_j is a gather over column j: no write conflicts, and
 // each y_j is summed in the same order whatever the thread count.
-void symmetric_spmv(const SpMat& A, const VecX& x, VecX& y, double shift = 0.0,
-                    int threads = 0);
+void symmetric_spmv(const SpMat& A, const VecX& x, VecX& y, double shift = 0.0, int threads = 0);
 
 // Same product, also returning x . y (the curvature x^T (A + shift I) x that
 // conjugate gradients needs) without a second pass over the vectors.
-double symmetric_spmv_dot(const SpMat& A, const VecX& x, VecX& y, double shift = 0.0,
-                          int threads = 0);
+double symmetric_spmv_dot(const SpMat& A, const VecX& x, VecX& y, double shift = 0.0, int threads = 0);
 
 // ||b - (A + shift I) x|| / ||b|| (0 when b = 0 and x = 0).
-double relative_residual(const SpMat& A, const VecX& x, const VecX& b, double shift = 0.0,
-                         int threads = 0);
+double relative_residual(const SpMat& A, const VecX& x, const VecX& b, double shift = 0.0, int threads = 0);
 
 // Position of entry (row, col) in A.valuePtr(), or -1 if it is not stored.
 // Inner indices are sorted in every Eigen sparse matrix, so this is a

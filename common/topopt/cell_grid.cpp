@@ -35,9 +35,7 @@ int CellGrid::pair_index(int s, int t, int m) {
   return s * m - s * (s - 1) / 2 + (t - s);
 }
 
-std::int64_t CellGrid::nodes() const {
-  return std::int64_t(n_[0] + 1) * (n_[1] + 1) * (dim_ == 3 ? n_[2] + 1 : 1);
-}
+std::int64_t CellGrid::nodes() const { return std::int64_t(n_[0] + 1) * (n_[1] + 1) * (dim_ == 3 ? n_[2] + 1 : 1); }
 
 std::array<int, 3> CellGrid::cell_coords(std::int64_t c) const {
   return {int(c % n_[0]), int((c / n_[0]) % n_[1]), int(c / (std::int64_t(n_[0]) * n_[1]))};

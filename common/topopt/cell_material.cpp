@@ -55,9 +55,7 @@ class CubicModel : public CellMaterialModel {
     return r;
   }
   bool has_constraint() const override { return true; }
-  double constraint(const VecX& p, VecX* g) const override {
-    return ls_->smooth_value(p, g);
-  }
+  double constraint(const VecX& p, VecX* g) const override { return ls_->smooth_value(p, g); }
   VecX initial_point(double rho) const override;
 
  protected:
@@ -116,9 +114,7 @@ class OrthotropicModel : public CellMaterialModel {
     return r;
   }
   bool has_constraint() const override { return true; }
-  double constraint(const VecX& p, VecX* g) const override {
-    return ls_->smooth_value(p, g);
-  }
+  double constraint(const VecX& p, VecX* g) const override { return ls_->smooth_value(p, g); }
   VecX initial_point(double rho) const override {
     VecX p(5);
     const double E = std::max(rho, 1e-3) * scale_.E0;
@@ -259,8 +255,7 @@ class AnalyticModel : public CellMaterialModel {
   VecX initial_point(double rho) const override {
     VecX p(2);
     // Just inside the boundary E = rho^3 E0 (and above the box's floor).
-    p << scale_.modulus_unit(std::max(0.9 * std::pow(rho, 3), std::pow(10.0, -scale_.decades + 1e-3)) * scale_.E0),
-        rho;
+    p << scale_.modulus_unit(std::max(0.9 * std::pow(rho, 3), std::pow(10.0, -scale_.decades + 1e-3)) * scale_.E0), rho;
     return p;
   }
 
@@ -341,8 +336,8 @@ double CellMaterialModel::density(const VecX& p, VecX* gradient) const {
 }
 
 std::vector<std::string> cell_material_spaces() {
-  return {"cubic3d", "cubic2d", "orthotropic2d", "cubic2d_slice", "isotropic2d", "isotropic3d",
-          "analytic2d", "analytic3d", "simp2d", "simp3d", "family3d"};
+  return {"cubic3d",    "cubic2d",    "orthotropic2d", "cubic2d_slice", "isotropic2d", "isotropic3d",
+          "analytic2d", "analytic3d", "simp2d",        "simp3d",        "family3d"};
 }
 
 bool needs_family_grid(const std::string& space) { return space == "family3d"; }
@@ -373,7 +368,8 @@ std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSe
       throw InputError("material space " + sp + ": the gamut level set has " +
                        std::to_string(s.level_set->dimension()) + " dimensions, expected " + std::to_string(want));
   }
-  if (needs_family_grid(sp)) throw InputError("material space " + sp + " is made from a family's structure grid (family:)");
+  if (needs_family_grid(sp))
+    throw InputError("material space " + sp + " is made from a family's structure grid (family:)");
   if (sp == "cubic3d") return std::make_unique<CubicModel>(3, scale, s.level_set);
   if (sp == "cubic2d") return std::make_unique<CubicModel>(2, scale, s.level_set);
   if (sp == "orthotropic2d") return std::make_unique<OrthotropicModel>(scale, s.level_set);
@@ -381,12 +377,14 @@ std::unique_ptr<CellMaterialModel> make_cell_material_model(const CellMaterialSe
   if (sp == "isotropic3d") return std::make_unique<IsotropicModel>(3, scale, s.level_set);
   if (sp == "isotropic2d") return std::make_unique<IsotropicModel>(2, scale, s.level_set);
   const double nu_hi = sp.back() == 'd' && sp[sp.size() - 2] == '3' ? 0.5 : 1.0;
-  if (!(s.nu > -1 && s.nu < nu_hi)) throw InputError("material space " + sp + ": nu must be in (-1, " +
-                                                     (nu_hi == 0.5 ? std::string("0.5") : std::string("1")) + ")");
+  if (!(s.nu > -1 && s.nu < nu_hi))
+    throw InputError("material space " + sp + ": nu must be in (-1, " +
+                     (nu_hi == 0.5 ? std::string("0.5") : std::string("1")) + ")");
   if (sp == "analytic3d") return std::make_unique<AnalyticModel>(3, scale, s.nu);
   if (sp == "analytic2d") return std::make_unique<AnalyticModel>(2, scale, s.nu);
   if (!(s.penalty >= 1)) throw InputError("material space " + sp + ": penalty must be >= 1");
-  if (!(s.E_min_ratio > 0 && s.E_min_ratio < 1)) throw InputError("material space " + sp + ": E_min_ratio must be in (0, 1)");
+  if (!(s.E_min_ratio > 0 && s.E_min_ratio < 1))
+    throw InputError("material space " + sp + ": E_min_ratio must be in (0, 1)");
   if (sp == "simp3d") return std::make_unique<SimpModel>(3, s.E_stiff, s.nu, s.penalty, s.E_min_ratio);
   if (sp == "simp2d") return std::make_unique<SimpModel>(2, s.E_stiff, s.nu, s.penalty, s.E_min_ratio);
   std::string choices;

@@ -99,12 +99,12 @@ class CellMaterialModel {
 };
 
 struct CellMaterialSettings {
-  std::string space;           // see the table above
-  double E_stiff = 1.0;        // E0: the stiffest base material, normalizes moduli
-  double decades = 4.0;        // log-scale span of the moduli
-  double nu = 0.3;             // analytic and simp: the fixed Poisson's ratio
-  double penalty = 3.0;        // simp: p
-  double E_min_ratio = 1e-9;   // simp: Emin / E0
+  std::string space;                         // see the table above
+  double E_stiff = 1.0;                      // E0: the stiffest base material, normalizes moduli
+  double decades = 4.0;                      // log-scale span of the moduli
+  double nu = 0.3;                           // analytic and simp: the fixed Poisson's ratio
+  double penalty = 3.0;                      // simp: p
+  double E_min_ratio = 1e-9;                 // simp: Emin / E0
   const GamutLevelSet* level_set = nullptr;  // gamut spaces and isotropic: the (cubic) gamut
 };
 

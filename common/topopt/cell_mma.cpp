@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "core/errors.hpp"
@@ -58,7 +58,6 @@ struct CellState {
   CellMmaSolution solution;  // its multipliers start the next solve
   CellMmaConstraintVec raa;  // the cell constraints' curvature terms
 };
-
 
 // One cell-MMA run: the iterate with its two predecessors and asymptotes,
 // every cell's approximation, and the steps of an iteration.
@@ -121,11 +120,13 @@ CellMmaRun::CellMmaRun(TopologyObjective& objective, const MatX& x0, const Optim
   // but a per-cell constraint on filtered parameters would couple the cells.
   const bool filtered = !objective.filter().identity();
   if (filtered && m_ > 0)
-    throw InputError("cell MMA: a density filter on the parameters needs a space without per-cell constraints "
-                     "(simp, or family3d with rho derived from the family); this space smooths the gradient instead");
+    throw InputError(
+        "cell MMA: a density filter on the parameters needs a space without per-cell constraints "
+        "(simp, or family3d with rho derived from the family); this space smooths the gradient instead");
   if (filtered && !gradient_smoothing.identity())
     throw InputError("cell MMA: both a density filter and gradient smoothing; choose one");
-  if (!(settings.mma_move > 0 && settings.mma_move <= 1)) throw InputError("cell MMA: the move limit must be in (0, 1]");
+  if (!(settings.mma_move > 0 && settings.mma_move <= 1))
+    throw InputError("cell MMA: the move limit must be in (0, 1]");
   if (!(settings.change_tolerance >= 0)) throw InputError("cell MMA: the change tolerance must be >= 0");
   N_ = x0.rows();
   d_ = int(x0.cols());
@@ -283,7 +284,10 @@ void CellMmaRun::budget_search(double& mass, double& slope) {
     spdlog::debug("budget search {}: mu {:.10e} excess {:.3e} slope {:.3e} bracket [{:.6e}, {:.6e}]", s, at,
                   excess / budget_cells_, slope, lo, hi);
     if (excess <= kBudgetTolerance * budget_cells_ && (at == 0 || excess >= -kBudgetTolerance * budget_cells_)) break;
-    if (excess > 0) lo = at; else hi = at;
+    if (excess > 0)
+      lo = at;
+    else
+      hi = at;
     if (std::isfinite(hi) && hi - lo <= 1e-14 * hi) break;
     double next = slope < 0 ? at - excess / slope : std::numeric_limits<double>::quiet_NaN();
     if (!(next > lo && next < hi))
@@ -372,8 +376,7 @@ OptimizationResult CellMmaRun::run() {
     MatX cval, cjac;
     cell_conditions(cval, cjac);
     double violation = m_ > 0 ? cval.maxCoeff() : -1.0;
-    if (settings_.mass_limit)
-      violation = std::max(violation, (objective_.mass(x_) - settings_.mass_budget) / domain_);
+    if (settings_.mass_limit) violation = std::max(violation, (objective_.mass(x_) - settings_.mass_budget) / domain_);
     result_.history.push_back({it, v.total, v.elastic, violation, seconds_since(t0_)});
     objective_history.push_back(v.total);
     result_.iterations = it;
@@ -429,10 +432,11 @@ OptimizationResult CellMmaRun::run() {
     x_ = x_new;
     result_.update_seconds += seconds_since(tu);
     if (settings_.log_every > 0 && it % settings_.log_every == 0)
-      spdlog::info("cell-mma iteration {:4d}: S {:.6e}  elastic {:.6e}  max constraint {:.2e}  change {:.3f}  "
-                   "budget searches {}, conservative rounds {}  ({:.1f} s, subproblem {:.2f} s)",
-                   it, v.total, v.elastic, violation, change, searches_, conservative_rounds, seconds_since(t0_),
-                   seconds_since(tu));
+      spdlog::info(
+          "cell-mma iteration {:4d}: S {:.6e}  elastic {:.6e}  max constraint {:.2e}  change {:.3f}  "
+          "budget searches {}, conservative rounds {}  ({:.1f} s, subproblem {:.2f} s)",
+          it, v.total, v.elastic, violation, change, searches_, conservative_rounds, seconds_since(t0_),
+          seconds_since(tu));
     if (m_ > 0 && spdlog::should_log(spdlog::level::debug)) {
       // Which cell holds the largest violation, where, and what its
       // multipliers became: the first thing to look at when a run stalls.

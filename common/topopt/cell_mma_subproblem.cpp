@@ -23,8 +23,8 @@ struct DualPoint {
   // The diagonal -d2W/dlambda2 would have if every x_j were free: the
   // curvature scale of a multiplier that no free variable answers to.
   CellMmaConstraintVec clamped_curvature;
-  double mass = 0;                // dW/dmu + bm: the approximate mass
-  double mass_curvature = 0;      // d2W/dmu2
+  double mass = 0;            // dW/dmu + bm: the approximate mass
+  double mass_curvature = 0;  // d2W/dmu2
   double slack = 0;
 };
 
@@ -138,8 +138,8 @@ CellMmaSquare regularized_block(const DualPoint& d, double projected,
 }  // namespace
 
 double mma_coefficients(const CellMmaVec& x, const CellMmaVec& lower, const CellMmaVec& upper,
-                        const CellMmaVec& gradient, double value, const CellMmaVec& range, double raa0,
-                        CellMmaVec& p, CellMmaVec& q) {
+                        const CellMmaVec& gradient, double value, const CellMmaVec& range, double raa0, CellMmaVec& p,
+                        CellMmaVec& q) {
   const int n = int(x.size());
   p.resize(n);
   q.resize(n);

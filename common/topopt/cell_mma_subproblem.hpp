@@ -33,10 +33,10 @@ constexpr int kCellMmaMaxConstraints = 10;
 
 using CellMmaVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kCellMmaMaxVariables, 1>;
 using CellMmaConstraintVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kCellMmaMaxConstraints, 1>;
-using CellMmaMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kCellMmaMaxConstraints,
-                                    kCellMmaMaxVariables>;
-using CellMmaSquare = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kCellMmaMaxConstraints,
-                                    kCellMmaMaxConstraints>;
+using CellMmaMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kCellMmaMaxConstraints, kCellMmaMaxVariables>;
+using CellMmaSquare =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kCellMmaMaxConstraints, kCellMmaMaxConstraints>;
 
 // The approximations of one cell around its iterate x^k.
 struct CellMmaApproximation {
@@ -45,7 +45,7 @@ struct CellMmaApproximation {
   CellMmaVec p0, q0;        // the objective
   CellMmaMatrix p, q;       // the cell's constraints (rows), each  <= b
   CellMmaConstraintVec b;
-  CellMmaVec pm, qm;        // the cell's share of the budget (its approximate mass is sum pm/(U-x) + qm/(x-L) - bm)
+  CellMmaVec pm, qm;  // the cell's share of the budget (its approximate mass is sum pm/(U-x) + qm/(x-L) - bm)
   double bm = 0;
   int variables() const { return int(lower.size()); }
   int constraints() const { return int(b.size()); }
@@ -56,15 +56,15 @@ struct CellMmaApproximation {
 // gradient's sign, plus `raa0` / (x_max - x_min) for strict convexity);
 // returns b such that p / (U - x) + q / (x - L) - b equals value at x.
 double mma_coefficients(const CellMmaVec& x, const CellMmaVec& lower, const CellMmaVec& upper,
-                        const CellMmaVec& gradient, double value, const CellMmaVec& range, double raa0,
-                        CellMmaVec& p, CellMmaVec& q);
+                        const CellMmaVec& gradient, double value, const CellMmaVec& range, double raa0, CellMmaVec& p,
+                        CellMmaVec& q);
 
 struct CellMmaSolution {
-  CellMmaVec x;                    // the subproblem's minimizer
-  CellMmaConstraintVec lambda;     // the cell constraints' multipliers
-  double mass = 0;                 // the approximate mass at x
-  double mass_derivative = 0;      // d mass / d mu (<= 0)
-  double slack = 0;                // largest artificial slack y_c (0: every approximate constraint met)
+  CellMmaVec x;                 // the subproblem's minimizer
+  CellMmaConstraintVec lambda;  // the cell constraints' multipliers
+  double mass = 0;              // the approximate mass at x
+  double mass_derivative = 0;   // d mass / d mu (<= 0)
+  double slack = 0;             // largest artificial slack y_c (0: every approximate constraint met)
   int newton_iterations = 0;
   bool converged = false;
 };

@@ -1,6 +1,5 @@
 #include "topopt/design_artifact.hpp"
 
-
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
 #include "io/xdmf.hpp"
@@ -25,8 +24,8 @@ void check_sizes(const Design& d, const std::string& where) {
     fail("/nodes/displacement must be nodes x dimension");
   if (!d.unit.allFinite() || !d.raw.allFinite()) fail("non-finite cell parameters");
   const Eigen::Index k = Eigen::Index(d.family_names.size());
-  if (k > 0 && (d.family_unit.rows() != n || d.family_unit.cols() != k || d.family_raw.rows() != n ||
-                d.family_raw.cols() != k))
+  if (k > 0 &&
+      (d.family_unit.rows() != n || d.family_unit.cols() != k || d.family_raw.rows() != n || d.family_raw.cols() != k))
     fail("/family/unit and /family/raw must be cells x family parameters");
   if (k > 0 && (!d.family_unit.allFinite() || !d.family_raw.allFinite())) fail("non-finite family parameters");
 }
@@ -68,8 +67,7 @@ void write_mesh(H5File& f, const Design& d) {
 }  // namespace
 
 void write_design_artifact(const std::string& path, const Design& d, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed) {
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
   check_sizes(d, path);
   ArtifactWriter out(path, kDesignSchema, kDesignSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
@@ -109,7 +107,8 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
   }
   if (!d.family_names.empty()) {
     f.write_matrix("/family/unit", d.family_unit);
-    f.write_attribute("/family/unit", "meaning", "the family grid's parameters, each normalized to [0, 1] along its axis");
+    f.write_attribute("/family/unit", "meaning",
+                      "the family grid's parameters, each normalized to [0, 1] along its axis");
     f.write_matrix("/family/raw", d.family_raw);
     f.write_attribute("/family/raw", "meaning", "the family's parameters (beam half-sizes in cell units)");
     f.write_attribute("/family", "names", format_name_list(d.family_names));

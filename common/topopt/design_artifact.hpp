@@ -24,24 +24,25 @@ enum class CellRole : std::uint8_t { design = 0, empty = 1, solid = 2 };
 
 struct DesignHistoryEntry {
   int iteration = 0;
-  double objective = 0;    // the full objective S (elasticity terms + mass terms)
-  double elastic = 0;      // the weighted elasticity terms alone (compliance / target error)
+  double objective = 0;      // the full objective S (elasticity terms + mass terms)
+  double elastic = 0;        // the weighted elasticity terms alone (compliance / target error)
   double max_violation = 0;  // max over cells of the gamut constraint Phi (or volume excess)
-  double seconds = 0;      // wall time since the start
+  double seconds = 0;        // wall time since the start
 };
 
 struct Design {
-  std::string space;       // cubic3d | cubic2d | orthotropic2d | isotropic2d | isotropic3d | analytic2d | analytic3d | simp2d | simp3d
+  std::string space;  // cubic3d | cubic2d | orthotropic2d | isotropic2d | isotropic3d | analytic2d | analytic3d |
+                      // simp2d | simp3d
   std::vector<std::string> property_names;
   double E_stiff = 0, decades = 4;  // the normalization (MaterialSpace)
-  int dimension = 2;       // 2 or 3
+  int dimension = 2;                // 2 or 3
   int nx = 0, ny = 0, nz = 1;
-  double cell_size = 1.0;  // cell edge length (m)
-  MatX unit;               // cells x properties, normalized parameters
-  MatX raw;                // cells x properties, raw parameters (moduli in Pa)
+  double cell_size = 1.0;       // cell edge length (m)
+  MatX unit;                    // cells x properties, normalized parameters
+  MatX raw;                     // cells x properties, raw parameters (moduli in Pa)
   std::vector<CellRole> roles;  // per cell
-  VecX phi;                // per cell, the gamut constraint value at the end (<= 0 inside)
-  MatX displacement;       // nodes x dimension, the first load case's solution
+  VecX phi;                     // per cell, the gamut constraint value at the end (<= 0 inside)
+  MatX displacement;            // nodes x dimension, the first load case's solution
   std::vector<DesignHistoryEntry> history;
   // A design in a family's own parameters (topopt space family3d; the cells
   // above then hold the cubic3d material they interpolate): the parameter
@@ -51,15 +52,12 @@ struct Design {
   MatX family_unit, family_raw;  // cells x family parameters
 
   std::int64_t cells() const { return std::int64_t(nx) * ny * nz; }
-  std::int64_t nodes() const {
-    return std::int64_t(nx + 1) * (ny + 1) * (dimension == 3 ? nz + 1 : 1);
-  }
+  std::int64_t nodes() const { return std::int64_t(nx + 1) * (ny + 1) * (dimension == 3 ? nz + 1 : 1); }
 };
 
 // Throws InputError naming the field for inconsistent sizes.
 void write_design_artifact(const std::string& path, const Design& design, const std::string& executable,
-                           const std::string& config_text, const std::vector<std::string>& inputs,
-                           std::uint64_t seed);
+                           const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
 // InputError naming the file and field on anything missing or inconsistent.
 Design read_design_artifact(const std::string& path);
 

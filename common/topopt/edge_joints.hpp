@@ -19,8 +19,8 @@
 namespace msfab {
 
 struct EdgeJoints {
-  std::int64_t count = 0;     // joints at or above the ratio
-  double largest_ratio = 0;   // over every edge-sharing pair, 0 if none; 1e12 for void bridges
+  std::int64_t count = 0;    // joints at or above the ratio
+  double largest_ratio = 0;  // over every edge-sharing pair, 0 if none; 1e12 for void bridges
 };
 
 // A cell's stiffness is the mean of its normal Voigt diagonal (C11, C22 and

@@ -76,7 +76,8 @@ class FamilyGridModel : public CellMaterialModel {
     double best_gap = 1e300;
     for (int i = 0; i < total; ++i) {
       int rest = i;
-      for (int a = k; a-- > 0;) t[a] = std::clamp(double(rest % (steps + 1)) / steps, 1e-3, 1 - 1e-3), rest /= steps + 1;
+      for (int a = k; a-- > 0;)
+        t[a] = std::clamp(double(rest % (steps + 1)) / steps, 1e-3, 1 - 1e-3), rest /= steps + 1;
       table_.evaluate(t, v);
       if (std::abs(v[3] - rho) < best_gap) best_gap = std::abs(v[3] - rho), best = t;
     }
@@ -143,8 +144,9 @@ class FamilyGridModel : public CellMaterialModel {
 std::unique_ptr<CellMaterialModel> make_family_material_model(const MicrostructureSet& set, const std::string& path,
                                                               bool derived_density) {
   if (set.grid.empty())
-    throw InputError(path + ": the structures are not a parameter grid (/grid missing; make them with "
-                            "msfab-family-generate and a `grid:` config)");
+    throw InputError(path +
+                     ": the structures are not a parameter grid (/grid missing; make them with "
+                     "msfab-family-generate and a `grid:` config)");
   if (set.space != "cubic3d") throw InputError(path + ": space " + set.space + ", the family3d space needs cubic3d");
   const int rho = static_cast<int>(set.property_names.size()) - 1;
   if (rho < 0 || set.property_names.back() != "rho") throw InputError(path + ": property_names: the last must be rho");

@@ -1,11 +1,11 @@
 // Problem 3.5 with Ipopt. Built as its own library (msfab_ipopt): the
 // Debian Ipopt links the sequential MUMPS, whose stand-in MPI symbols clash
 // with Open MPI in the MPI stages, so only the stages that optimize link it.
-#include <IpIpoptApplication.hpp>
-#include <IpTNLP.hpp>
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <IpIpoptApplication.hpp>
+#include <IpTNLP.hpp>
 #include <chrono>
 #include <cmath>
 
@@ -29,8 +29,15 @@ class GamutProblem : public Ipopt::TNLP {
  public:
   GamutProblem(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings,
                OptimizationResult& result)
-      : obj_(objective), model_(objective.model()), q0_(q0), settings_(settings), result_(result),
-        rows_(q0.rows()), d_(q0.cols()), threads_(omp_get_max_threads()), t0_(std::chrono::steady_clock::now()) {
+      : obj_(objective),
+        model_(objective.model()),
+        q0_(q0),
+        settings_(settings),
+        result_(result),
+        rows_(q0.rows()),
+        d_(q0.cols()),
+        threads_(omp_get_max_threads()),
+        t0_(std::chrono::steady_clock::now()) {
     per_cell_ = model_.has_constraint() ? 1 + model_.bound_conditions() : 0;
     gamut_rows_ = per_cell_ * rows_;
     const double V = obj_.grid().cell_volume();
@@ -150,8 +157,8 @@ class GamutProblem : public Ipopt::TNLP {
     return true;
   }
 
-  bool intermediate_callback(Ipopt::AlgorithmMode, Index iter, Number obj_value, Number inf_pr, Number, Number,
-                             Number, Number, Number, Number, Index, const Ipopt::IpoptData*,
+  bool intermediate_callback(Ipopt::AlgorithmMode, Index iter, Number obj_value, Number inf_pr, Number, Number, Number,
+                             Number, Number, Number, Index, const Ipopt::IpoptData*,
                              Ipopt::IpoptCalculatedQuantities*) override {
     DesignHistoryEntry h;
     h.iteration = iter;
@@ -242,7 +249,9 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   }();
   switch (status) {
     case Ipopt::Solve_Succeeded: result.status = "converged", result.converged = true; break;
-    case Ipopt::Solved_To_Acceptable_Level: result.status = "converged to the acceptable level", result.converged = true; break;
+    case Ipopt::Solved_To_Acceptable_Level:
+      result.status = "converged to the acceptable level", result.converged = true;
+      break;
     case Ipopt::Maximum_Iterations_Exceeded: result.status = "iteration limit reached"; break;
     case Ipopt::Search_Direction_Becomes_Too_Small: result.status = "search direction too small"; break;
     case Ipopt::Restoration_Failed: result.status = "restoration phase failed"; break;
@@ -256,8 +265,9 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   const MatX p = objective.physical(result.q);
   result.max_violation = max_gamut_violation(objective.model(), p);
   if (settings.mass_limit)
-    result.max_violation = std::max(result.max_violation, (objective.mass(result.q) - settings.mass_budget) /
-                                                              (objective.grid().cell_volume() * objective.grid().cells()));
+    result.max_violation =
+        std::max(result.max_violation, (objective.mass(result.q) - settings.mass_budget) /
+                                           (objective.grid().cell_volume() * objective.grid().cells()));
   result.seconds = seconds_since(t0);
   return result;
 }

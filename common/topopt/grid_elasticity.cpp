@@ -3,23 +3,22 @@
 #include <algorithm>
 #include <chrono>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "solve/dirichlet_grid_multigrid.hpp"
 #include "solve/sparse_ops.hpp"
 
 namespace msfab {
 
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs) {
   if (grid.dimension() != 3) throw std::invalid_argument("stiffness_field: a 3D grid");
   if (pairs.rows() != grid.cells() || pairs.cols() != grid.voigt_pairs())
     throw std::invalid_argument("stiffness_field: cells x voigt_pairs");
   struct Group {
-    Eigen::Index reference;  // the column the group's weights are
-    Eigen::Index peak_row;   // where |reference| is largest
+    Eigen::Index reference;                       // the column the group's weights are
+    Eigen::Index peak_row;                        // where |reference| is largest
     std::vector<std::pair<int, double>> members;  // (pair, factor on the reference)
   };
   std::vector<Group> groups;
@@ -54,7 +53,8 @@ VoxelStiffnessField stiffness_field(const CellGrid& grid, const MatX& pairs) {
   const std::size_t G = groups.size();
   field.weights.resize(std::size_t(grid.cells()) * G);
   for (std::size_t g = 0; g < G; ++g)
-    for (Eigen::Index c = 0; c < pairs.rows(); ++c) field.weights[std::size_t(c) * G + g] = pairs(c, groups[g].reference);
+    for (Eigen::Index c = 0; c < pairs.rows(); ++c)
+      field.weights[std::size_t(c) * G + g] = pairs(c, groups[g].reference);
   return field;
 }
 
@@ -202,8 +202,9 @@ void GridElasticity::set_stiffness(const MatX& pairs) {
     analyzed_ = true;
   }
   if (!solver_->factorize(K_))
-    throw NumericalError("the stiffness matrix is not positive definite: some part of the design is not held by a "
-                         "support, or a cell's stiffness is not positive definite");
+    throw NumericalError(
+        "the stiffness matrix is not positive definite: some part of the design is not held by a "
+        "support, or a cell's stiffness is not positive definite");
   ++stats_.factorizations;
   stats_.factorize_seconds += seconds_since(t1);
 }
@@ -298,17 +299,17 @@ double GridElasticity::energy(const VecX& u) const {
   const VoxelStiffnessField& field = matrix_free_->field();
   const int B = field.basis_size();
   return 0.5 * chunked_reduce(grid_.cells(), options_.threads, [&](Eigen::Index begin, Eigen::Index end) {
-    double sum = 0;
-    std::int64_t dofs[24];
-    Vec24 ue;
-    for (Eigen::Index c = begin; c < end; ++c) {
-      grid_.cell_unknowns(c, dofs);
-      for (int i = 0; i < 24; ++i) ue[i] = u[dofs[i]];
-      for (int b = 0; b < B; ++b)
-        if (const double w = field.weight(c, b); w != 0.0) sum += w * ue.dot(field.basis[std::size_t(b)] * ue);
-    }
-    return sum;
-  });
+           double sum = 0;
+           std::int64_t dofs[24];
+           Vec24 ue;
+           for (Eigen::Index c = begin; c < end; ++c) {
+             grid_.cell_unknowns(c, dofs);
+             for (int i = 0; i < 24; ++i) ue[i] = u[dofs[i]];
+             for (int b = 0; b < B; ++b)
+               if (const double w = field.weight(c, b); w != 0.0) sum += w * ue.dot(field.basis[std::size_t(b)] * ue);
+           }
+           return sum;
+         });
 }
 
 }  // namespace msfab

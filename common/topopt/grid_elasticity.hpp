@@ -27,9 +27,9 @@
 namespace msfab {
 
 struct GridSolveStats {
-  int solves = 0;             // load and adjoint solves so far
+  int solves = 0;  // load and adjoint solves so far
   int factorizations = 0;
-  long long iterations = 0;   // CG iterations over all solves (iterative solvers)
+  long long iterations = 0;  // CG iterations over all solves (iterative solvers)
   double assemble_seconds = 0, factorize_seconds = 0, solve_seconds = 0;
 };
 
@@ -91,8 +91,8 @@ class GridElasticity {
   std::unique_ptr<LinearSolver> solver_;                 // assembled solvers
   std::unique_ptr<DirichletGridMultigrid> matrix_free_;  // or this
   SpMat K_;
-  std::vector<int> slot_;       // cells x ne x ne: value index of each element entry, -1 if dropped
-  std::vector<int> fixed_slot_; // diagonal value index of each fixed unknown
+  std::vector<int> slot_;        // cells x ne x ne: value index of each element entry, -1 if dropped
+  std::vector<int> fixed_slot_;  // diagonal value index of each fixed unknown
   std::vector<std::vector<std::int64_t>> colours_;
   MatX pairs_;
   double fixed_scale_ = 1.0;

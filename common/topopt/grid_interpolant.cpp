@@ -56,7 +56,8 @@ HermiteAxisWeights hermite_axis_weights(double t, int n) {
 
 }  // namespace
 
-GridInterpolant::GridInterpolant(std::vector<int> sizes, MatX values) : sizes_(std::move(sizes)), values_(std::move(values)) {
+GridInterpolant::GridInterpolant(std::vector<int> sizes, MatX values)
+    : sizes_(std::move(sizes)), values_(std::move(values)) {
   if (sizes_.empty()) throw std::invalid_argument("GridInterpolant: no axes");
   Eigen::Index points = 1;
   for (int n : sizes_) {

@@ -1,15 +1,15 @@
 #include "topopt/simp_mma.hpp"
 
-#include <nlopt.hpp>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <nlopt.hpp>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 
 namespace msfab {
 
@@ -37,10 +37,10 @@ struct MmaProblem {
   OptimizationResult* result = nullptr;
   nlopt::opt* opt = nullptr;
   std::chrono::steady_clock::time_point t0;
-  VecX dmass;               // d mass / dq: the filter's column sums times the cell volume
-  double fixed_mass = 0;    // forced-solid cells
+  VecX dmass;             // d mass / dq: the filter's column sums times the cell volume
+  double fixed_mass = 0;  // forced-solid cells
   double cell_volume = 1, domain_volume = 1;
-  double objective_scale = 1;   // kObjectiveStart / S(q0)
+  double objective_scale = 1;  // kObjectiveStart / S(q0)
   // The incumbent: the best feasible design evaluated so far (or, before
   // any is feasible, the least infeasible). With a feasible start this is
   // MMA's own iterate: once feasible, NLopt keeps a trial point when it
@@ -56,9 +56,7 @@ struct MmaProblem {
   int solves_before = 0;
   std::exception_ptr error;
 
-  double mass(const double* q) const {
-    return Eigen::Map<const VecX>(q, dmass.size()).dot(dmass) + fixed_mass;
-  }
+  double mass(const double* q) const { return Eigen::Map<const VecX>(q, dmass.size()).dot(dmass) + fixed_mass; }
 };
 
 double mma_objective(unsigned n, const double* q, double* grad, void* data) {
@@ -93,8 +91,8 @@ double mma_objective(unsigned n, const double* q, double* grad, void* data) {
     if (P.settings->log_every > 0 && it % P.settings->log_every == 0) {
       const int solves = st.solves - P.solves_before;
       const double cg = solves > 0 ? double(st.iterations - P.cg_before) / solves : 0.0;
-      spdlog::info("mma iteration {:4d}: objective {:.6e}  volume {:.4f}  step {:.3f}  CG/solve {:.1f}  ({:.1f} s)",
-                   it, h.objective, P.best_excess + P.settings->mass_budget / P.domain_volume, change, cg, h.seconds);
+      spdlog::info("mma iteration {:4d}: objective {:.6e}  volume {:.4f}  step {:.3f}  CG/solve {:.1f}  ({:.1f} s)", it,
+                   h.objective, P.best_excess + P.settings->mass_budget / P.domain_volume, change, cg, h.seconds);
       P.cg_before = st.iterations, P.solves_before = st.solves;
     }
     if (grad) Eigen::Map<VecX>(grad, n) = g.col(0) * P.objective_scale;

@@ -30,22 +30,22 @@ struct LoadCase {
   std::string name;
   double weight = 1.0;
   ElasticObjective objective = ElasticObjective::compliance;
-  VecX force;            // per unknown
-  VecX prescribed;       // per unknown; read at fixed unknowns only (empty: zeros)
-  VecX target;           // target: u^ per unknown
-  VecX target_weight;    // target: the diagonal of D per unknown (0 = free)
+  VecX force;          // per unknown
+  VecX prescribed;     // per unknown; read at fixed unknowns only (empty: zeros)
+  VecX target;         // target: u^ per unknown
+  VecX target_weight;  // target: the diagonal of D per unknown (0 = free)
 };
 
 struct MassTerms {
-  double total_weight = 0;   // w_M; 0 disables the total-mass term
-  double total_target = 0;   // M (in rho * volume)
-  double local_weight = 0;   // w_r; 0 disables the local terms
-  VecX local_target;         // rho^ per grid cell
+  double total_weight = 0;  // w_M; 0 disables the total-mass term
+  double total_target = 0;  // M (in rho * volume)
+  double local_weight = 0;  // w_r; 0 disables the local terms
+  VecX local_target;        // rho^ per grid cell
 };
 
 struct TopologySetup {
   CellGrid grid;
-  std::vector<CellRole> roles;         // per grid cell
+  std::vector<CellRole> roles;  // per grid cell
   // The mesh the elasticity is solved on: the design grid itself
   // (elements_per_cell 1), or m^3 hexahedra per design cell, each taking its
   // cell's stiffness (fem_grid, m = elements_per_cell): one trilinear
@@ -54,20 +54,20 @@ struct TopologySetup {
   // (docs/topopt.md, "Elements per cell"). `fixed` and the loads' vectors
   // are per unknown of this mesh.
   int elements_per_cell = 1;
-  CellGrid fem_grid;                   // read when elements_per_cell > 1
-  std::vector<char> fixed;             // per unknown (of the FEM mesh)
+  CellGrid fem_grid;        // read when elements_per_cell > 1
+  std::vector<char> fixed;  // per unknown (of the FEM mesh)
   std::vector<LoadCase> loads;
   MassTerms mass;
-  double filter_radius = 0;            // in cells; <= 1: none
-  MatX solid_C, empty_C;               // Voigt stiffness of forced-solid and forced-empty cells
+  double filter_radius = 0;  // in cells; <= 1: none
+  MatX solid_C, empty_C;     // Voigt stiffness of forced-solid and forced-empty cells
   std::string solver = "auto";
   LinearSolverOptions solver_options;
 };
 
 struct ObjectiveValue {
-  double total = 0;     // S
-  double elastic = 0;   // the weighted elasticity terms
-  double mass = 0;      // the mass terms
+  double total = 0;              // S
+  double elastic = 0;            // the weighted elasticity terms
+  double mass = 0;               // the mass terms
   std::vector<double> per_load;  // C_l (unweighted)
 };
 

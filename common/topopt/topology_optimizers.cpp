@@ -6,13 +6,12 @@
 #include <cmath>
 #include <limits>
 
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 
 namespace msfab {
 
-namespace {
-}  // namespace
+namespace {}  // namespace
 
 VecX cell_gamut_conditions(const CellMaterialModel& model, const VecX& p, MatX* jacobian) {
   if (!model.has_constraint()) return VecX();
@@ -58,9 +57,13 @@ OptimizationResult optimize_oc(TopologyObjective& objective, const MatX& q0, con
       const double mid = 0.5 * (l1 + l2);
       for (Eigen::Index i = 0; i < x.size(); ++i) {
         const double be = std::sqrt(std::max(0.0, -dc[i] / (dmass[i] * mid)));
-        x_new[i] = std::clamp(x[i] * be, std::max(0.0, x[i] - settings.oc_move), std::min(1.0, x[i] + settings.oc_move));
+        x_new[i] =
+            std::clamp(x[i] * be, std::max(0.0, x[i] - settings.oc_move), std::min(1.0, x[i] + settings.oc_move));
       }
-      if (objective.mass(x_new) > settings.mass_budget) l1 = mid; else l2 = mid;
+      if (objective.mass(x_new) > settings.mass_budget)
+        l1 = mid;
+      else
+        l2 = mid;
     }
     const double change = (x_new - x).cwiseAbs().maxCoeff();
     x = x_new;

@@ -21,29 +21,29 @@ namespace msfab {
 
 struct OptimizerSettings {
   int max_iterations = 100;
-  double tolerance = 1e-5;           // Ipopt: relative convergence tolerance (on the scaled objective)
+  double tolerance = 1e-5;             // Ipopt: relative convergence tolerance (on the scaled objective)
   double constraint_tolerance = 1e-3;  // Ipopt: Phi violation accepted at the end (normalized units)
   int lbfgs_memory = 8;
-  bool mass_limit = false;           // add the constraint sum rho_i V_i <= mass_budget
+  bool mass_limit = false;  // add the constraint sum rho_i V_i <= mass_budget
   double mass_budget = 0;
-  double oc_move = 0.2;              // OC only
-  double mma_move = 0.2;             // cell MMA: largest step per iteration, in unit parameters
+  double oc_move = 0.2;   // OC only
+  double mma_move = 0.2;  // cell MMA: largest step per iteration, in unit parameters
   // OC and MMA: stop when no design variable changes by this much in an
   // iteration (0: never; run max_iterations).
   double change_tolerance = 0.01;
-  int log_every = 10;                // progress line every this many iterations (0: none)
+  int log_every = 10;  // progress line every this many iterations (0: none)
 };
 
 struct OptimizationResult {
-  MatX q;                            // final design variables
-  ObjectiveValue value;              // at q
+  MatX q;                // final design variables
+  ObjectiveValue value;  // at q
   std::vector<DesignHistoryEntry> history;
-  std::string status;                // optimizer's own words
+  std::string status;  // optimizer's own words
   bool converged = false;
   int iterations = 0, evaluations = 0;
-  double max_violation = 0;          // max_i of Phi(p_i) and the Voigt bound's conditions (or the mass excess) at q
+  double max_violation = 0;  // max_i of Phi(p_i) and the Voigt bound's conditions (or the mass excess) at q
   double seconds = 0;
-  double update_seconds = 0;         // time outside the objective's evaluations (cell MMA: the subproblems)
+  double update_seconds = 0;  // time outside the objective's evaluations (cell MMA: the subproblems)
 };
 
 OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q0, const OptimizerSettings& settings);

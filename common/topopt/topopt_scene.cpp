@@ -129,8 +129,7 @@ LoadCase read_load_case(const Config& lc, const CellGrid& g, const std::vector<c
       const Vec3 value = read_vector(pr, "displacement", dim);
       for (std::int64_t node : select_nodes(pr, g))
         for (int a = 0; a < dim; ++a) {
-          if (!fixed[node * dim + a])
-            pr.fail("displacement", "prescribes a value on an unknown no support fixes");
+          if (!fixed[node * dim + a]) pr.fail("displacement", "prescribes a value on an unknown no support fixes");
           l.prescribed[node * dim + a] = value[a];
           case_value = case_value || value[a] != 0;
         }

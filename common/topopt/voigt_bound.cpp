@@ -57,8 +57,7 @@ VoigtBound::VoigtBound(MatX stiff, MatX soft, VoigtBoundModes modes)
 
 int VoigtBound::count() const { return active() ? int(mode_vectors_.size()) : 0; }
 
-VecX VoigtBound::evaluate(const MatX& C, double rho, const std::vector<MatX>* dC, int rho_index,
-                          MatX* jacobian) const {
+VecX VoigtBound::evaluate(const MatX& C, double rho, const std::vector<MatX>* dC, int rho_index, MatX* jacobian) const {
   const int n = count();
   VecX g(n);
   if (n == 0) return g;

@@ -17,13 +17,13 @@ enum class SampleKind : std::uint8_t {
 };
 
 struct DisplacementComparison {
-  std::int64_t compared = 0;  // coarse nodes compared
-  std::int64_t nearest = 0;   // of those, sampled off the node (void there)
-  double mean_homogenized = 0;  // mean |u_hom| over the compared nodes
-  double mean_full = 0;         // mean |u_full|
-  double mean_difference = 0;   // mean |u_full - u_hom|
-  double relative = 0;          // mean_difference / mean_homogenized (0 when both vanish)
-  MatX sampled;                 // coarse nodes x 3, the fine displacement sampled (0 where skipped)
+  std::int64_t compared = 0;     // coarse nodes compared
+  std::int64_t nearest = 0;      // of those, sampled off the node (void there)
+  double mean_homogenized = 0;   // mean |u_hom| over the compared nodes
+  double mean_full = 0;          // mean |u_full|
+  double mean_difference = 0;    // mean |u_full - u_hom|
+  double relative = 0;           // mean_difference / mean_homogenized (0 when both vanish)
+  MatX sampled;                  // coarse nodes x 3, the fine displacement sampled (0 where skipped)
   std::vector<SampleKind> kind;  // per coarse node
 };
 

@@ -1,11 +1,11 @@
 #include "verify/refinement.hpp"
-#include "verify/solid_pieces.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "verify/solid_pieces.hpp"
 
 namespace msfab {
 
@@ -158,7 +158,8 @@ CellRefinement::Supports CellRefinement::refine_supports(const std::vector<char>
 
 VecX CellRefinement::refine_forces(const VecX& coarse_force, const std::vector<char>& node_material,
                                    const std::string& what, LoadStats* stats) const {
-  if (coarse_force.size() != coarse_.unknowns()) throw std::invalid_argument("refine_forces: one entry per coarse unknown");
+  if (coarse_force.size() != coarse_.unknowns())
+    throw std::invalid_argument("refine_forces: one entry per coarse unknown");
   LoadStats st;
   std::vector<char> loaded(std::size_t(coarse_.nodes()), 0);
   for (std::int64_t cn = 0; cn < coarse_.nodes(); ++cn)

@@ -73,9 +73,9 @@ class CellRefinement {
                                              int max_distance) const;
 
   struct Supports {
-    std::vector<char> fixed;  // per fine unknown
-    SpMat values;             // fine unknowns x coarse unknowns: prescribed_fine = values * prescribed_coarse
-    std::int64_t point_supports = 0;      // coarse (node, component) fixed alone
+    std::vector<char> fixed;          // per fine unknown
+    SpMat values;                     // fine unknowns x coarse unknowns: prescribed_fine = values * prescribed_coarse
+    std::int64_t point_supports = 0;  // coarse (node, component) fixed alone
     std::int64_t moved_point_supports = 0;  // of those, carried to nearest material nodes
     std::int64_t lost_point_supports = 0;   // of those, with no material within half a cell (fixed on void)
   };
@@ -83,10 +83,10 @@ class CellRefinement {
   Supports refine_supports(const std::vector<char>& coarse_fixed, const std::vector<char>& node_material) const;
 
   struct LoadStats {
-    std::int64_t loaded_nodes = 0;   // coarse nodes carrying a force
-    std::int64_t point_loads = 0;    // of those, point loads (spread over the surface patch)
-    std::int64_t fallbacks = 0;      // loads whose footprint held only void and went to the surface patch / cell volume
-    std::int64_t fine_nodes = 0;     // fine nodes that received a force
+    std::int64_t loaded_nodes = 0;  // coarse nodes carrying a force
+    std::int64_t point_loads = 0;   // of those, point loads (spread over the surface patch)
+    std::int64_t fallbacks = 0;     // loads whose footprint held only void and went to the surface patch / cell volume
+    std::int64_t fine_nodes = 0;    // fine nodes that received a force
   };
   // Fine nodal forces for coarse nodal forces (per unknown). InputError when
   // a coarse node's force finds no fine node with material within one cell;

@@ -17,7 +17,8 @@ void require_3d(const CellGrid& grid, const char* what) {
 
 SolidPieces face_connected_pieces(const CellGrid& grid, const std::vector<char>& solid) {
   require_3d(grid, "face_connected_pieces");
-  if (std::int64_t(solid.size()) != grid.cells()) throw std::invalid_argument("face_connected_pieces: one flag per cell");
+  if (std::int64_t(solid.size()) != grid.cells())
+    throw std::invalid_argument("face_connected_pieces: one flag per cell");
   const int n[3] = {grid.nx(), grid.ny(), grid.nz()};
   SolidPieces out;
   out.piece.assign(solid.size(), -1);
@@ -65,7 +66,8 @@ std::vector<int> restrained_rigid_motions(const CellGrid& grid, const SolidPiece
   const int n[3] = {grid.nx(), grid.ny(), grid.nz()};
   int touching[8];
   for (std::int64_t node = 0; node < grid.nodes(); ++node) {
-    const bool any_fixed = fixed[std::size_t(3 * node)] || fixed[std::size_t(3 * node + 1)] || fixed[std::size_t(3 * node + 2)];
+    const bool any_fixed =
+        fixed[std::size_t(3 * node)] || fixed[std::size_t(3 * node + 1)] || fixed[std::size_t(3 * node + 2)];
     if (!any_fixed) continue;
     const auto v = grid.node_coords(node);
     int distinct = 0;

@@ -41,10 +41,10 @@ std::vector<int> restrained_rigid_motions(const CellGrid& grid, const SolidPiece
                                           const std::vector<char>& fixed);
 
 struct PieceRemoval {
-  int pieces = 0;                    // face-connected pieces before removal
-  int removed = 0;                   // of those, not held and removed
-  std::int64_t removed_cells = 0;    // solid cells removed with them
-  std::int64_t kept_cells = 0;       // solid cells left
+  int pieces = 0;                  // face-connected pieces before removal
+  int removed = 0;                 // of those, not held and removed
+  std::int64_t removed_cells = 0;  // solid cells removed with them
+  std::int64_t kept_cells = 0;     // solid cells left
 };
 // Sets the cells of every piece that is not held to void.
 PieceRemoval remove_unheld_pieces(const CellGrid& grid, std::vector<char>& solid, const std::vector<char>& fixed);

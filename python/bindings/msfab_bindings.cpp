@@ -52,8 +52,7 @@ py::array_t<double> to_numpy(const Matrix& m) {
 VoxelGrid cell_from_array(const py::array& ids, const std::vector<MaterialPtr>& material_by_id) {
   const char kind = ids.dtype().kind();
   if (kind != 'i' && kind != 'u' && kind != 'b')
-    throw InputError("ids: expected an integer array of material ids, got dtype " +
-                     std::string(py::str(ids.dtype())));
+    throw InputError("ids: expected an integer array of material ids, got dtype " + std::string(py::str(ids.dtype())));
   if (ids.ndim() != 3 && ids.ndim() != 2)
     throw InputError("ids: expected an array of shape (nx, ny, nz) or (nx, ny), got " + std::to_string(ids.ndim()) +
                      " dimensions");
@@ -177,8 +176,8 @@ py::object lookup_block(const CoarseDatabase& db, const std::vector<int>& ids) {
     throw InputError("lookup: this is a level-" + std::to_string(db.level) +
                      " database, whose rows are found from the level-1 entries of a cell's children; look blocks up "
                      "in its level-1 database");
-  if (ids.size() != 8) throw InputError("lookup: expected the 8 child ids of a 2 x 2 x 2 block, got " +
-                                        std::to_string(ids.size()));
+  if (ids.size() != 8)
+    throw InputError("lookup: expected the 8 child ids of a 2 x 2 x 2 block, got " + std::to_string(ids.size()));
   BlockMaterials block{};
   for (int c = 0; c < 8; ++c) {
     if (ids[c] < 0 || ids[c] > db.num_materials())

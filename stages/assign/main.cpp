@@ -40,7 +40,9 @@ CellPattern read_pattern(const Config& config, int dimension, std::uint64_t seed
   const Config p = config.child("pattern");
   CellPattern pattern;
   const std::string kind = p.has("kind") ? p.one_of("kind", {"uniform", "layers", "random"}) : "uniform";
-  pattern.kind = kind == "uniform" ? PatternKind::uniform : kind == "layers" ? PatternKind::layers : PatternKind::random;
+  pattern.kind = kind == "uniform"  ? PatternKind::uniform
+                 : kind == "layers" ? PatternKind::layers
+                                    : PatternKind::random;
   const auto structures = p.get<std::vector<int>>("structures");
   if (structures.empty()) p.fail("structures", "needs at least one structure index");
   for (int s : structures)
@@ -48,10 +50,9 @@ CellPattern read_pattern(const Config& config, int dimension, std::uint64_t seed
   if (pattern.kind == PatternKind::uniform && structures.size() != 1)
     p.fail("structures", "a uniform pattern takes exactly one structure");
   pattern.structures.assign(structures.begin(), structures.end());
-  const std::string axis =
-      p.has("axis") ? p.one_of("axis", dimension == 3 ? std::vector<std::string>{"x", "y", "z"}
-                                                      : std::vector<std::string>{"x", "y"})
-                    : std::string(dimension == 3 ? "z" : "y");
+  const std::string axis = p.has("axis") ? p.one_of("axis", dimension == 3 ? std::vector<std::string>{"x", "y", "z"}
+                                                                           : std::vector<std::string>{"x", "y"})
+                                         : std::string(dimension == 3 ? "z" : "y");
   pattern.axis = axis[0] - 'x';
   pattern.thickness = p.get_or<int>("thickness", 1);
   if (pattern.thickness < 1) p.fail("thickness", "must be >= 1");
@@ -79,7 +80,8 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string structures_path;
-  app.cli().add_option("--structures", structures_path, "msfab.microstructures artifact the pattern indexes")
+  app.cli()
+      .add_option("--structures", structures_path, "msfab.microstructures artifact the pattern indexes")
       ->type_name("FILE")
       ->required();
   return app.run(argc, argv, [&](StageContext& ctx) {

@@ -81,38 +81,44 @@ double undamped_if_unresolved(const std::string& track_path, double decay, doubl
 void report_search(const DacResult& search, const DacOptions& options, double voxel_size) {
   const int num_modes = options.num_modes;
   for (const DacLevelReport& l : search.levels)
-    spdlog::info("level {}: {} elements, f1 {:.4f} Hz, frequency change {:.2f}%, shape distance {:.4f}, "
-                 "frequency error against the converged values: largest {:.2f}%, mean {:.2f}%",
-                 l.level, l.elements, l.frequencies.size() ? l.frequencies[0] : 0.0, 100 * l.frequency_change,
-                 l.max_distance, 100 * l.limit_error, 100 * l.mean_limit_error);
+    spdlog::info(
+        "level {}: {} elements, f1 {:.4f} Hz, frequency change {:.2f}%, shape distance {:.4f}, "
+        "frequency error against the converged values: largest {:.2f}%, mean {:.2f}%",
+        l.level, l.elements, l.frequencies.size() ? l.frequencies[0] : 0.0, 100 * l.frequency_change, l.max_distance,
+        100 * l.limit_error, 100 * l.mean_limit_error);
   std::string limits;
   for (const FrequencyLimit& f : search.limits)
-    limits += f.monotone ? fmt::format(" {:.6g} (p {:.2f})", f.limit, f.order) : fmt::format(" {:.6g} (finest)", f.limit);
-  std::printf("  converged frequencies of the first %d modes (Hz; Richardson extrapolation over the three finest "
-              "levels, observed order p):%s\n",
-              num_modes, limits.c_str());
-  const bool all_extrapolated = std::all_of(search.limits.begin(), search.limits.end(),
-                                           [](const FrequencyLimit& f) { return f.monotone; });
+    limits +=
+        f.monotone ? fmt::format(" {:.6g} (p {:.2f})", f.limit, f.order) : fmt::format(" {:.6g} (finest)", f.limit);
+  std::printf(
+      "  converged frequencies of the first %d modes (Hz; Richardson extrapolation over the three finest "
+      "levels, observed order p):%s\n",
+      num_modes, limits.c_str());
+  const bool all_extrapolated =
+      std::all_of(search.limits.begin(), search.limits.end(), [](const FrequencyLimit& f) { return f.monotone; });
   if (!search.converged && !all_extrapolated)
-    std::printf("  note: the levels neither converged (frequency change < %g%%) nor gave every mode a limit (three "
-                "levels converging monotonically): the accurate mesh below is judged against the finest level\n",
-                100 * options.convergence_tolerance);
+    std::printf(
+        "  note: the levels neither converged (frequency change < %g%%) nor gave every mode a limit (three "
+        "levels converging monotonically): the accurate mesh below is judged against the finest level\n",
+        100 * options.convergence_tolerance);
   if (search.accurate_level < 0) {
     std::printf("  accurate mesh: none of the levels searched (finest: largest error %.2f%%)\n",
                 100 * search.levels.back().limit_error);
     return;
   }
   const DacLevelReport& a = search.levels[search.accurate_index];
-  std::printf("  accurate mesh: level %d, voxel %.4g m, %d elements (first %d frequencies within %.2f%% of the "
-              "converged values, mean %.2f%%)\n",
-              a.level, voxel_size / std::pow(2.0, a.level), a.elements, num_modes, 100 * a.limit_error,
-              100 * a.mean_limit_error);
+  std::printf(
+      "  accurate mesh: level %d, voxel %.4g m, %d elements (first %d frequencies within %.2f%% of the "
+      "converged values, mean %.2f%%)\n",
+      a.level, voxel_size / std::pow(2.0, a.level), a.elements, num_modes, 100 * a.limit_error,
+      100 * a.mean_limit_error);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  StageApp app("msfab-dac-calibrate", "Dynamics-aware coarsening: numerical modulus and damping from a target (thesis §4.3)");
+  StageApp app("msfab-dac-calibrate",
+               "Dynamics-aware coarsening: numerical modulus and damping from a target (thesis §4.3)");
   app.add_common_options();
   app.set_default_config(kDefaultCalibration);
   return app.run(argc, argv, [&](StageContext& ctx) {
@@ -200,8 +206,9 @@ int main(int argc, char** argv) {
       f_t = m.frequency;
       d_t = m.decay;
       rms = fit.rms_residual;
-      spdlog::info("{}: {} samples at {:.4g} s, dominant mode f = {:.6g} Hz, d = {:.6g} ± {:.2g} 1/s (rms residual {:.3g})",
-                   marker_path, track.values.size(), track.sample_interval, f_t, d_t, m.decay_uncertainty, rms);
+      spdlog::info(
+          "{}: {} samples at {:.4g} s, dominant mode f = {:.6g} Hz, d = {:.6g} ± {:.2g} 1/s (rms residual {:.3g})",
+          marker_path, track.values.size(), track.sample_interval, f_t, d_t, m.decay_uncertainty, rms);
       d_t = undamped_if_unresolved(marker_path, d_t, m.decay_uncertainty,
                                    double(track.values.size()) * track.sample_interval);
     }
@@ -235,8 +242,8 @@ int main(int argc, char** argv) {
     std::printf("  E_m = %.6g Pa, lambda_1^0 = %.6g -> E_n = %.6g Pa (x%.4f), b = %.4e s, a = 0\n", E_m, lambda1,
                 cal.youngs_modulus, cal.stiffness_scale, cal.damping.b);
     for (int i = 0; i < modes.eigenvalues.size(); ++i)
-      std::printf("  mode %d: f with E_m %.6g Hz -> calibrated %.6g Hz, decay %.4g 1/s\n", i + 1,
-                  modes.frequencies(i), after[i].frequency, after[i].decay);
+      std::printf("  mode %d: f with E_m %.6g Hz -> calibrated %.6g Hz, decay %.4g 1/s\n", i + 1, modes.frequencies(i),
+                  after[i].frequency, after[i].decay);
     std::printf("  artifact: %s\n", out.c_str());
   });
 }

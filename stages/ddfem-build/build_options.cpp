@@ -16,7 +16,8 @@ BuildOptions read_build_options(const Config& config) {
       HierarchyOptions& h = o.hierarchy;
       if (l.has("representatives")) {
         const auto k = l.get<std::vector<int>>("representatives");
-        if (k.size() != 3) l.fail("representatives", "expected three counts [x, y, z], got " + std::to_string(k.size()));
+        if (k.size() != 3)
+          l.fail("representatives", "expected three counts [x, y, z], got " + std::to_string(k.size()));
         for (int i = 0; i < 3; ++i) {
           if (k[i] < 1) l.fail("representatives", "counts must be >= 1");
           h.representatives[i] = k[i];
@@ -30,8 +31,8 @@ BuildOptions read_build_options(const Config& config) {
       h.corner_moves = l.get_or<bool>("corner_moves", h.corner_moves);
       const std::string samples = l.get_or<std::string>("samples", "level1");
       if (samples != "level1" && samples != "voxels")
-        l.fail("samples", "must be level1 (2 x 2 x 2 level-1 elements) or voxels (4 x 4 x 4 fine voxels), got '" +
-                              samples + "'");
+        l.fail("samples",
+               "must be level1 (2 x 2 x 2 level-1 elements) or voxels (4 x 4 x 4 fine voxels), got '" + samples + "'");
       o.level2_voxel_samples = samples == "voxels";
       l.check_no_unknown_keys();
     }
@@ -127,12 +128,14 @@ BuildOptions read_build_options(const Config& config) {
     // may hang together by an edge. Among periodic copies every corner class
     // has material and the sample prescribes the corners.
     if (o.void_children && o.fit.sampling.mode != ForceSamplingOptions::Mode::periodic)
-      config.fail("void_children", "needs sampling.mode: periodic (blocks with void children are sampled among "
-                                   "their periodic copies)");
+      config.fail("void_children",
+                  "needs sampling.mode: periodic (blocks with void children are sampled among "
+                  "their periodic copies)");
   }
   if (o.level2_voxel_samples && o.fit.sampling.mode != ForceSamplingOptions::Mode::periodic)
-    config.child("level2").fail("samples", "voxels needs sampling.mode: periodic (a block of 4 x 4 x 4 voxels is "
-                                           "sampled among its periodic copies)");
+    config.child("level2").fail("samples",
+                                "voxels needs sampling.mode: periodic (a block of 4 x 4 x 4 voxels is "
+                                "sampled among its periodic copies)");
   o.use_symmetry = config.get_or<bool>("symmetry", o.use_symmetry);
   o.orbits_per_round = config.get_or<int>("orbits_per_round", o.orbits_per_round);
   if (o.orbits_per_round < 1) config.fail("orbits_per_round", "must be >= 1");

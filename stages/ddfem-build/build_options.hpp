@@ -22,10 +22,10 @@ struct BuildOptions {
   // 2 x 2 x 2 level-1 elements with their fitted materials, so a level-1
   // fit's error is not fitted into level 2 (`level2.samples: voxels`).
   bool level2_voxel_samples = false;
-  double voxel_size = 1e-3;           // of the sampled block; the fit is scale-invariant
+  double voxel_size = 1e-3;  // of the sampled block; the fit is scale-invariant
   CoarseFitOptions fit;
-  bool use_symmetry = true;           // fit one block per cube-symmetry orbit
-  int orbits_per_round = 8;           // work between checkpoints, over all ranks
+  bool use_symmetry = true;  // fit one block per cube-symmetry orbit
+  int orbits_per_round = 8;  // work between checkpoints, over all ranks
 };
 
 // Reads and validates; InputError naming the key on bad input.

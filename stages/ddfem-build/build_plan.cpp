@@ -45,9 +45,8 @@ BuildPlan plan_level1(const BuildOptions& options) {
   plan.item_of.assign(N, -1);
   for (std::int64_t code = 0; code < N; ++code) {
     if (is_all_void(plan.db.combination_ids(code))) continue;  // no element, nothing to fit
-    const std::int64_t rep = options.use_symmetry
-                                 ? plan.db.combination_code(canonical_block(plan.db.combination_ids(code)).ids)
-                                 : code;
+    const std::int64_t rep =
+        options.use_symmetry ? plan.db.combination_code(canonical_block(plan.db.combination_ids(code)).ids) : code;
     plan.item_of[code] = rep;
     if (rep == code) plan.items.push_back(code);
   }
@@ -74,7 +73,8 @@ BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memo
                      std::to_string(base->level));
   for (const CoarseMaterialFit& fit : base->entries)
     if (!fit.fitted)
-      throw InputError(options.base_database + ": holds blocks that were not fitted (the all-void block, or blocks "
+      throw InputError(options.base_database +
+                       ": holds blocks that were not fitted (the all-void block, or blocks "
                        "with void children without usable samples); compress it first with msfab-ddfem-compress, "
                        "which keeps the fitted ones");
   const int k1 = static_cast<int>(base->entries.size());
@@ -110,8 +110,9 @@ BuildPlan plan_level2(const BuildOptions& options, const MemoryCheck& check_memo
   int inputs = k1;
   for (int s = 0; s < 3; ++s) {
     const PairStage& stage = plan.db.hierarchy.stages[s];
-    spdlog::info("level 2, pairs along {}: {} candidates -> {} representatives (Eq. 2.10 distance mean {:.4f}, max {:.4f})",
-                 "xyz"[s], std::int64_t(inputs) * inputs, stage.outputs(), stage.mean_distance, stage.max_distance);
+    spdlog::info(
+        "level 2, pairs along {}: {} candidates -> {} representatives (Eq. 2.10 distance mean {:.4f}, max {:.4f})",
+        "xyz"[s], std::int64_t(inputs) * inputs, stage.outputs(), stage.mean_distance, stage.max_distance);
     inputs = stage.outputs();
   }
   spdlog::info("level 2 hierarchy: {:.2f} s", seconds);
@@ -160,8 +161,9 @@ CoarseDatabase assemble_database(BuildPlan plan, const FittedOrbits& done) {
   }
   if (unfitted > 0) throw NumericalError(std::to_string(unfitted) + " block(s) could not be fitted");
   if (unfitted_void > 0)
-    spdlog::warn("{} of {} fitted blocks with void children have no fit (no usable samples); they are coarsened naively",
-                 unfitted_void, done.size());
+    spdlog::warn(
+        "{} of {} fitted blocks with void children have no fit (no usable samples); they are coarsened naively",
+        unfitted_void, done.size());
   if (db.level == 2) {
     for (std::int64_t r : plan.items) db.entries.push_back(done.at(r));
     return db;

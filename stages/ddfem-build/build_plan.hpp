@@ -15,11 +15,11 @@
 namespace msfab {
 
 struct BuildPlan {
-  CoarseDatabase db;                      // palette; at level 2 also level1 and hierarchy
-  std::vector<std::int64_t> items;        // what to fit, increasing
-  std::vector<std::int64_t> item_of;      // level 1: per combination code, its orbit's representative
-  int points = 8;                         // quadrature points of each fit
-  std::string fingerprint;                // the inputs a checkpoint must agree on besides the config
+  CoarseDatabase db;                                  // palette; at level 2 also level1 and hierarchy
+  std::vector<std::int64_t> items;                    // what to fit, increasing
+  std::vector<std::int64_t> item_of;                  // level 1: per combination code, its orbit's representative
+  int points = 8;                                     // quadrature points of each fit
+  std::string fingerprint;                            // the inputs a checkpoint must agree on besides the config
   std::function<FineBlock(std::int64_t item)> block;  // the block fitted for an item
   // Void children of an item's block (0..8). A block with void children
   // may stay unfitted (coarsened naively online); one with 8 is no element

@@ -11,7 +11,8 @@
 
 namespace msfab {
 
-using FittedOrbits = std::map<std::int64_t, CoarseMaterialFit>;  // orbit representative code (level 2: final representative) -> fit
+using FittedOrbits =
+    std::map<std::int64_t, CoarseMaterialFit>;  // orbit representative code (level 2: final representative) -> fit
 
 // All fits in `done` have `points` quadrature points (8 at level 1, 64 at level 2).
 void write_checkpoint(const std::string& path, const std::string& config_text, const FittedOrbits& done, int points);

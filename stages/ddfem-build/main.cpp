@@ -24,11 +24,11 @@
 #include <filesystem>
 
 #include "build_options.hpp"
+#include "build_plan.hpp"
 #include "checkpoint.hpp"
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "build_plan.hpp"
 #include "fit_record.hpp"
 #include "parallel/fan_out.hpp"
 #include "parallel/mpi_session.hpp"
@@ -72,8 +72,9 @@ int main(int argc, char** argv) {
   bool resume = false;
   int max_rounds = 0;
   app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config required)");
-  app.cli().add_option("--max-rounds", max_rounds,
-                       "stop after this many rounds, keeping the checkpoint (for time-limited batch jobs); 0 = all")
+  app.cli()
+      .add_option("--max-rounds", max_rounds,
+                  "stop after this many rounds, keeping the checkpoint (for time-limited batch jobs); 0 = all")
       ->check(CLI::NonNegativeNumber);
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
@@ -103,14 +104,16 @@ int main(int argc, char** argv) {
       ctx.check_memory(bytes, what, remedy);
     };
     const BuildPlan plan = level2 ? plan_level2(options, check_memory) : plan_level1(options);
-    const std::string config_text = ctx.config.resolved_text() + (plan.fingerprint.empty() ? "" : "# " + plan.fingerprint + "\n");
+    const std::string config_text =
+        ctx.config.resolved_text() + (plan.fingerprint.empty() ? "" : "# " + plan.fingerprint + "\n");
     if (rank == 0) {
       if (level2)
-        spdlog::info("level 2 over {} level-1 materials: {} blocks of 64-point elements to fit; {} rank(s) x {} thread(s)",
-                     plan.db.level1->entries.size(), plan.items.size(), size, omp_get_max_threads());
+        spdlog::info(
+            "level 2 over {} level-1 materials: {} blocks of 64-point elements to fit; {} rank(s) x {} thread(s)",
+            plan.db.level1->entries.size(), plan.items.size(), size, omp_get_max_threads());
       else
-        spdlog::info("{} materials: {} combinations in {} orbits{}; {} rank(s) x {} thread(s)",
-                     plan.db.num_materials(), plan.db.num_combinations(), plan.items.size(),
+        spdlog::info("{} materials: {} combinations in {} orbits{}; {} rank(s) x {} thread(s)", plan.db.num_materials(),
+                     plan.db.num_combinations(), plan.items.size(),
                      options.use_symmetry ? " of the cube symmetries" : "", size, omp_get_max_threads());
     }
 
@@ -119,7 +122,8 @@ int main(int argc, char** argv) {
     FittedOrbits done;
     if (resume && std::filesystem::exists(ckpt)) {
       done = read_checkpoint(ckpt, config_text, plan.points);
-      if (rank == 0) spdlog::info("resuming: {} of {} blocks already fitted in {}", done.size(), plan.items.size(), ckpt);
+      if (rank == 0)
+        spdlog::info("resuming: {} of {} blocks already fitted in {}", done.size(), plan.items.size(), ckpt);
     } else if (resume && rank == 0) {
       spdlog::warn("--resume: no checkpoint {} yet, starting from the beginning", ckpt);
     }
@@ -157,15 +161,16 @@ int main(int argc, char** argv) {
       mean /= std::max<std::size_t>(1, done.size());
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (level2)
-        std::printf("msfab-ddfem-build: %zu level-2 coarse materials over %zu level-1 materials\n",
-                    db.entries.size(), db.level1->entries.size());
+        std::printf("msfab-ddfem-build: %zu level-2 coarse materials over %zu level-1 materials\n", db.entries.size(),
+                    db.level1->entries.size());
       else
         std::printf("msfab-ddfem-build: %lld combinations (%d orbits) of %d materials, level 1\n",
                     static_cast<long long>(db.num_combinations()), db.num_orbits, db.num_materials());
-      std::printf("  held-out relative energy error: mean %.4f, worst %.4f\n"
-                  "    (per block, the RMS of (coarse - fine energy) / fine energy over the force samples kept out of "
-                  "its fit, fit.heldout_fraction; 0 would be exact, 0.1 is 10%% energy error; docs/ddfem.md)\n",
-                  mean, worst);
+      std::printf(
+          "  held-out relative energy error: mean %.4f, worst %.4f\n"
+          "    (per block, the RMS of (coarse - fine energy) / fine energy over the force samples kept out of "
+          "its fit, fit.heldout_fraction; 0 would be exact, 0.1 is 10%% energy error; docs/ddfem.md)\n",
+          mean, worst);
       std::printf("  time: %.2f s wall, %.2f s of fitting (%.2f blocks/s per core)\n", wall, fit_seconds,
                   fit_seconds > 0 ? done.size() / fit_seconds : 0.0);
       std::printf("  artifact: %s (%.1f kB)\n", out.c_str(), std::filesystem::file_size(out) / 1024.0);

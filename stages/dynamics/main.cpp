@@ -23,8 +23,8 @@
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "default_scene.hpp"
 #include "ddfem/coarsening_options.hpp"
+#include "default_scene.hpp"
 #include "dynamics/coarse_dynamics.hpp"
 #include "dynamics/dynamics_run.hpp"
 #include "dynamics/dynamics_scene.hpp"
@@ -48,7 +48,8 @@ struct MarkerTrace {
 int nearest_rest_node(const DynamicsScene& scene, const Vec3& x) {
   int best = 0;
   for (int i = 1; i < scene.model.mesh.num_nodes(); ++i)
-    if ((scene.model.mesh.nodes.row(i).transpose() - x).norm() < (scene.model.mesh.nodes.row(best).transpose() - x).norm())
+    if ((scene.model.mesh.nodes.row(i).transpose() - x).norm() <
+        (scene.model.mesh.nodes.row(best).transpose() - x).norm())
       best = i;
   return best;
 }
@@ -69,8 +70,8 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
   int elastic_steps = 0, rigid_steps = 0, newton = 0, max_contacts = 0;
   double max_penetration = 0, max_z = -INFINITY, step_seconds = 0;
   for (const TrajectorySample& s : t.samples) {
-    if (s.phase == SimulationPhase::kElastic && s.time > 0) ++elastic_steps, newton += s.newton_iterations,
-                                                            step_seconds += s.seconds;
+    if (s.phase == SimulationPhase::kElastic && s.time > 0)
+      ++elastic_steps, newton += s.newton_iterations, step_seconds += s.seconds;
     if (s.phase == SimulationPhase::kRigid) ++rigid_steps;
     max_contacts = std::max(max_contacts, s.active_contacts);
     max_penetration = std::max(max_penetration, s.max_penetration);
@@ -81,8 +82,8 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
   std::printf("msfab-dynamics: scene '%s', %d elements, %d DOFs, impact model %s, h = %g s\n", scene.name.c_str(),
               scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(), t.impact_model.c_str(), t.time_step);
   std::printf("  %d elastic steps (%.2f Newton iterations, %.3f ms each), %d rigid steps\n", elastic_steps,
-              elastic_steps ? double(newton) / elastic_steps : 0.0, elastic_steps ? 1e3 * step_seconds / elastic_steps : 0.0,
-              rigid_steps);
+              elastic_steps ? double(newton) / elastic_steps : 0.0,
+              elastic_steps ? 1e3 * step_seconds / elastic_steps : 0.0, rigid_steps);
   std::printf("  centre of mass: start (%.5f, %.5f, %.5f) m, end (%.5f, %.5f, %.5f) m, highest z %.5f m\n",
               first.center_of_mass.x(), first.center_of_mass.y(), first.center_of_mass.z(), last.center_of_mass.x(),
               last.center_of_mass.y(), last.center_of_mass.z(), max_z);
@@ -116,11 +117,12 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
 }
 
 void print_difference(const TrajectoryDifference& d) {
-  std::printf("  vs fine (%s): error at release %.3e, max %.3e, mean %.3e, at the end %.3e over %zu frames\n"
-              "    (mean fine-vertex distance of this run's displacements interpolated to the fine nodes, over the\n"
-              "     longest side of the rest box; thesis 2.5.2); centre of mass apart by up to %.3e m\n",
-              d.model_nodes == d.fine_nodes ? "same mesh" : "interpolated", d.error.front(), d.max_error,
-              d.mean_error, d.final_error, d.error.size(), d.max_center_of_mass_distance);
+  std::printf(
+      "  vs fine (%s): error at release %.3e, max %.3e, mean %.3e, at the end %.3e over %zu frames\n"
+      "    (mean fine-vertex distance of this run's displacements interpolated to the fine nodes, over the\n"
+      "     longest side of the rest box; thesis 2.5.2); centre of mass apart by up to %.3e m\n",
+      d.model_nodes == d.fine_nodes ? "same mesh" : "interpolated", d.error.front(), d.max_error, d.mean_error,
+      d.final_error, d.error.size(), d.max_center_of_mass_distance);
   std::printf("  Newmark step: fine %.3f ms, this run %.3f ms (%d and %d elastic steps): %.1fx faster\n",
               1e3 * d.fine_seconds_per_step, 1e3 * d.model_seconds_per_step, d.fine_steps, d.model_steps,
               d.model_seconds_per_step > 0 ? d.fine_seconds_per_step / d.model_seconds_per_step : 0.0);
@@ -161,10 +163,9 @@ int main(int argc, char** argv) {
                                  scene.model.mesh.num_elements(), scene.duration, scene.output_every),
                      "use a coarser geometry.voxel_size, a larger simulation.output_every or a shorter duration");
     spdlog::info("scene '{}': {} elements, {} DOFs, {} obstacles, contact {}, friction {}, impact {}, h = {} s, {} s",
-                 scene.name, scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(),
-                 scene.model.obstacles.size(), scene.model.contact ? "on" : "off",
-                 scene.model.friction ? "on" : "off", impact_model_name(scene.model.impact), scene.newmark.time_step,
-                 scene.duration);
+                 scene.name, scene.model.mesh.num_elements(), scene.model.mesh.num_dofs(), scene.model.obstacles.size(),
+                 scene.model.contact ? "on" : "off", scene.model.friction ? "on" : "off",
+                 impact_model_name(scene.model.impact), scene.newmark.time_step, scene.duration);
     if (scene.coarsening)
       spdlog::info("coarsened to level {} with {} materials: {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, scene.model.mesh.num_elements(),

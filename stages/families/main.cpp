@@ -185,9 +185,8 @@ void fit_family(FamilyRecord& fam, const MicrostructureSet& set, const Settings&
   fam.caps = rep_fit.fitted.caps;
   fam.representative_template = template_parameters(rep_fit.fitted);
   fam.representative_difference = rep_fit.voxel_difference;
-  spdlog::info("{}: representative {} -> {} beams, voxel difference {:.2f}% ({} evaluations)", name,
-               fam.representative, rep_fit.fitted.beams.size(), 100 * rep_fit.voxel_difference,
-               rep_fit.evaluations);
+  spdlog::info("{}: representative {} -> {} beams, voxel difference {:.2f}% ({} evaluations)", name, fam.representative,
+               rep_fit.fitted.beams.size(), 100 * rep_fit.voxel_difference, rep_fit.evaluations);
 
   const std::size_t n = fam.members.size();
   const Eigen::Index p = fam.representative_template.size();
@@ -214,8 +213,8 @@ void fit_family(FamilyRecord& fam, const MicrostructureSet& set, const Settings&
   std::vector<Eigen::Index> rows;
   for (std::size_t i = 0; i < n; ++i)
     if (fam.member_kept[i]) rows.push_back(Eigen::Index(i));
-  spdlog::info("{}: template refitted to {} of {} members, {} within {:.0f}% voxel difference", name, chosen.size(),
-               n, rows.size(), 100 * settings.max_voxel_difference);
+  spdlog::info("{}: template refitted to {} of {} members, {} within {:.0f}% voxel difference", name, chosen.size(), n,
+               rows.size(), 100 * settings.max_voxel_difference);
   if (rows.size() < 3) {
     spdlog::warn("{}: fewer than 3 members fit the template; no reduced parameters", name);
     return;
@@ -269,17 +268,17 @@ int main(int argc, char** argv) {
     result.decades = set.decades;
     result.stiff_E = set.stiff.E;
     result.stiff_nu = set.stiff.nu;
-    result.selection = select_structures(set, settings.selection, gamut_path.empty() ? nullptr : &gamut.level_set,
-                                         structures_path);
+    result.selection =
+        select_structures(set, settings.selection, gamut_path.empty() ? nullptr : &gamut.level_set, structures_path);
     const std::size_t selected = result.selection.size();
     if (selected == 0)
       throw InputError(structures_path + ": no structure lies in the selection (" + std::to_string(set.items.size()) +
                        " structures; widen selection.nu / E / density or the boundary margin)");
     if (selected < std::size_t(settings.min_members) || selected <= std::size_t(settings.isomap.neighbors))
-      throw InputError(structures_path + ": the selection holds " + std::to_string(selected) +
-                       " structures; family discovery needs at least min_members = " +
-                       std::to_string(settings.min_members) + " and more than isomap.neighbours = " +
-                       std::to_string(settings.isomap.neighbors));
+      throw InputError(
+          structures_path + ": the selection holds " + std::to_string(selected) +
+          " structures; family discovery needs at least min_members = " + std::to_string(settings.min_members) +
+          " and more than isomap.neighbours = " + std::to_string(settings.isomap.neighbors));
     spdlog::info("{} of {} structures selected ({}^3 voxels)", selected, set.items.size(), set.nx);
     check_distance_memory(ctx, selected, set.nx / settings.field.pool_factor);
 
@@ -299,8 +298,8 @@ int main(int argc, char** argv) {
     if (!embedding.left_out.empty())
       spdlog::warn("{} structures are not connected to the largest neighbour-graph component and are left out",
                    embedding.left_out.size());
-    result.embedding = MatX::Constant(Eigen::Index(selected), settings.isomap.dimensions,
-                                      std::numeric_limits<double>::quiet_NaN());
+    result.embedding =
+        MatX::Constant(Eigen::Index(selected), settings.isomap.dimensions, std::numeric_limits<double>::quiet_NaN());
     for (std::size_t k = 0; k < embedding.kept.size(); ++k)
       result.embedding.row(embedding.kept[k]) = embedding.coordinates.row(Eigen::Index(k));
     result.eigenvalues = embedding.eigenvalues;
@@ -328,8 +327,9 @@ int main(int argc, char** argv) {
     // representative is the member nearest its cluster's mean.
     std::vector<int> order(std::size_t(result.clusters));
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return clusters.best.sizes[std::size_t(a)] > clusters.best.sizes[std::size_t(b)]; });
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return clusters.best.sizes[std::size_t(a)] > clusters.best.sizes[std::size_t(b)];
+    });
     result.family_of.assign(selected, -1);
     for (int c : order) {
       if (clusters.best.sizes[std::size_t(c)] < settings.min_members) continue;
@@ -346,10 +346,11 @@ int main(int argc, char** argv) {
       }
       result.families.push_back(std::move(fam));
     }
-    std::printf("msfab-families: %zu structures selected, %zu embedded (%d graph components), %d clusters, %zu "
-                "families of >= %d members\n",
-                selected, embedding.kept.size(), embedding.components, result.clusters, result.families.size(),
-                settings.min_members);
+    std::printf(
+        "msfab-families: %zu structures selected, %zu embedded (%d graph components), %d clusters, %zu "
+        "families of >= %d members\n",
+        selected, embedding.kept.size(), embedding.components, result.clusters, result.families.size(),
+        settings.min_members);
 
     // 5-7. Templates and reduced parameters.
     for (std::size_t f = 0; f < result.families.size(); ++f) {
@@ -367,13 +368,14 @@ int main(int argc, char** argv) {
       fit_family(fam, set, settings, name);
       int kept = 0;
       for (char k : fam.member_kept) kept += k;
-      std::printf("  family %zu: %zu members, E %.3g..%.3g, nu %.3f..%.3f, G' %.3f..%.3f; template %lld beams, "
-                  "representative differs by %.2f%%, %d members fit within %.0f%%%s\n",
-                  f + 1, fam.members.size(), fam.E_range[0], fam.E_range[1], fam.nu_range[0], fam.nu_range[1],
-                  fam.shear_ratio_range[0], fam.shear_ratio_range[1],
-                  static_cast<long long>(fam.representative_template.size() / kBeamParameters),
-                  100 * fam.representative_difference, kept, 100 * settings.max_voxel_difference,
-                  fam.has_reduced ? "" : " (no reduced parameters)");
+      std::printf(
+          "  family %zu: %zu members, E %.3g..%.3g, nu %.3f..%.3f, G' %.3f..%.3f; template %lld beams, "
+          "representative differs by %.2f%%, %d members fit within %.0f%%%s\n",
+          f + 1, fam.members.size(), fam.E_range[0], fam.E_range[1], fam.nu_range[0], fam.nu_range[1],
+          fam.shear_ratio_range[0], fam.shear_ratio_range[1],
+          static_cast<long long>(fam.representative_template.size() / kBeamParameters),
+          100 * fam.representative_difference, kept, 100 * settings.max_voxel_difference,
+          fam.has_reduced ? "" : " (no reduced parameters)");
     }
 
     // 8. Output.

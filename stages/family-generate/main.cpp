@@ -27,9 +27,9 @@
 #include "families/beam_template.hpp"
 #include "families/families_artifact.hpp"
 #include "families/family_selection.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "gamut/structure_ops.hpp"
-#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 
 using namespace msfab;
@@ -53,7 +53,7 @@ struct TemplateRequest {
   BeamTemplate tpl;
   std::vector<Vec3> a_to, b_to;  // per beam: where its ends move over the sweep
   std::vector<double> scales;
-  int moves = 1;                 // end positions per scale (from a, b to a_to, b_to)
+  int moves = 1;  // end positions per scale (from a, b to a_to, b_to)
 };
 
 // A beam's ends `a` and `b` (unit-cell coordinates) from its config item.
@@ -234,12 +234,15 @@ int main(int argc, char** argv) {
   std::string families_path;
   int family = 0, sweep = 0;
   std::vector<std::string> reduced_options;
-  app.cli().add_option("--families", families_path, "msfab.families artifact (without it: the config's templates)")
+  app.cli()
+      .add_option("--families", families_path, "msfab.families artifact (without it: the config's templates)")
       ->type_name("FILE");
   app.cli().add_option("--family", family, "family number, from 1 (with --families)");
-  app.cli().add_option("--reduced", reduced_options, "reduced parameters r1,r2 in [-1, 1] (repeatable)")
+  app.cli()
+      .add_option("--reduced", reduced_options, "reduced parameters r1,r2 in [-1, 1] (repeatable)")
       ->type_name("R1,R2");
-  app.cli().add_option("--sweep", sweep, "each reduced parameter over N values in [-1, 1], the others 0")
+  app.cli()
+      .add_option("--sweep", sweep, "each reduced parameter over N values in [-1, 1], the others 0")
       ->type_name("N");
   return app.run(argc, argv, [&](StageContext& ctx) {
     int resolution = ctx.config.get_or<int>("resolution", 0);
@@ -344,8 +347,9 @@ int main(int argc, char** argv) {
       std::vector<std::vector<double>> requests;
       for (const std::string& text : reduced_options) requests.push_back(parse_reduced(text));
       const std::size_t reduced_count = fam.reduced.plus.size();
-      check_memory(std::max<std::size_t>(1, reduced_options.size() + (sweep >= 2 ? reduced_count * std::size_t(sweep) : 0)),
-                   resolution, "--sweep and --reduced");
+      check_memory(
+          std::max<std::size_t>(1, reduced_options.size() + (sweep >= 2 ? reduced_count * std::size_t(sweep) : 0)),
+          resolution, "--sweep and --reduced");
       for (std::size_t j = 0; sweep >= 2 && j < reduced_count; ++j)
         for (int s = 0; s < sweep; ++s) {
           std::vector<double> r(reduced_count, 0.0);

@@ -117,7 +117,8 @@ Settings read_settings(const Config& config) {
   k.projection_beta = r.get_or<double>("projection_beta", k.projection_beta);
   if (!(k.projection_beta >= 0 && k.projection_beta <= 1024)) r.fail("projection_beta", "must be in [0, 1024]");
   k.threshold_levels = r.get_or<std::vector<double>>("threshold_levels", k.threshold_levels);
-  if (k.threshold_levels.empty() || k.threshold_levels.size() > 64) r.fail("threshold_levels", "must hold 1..64 levels");
+  if (k.threshold_levels.empty() || k.threshold_levels.size() > 64)
+    r.fail("threshold_levels", "must hold 1..64 levels");
   for (double level : k.threshold_levels)
     if (!(level > 0 && level < 1)) r.fail("threshold_levels", "every level must lie in (0, 1)");
   return s;
@@ -125,8 +126,7 @@ Settings read_settings(const Config& config) {
 
 void report(const char* when, const CellCoverage& c, double gap) {
   std::printf("  %s: property gap of the best candidate max %.4g, mean %.4g; %lld of %lld cells above %g\n", when,
-              c.max_gap, c.mean_gap, static_cast<long long>(c.above(gap)), static_cast<long long>(c.design_cells),
-              gap);
+              c.max_gap, c.mean_gap, static_cast<long long>(c.above(gap)), static_cast<long long>(c.design_cells), gap);
 }
 
 }  // namespace
@@ -140,10 +140,12 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string design_path, structures_path;
-  app.cli().add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
+  app.cli()
+      .add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
       ->type_name("FILE")
       ->required();
-  app.cli().add_option("--structures", structures_path, "msfab.microstructures artifact of the design's space")
+  app.cli()
+      .add_option("--structures", structures_path, "msfab.microstructures artifact of the design's space")
       ->type_name("FILE")
       ->required();
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
@@ -180,8 +182,8 @@ int main(int argc, char** argv) {
       run.refine.frozen_stiff =
           add_face_connector(set, settings.connector_half_width, settings.connector_depth, settings.void_stiffness);
       if (rank == 0)
-        spdlog::info("face connector ({} voxels wide, {} deep) added to the {} structures", 2 * settings.connector_half_width,
-                     settings.connector_depth, given);
+        spdlog::info("face connector ({} voxels wide, {} deep) added to the {} structures",
+                     2 * settings.connector_half_width, settings.connector_depth, given);
     }
     // 1. Coverage of the given set.
     const CellCoverage before = cell_coverage(design, set, settings.plan.candidates);
@@ -195,7 +197,8 @@ int main(int argc, char** argv) {
       Progress progress("round " + std::to_string(round) + ": structures at targets", targets.size());
       const int row = generated_record_size(set);
       const std::vector<double> records = fan_out(static_cast<int>(targets.size()), row, [&](int t, double* r) {
-        write_generated_record(generate_at_target(set, targets[std::size_t(t)], run.refine, settings.void_stiffness), r);
+        write_generated_record(generate_at_target(set, targets[std::size_t(t)], run.refine, settings.void_stiffness),
+                               r);
         progress.tick();
       });
       progress.done();
@@ -206,18 +209,20 @@ int main(int argc, char** argv) {
         const GeneratedStructure& g = generated.back();
         found += g.found;
         if (rank == 0)
-          spdlog::debug("target {} ({} cells, rho {:.3f}): gap of the set {:.4f}; generated {:.4f} (rho {:.3f}, from {})",
-                        t, targets[t].cells.size(), targets[t].raw[targets[t].raw.size() - 1], targets[t].gap,
-                        g.found ? g.gap : -1.0, g.rho, g.parent);
+          spdlog::debug(
+              "target {} ({} cells, rho {:.3f}): gap of the set {:.4f}; generated {:.4f} (rho {:.3f}, from {})", t,
+              targets[t].cells.size(), targets[t].raw[targets[t].raw.size() - 1], targets[t].gap,
+              g.found ? g.gap : -1.0, g.rho, g.parent);
       }
       // 4. The new structures, then the coverage they give.
       const int added = append_generated(set, targets, generated, round);
       now = cell_coverage(design, set, settings.plan.candidates);
       char line[256];
-      std::snprintf(line, sizeof line,
-                    "  round %d: %zu targets, %d printable, %d added; gap max %.4g, mean %.4g, %lld cells above; %.1f s",
-                    round, targets.size(), found, added, now.max_gap, now.mean_gap,
-                    static_cast<long long>(now.above(settings.plan.gap)), seconds_since(t_round));
+      std::snprintf(
+          line, sizeof line,
+          "  round %d: %zu targets, %d printable, %d added; gap max %.4g, mean %.4g, %lld cells above; %.1f s", round,
+          targets.size(), found, added, now.max_gap, now.mean_gap, static_cast<long long>(now.above(settings.plan.gap)),
+          seconds_since(t_round));
       round_lines.emplace_back(line);
       if (rank == 0) spdlog::info("{}", line + 2);
       if (added == 0) break;

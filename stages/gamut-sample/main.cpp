@@ -87,8 +87,9 @@ int main(int argc, char** argv) {
   int max_cycles = 0;
   std::string structures_path;
   app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config and seed required)");
-  app.cli().add_option("--max-cycles", max_cycles,
-                       "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
+  app.cli()
+      .add_option("--max-cycles", max_cycles,
+                  "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
       ->check(CLI::NonNegativeNumber);
   app.cli().add_option("--structures", structures_path,
                        "the microstructures artifact (default: <out without .gamut.h5>.microstructures.h5)");
@@ -107,12 +108,13 @@ int main(int argc, char** argv) {
       const bool three_d = options.kind == MaterialSpaceKind::cubic3d;
       const int n = options.resolution;
       const double voxels = std::pow(double(n), three_d ? 3 : 2);
-      const double at_once = 3.0 * (double(options.population) + options.continuous_per_cycle +
-                                    options.directed_per_cycle);
-      const double bytes = at_once * voxels * 4 + omp_get_max_threads() *
-                                                      homogenization_peak_bytes(n, n, three_d ? n : 1, "auto");
-      ctx.check_memory(bytes, "a population of " + std::to_string(options.population) + " structures of " +
-                                  std::to_string(options.resolution) + (three_d ? "^3" : "^2") + " voxels",
+      const double at_once =
+          3.0 * (double(options.population) + options.continuous_per_cycle + options.directed_per_cycle);
+      const double bytes =
+          at_once * voxels * 4 + omp_get_max_threads() * homogenization_peak_bytes(n, n, three_d ? n : 1, "auto");
+      ctx.check_memory(bytes,
+                       "a population of " + std::to_string(options.population) + " structures of " +
+                           std::to_string(options.resolution) + (three_d ? "^3" : "^2") + " voxels",
                        "lower population or resolution");
     }
     if (structures_path.empty()) structures_path = without_suffix(out, {".gamut.h5"}) + ".microstructures.h5";
@@ -136,7 +138,8 @@ int main(int argc, char** argv) {
     std::optional<GamutLevelSet> gamut;  // of the current set (none yet after resuming)
     if (resume && std::filesystem::exists(ckpt)) {
       state = read_sampler_checkpoint(ckpt, run_text);
-      if (rank == 0) spdlog::info("resuming after cycle {} with {} structures", state.cycles_done, state.set.items.size());
+      if (rank == 0)
+        spdlog::info("resuming after cycle {} with {} structures", state.cycles_done, state.set.items.size());
     } else {
       if (resume && rank == 0) spdlog::warn("--resume: no checkpoint {} yet, starting from the beginning", ckpt);
       const auto t0 = std::chrono::steady_clock::now();
@@ -168,8 +171,8 @@ int main(int argc, char** argv) {
       sampler.resample(state, *gamut, cycle);
       state.cycles_done = cycle;
       state.history.push_back({cycle, static_cast<int>(state.set.items.size()), discrete.added,
-                               continuous.added + directed.added,
-                               coverage(*gamut), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
+                               continuous.added + directed.added, coverage(*gamut),
+                               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()});
       if (rank == 0) {
         const GamutCycle& h = state.history.back();
         spdlog::info("cycle {}/{}: {} structures, coverage {:.4f}, {:.1f} s", cycle, options.cycles, h.samples,
@@ -209,7 +212,8 @@ int main(int argc, char** argv) {
           add_set_and_gamut(artifacts, structures_path, state.set, out, g, {}, run_text, ctx.options.seed);
       if (options.void_variants) {
         log_step("void variants", void_report);
-        if (voids.set.items.empty()) throw NumericalError("void variants: no structure survives removing the soft material");
+        if (voids.set.items.empty())
+          throw NumericalError("void variants: no structure survives removing the soft material");
         Gamut vg = g;
         vg.level_set = sampler.level_set(voids);
         vg.history.clear();
@@ -217,8 +221,8 @@ int main(int argc, char** argv) {
         const std::string vstem = without_suffix(out, {".gamut.h5"}) + ".void";
         add_set_and_gamut(artifacts, vstem + ".microstructures.h5", voids.set, vstem + ".gamut.h5", vg, {set_input},
                           run_text, ctx.options.seed);
-        std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n",
-                    voids.set.items.size(), state.set.items.size(), vstem.c_str());
+        std::printf("  void variants: %zu of %zu structures -> %s.{gamut,microstructures}.h5\n", voids.set.items.size(),
+                    state.set.items.size(), vstem.c_str());
       }
       artifacts.commit();
       std::filesystem::remove(ckpt);
@@ -226,7 +230,8 @@ int main(int argc, char** argv) {
       int by_step[5] = {0, 0, 0, 0, 0};
       for (const Microstructure& m : state.set.items) ++by_step[static_cast<int>(m.step)];
       std::printf(
-          "msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous, %d directed) after %d cycles\n",
+          "msfab-gamut-sample: %s, %zu structures (%d initial, %d discrete, %d continuous, %d directed) after %d "
+          "cycles\n",
           options.space.c_str(), state.set.items.size(), by_step[0], by_step[1], by_step[2], by_step[4],
           state.cycles_done);
       std::printf("  coverage %.4f (cycle 0: %.4f)\n", state.history.back().coverage, state.history.front().coverage);
@@ -254,7 +259,8 @@ int main(int argc, char** argv) {
       const std::vector<std::string> names = sampler.space().names();
       for (std::size_t a = 0; a < names.size(); ++a) {
         double lo = HUGE_VAL, hi = -HUGE_VAL;
-        for (const Microstructure& m : state.set.items) lo = std::min(lo, m.properties[a]), hi = std::max(hi, m.properties[a]);
+        for (const Microstructure& m : state.set.items)
+          lo = std::min(lo, m.properties[a]), hi = std::max(hi, m.properties[a]);
         std::printf("  range %s: [%.6g, %.6g]\n", names[a].c_str(), lo, hi);
       }
       std::printf("  time: %.1f s wall\n", wall);

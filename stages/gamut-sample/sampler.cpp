@@ -7,11 +7,11 @@
 #include <unordered_set>
 
 #include "core/errors.hpp"
+#include "gamut/batch_homogenization.hpp"
 #include "gamut/continuous_refinement.hpp"
 #include "gamut/particle_scoring.hpp"
 #include "gamut/structure_evolution.hpp"
 #include "gamut/structure_ops.hpp"
-#include "gamut/batch_homogenization.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
 #include "parallel/fan_out.hpp"
@@ -217,7 +217,8 @@ StepReport GamutSampler::discrete_step(SamplerState& state, int cycle) const {
   }
   for (std::size_t i = 0; i < state.population.size(); ++i) {
     const std::int64_t p = state.population[i];
-    cells.push_back(evolve_structure(cell_of(state.set.items[p]), stream(seed_, cycle, static_cast<std::int64_t>(i), 2), o_.move));
+    cells.push_back(
+        evolve_structure(cell_of(state.set.items[p]), stream(seed_, cycle, static_cast<std::int64_t>(i), 2), o_.move));
     parents.push_back(p);
   }
   return add_structures(state, cells, parents, cycle, SampleStep::discrete, palette_);
@@ -263,7 +264,8 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
   // The unrefined structures nearest the boundary (ties: the older first).
   std::vector<std::pair<double, std::int64_t>> order;
   for (std::size_t i = 0; i < state.set.items.size(); ++i)
-    if (!(state.refined[i] & 1)) order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
+    if (!(state.refined[i] & 1))
+      order.emplace_back(std::abs(gamut.value(state.set.items[i].unit)), static_cast<std::int64_t>(i));
   std::sort(order.begin(), order.end());
   order.resize(std::min<std::size_t>(order.size(), o_.continuous_per_cycle));
   std::vector<std::int64_t> starts;
@@ -280,20 +282,25 @@ StepReport GamutSampler::continuous_step(SamplerState& state, const GamutLevelSe
     for (int a = 0; a < q.size(); ++a) q[a] = std::clamp(q[a], 0.005, 0.995);
     const VecX raw = space_.denormalize(q);
     RefinementTarget target;
-    if (o_.kind == MaterialSpaceKind::cubic3d) target.G = space_.tensor_3d(raw).inverse();
-    else target.G = space_.tensor_2d(raw).inverse();
+    if (o_.kind == MaterialSpaceKind::cubic3d)
+      target.G = space_.tensor_3d(raw).inverse();
+    else
+      target.G = space_.tensor_2d(raw).inverse();
     target.rho = raw[raw.size() - 1];
     return refine_structure(cell_of(start), 1, soft_id, palette_[1], o_.soft_is_void ? nullptr : palette_[2], target,
                             o_.continuous)
         .structure;
   });
   report.step = step;
-  for (std::size_t i = before; i < state.set.items.size(); ++i) report.expanded += gamut.value(state.set.items[i].unit) > 0;
+  for (std::size_t i = before; i < state.set.items.size(); ++i)
+    report.expanded += gamut.value(state.set.items[i].unit) > 0;
   state.push_step = step;
   if (o_.continuous_adaptive && report.tried > 0) {
     const double progress = double(report.expanded) / report.tried;
-    if (progress >= 0.5) state.push_step = std::min(1.5 * step, 4 * o_.continuous_step);
-    else if (progress < 0.25) state.push_step = std::max(step / 1.5, o_.continuous_step / 4);
+    if (progress >= 0.5)
+      state.push_step = std::min(1.5 * step, 4 * o_.continuous_step);
+    else if (progress < 0.25)
+      state.push_step = std::max(step / 1.5, o_.continuous_step / 4);
   }
   return report;
 }
@@ -326,8 +333,8 @@ StepReport GamutSampler::directed_step(SamplerState& state, int cycle) const {
     target.floor = VecX::Constant(target.direction.size(), -1.0);
     for (int a = 0; a < target.direction.size(); ++a)
       if (target.direction[a] == 0 && space_.is_modulus(a)) target.floor[a] = start.unit[a] - o_.directed_modulus_drop;
-    ContinuousResult c = refine_structure_directed(cell_of(start), 1, soft_id, palette_[1],
-                                                   o_.soft_is_void ? nullptr : palette_[2], space_, target, o_.directed);
+    ContinuousResult c = refine_structure_directed(
+        cell_of(start), 1, soft_id, palette_[1], o_.soft_is_void ? nullptr : palette_[2], space_, target, o_.directed);
     if (!c.found) return std::nullopt;
     return std::move(c.structure);
   });

@@ -21,16 +21,16 @@ struct SamplerState {
   // pushed along directed objective k.
   std::vector<std::uint8_t> refined;
   std::vector<GamutCycle> history;
-  int cycles_done = -1;                  // -1: not initialized; 0: initial population only
-  double push_step = 0;                  // the level-set push's step now (0: continuous.step)
+  int cycles_done = -1;  // -1: not initialized; 0: initial population only
+  double push_step = 0;  // the level-set push's step now (0: continuous.step)
 };
 
 struct StepReport {
   int tried = 0, added = 0;
   // rejected: already in the set, outside the space's box, a feature below min_feature, no result
   int duplicates = 0, outside = 0, thin = 0, failed = 0;
-  int expanded = 0;      // level-set pushes: added structures outside the gamut they were pushed from
-  double step = 0;       // level-set pushes: the step they used
+  int expanded = 0;  // level-set pushes: added structures outside the gamut they were pushed from
+  double step = 0;   // level-set pushes: the step they used
 };
 
 class GamutSampler {
@@ -64,7 +64,7 @@ class GamutSampler {
   SamplerOptions o_;
   std::uint64_t seed_;
   MaterialSpace space_;
-  std::vector<MaterialPtr> palette_;  // [0] void, [1] stiff, [2] soft (if any)
+  std::vector<MaterialPtr> palette_;       // [0] void, [1] stiff, [2] soft (if any)
   std::vector<MaterialPtr> void_palette_;  // [0] void, [1] stiff
   int voxels_per_side_z() const;
   // A cell of the sampler's resolution with these ids, or with a structure's.

@@ -14,8 +14,8 @@ void write_sampler_checkpoint(const std::string& path, const std::string& run_te
     f.write_vector("/refined", s.refined);
     std::vector<double> rows;
     for (const GamutCycle& c : s.history)
-      rows.insert(rows.end(), {double(c.cycle), double(c.samples), double(c.discrete_added),
-                               double(c.continuous_added), c.coverage, c.seconds});
+      rows.insert(rows.end(), {double(c.cycle), double(c.samples), double(c.discrete_added), double(c.continuous_added),
+                               c.coverage, c.seconds});
     f.write_dataset("/history", rows, {hsize_t(s.history.size()), 6});
   });
 }
@@ -30,7 +30,8 @@ SamplerState read_sampler_checkpoint(const std::string& path, const std::string&
   s.refined = f.read_vector<std::uint8_t>("/refined");
   if (s.refined.size() != s.set.items.size()) throw InputError(path + ": /refined does not match /set");
   for (std::int64_t p : s.population)
-    if (p < 0 || p >= static_cast<std::int64_t>(s.set.items.size())) throw InputError(path + ": /population index out of range");
+    if (p < 0 || p >= static_cast<std::int64_t>(s.set.items.size()))
+      throw InputError(path + ": /population index out of range");
   const NdArray<double> h = f.read_dataset<double>("/history");
   for (std::size_t r = 0; r + 6 <= h.values.size(); r += 6) {
     const double* v = &h.values[r];

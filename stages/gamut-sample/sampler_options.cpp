@@ -71,11 +71,16 @@ VecX directed_direction(const MaterialSpace& space, const std::string& objective
   VecX d = VecX::Zero(space.dimension());
   const bool ortho = space.kind() == MaterialSpaceKind::orthotropic2d;
   const int nu = ortho ? 2 : 1, shear = ortho ? 3 : 2;
-  if (objective == "min_nu") d[nu] = -1;
-  else if (objective == "max_nu") d[nu] = 1;
-  else if (objective == "min_shear") d[shear] = -1;
-  else if (objective == "max_shear") d[shear] = 1;
-  else throw InputError("directed objective '" + objective + "': expected min_nu, max_nu, min_shear or max_shear");
+  if (objective == "min_nu")
+    d[nu] = -1;
+  else if (objective == "max_nu")
+    d[nu] = 1;
+  else if (objective == "min_shear")
+    d[shear] = -1;
+  else if (objective == "max_shear")
+    d[shear] = 1;
+  else
+    throw InputError("directed objective '" + objective + "': expected min_nu, max_nu, min_shear or max_shear");
   return d;
 }
 
@@ -94,7 +99,8 @@ SamplerOptions read_sampler_options(const Config& config) {
   }
   if (mats.has("void")) {
     const bool with_void = mats.get_or<bool>("void", false);
-    if (o.soft_is_void && !with_void) mats.fail("void", "false needs materials.soft (without it the second phase is void)");
+    if (o.soft_is_void && !with_void)
+      mats.fail("void", "false needs materials.soft (without it the second phase is void)");
     o.three_phase = with_void && !o.soft_is_void;
   }
   mats.check_no_unknown_keys();
@@ -163,8 +169,9 @@ SamplerOptions read_sampler_options(const Config& config) {
   if (o.backbone < 0 || o.backbone > o.resolution / 2)
     config.fail("backbone", "must be in 0..resolution/2 (" + std::to_string(o.resolution / 2) + "; 0: none)");
   if (o.backbone > 0 && !o.soft_is_void && !o.three_phase)
-    config.fail("backbone", "needs a void phase (leave out materials.soft, or set materials.void: true): with two "
-                            "materials every cell is solid");
+    config.fail("backbone",
+                "needs a void phase (leave out materials.soft, or set materials.void: true): with two "
+                "materials every cell is solid");
   o.continuous.void_stiffness = o.void_stiffness;
   o.continuous.symmetry = o.move.symmetry;
   o.continuous.use_symmetry = o.use_symmetry;
@@ -229,7 +236,8 @@ SamplerOptions read_sampler_options(const Config& config) {
   o.boundary_depth = config.get_or<double>("boundary_depth", o.boundary_depth);
   if (!(o.boundary_depth > 0 && o.boundary_depth <= 1)) config.fail("boundary_depth", "must be in (0, 1]");
   o.void_variants = config.get_or<bool>("void_variants", o.void_variants);
-  if (o.void_variants && o.soft_is_void) config.fail("void_variants", "needs a soft material to remove (materials.soft)");
+  if (o.void_variants && o.soft_is_void)
+    config.fail("void_variants", "needs a soft material to remove (materials.soft)");
   if (config.has("mode")) {
     const std::string mode = config.one_of("mode", {"sampler", "random", "set"});
     o.random_baseline = mode == "random";

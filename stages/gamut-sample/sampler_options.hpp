@@ -17,7 +17,7 @@ namespace msfab {
 struct SamplerOptions {
   std::string space = "cubic2d";
   MaterialSpaceKind kind = MaterialSpaceKind::cubic2d;
-  int resolution = 16;           // voxels per side; a 2D space uses n x n x 1
+  int resolution = 16;  // voxels per side; a 2D space uses n x n x 1
   BaseMaterial stiff{1e6, 0.3}, soft{1e4, 0.45};
   bool soft_is_void = false;
   // Two materials and void (thesis Fig. 3-15, `materials.void: true` with a
@@ -25,7 +25,7 @@ struct SamplerOptions {
   // Discrete sampling only: the continuous and directed steps interpolate
   // between two phases.
   bool three_phase = false;
-  double decades = 4;            // log range of the moduli below the stiff E
+  double decades = 4;  // log range of the moduli below the stiff E
   double void_stiffness = 1e-6;
   // Cell problems solved on the cell's symmetric part: two strain cases for
   // a cubic cell, one octant for a mirror-symmetric one (both exact);
@@ -49,15 +49,15 @@ struct SamplerOptions {
   std::string initial_set;
   int initial_refine = 1;
 
-  int population = 24;           // particles
-  int cycles = 6;                // discrete + continuous cycles after the initial population (the most)
+  int population = 24;  // particles
+  int cycles = 6;       // discrete + continuous cycles after the initial population (the most)
   // Stop before `cycles` once the gamut has converged: its coverage grew by
   // less than `stop_coverage_growth` (relative) over the last
   // `stop_window` cycles. 0: run all `cycles`.
   double stop_coverage_growth = 0;
   int stop_window = 3;
-  int initial_beams = 8;         // beams cut from the solid cell for the initial population
-  BeamMoveOptions move;          // the discrete step's move
+  int initial_beams = 8;  // beams cut from the solid cell for the initial population
+  BeamMoveOptions move;   // the discrete step's move
 
   int continuous_per_cycle = 4;  // boundary structures refined per cycle (0: discrete only)
   double continuous_step = 0.1;  // |q - p| in the unit cube (the first step when adaptive)
@@ -77,8 +77,8 @@ struct SamplerOptions {
   ContinuousOptions directed;  // MMA settings of the directed pushes
 
   LevelSetOptions level_set{16, 0.1, 0.0, 2};
-  double density_radius = 0.1;   // h of Eq. 3.2 (a tenth of the lattice's extent)
-  double boundary_depth = 0.1;   // depth of the boundary weight in Eq. 3.1
+  double density_radius = 0.1;  // h of Eq. 3.2 (a tenth of the lattice's extent)
+  double boundary_depth = 0.1;  // depth of the boundary weight in Eq. 3.1
 
   // §3.6.1: after sampling, the soft material of every structure replaced
   // by void, cleaned and homogenized again (a second pair of artifacts).

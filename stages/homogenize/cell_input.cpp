@@ -33,8 +33,8 @@ VoxelGrid read_voxel_text(const std::string& path, double voxel_size) {
     if (numbers[a] < 1 || numbers[a] > 4096) throw InputError(path + ": cell size must be 1..4096 per axis");
   VoxelGrid g(static_cast<int>(numbers[0]), static_cast<int>(numbers[1]), static_cast<int>(numbers[2]), voxel_size, 0);
   if (numbers.size() - 3 != g.size())
-    throw InputError(path + ": " + std::to_string(numbers.size() - 3) + " voxel ids for a " +
-                     std::to_string(g.nx) + " x " + std::to_string(g.ny) + " x " + std::to_string(g.nz) + " cell (" +
+    throw InputError(path + ": " + std::to_string(numbers.size() - 3) + " voxel ids for a " + std::to_string(g.nx) +
+                     " x " + std::to_string(g.ny) + " x " + std::to_string(g.nz) + " cell (" +
                      std::to_string(g.size()) + " expected)");
   for (std::size_t v = 0; v < g.size(); ++v) {
     if (numbers[3 + v] < 0 || numbers[3 + v] > 65535) throw InputError(path + ": voxel ids must be 0..65535");
@@ -49,7 +49,8 @@ namespace {
 // materials as Neo-Hookean (C^H is the same for any model linearized at
 // rest; the finite-strain check needs a hyperelastic one).
 CellInput read_set_structure(const Config& config, const Config& c) {
-  if (config.has("materials")) config.fail("materials", "come from cell.structures (the set's base materials); drop it");
+  if (config.has("materials"))
+    config.fail("materials", "come from cell.structures (the set's base materials); drop it");
   if (config.has("layout")) config.fail("layout", "the cell comes from cell.structures; drop the layout");
   if (c.has("size") || c.has("voxels")) c.fail("structures", "give one of structures, voxels or size + layout");
   const std::string path = c.get_path("structures");

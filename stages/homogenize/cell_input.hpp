@@ -18,7 +18,7 @@ struct CellInput {
   VoxelGrid cell;
   std::vector<PaletteEntry> palette;
   std::vector<MaterialPtr> material_by_id;  // [0] = void
-  std::string source;  // the microstructures artifact the cell came from (an input of the result), or empty
+  std::string source;              // the microstructures artifact the cell came from (an input of the result), or empty
   std::vector<std::string> files;  // the voxel files the cell was read from (inputs of the result)
 };
 

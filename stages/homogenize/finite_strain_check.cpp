@@ -39,9 +39,11 @@ void run_finite_strain_check(FiniteStrainCheck& check, const CellInput& in, cons
   check.points = uniaxial_finite_strain(in.cell, in.material_by_id, a, check.strains, check.options);
   check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const char axes[] = "xyz";
-  std::printf("  finite strain, uniaxial stress along %c (void removed; %.2f s); linear C^H: E %.6g, nu_%c%c %.4f, nu_%c%c %.4f\n",
-              axes[a], check.seconds, check.linear_E, axes[a], axes[lat[0]], check.linear_nu[0], axes[a], axes[lat[1]],
-              check.linear_nu[1]);
+  std::printf(
+      "  finite strain, uniaxial stress along %c (void removed; %.2f s); linear C^H: E %.6g, nu_%c%c %.4f, nu_%c%c "
+      "%.4f\n",
+      axes[a], check.seconds, check.linear_E, axes[a], axes[lat[0]], check.linear_nu[0], axes[a], axes[lat[1]],
+      check.linear_nu[1]);
   std::printf("    strain    nu_%c%c     nu_%c%c     vs linear   secant E / linear E   Newton its\n", axes[a],
               axes[lat[0]], axes[a], axes[lat[1]]);
   for (const UniaxialStrainPoint& p : check.points) {

@@ -7,7 +7,8 @@ namespace msfab {
 HomogenizationOptions read_homogenization_options(const Config& config) {
   HomogenizationOptions options;
   options.void_stiffness = config.get_or<double>("void_stiffness", options.void_stiffness);
-  if (!(options.void_stiffness > 0 && options.void_stiffness < 1e-2)) config.fail("void_stiffness", "must be in (0, 0.01)");
+  if (!(options.void_stiffness > 0 && options.void_stiffness < 1e-2))
+    config.fail("void_stiffness", "must be in (0, 0.01)");
   LinearSolverChoice defaults;
   defaults.kind = options.solver;
   defaults.tolerance = options.tolerance;
@@ -15,7 +16,8 @@ HomogenizationOptions read_homogenization_options(const Config& config) {
   LinearSolverKeys keys;
   keys.legacy_kind = "solver";
   keys.legacy_tolerance = "multigrid_tolerance";
-  const LinearSolverChoice linear = read_linear_solver_choice(config, {"auto", "cholmod", "matrix-free"}, defaults, keys);
+  const LinearSolverChoice linear =
+      read_linear_solver_choice(config, {"auto", "cholmod", "matrix-free"}, defaults, keys);
   options.solver = linear.kind;
   options.tolerance = linear.tolerance;
   options.max_iterations = linear.max_iterations;

@@ -6,12 +6,12 @@ namespace msfab {
 
 void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
                        const PlaneStrainResult* plane, const FiniteStrainCheck* finite_strain,
-                       const std::string& config_text,
-                       const std::string& command_line, std::uint64_t seed) {
+                       const std::string& config_text, const std::string& command_line, std::uint64_t seed) {
   std::vector<std::string> inputs;
   if (!in.source.empty()) inputs.push_back(in.source);
   inputs.insert(inputs.end(), in.files.begin(), in.files.end());
-  ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, inputs, seed);
+  ArtifactWriter out(path, kHomogenizedSchema, kHomogenizedSchemaVersion, "msfab-homogenize", config_text, inputs,
+                     seed);
   H5File& f = out.file();
   f.write_attribute("/", "command_line", command_line);
   f.write_matrix("/C", r.C);
@@ -68,10 +68,12 @@ void write_homogenized(const std::string& path, const CellInput& in, const Homog
     f.write_matrix("/finite_strain/stretch", stretch);
     f.write_attribute("/finite_strain/stretch", "meaning", "macroscopic stretches x, y, z (lateral ones stress-free)");
     f.write_matrix("/finite_strain/nu", nu);
-    f.write_attribute("/finite_strain/nu", "meaning",
-                      "secant Poisson ratios -(lateral stretch - 1) / strain, the two lateral axes after the axis, cyclically");
+    f.write_attribute(
+        "/finite_strain/nu", "meaning",
+        "secant Poisson ratios -(lateral stretch - 1) / strain, the two lateral axes after the axis, cyclically");
     f.write_vector("/finite_strain/nominal_stress", stress);
-    f.write_attribute("/finite_strain/nominal_stress", "meaning", "axial first Piola-Kirchhoff stress (force per reference area)");
+    f.write_attribute("/finite_strain/nominal_stress", "meaning",
+                      "axial first Piola-Kirchhoff stress (force per reference area)");
     f.write_vector("/finite_strain/shifted_factorizations", shifted);
     f.write_attribute("/finite_strain/shifted_factorizations", "meaning",
                       "Newton iterations whose Hessian needed a shift: a zero-energy hinge, or the structure buckled");

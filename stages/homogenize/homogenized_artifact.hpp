@@ -17,7 +17,6 @@ constexpr double kCubicTolerance = 1e-6;
 // `finite_strain`: the finite-strain check, or null.
 void write_homogenized(const std::string& path, const CellInput& in, const HomogenizationResult& r,
                        const PlaneStrainResult* plane, const FiniteStrainCheck* finite_strain,
-                       const std::string& config_text,
-                       const std::string& command_line, std::uint64_t seed);
+                       const std::string& config_text, const std::string& command_line, std::uint64_t seed);
 
 }  // namespace msfab

@@ -21,14 +21,14 @@
 #include <cstdio>
 #include <optional>
 
-#include "gamut/batch_homogenization.hpp"
 #include "cell_input.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "homog/periodic_homogenization.hpp"
 #include "finite_strain_check.hpp"
-#include "homogenized_artifact.hpp"
+#include "gamut/batch_homogenization.hpp"
+#include "homog/periodic_homogenization.hpp"
 #include "homogenization_options.hpp"
+#include "homogenized_artifact.hpp"
 
 using namespace msfab;
 
@@ -96,7 +96,7 @@ void run_batch(StageContext& ctx, const std::string& structures) {
     spdlog::warn("{} structures now lie outside the material space's box (unit coordinates clamped)", report.outside);
   std::printf("  artifact: %s\n", out.c_str());
 }
-}
+}  // namespace
 
 int main(int argc, char** argv) {
   StageApp app("msfab-homogenize", "Periodic homogenization of a voxel cell: C^H, G, cubic moduli (thesis 3.2)");
@@ -117,7 +117,8 @@ int main(int argc, char** argv) {
       ctx.check_memory(homogenization_peak_bytes(nx, ny, nz, options.solver),
                        "a " + std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) +
                            " cell with the " + options.solver + " solver",
-                       "use a smaller cell" + std::string(nz > 1 && options.solver == "cholmod" ? " or linear_solver: matrix-free" : ""));
+                       "use a smaller cell" +
+                           std::string(nz > 1 && options.solver == "cholmod" ? " or linear_solver: matrix-free" : ""));
     });
     options.threads = ctx.options.threads;
     std::optional<FiniteStrainCheck> finite_strain = read_finite_strain_check(ctx.config);

@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
   return app.run(argc, argv, [&](StageContext&) {
     std::string found_schema;
     if (!schema.empty()) {
-      const ArtifactReader reader = version > 0 ? ArtifactReader(path, schema, version)
-                                                : ArtifactReader(path, schema, 1, 1 << 30);
+      const ArtifactReader reader =
+          version > 0 ? ArtifactReader(path, schema, version) : ArtifactReader(path, schema, 1, 1 << 30);
       found_schema = reader.schema();
     }
     // Without --schema any schema is accepted: read it from the file first.

@@ -12,10 +12,10 @@ constexpr int kVersion = 1;
 
 std::vector<double> outcome_row(const Evaluation& e) {
   const JumpOutcome& o = e.outcome;
-  return {double(o.lifted_off), double(o.landed), double(o.upright), o.lift_off_time, o.landing_time, o.end_time,
-          o.flip_at_landing, o.flip_at_end, o.com_at_landing.x(), o.com_at_landing.y(), o.com_at_landing.z(),
-          o.com_at_end.x(), o.com_at_end.y(), o.com_at_end.z(), o.com_highest.x(), o.com_highest.y(),
-          o.com_highest.z(), double(e.crossed_wall), e.z_over_wall};
+  return {double(o.lifted_off), double(o.landed),  double(o.upright),      o.lift_off_time,      o.landing_time,
+          o.end_time,           o.flip_at_landing, o.flip_at_end,          o.com_at_landing.x(), o.com_at_landing.y(),
+          o.com_at_landing.z(), o.com_at_end.x(),  o.com_at_end.y(),       o.com_at_end.z(),     o.com_highest.x(),
+          o.com_highest.y(),    o.com_highest.z(), double(e.crossed_wall), e.z_over_wall};
 }
 
 void write_design(H5File& f, const std::string& group, const Evaluation& e) {
@@ -55,9 +55,10 @@ void write_evaluation_table(H5File& f, const std::string& group, const std::vect
 }  // namespace
 
 std::vector<std::string> outcome_columns() {
-  return {"lifted_off", "landed", "upright", "lift_off_time", "landing_time", "end_time", "flip_at_landing",
-          "flip_at_end", "com_landing_x", "com_landing_y", "com_landing_z", "com_end_x", "com_end_y", "com_end_z",
-          "com_highest_x", "com_highest_y", "com_highest_z", "crossed_wall", "z_over_wall"};
+  return {"lifted_off",    "landed",          "upright",      "lift_off_time", "landing_time",
+          "end_time",      "flip_at_landing", "flip_at_end",  "com_landing_x", "com_landing_y",
+          "com_landing_z", "com_end_x",       "com_end_y",    "com_end_z",     "com_highest_x",
+          "com_highest_y", "com_highest_z",   "crossed_wall", "z_over_wall"};
 }
 
 void write_jump_design_artifact(const std::string& path, const DesignProblem& p, const DesignRun& run,

@@ -109,8 +109,9 @@ DesignProblem read_design_problem(const Config& c) {
     q.upper = d.require_finite("upper");
     if (!(q.lower < q.upper)) d.fail("upper", "must exceed lower (" + std::to_string(q.lower) + ")");
     if (q.initial < q.lower || q.initial > q.upper)
-      d.fail("name", "the initial design " + q.name + " = " + std::to_string(q.initial) + " (from the scene) lies outside [" +
-                         std::to_string(q.lower) + ", " + std::to_string(q.upper) + "]");
+      d.fail("name", "the initial design " + q.name + " = " + std::to_string(q.initial) +
+                         " (from the scene) lies outside [" + std::to_string(q.lower) + ", " + std::to_string(q.upper) +
+                         "]");
     q.step = d.require_positive<double>("step", "initial step");
     if (q.step > q.upper - q.lower) d.fail("step", "must not exceed upper - lower");
     for (const DesignParameter& other : p.parameters)

@@ -35,9 +35,9 @@ const char* design_task_name(DesignTask task);
 // +-geometry. What counts as success depends on the task
 // (design_robustness.hpp).
 struct RobustnessCheck {
-  int samples = 0;              // 0: no check
-  double modulus = 0.2;         // relative
-  double geometry = 2e-4;       // m
+  int samples = 0;                // 0: no check
+  double modulus = 0.2;           // relative
+  double geometry = 2e-4;         // m
   double target_distance = 0.01;  // m: a target-task landing within this counts as a hit
 };
 
@@ -46,13 +46,13 @@ struct DesignProblem {
   std::vector<std::string> scene_set;  // --set style overrides of the scene
   std::vector<DesignParameter> parameters;
   DesignTask task = DesignTask::kFlip;
-  double target_flip = 0;    // rad: flip wanted at landing (flip and upright objectives)
-  double target_x = 0;       // m (target)
-  std::string obstacle;      // scene obstacle (jump-onto, jump-over)
-  std::string body;          // measured body (measure.body; empty: the whole mesh)
-  double clearance = 0;      // m: extra height over the obstacle top the constraints ask for
+  double target_flip = 0;  // rad: flip wanted at landing (flip and upright objectives)
+  double target_x = 0;     // m (target)
+  std::string obstacle;    // scene obstacle (jump-onto, jump-over)
+  std::string body;        // measured body (measure.body; empty: the whole mesh)
+  double clearance = 0;    // m: extra height over the obstacle top the constraints ask for
   JumpMeasureOptions measure;
-  double settle = 0.01;      // s: simulated after the landing before the run is stopped
+  double settle = 0.01;  // s: simulated after the landing before the run is stopped
   // Optimizer.
   int max_evaluations = 20;  // per start
   int starts = 1;            // the initial design and starts - 1 more (see start_point)
@@ -61,8 +61,8 @@ struct DesignProblem {
   // `space_filling` (a Halton sequence over the whole box, independent of
   // the initial design: a global stage).
   bool space_filling_starts = false;
-  double xtol = 0.01;        // stop when a step changes no normalized parameter by more
-  double stop_below = 0;     // stop a start once its objective is below this (0: never)
+  double xtol = 0.01;          // stop when a step changes no normalized parameter by more
+  double stop_below = 0;       // stop a start once its objective is below this (0: never)
   double length_scale = 0.01;  // m: constraints and distances are divided by it for COBYLA
   RobustnessCheck robustness;
   std::string config_source;

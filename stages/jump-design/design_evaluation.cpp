@@ -36,11 +36,11 @@ constexpr int kHeader = 8;
 constexpr int kOutcomeSize = 17;
 
 void pack_outcome(const JumpOutcome& o, double* r) {
-  const double v[kOutcomeSize] = {double(o.lifted_off), double(o.landed), double(o.upright), o.lift_off_time,
-                                  o.landing_time, o.end_time, o.flip_at_landing, o.flip_at_end,
-                                  o.com_at_landing.x(), o.com_at_landing.y(), o.com_at_landing.z(),
-                                  o.com_at_end.x(), o.com_at_end.y(), o.com_at_end.z(),
-                                  o.com_highest.x(), o.com_highest.y(), o.com_highest.z()};
+  const double v[kOutcomeSize] = {double(o.lifted_off), double(o.landed),     double(o.upright),    o.lift_off_time,
+                                  o.landing_time,       o.end_time,           o.flip_at_landing,    o.flip_at_end,
+                                  o.com_at_landing.x(), o.com_at_landing.y(), o.com_at_landing.z(), o.com_at_end.x(),
+                                  o.com_at_end.y(),     o.com_at_end.z(),     o.com_highest.x(),    o.com_highest.y(),
+                                  o.com_highest.z()};
   std::copy(v, v + kOutcomeSize, r);
 }
 

@@ -13,15 +13,15 @@
 namespace msfab {
 
 struct Evaluation {
-  int start = 0, index = 0;          // which optimizer start, which of its evaluations
-  std::vector<double> parameters;    // physical values, in DesignProblem order
-  bool ok = false;                   // false: the simulation failed (penalty values below)
-  double objective = 0;              // rad^2 (flip, upright) or m (target)
-  std::vector<double> constraints;   // m, feasible when <= 0
-  double seconds = 0;                // wall time of the simulation
+  int start = 0, index = 0;         // which optimizer start, which of its evaluations
+  std::vector<double> parameters;   // physical values, in DesignProblem order
+  bool ok = false;                  // false: the simulation failed (penalty values below)
+  double objective = 0;             // rad^2 (flip, upright) or m (target)
+  std::vector<double> constraints;  // m, feasible when <= 0
+  double seconds = 0;               // wall time of the simulation
   JumpOutcome outcome;
-  bool crossed_wall = false;         // jump-over: the centre of mass crossed the obstacle's middle
-  double z_over_wall = 0;            // its height there (m); the wall's foot if it never crossed
+  bool crossed_wall = false;  // jump-over: the centre of mass crossed the obstacle's middle
+  double z_over_wall = 0;     // its height there (m); the wall's foot if it never crossed
   int elements = 0;
 
   // Constraints met to within `tolerance` (m) and the simulation succeeded.

@@ -15,7 +15,8 @@ bool design_succeeded(const DesignProblem& p, const Evaluation& e) {
   const double tolerance = p.measure.upright_tolerance;
   switch (p.task) {
     case DesignTask::kFlip: return std::abs(turn) <= tolerance;
-    case DesignTask::kTarget: return std::abs(e.outcome.com_at_landing.x() - p.target_x) <= p.robustness.target_distance;
+    case DesignTask::kTarget:
+      return std::abs(e.outcome.com_at_landing.x() - p.target_x) <= p.robustness.target_distance;
     case DesignTask::kJumpOnto:
     case DesignTask::kJumpOver: return e.feasible() && std::abs(std::remainder(turn, 2 * M_PI)) <= tolerance;
   }
@@ -38,8 +39,8 @@ RobustnessResult check_robustness(const DesignProblem& p, const DesignEvaluator&
   const int per = evaluation_record_size(p);
   const std::vector<double> records = fan_out(r.samples, per, [&](int i, double* row) {
     const Evaluation e = evaluator.evaluate(parameters[i], -1, i, modulus[i]);
-    spdlog::info("print variation {}: E x {:.3f}, {} : {} ({:.1f} s)", i, modulus[i],
-                 fmt::join(parameters[i], ", "), design_succeeded(p, e) ? "succeeds" : "fails", e.seconds);
+    spdlog::info("print variation {}: E x {:.3f}, {} : {} ({:.1f} s)", i, modulus[i], fmt::join(parameters[i], ", "),
+                 design_succeeded(p, e) ? "succeeds" : "fails", e.seconds);
     pack_evaluation(e, row);
   });
   RobustnessResult result;

@@ -88,7 +88,8 @@ void log_evaluation(const DesignProblem& p, const Evaluation& e) {
 const Evaluation& evaluation_at(StartState& s, const double* u) {
   const std::size_t n = s.problem->parameters.size();
   if (!s.evaluations.empty() && std::equal(u, u + n, s.last_x.begin())) return s.evaluations.back();
-  s.evaluations.push_back(s.evaluator->evaluate(physical(*s.problem, u), s.start, static_cast<int>(s.evaluations.size())));
+  s.evaluations.push_back(
+      s.evaluator->evaluate(physical(*s.problem, u), s.start, static_cast<int>(s.evaluations.size())));
   s.last_x.assign(u, u + n);
   log_evaluation(*s.problem, s.evaluations.back());
   return s.evaluations.back();
@@ -131,8 +132,10 @@ std::vector<Evaluation> run_start(const DesignProblem& p, const DesignEvaluator&
   try {
     const nlopt::result r = opt.optimize(u, f);
     spdlog::info("start {}: COBYLA stopped ({}) after {} evaluations", start,
-                 r == nlopt::MAXEVAL_REACHED ? "evaluation budget" : r == nlopt::STOPVAL_REACHED ? "objective reached"
-                 : r == nlopt::XTOL_REACHED ? "step below xtol" : "converged",
+                 r == nlopt::MAXEVAL_REACHED   ? "evaluation budget"
+                 : r == nlopt::STOPVAL_REACHED ? "objective reached"
+                 : r == nlopt::XTOL_REACHED    ? "step below xtol"
+                                               : "converged",
                  state.evaluations.size());
   } catch (const nlopt::roundoff_limited&) {
     spdlog::info("start {}: COBYLA stopped on round-off after {} evaluations", start, state.evaluations.size());

@@ -43,7 +43,8 @@ RigidBody measured_body(const DynamicsScene& scene, const std::vector<int>& node
   std::vector<Eigen::Triplet<double>> entries;
   for (int j = 0; j < m.outerSize(); ++j)
     for (SpMat::InnerIterator it(m, j); it; ++it)
-      if (local[it.row()] >= 0 && local[it.col()] >= 0) entries.emplace_back(local[it.row()], local[it.col()], it.value());
+      if (local[it.row()] >= 0 && local[it.col()] >= 0)
+        entries.emplace_back(local[it.row()], local[it.col()], it.value());
   SpMat sub(static_cast<Eigen::Index>(nodes.size()), static_cast<Eigen::Index>(nodes.size()));
   sub.setFromTriplets(entries.begin(), entries.end());
   NodeArray rest(static_cast<Eigen::Index>(nodes.size()), 3);
@@ -54,10 +55,7 @@ RigidBody measured_body(const DynamicsScene& scene, const std::vector<int>& node
 }  // namespace
 
 JumpObserver::JumpObserver(const DynamicsScene& scene, const ObserverOptions& options)
-    : scene_(scene),
-      options_(options),
-      nodes_(body_nodes(scene, options.body)),
-      body_(measured_body(scene, nodes_)) {
+    : scene_(scene), options_(options), nodes_(body_nodes(scene, options.body)), body_(measured_body(scene, nodes_)) {
   const VecX still = VecX::Zero(3 * nodes_.size());
   R0_ = project_to_rigid(body_, gather(scene.initial_positions, nodes_), still).R;
   tolerance_ = options.touch * scene.grid.voxel_size;

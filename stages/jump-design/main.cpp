@@ -55,9 +55,10 @@ int main(int argc, char** argv) {
                          std::to_string(omp_get_max_threads()) + " threads)",
                      "use fewer threads (--threads) or a coarser scene");
     if (rank == 0)
-      spdlog::info("{} design of {}: {} parameters, {} elements, {} start(s) x <= {} evaluations; {} rank(s) x {} thread(s)",
-                   design_task_name(problem.task), problem.scene_path, problem.parameters.size(), evaluator.elements(),
-                   problem.starts, problem.max_evaluations, size, omp_get_max_threads());
+      spdlog::info(
+          "{} design of {}: {} parameters, {} elements, {} start(s) x <= {} evaluations; {} rank(s) x {} thread(s)",
+          design_task_name(problem.task), problem.scene_path, problem.parameters.size(), evaluator.elements(),
+          problem.starts, problem.max_evaluations, size, omp_get_max_threads());
 
     // 2-3. Starts and the final design.
     DesignRun run;

@@ -21,8 +21,8 @@
 #include <cstdio>
 
 #include "cli/stage_app.hpp"
-#include "core/timing.hpp"
 #include "core/errors.hpp"
+#include "core/timing.hpp"
 #include "io/path_names.hpp"
 #include "mapping/mapper.hpp"
 #include "mapping/set_lineage.hpp"
@@ -86,10 +86,12 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string design_path, structures_path;
-  app.cli().add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
+  app.cli()
+      .add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
       ->type_name("FILE")
       ->required();
-  app.cli().add_option("--structures", structures_path, "msfab.microstructures artifact of the same space")
+  app.cli()
+      .add_option("--structures", structures_path, "msfab.microstructures artifact of the same space")
       ->type_name("FILE")
       ->required();
   return app.run(argc, argv, [&](StageContext& ctx) {
@@ -138,9 +140,10 @@ int main(int argc, char** argv) {
 
     const DistanceSummary distances = summarize_distances(candidates, mapped, settings.mapper.max_distance);
     if (distances.far_cells > 0)
-      spdlog::warn("{} of {} design cells have no structure within max_distance {} of their target (farthest "
-                   "nearest candidate {:.4g}); the set does not cover those properties",
-                   distances.far_cells, distances.design_cells, settings.mapper.max_distance, distances.max_nearest);
+      spdlog::warn(
+          "{} of {} design cells have no structure within max_distance {} of their target (farthest "
+          "nearest candidate {:.4g}); the set does not cover those properties",
+          distances.far_cells, distances.design_cells, settings.mapper.max_distance, distances.max_nearest);
 
     std::int64_t min_cand = 0, max_cand = 0, sum_cand = 0;
     for (std::int64_t c = 0; c < candidates.cells(); ++c) {
@@ -155,8 +158,10 @@ int main(int argc, char** argv) {
     if (settings.tiling > 1)
       std::printf("  tiling: %d^%d copies of its structure per cell\n", settings.tiling, design.dimension);
     std::printf("  candidates per cell: %.1f (min %lld, max %lld)%s\n", mean_cand, static_cast<long long>(min_cand),
-                static_cast<long long>(max_cand), settings.mapper.half_shift ? ", each with its half-shifted exemplar" : "");
-    const double drop = descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;
+                static_cast<long long>(max_cand),
+                settings.mapper.half_shift ? ", each with its half-shifted exemplar" : "");
+    const double drop =
+        descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;
     std::printf("  mismatch: initial %lld, final %lld (-%.1f%%), %lld moves, %lld evaluations, descent %.3f s\n",
                 static_cast<long long>(descent.initial), static_cast<long long>(descent.final), drop,
                 static_cast<long long>(descent.moves), static_cast<long long>(descent.evaluations), descent.seconds);
@@ -176,7 +181,8 @@ int main(int argc, char** argv) {
     }
     if (design_rho > 0)
       std::printf("  material in the mapped cells: %+.1f%% against the design's (match: %s)\n",
-                  100.0 * (mapped_rho / design_rho - 1), settings.mapper.candidates.stiffness_only ? "stiffness" : "all");
+                  100.0 * (mapped_rho / design_rho - 1),
+                  settings.mapper.candidates.stiffness_only ? "stiffness" : "all");
     std::printf("  artifact: %s\n", out.c_str());
 
     // Exports of the voxel model, each streamed layer by layer.

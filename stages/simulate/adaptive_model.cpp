@@ -61,7 +61,8 @@ AdaptiveResultOnMesh adaptive_result_on_mesh(const AdaptiveModel& model, const E
   r.mesh.mesh = model.mixed.mesh;
   r.conditions.force = as_vecx(on_mesh_nodes<double>(model.mixed, model.conditions.force));
   r.conditions.dirichlet.fixed = on_mesh_nodes<char>(model.mixed, model.conditions.dirichlet.fixed);
-  r.conditions.dirichlet.displacement = as_vecx(on_mesh_nodes<double>(model.mixed, model.conditions.dirichlet.displacement));
+  r.conditions.dirichlet.displacement =
+      as_vecx(on_mesh_nodes<double>(model.mixed, model.conditions.dirichlet.displacement));
   r.newton = result;
   r.newton.x = assembler.mesh_positions(result.x);
   return r;
@@ -91,18 +92,19 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
 }
 
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
-                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
-                                   const VecX& x1, double target_error) {
+                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
+                                   double target_error) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!level2.database || level2.database->level != 2)
     throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
   AdaptiveModel m;
 
   // The estimate: the two uniform solutions' difference, energies of the finer one.
-  m.level_difference = mean_vertex_error(fine.mesh, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
+  m.level_difference =
+      mean_vertex_error(fine.mesh, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
   m.level_errors = level_errors_from_difference(m.level_difference);
-  const std::vector<CellErrorModel> cells = cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh,
-                                                              element_energies(level1.mesh.mesh, x1));
+  const std::vector<CellErrorModel> cells =
+      cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh, element_energies(level1.mesh.mesh, x1));
   m.choice = choose_cell_levels(cells, m.level_errors, target_error);
 
   // The mixed mesh, with the same materials as the uniform models. A node

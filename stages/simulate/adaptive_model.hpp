@@ -13,12 +13,12 @@ namespace msfab {
 
 struct AdaptiveModel {
   MixedLevelMesh mixed;
-  StaticConditions conditions;     // on the unknowns
-  LevelErrors level_errors{};      // estimated errors of the uniform models
-  double level_difference = 0;     // D: mean-vertex distance between the level-1 and level-2 solutions
+  StaticConditions conditions;  // on the unknowns
+  LevelErrors level_errors{};   // estimated errors of the uniform models
+  double level_difference = 0;  // D: mean-vertex distance between the level-1 and level-2 solutions
   LevelChoice choice;
   int cells_refined_for_conditions = 0;  // level-2 cells set to level 0 so that no fixed node hangs
-  double seconds = 0;              // estimate, choice and mesh (not the two solves)
+  double seconds = 0;                    // estimate, choice and mesh (not the two solves)
 };
 
 // The uniform level-1 model of the scene with the level-1 materials of the
@@ -33,8 +33,8 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
 // `level2` / `level1` are the uniform models and x2 / x1 their solutions
 // (positions).
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
-                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1,
-                                   const VecX& x1, double target_error);
+                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
+                                   double target_error);
 
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine

@@ -23,14 +23,14 @@
 #include <string>
 #include <vector>
 
+#include "adaptive_model.hpp"
 #include "cli/progress.hpp"
-#include "core/timing.hpp"
 #include "cli/stage_app.hpp"
 #include "coarse_model.hpp"
-#include "ddfem/coarsening_options.hpp"
 #include "core/errors.hpp"
-#include "adaptive_model.hpp"
+#include "core/timing.hpp"
 #include "ddfem/coarsening_error.hpp"
+#include "ddfem/coarsening_options.hpp"
 #include "default_scene.hpp"
 #include "result_artifact.hpp"
 #include "scene/scene.hpp"
@@ -109,9 +109,10 @@ void check_solve_memory(const StageContext& ctx, const Scene& scene, std::vector
     bytes += static_solve_peak_bytes(elements, 3 * elements, scene.newton);
     largest = std::max(largest, elements);
   }
-  ctx.check_memory(bytes, fmt::format("a model of {:.0f} elements ({} solver)", largest,
-                                      static_linear_solver(3 * largest, scene.newton)),
-                   levels.front() == 0 ? "coarsen it (--coarsen 1 or 2) or use a coarser grid" : "use a coarser grid");
+  ctx.check_memory(
+      bytes,
+      fmt::format("a model of {:.0f} elements ({} solver)", largest, static_linear_solver(3 * largest, scene.newton)),
+      levels.front() == 0 ? "coarsen it (--coarsen 1 or 2) or use a coarser grid" : "use a coarser grid");
 }
 
 }  // namespace
@@ -141,7 +142,8 @@ int main(int argc, char** argv) {
     const Scene scene = read_scene(ctx.config);
     ctx.finish_config();
     const bool adaptive = target_option->count() > 0;
-    check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level}, compare_fine);
+    check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level},
+                       compare_fine);
 
     // 2. Fine mesh and conditions.
     const VoxelMesh fine = build_voxel_mesh(scene.grid, scene.material_by_id);
@@ -156,8 +158,9 @@ int main(int argc, char** argv) {
       if (coarsening.material != "ddfem")
         throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
       if (coarsening.window > 0)
-        throw InputError("--target-error: --coarse-window is not supported (the mixed mesh takes one material set "
-                         "per distinct block, a window needs one per cell); drop it");
+        throw InputError(
+            "--target-error: --coarse-window is not supported (the mixed mesh takes one material set "
+            "per distinct block, a window needs one per cell); drop it");
       if (scene.newton.linear_solver == "pcg-mg")
         throw InputError((ctx.options.config_path.empty() ? std::string("built-in scene") : ctx.options.config_path) +
                          ": solver.linear_solver: pcg-mg needs a mesh of equal elements and --target-error meshes "
@@ -188,7 +191,9 @@ int main(int argc, char** argv) {
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
     const HexMesh& solved_mesh = adaptive ? adapted.mixed.mesh : vm.mesh;
-    const StaticConditions& conditions = adaptive ? adapted.conditions : coarsened ? coarse.conditions : fine_conditions;
+    const StaticConditions& conditions = adaptive    ? adapted.conditions
+                                         : coarsened ? coarse.conditions
+                                                     : fine_conditions;
     const ElasticAssembler assembler =
         adaptive ? ElasticAssembler(solved_mesh, adapted.mixed.constraints) : ElasticAssembler(solved_mesh);
     const double setup = seconds_since(t0);
@@ -196,13 +201,13 @@ int main(int argc, char** argv) {
                  scene.grid.ny, scene.grid.nz, solved_mesh.num_elements(), assembler.num_dofs(),
                  conditions.dirichlet.count_fixed(), scene.nonlinear ? "Neo-Hookean" : "linear");
     if (adaptive)
-      spdlog::info("adaptive: level-1/level-2 difference {:.3g} (estimated errors {:.3g} / {:.3g}); target {:.3g}, "
-                   "predicted {:.3g}; elements fine {} / level 1 {} / level 2 {}, {} hanging nodes; uniform solves "
-                   "{:.3f} s, level choice and mesh {:.3f} s",
-                   adapted.level_difference, adapted.level_errors[1], adapted.level_errors[2], target_error,
-                   adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
-                   adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2],
-                   adapted.mixed.hanging_nodes, uniform_seconds, adapted.seconds);
+      spdlog::info(
+          "adaptive: level-1/level-2 difference {:.3g} (estimated errors {:.3g} / {:.3g}); target {:.3g}, "
+          "predicted {:.3g}; elements fine {} / level 1 {} / level 2 {}, {} hanging nodes; uniform solves "
+          "{:.3f} s, level choice and mesh {:.3f} s",
+          adapted.level_difference, adapted.level_errors[1], adapted.level_errors[2], target_error,
+          adapted.choice.predicted_error, adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
+          adapted.mixed.elements_per_level[2], adapted.mixed.hanging_nodes, uniform_seconds, adapted.seconds);
     else if (coarsened)
       spdlog::info("coarsened to level {} with {} materials: {} -> {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, fine.mesh.num_elements(), vm.mesh.num_elements(),
@@ -211,17 +216,20 @@ int main(int argc, char** argv) {
                                                         coarse.fallback_blocks, coarsening.fallback)
                                           : std::string());
     if (coarsened && coarsening.check_tolerance > 0 && coarsening.window == 0)
-      spdlog::info("checked lookup: {} of {} solid mixed block kinds had a fit farther than {} from their own "
-                   "homogenized stiffness and were coarsened by the matched model",
-                   coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance);
+      spdlog::info(
+          "checked lookup: {} of {} solid mixed block kinds had a fit farther than {} from their own "
+          "homogenized stiffness and were coarsened by the matched model",
+          coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance);
     if (coarsened && coarsening.check_tolerance > 0 && coarsening.window > 0)
-      spdlog::info("checked lookup against windows: {} of {} solid mixed cells had a fit farther than {} from their "
-                   "stiffness among {} voxels of their neighbours and were coarsened by the windowed matched model",
-                   coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance, coarsening.window);
+      spdlog::info(
+          "checked lookup against windows: {} of {} solid mixed cells had a fit farther than {} from their "
+          "stiffness among {} voxels of their neighbours and were coarsened by the windowed matched model",
+          coarse.replaced_blocks, coarse.checked_blocks, coarsening.check_tolerance, coarsening.window);
     if (coarsened && coarsening.window > 0)
-      spdlog::info("windows: {} distinct among the solid cells, each homogenized once; {} cells kept their own "
-                   "homogenized stiffness (void in the window, or a stiffness the window does not determine)",
-                   coarse.distinct_windows, coarse.unresolved_windows);
+      spdlog::info(
+          "windows: {} distinct among the solid cells, each homogenized once; {} cells kept their own "
+          "homogenized stiffness (void in the window, or a stiffness the window does not determine)",
+          coarse.distinct_windows, coarse.unresolved_windows);
 
     // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
     // step apart, which elements of mixed sizes are not: adaptive models are
@@ -229,7 +237,9 @@ int main(int argc, char** argv) {
     NewtonOptions newton = adaptive ? warm_newton : scene.newton;
     if (adaptive && newton.linear_solver == "auto") newton.linear_solver = "cholmod";
     const NewtonResult result = solve_or_throw(assembler, conditions, newton,
-                                               adaptive ? "adaptive load" : coarsened ? "coarse load" : "load",
+                                               adaptive    ? "adaptive load"
+                                               : coarsened ? "coarse load"
+                                                           : "load",
                                                adaptive_start);
     // The coarse model's Newton time; adaptive runs include the uniform solves.
     const double coarse_seconds = result.timings.total + (adaptive ? uniform_seconds + adapted.seconds : 0.0);
@@ -253,7 +263,8 @@ int main(int argc, char** argv) {
       }
       record.compared = true;
       record.error_vs_fine =
-          adaptive ? mean_vertex_error(fine.mesh, uf, adaptive_displacement_on_fine(scene, fine, adapted, assembler, result.x))
+          adaptive ? mean_vertex_error(fine.mesh, uf,
+                                       adaptive_displacement_on_fine(scene, fine, adapted, assembler, result.x))
                    : mean_vertex_error(scene.grid, fine, uf, coarse.grid, vm, result.x - assembler.rest_positions());
       if (!adaptive) {
         const CoarseErrorFloor floor = coarse_error_floor(scene.grid, fine, uf, coarse.grid, vm);
@@ -317,11 +328,12 @@ int main(int argc, char** argv) {
     std::printf("  elements %d, DOFs %d, max displacement %.6g m\n", solved_mesh.num_elements(), assembler.num_dofs(),
                 max_u);
     if (adaptive)
-      std::printf("  adaptive: target error %.3g, predicted %.3g; elements fine %d / level 1 %d / level 2 %d "
-                  "(of %d fine); level-1 and level-2 solves %.3f s\n",
-                  target_error, adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
-                  adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2], fine.mesh.num_elements(),
-                  uniform_seconds);
+      std::printf(
+          "  adaptive: target error %.3g, predicted %.3g; elements fine %d / level 1 %d / level 2 %d "
+          "(of %d fine); level-1 and level-2 solves %.3f s\n",
+          target_error, adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
+          adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2], fine.mesh.num_elements(),
+          uniform_seconds);
     else if (coarsened)
       std::printf("  coarsening: level %d, %s materials, %s elements, %d -> %d elements, %.3f ms\n", coarsening.level,
                   coarsening.material.c_str(), coarse.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
@@ -330,13 +342,15 @@ int main(int argc, char** argv) {
                 setup, result.timings.assembly, result.timings.solve, result.timings.line_search,
                 result.timings.total / its);
     if (record.compared)
-      std::printf("  vs fine: error %.4e, Newton time fine %.3f s / coarse %.3f s = speedup %.1fx\n"
-                  "    (error: mean distance between the fine and the interpolated coarse displacement over the fine "
-                  "vertices, divided by the longest side of the body, thesis 2.5.2; 1e-2 is 1%% of the body)\n",
-                  record.error_vs_fine, record.fine_seconds, coarse_seconds, record.fine_seconds / coarse_seconds);
+      std::printf(
+          "  vs fine: error %.4e, Newton time fine %.3f s / coarse %.3f s = speedup %.1fx\n"
+          "    (error: mean distance between the fine and the interpolated coarse displacement over the fine "
+          "vertices, divided by the longest side of the body, thesis 2.5.2; 1e-2 is 1%% of the body)\n",
+          record.error_vs_fine, record.fine_seconds, coarse_seconds, record.fine_seconds / coarse_seconds);
     if (record.has_error_floor)
-      std::printf("  best possible on this coarse mesh: error %.4e (the best trilinear fit of the fine displacements)\n",
-                  record.error_floor);
+      std::printf(
+          "  best possible on this coarse mesh: error %.4e (the best trilinear fit of the fine displacements)\n",
+          record.error_floor);
     std::printf("  artifact: %s\n  ParaView: %s\n", out.c_str(), xmf.c_str());
   });
 }

@@ -1,9 +1,9 @@
 #include "result_artifact.hpp"
 
+#include "core/errors.hpp"
 #include "io/artifact.hpp"
 #include "io/mesh_io.hpp"
 #include "io/xdmf.hpp"
-#include "core/errors.hpp"
 
 namespace msfab {
 
@@ -139,8 +139,8 @@ FineReference read_fine_reference(const std::string& path, const VoxelMesh& fine
   if (in.file().exists("/coarsening")) throw InputError(path + ": --reference must be a fine (uncoarsened) result");
   const MatX u = in.file().read_matrix<double>("/displacement");
   const MatX X = in.file().read_matrix<double>("/mesh/nodes");
-  if (u.rows() != fine.mesh.num_nodes() || u.cols() != 3 || X.rows() != u.rows() ||
-      X.cols() != 3 || (X - MatX(fine.mesh.nodes)).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + fine.mesh.nodes.cwiseAbs().maxCoeff()))
+  if (u.rows() != fine.mesh.num_nodes() || u.cols() != 3 || X.rows() != u.rows() || X.cols() != 3 ||
+      (X - MatX(fine.mesh.nodes)).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + fine.mesh.nodes.cwiseAbs().maxCoeff()))
     throw InputError(path + ": /displacement and /mesh/nodes do not belong to this scene's fine mesh (" +
                      std::to_string(fine.mesh.num_nodes()) + " nodes)");
   FineReference ref;

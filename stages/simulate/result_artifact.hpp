@@ -26,22 +26,22 @@ struct SimulationRecord {
   std::uint64_t seed = 0;
   // Coarsened runs (level > 0): the mesh is the coarse one.
   int coarsen_level = 0;
-  std::string coarse_material;       // ddfem | naive | averaged | homogenized | galerkin
-  std::string coarse_fallback;       // ddfem: naive | galerkin, for blocks without a fit
-  int fallback_blocks = 0;           // ddfem: distinct blocks coarsened by the fallback
-  double check_tolerance = 0;        // ddfem: --coarse-check (0: no check)
+  std::string coarse_material;                  // ddfem | naive | averaged | homogenized | galerkin
+  std::string coarse_fallback;                  // ddfem: naive | galerkin, for blocks without a fit
+  int fallback_blocks = 0;                      // ddfem: distinct blocks coarsened by the fallback
+  double check_tolerance = 0;                   // ddfem: --coarse-check (0: no check)
   int checked_blocks = 0, replaced_blocks = 0;  // ddfem with a check: solid mixed blocks checked, replaced
-  int window = 0, unresolved_windows = 0;        // --coarse-window, cells left on their own C^H
-  int distinct_windows = 0;                      // --coarse-window: distinct windows, each computed once
-  std::string coarse_element = "trilinear";  // trilinear | enhanced
-  std::string database;              // ddfem: the coarse_db path
+  int window = 0, unresolved_windows = 0;       // --coarse-window, cells left on their own C^H
+  int distinct_windows = 0;                     // --coarse-window: distinct windows, each computed once
+  std::string coarse_element = "trilinear";     // trilinear | enhanced
+  std::string database;                         // ddfem: the coarse_db path
   double coarsening_seconds = 0;
   int fine_elements = 0;
   // Adaptive runs (--target-error; coarsen_level is 2, the coarsest level used).
   bool adaptive = false;
   double target_error = 0, predicted_error = 0;
-  double uniform_solve_seconds = 0;   // the level-2 and level-1 solves the levels are chosen from
-  double level_difference = 0;        // mean-vertex distance between those two solutions
+  double uniform_solve_seconds = 0;  // the level-2 and level-1 solves the levels are chosen from
+  double level_difference = 0;       // mean-vertex distance between those two solutions
   std::array<int, 3> elements_per_level{};
   // With --compare-fine: the fine reference run and the §2.5.2 error.
   bool compared = false;

@@ -21,8 +21,8 @@
 
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
-#include "design_start.hpp"
 #include "design_report.hpp"
+#include "design_start.hpp"
 #include "gamut/gamut_artifact.hpp"
 #include "gamut/microstructure_set.hpp"
 #include "topopt/cell_mma.hpp"
@@ -48,9 +48,10 @@ void check_grid_memory(const StageContext& ctx, const Config& config) {
   if (size.counts.empty()) return;  // read_topopt_scene names the missing key
   const int m = std::clamp(config.get_or<int>("elements_per_cell", 1), 1, 8);
   const double elements = size.cells * (size.counts.size() == 3 ? double(m) * m * m : 1.0);
-  const double bytes =
-      size.counts.size() == 2 ? 265.0 * elements * std::log2(std::max(elements, 2.0)) : 5e3 * elements;
-  ctx.check_memory(bytes, "a grid of " + size.text + " cells (grid.size)" + (m > 1 ? " with elements_per_cell " + std::to_string(m) : std::string()),
+  const double bytes = size.counts.size() == 2 ? 265.0 * elements * std::log2(std::max(elements, 2.0)) : 5e3 * elements;
+  ctx.check_memory(bytes,
+                   "a grid of " + size.text + " cells (grid.size)" +
+                       (m > 1 ? " with elements_per_cell " + std::to_string(m) : std::string()),
                    "use a coarser grid");
 }
 // A 2D cantilever (Fig. 3-16's loading): left side clamped, a downward load
@@ -105,7 +106,8 @@ int main(int argc, char** argv) {
     std::string family_path;
     if (needs_family_grid(space)) {
       if (!config.has("family"))
-        config.fail("family", "is missing: space " + space + " needs a family's structures (msfab-family-generate, grid:)");
+        config.fail("family",
+                    "is missing: space " + space + " needs a family's structures (msfab-family-generate, grid:)");
       family_path = config.get_path("family");
       family = read_microstructures_artifact(family_path);
       inputs.push_back(family_path);
@@ -136,14 +138,20 @@ int main(int argc, char** argv) {
     if (!family_path.empty() && std::abs(scene.nu - family.stiff.nu) > 1e-12)
       config.fail("material.nu", "is " + std::to_string(scene.nu) + " but the family's base material has " +
                                      std::to_string(family.stiff.nu));
-    CellMaterialSettings ms{scene.space, scene.E0, scene.decades, scene.nu, scene.penalty, scene.E_min_ratio,
+    CellMaterialSettings ms{scene.space,
+                            scene.E0,
+                            scene.decades,
+                            scene.nu,
+                            scene.penalty,
+                            scene.E_min_ratio,
                             needs.empty() ? nullptr : &gamut.level_set};
     // Regularization: cell-mma smooths the gradient as the thesis does
     // (`filter.kind: smoothing`) or, in spaces without per-cell
     // constraints, filters the parameters (`density`: family3d then derives
     // each cell's rho from its family parameters); ipopt always filters.
-    const std::string optimizer =
-        config.has("optimizer.name") ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma", "cell-mma"}) : "auto";
+    const std::string optimizer = config.has("optimizer.name")
+                                      ? config.one_of("optimizer.name", {"auto", "ipopt", "oc", "mma", "cell-mma"})
+                                      : "auto";
     const bool use_cell_mma = optimizer == "cell-mma";
     const bool density_filter =
         config.has("filter.kind") && config.one_of("filter.kind", {"smoothing", "density"}) == "density";
@@ -153,8 +161,9 @@ int main(int argc, char** argv) {
                                            : make_family_material_model(family, family_path, density_filter);
     if (use_bound && gamut.bound_stiff.size() > 0) model->set_voigt_bound(gamut.bound_stiff, gamut.bound_soft);
     if (density_filter && (model->has_constraint() || model->bound_conditions() > 0))
-      config.fail("filter.kind", "density needs a space without per-cell constraints (family3d, simp2d, simp3d); space " +
-                                     space + " has them, so cell-mma smooths its gradient instead");
+      config.fail("filter.kind",
+                  "density needs a space without per-cell constraints (family3d, simp2d, simp3d); space " + space +
+                      " has them, so cell-mma smooths its gradient instead");
 
     OptimizerSettings os;
     os.max_iterations = config.get_or<int>("optimizer.max_iterations", 500);
@@ -176,7 +185,8 @@ int main(int argc, char** argv) {
     }
     if ((use_oc || use_mma) && model->parameters() != 1)
       config.fail("optimizer.name", chosen + " is for the simp spaces (simp2d, simp3d); space " + space + " has " +
-                                        std::to_string(model->parameters()) + " parameters per cell (use ipopt or cell-mma)");
+                                        std::to_string(model->parameters()) +
+                                        " parameters per cell (use ipopt or cell-mma)");
     const CellGrid& grid = scene.setup.grid;
     os.mass_limit = scene.volume_fraction > 0;
     os.mass_budget = scene.volume_fraction * grid.cell_volume() * double(grid.cells());
@@ -199,12 +209,12 @@ int main(int argc, char** argv) {
     TopologyObjective objective(setup, *model);
     const CellFilter smoothing(grid, objective.design_cells(), smoothing_radius);
     const MatX q0 = start.rows(objective.design_cells());
-    spdlog::info("{}D grid {} x {} x {} ({} design cells; {}^{} elements per cell, {} unknowns), space {} ({} parameters), "
-                 "{} load case(s), solver {}, optimizer {}",
-                 grid.dimension(), grid.nx(), grid.ny(), grid.nz(), objective.design_cells().size(),
-                 scene.elements_per_cell, grid.dimension(), objective.fem_grid().unknowns(), space, model->parameters(),
-                 setup.loads.size(),
-                 objective.elasticity().solver_name(), chosen);
+    spdlog::info(
+        "{}D grid {} x {} x {} ({} design cells; {}^{} elements per cell, {} unknowns), space {} ({} parameters), "
+        "{} load case(s), solver {}, optimizer {}",
+        grid.dimension(), grid.nx(), grid.ny(), grid.nz(), objective.design_cells().size(), scene.elements_per_cell,
+        grid.dimension(), objective.fem_grid().unknowns(), space, model->parameters(), setup.loads.size(),
+        objective.elasticity().solver_name(), chosen);
 
     // 4. Optimize.
     os.log_every = 10;
@@ -230,15 +240,17 @@ int main(int argc, char** argv) {
     std::printf("  mass fraction %.4f, max constraint %.3e\n",
                 objective.mass(r.q) / (grid.cell_volume() * double(grid.cells())), r.max_violation);
     const EdgeJoints joints = find_edge_joints(grid, objective.cell_pairs(objective.physical(r.q)));
-    std::printf("  edge joints: %lld (pairs of cells meeting only along an edge, or at a corner in 2D, both >= 10x "
-                "stiffer than the cells between them; largest ratio %.3g)\n",
-                static_cast<long long>(joints.count), joints.largest_ratio);
+    std::printf(
+        "  edge joints: %lld (pairs of cells meeting only along an edge, or at a corner in 2D, both >= 10x "
+        "stiffer than the cells between them; largest ratio %.3g)\n",
+        static_cast<long long>(joints.count), joints.largest_ratio);
     const double per = 1.0 / std::max(1, st.factorizations);
-    std::printf("  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve (assembly %.3f, "
-                "factorization %.3f, solves %.3f)\n",
-                st.factorizations, st.solves, objective.elasticity().solver_name().c_str(),
-                (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) * per, st.assemble_seconds * per,
-                st.factorize_seconds * per, st.solve_seconds * per);
+    std::printf(
+        "  FEM: %d factorizations, %d solves (%s), %.3f s per factorization+solve (assembly %.3f, "
+        "factorization %.3f, solves %.3f)\n",
+        st.factorizations, st.solves, objective.elasticity().solver_name().c_str(),
+        (st.assemble_seconds + st.factorize_seconds + st.solve_seconds) * per, st.assemble_seconds * per,
+        st.factorize_seconds * per, st.solve_seconds * per);
     if (st.iterations > 0) std::printf("  CG iterations per solve: %.1f\n", double(st.iterations) / st.solves);
     std::printf("  artifact: %s\n", out.c_str());
   });

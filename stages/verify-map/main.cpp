@@ -127,15 +127,16 @@ void check_inputs(const Design& design, const std::string& design_path, const Ma
   // Structure indices mean nothing in another set: compare content hashes.
   const std::vector<ArtifactInput> inputs = ArtifactReader(mapped_path, kMappedSchema, kMappedSchemaVersion).inputs();
   const std::string set_hash = sha256_file_hex(structures_path);
-  const bool set_known = std::any_of(inputs.begin(), inputs.end(), [&](const ArtifactInput& i) { return i.sha256 == set_hash; });
+  const bool set_known =
+      std::any_of(inputs.begin(), inputs.end(), [&](const ArtifactInput& i) { return i.sha256 == set_hash; });
   if (!set_known)
     throw InputError(mapped_path + ": was not mapped with " + structures_path + " (its attribute 'inputs' lists " +
                      (inputs.size() > 1 ? inputs[1].path : std::string("no structures")) +
                      " with another SHA-256); pass the microstructures artifact the mapping used");
   const std::string design_hash = sha256_file_hex(design_path);
   if (std::none_of(inputs.begin(), inputs.end(), [&](const ArtifactInput& i) { return i.sha256 == design_hash; }))
-    spdlog::warn("{}: was mapped from another design file than {} (grid and roles agree; checking anyway)",
-                 mapped_path, design_path);
+    spdlog::warn("{}: was mapped from another design file than {} (grid and roles agree; checking anyway)", mapped_path,
+                 design_path);
 }
 
 // The scene: --scene, or the config the design was optimized with.
@@ -168,16 +169,18 @@ void remove_void_from_cells(const CellGrid& grid, std::vector<char>& solid, std:
                             VerifyReport& report, const std::string& design_path) {
   const PieceRemoval removal = remove_unheld_pieces(grid, solid, fixed);
   if (removal.kept_cells == 0)
-    throw InputError(design_path + ": the scene's supports hold none of the design's non-empty cells (every "
+    throw InputError(design_path +
+                     ": the scene's supports hold none of the design's non-empty cells (every "
                      "piece of them can move freely); nothing to check");
   report.pieces_homogenized = removal.pieces;
   report.removed_pieces_homogenized = removal.removed;
   report.removed_cells_homogenized = removal.removed_cells;
   report.inactive_nodes_homogenized = fix_unknowns_without_material(grid, solid_nodes(grid, solid), fixed);
   if (removal.removed > 0)
-    spdlog::warn("homogenized model: {} of {} pieces of cells are not held by the supports and were removed ({} "
-                 "hexahedra)",
-                 removal.removed, removal.pieces, removal.removed_cells);
+    spdlog::warn(
+        "homogenized model: {} of {} pieces of cells are not held by the supports and were removed ({} "
+        "hexahedra)",
+        removal.removed, removal.pieces, removal.removed_cells);
 }
 
 // The same for the voxel model. Removing a piece can move a point support
@@ -200,10 +203,11 @@ void remove_void_from_voxels(const CellRefinement& refinement, const std::vector
   }
   report.inactive_nodes_full = fix_unknowns_without_material(refinement.fine(), node_material, supports.fixed);
   if (report.removed_pieces_full > 0)
-    spdlog::warn("full-resolution model: {} of {} pieces are not held by the supports (floating, or held at a point "
-                 "or along a line) and were removed: {} voxels, {:.2f}% of the material",
-                 report.removed_pieces_full, report.pieces_full, report.removed_voxels_full,
-                 100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
+    spdlog::warn(
+        "full-resolution model: {} of {} pieces are not held by the supports (floating, or held at a point "
+        "or along a line) and were removed: {} voxels, {:.2f}% of the material",
+        report.removed_pieces_full, report.pieces_full, report.removed_voxels_full,
+        100.0 * double(report.removed_voxels_full) / double(std::max<std::int64_t>(report.material_voxels, 1)));
 }
 
 // GridElasticity, with a solver the grid does not allow reported against
@@ -235,11 +239,13 @@ int main(int argc, char** argv) {
       .add_option("--structures", structures_path, "the msfab.microstructures artifact the mapping used")
       ->type_name("FILE")
       ->required();
-  app.cli().add_option("--scene", scene_path,
-                       "topopt scene YAML with the supports and loads (default: the design's own config)")
+  app.cli()
+      .add_option("--scene", scene_path,
+                  "topopt scene YAML with the supports and loads (default: the design's own config)")
       ->type_name("FILE");
-  app.cli().add_option("--solver", solver_option,
-                       "linear solver of the full-resolution model (same as --set linear_solver=NAME)")
+  app.cli()
+      .add_option("--solver", solver_option,
+                  "linear solver of the full-resolution model (same as --set linear_solver=NAME)")
       ->type_name("NAME");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
@@ -293,22 +299,23 @@ int main(int argc, char** argv) {
     std::vector<char> hsolid(std::size_t(hgrid.cells()));
     for (std::int64_t e = 0; e < hgrid.cells(); ++e) {
       const auto q = hgrid.cell_coords(e);
-      hsolid[std::size_t(e)] = mapped.roles[std::size_t(coarse.cell_index(q[0] / m, q[1] / m, q[2] / m))] != CellRole::empty;
+      hsolid[std::size_t(e)] =
+          mapped.roles[std::size_t(coarse.cell_index(q[0] / m, q[1] / m, q[2] / m))] != CellRole::empty;
     }
     if (settings.remove_void) remove_void_from_cells(hgrid, hsolid, hfixed, report, design_path);
     const auto homogenized_model =
-        make_model(hgrid, hfixed, settings.homogenized_solver, solver_options,
-                   settings.material_coarse_space);
+        make_model(hgrid, hfixed, settings.homogenized_solver, solver_options, settings.material_coarse_space);
     GridElasticity& homogenized = *homogenized_model;
     {
       const MatX cell_pairs = homogenized_pairs(coarse, mapped, set, materials, settings.fill);
       const EdgeJoints joints = find_edge_joints(coarse, cell_pairs);
       report.edge_joints = joints.count, report.edge_joint_largest_ratio = joints.largest_ratio;
       if (joints.count > 0)
-        spdlog::warn("{} edge joint(s): pairs of cells that meet only along an edge, both at least 10x stiffer than "
-                     "the cells between them (largest ratio {:.3g}); the homogenized model holds such a joint stiffer "
-                     "than the print, more so the finer the voxels (docs/topopt.md, \"Edge joints\")",
-                     joints.count, joints.largest_ratio);
+        spdlog::warn(
+            "{} edge joint(s): pairs of cells that meet only along an edge, both at least 10x stiffer than "
+            "the cells between them (largest ratio {:.3g}); the homogenized model holds such a joint stiffer "
+            "than the print, more so the finer the voxels (docs/topopt.md, \"Edge joints\")",
+            joints.count, joints.largest_ratio);
       MatX pairs(hgrid.cells(), cell_pairs.cols());
       for (std::int64_t e = 0; e < hgrid.cells(); ++e) {
         const auto q = hgrid.cell_coords(e);
@@ -320,8 +327,7 @@ int main(int argc, char** argv) {
     report.solver_homogenized = homogenized.solver_name();
     report.unknowns_homogenized = hgrid.unknowns();
     report.homogenized_elements = m;
-    report.seconds_factorize_homogenized =
-        homogenized.stats().assemble_seconds + homogenized.stats().factorize_seconds;
+    report.seconds_factorize_homogenized = homogenized.stats().assemble_seconds + homogenized.stats().factorize_seconds;
 
     // The full-resolution model.
     const auto model_start = std::chrono::steady_clock::now();
@@ -352,17 +358,18 @@ int main(int argc, char** argv) {
     report.moved_point_supports = supports.moved_point_supports;
     report.lost_point_supports = supports.lost_point_supports;
     if (supports.lost_point_supports > 0)
-      spdlog::warn("{} point support(s) find no material within half a cell in the full-resolution model: they "
-                   "hold only void there",
-                   supports.lost_point_supports);
-    spdlog::info("full-resolution model: {} voxels ({:.1f}% material), {} unknowns ({} nodes without material "
-                 "fixed)",
-                 report.voxels,
-                 100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
-                 fine.unknowns(), report.inactive_nodes_full);
+      spdlog::warn(
+          "{} point support(s) find no material within half a cell in the full-resolution model: they "
+          "hold only void there",
+          supports.lost_point_supports);
+    spdlog::info(
+        "full-resolution model: {} voxels ({:.1f}% material), {} unknowns ({} nodes without material "
+        "fixed)",
+        report.voxels, 100.0 * double(report.material_voxels) / double(std::max<std::int64_t>(report.voxels, 1)),
+        fine.unknowns(), report.inactive_nodes_full);
     // The model keeps the support flags from here on (one grid-sized copy, not two).
-    const auto full_model = make_model(fine, std::move(supports.fixed), settings.solver, solver_options,
-                                       settings.material_coarse_space);
+    const auto full_model =
+        make_model(fine, std::move(supports.fixed), settings.solver, solver_options, settings.material_coarse_space);
     GridElasticity& full = *full_model;
     if (full.solver_name() == "matrix-free") {
       VoxelStiffnessField field = voxel_field(fine, voxels, materials);
@@ -374,7 +381,8 @@ int main(int argc, char** argv) {
       full.set_stiffness(pairs);
     }
     report.solver_full = full.solver_name();
-    if (report.solver_full == "matrix-free") report.coarse_space_full = settings.material_coarse_space ? "material" : "lattice";
+    if (report.solver_full == "matrix-free")
+      report.coarse_space_full = settings.material_coarse_space ? "material" : "lattice";
     report.unknowns_full = fine.unknowns();
     report.seconds_factorize_full = full.stats().assemble_seconds + full.stats().factorize_seconds;
     spdlog::info("stiffness: homogenized {} ({:.3f} s), full {} ({:.3f} s)", report.solver_homogenized,
@@ -396,15 +404,16 @@ int main(int argc, char** argv) {
       } else {
         const VecX prescribed =
             load.prescribed.size() == coarse.unknowns() ? VecX(hsupports.values * load.prescribed) : VecX();
-        u_split = homogenized.solve(split.refine_forces(load.force, everywhere, "load case '" + load.name + "'"),
-                                    prescribed);
+        u_split =
+            homogenized.solve(split.refine_forces(load.force, everywhere, "load case '" + load.name + "'"), prescribed);
       }
       vc.solve_seconds_homogenized = homogenized.stats().solve_seconds - t_hom0;
       VecX u_hom(coarse.unknowns());
-      for (std::int64_t n = 0; n < coarse.nodes(); ++n) u_hom.segment<3>(n * 3) = u_split.segment<3>(split.fine_node_of(n) * 3);
+      for (std::int64_t n = 0; n < coarse.nodes(); ++n)
+        u_hom.segment<3>(n * 3) = u_split.segment<3>(split.fine_node_of(n) * 3);
       CellRefinement::LoadStats load_stats;
-      VecX fine_force = refinement.refine_forces(load.force, node_material, "load case '" + load.name + "'",
-                                                 &load_stats);
+      VecX fine_force =
+          refinement.refine_forces(load.force, node_material, "load case '" + load.name + "'", &load_stats);
       const VecX fine_prescribed =
           load.prescribed.size() == coarse.unknowns() ? VecX(supports.values * load.prescribed) : VecX();
       const double t_full0 = full.stats().solve_seconds;
@@ -424,24 +433,26 @@ int main(int argc, char** argv) {
       vc.relative_energy = relative_difference(vc.energy_homogenized, vc.energy_full);
       if (!std::isfinite(vc.relative_energy) || !std::isfinite(vc.displacement.relative))
         throw NumericalError("load case '" + load.name + "': the homogenized model has no strain energy");
-      spdlog::info("load case '{}': mean |u| homogenized {:.4g}, full {:.4g}, mean |du| {:.4g} ({:.2f}%) over {} "
-                   "nodes ({} sampled off the node); energy homogenized {:.4g}, full {:.4g} ({:.2f}%); solve "
-                   "{:.3f} s / {:.3f} s ({} CG iterations)",
-                   load.name, vc.displacement.mean_homogenized, vc.displacement.mean_full,
-                   vc.displacement.mean_difference, 100 * vc.displacement.relative, vc.displacement.compared,
-                   vc.displacement.nearest, vc.energy_homogenized, vc.energy_full, 100 * vc.relative_energy,
-                   vc.solve_seconds_homogenized, vc.solve_seconds_full, vc.iterations_full);
+      spdlog::info(
+          "load case '{}': mean |u| homogenized {:.4g}, full {:.4g}, mean |du| {:.4g} ({:.2f}%) over {} "
+          "nodes ({} sampled off the node); energy homogenized {:.4g}, full {:.4g} ({:.2f}%); solve "
+          "{:.3f} s / {:.3f} s ({} CG iterations)",
+          load.name, vc.displacement.mean_homogenized, vc.displacement.mean_full, vc.displacement.mean_difference,
+          100 * vc.displacement.relative, vc.displacement.compared, vc.displacement.nearest, vc.energy_homogenized,
+          vc.energy_full, 100 * vc.relative_energy, vc.solve_seconds_homogenized, vc.solve_seconds_full,
+          vc.iterations_full);
       if (vc.load_fallbacks > 0)
-        spdlog::warn("load case '{}': {} coarse load(s) found only void on their face or edge and were spread over "
-                     "the nearby material instead",
-                     load.name, vc.load_fallbacks);
+        spdlog::warn(
+            "load case '{}': {} coarse load(s) found only void on their face or edge and were spread over "
+            "the nearby material instead",
+            load.name, vc.load_fallbacks);
       report.cases.push_back(std::move(vc));
     }
     report.seconds_total = seconds_since(start);
     write_verify_report(out, report, "msfab-verify-map", ctx.config.resolved_text(),
-                        scene_path.empty() ? std::vector<std::string>{design_path, mapped_path, structures_path}
-                                           : std::vector<std::string>{design_path, mapped_path, structures_path,
-                                                                      scene_path},
+                        scene_path.empty()
+                            ? std::vector<std::string>{design_path, mapped_path, structures_path}
+                            : std::vector<std::string>{design_path, mapped_path, structures_path, scene_path},
                         ctx.options.seed);
 
     std::string cases;
@@ -456,12 +467,13 @@ int main(int argc, char** argv) {
     }
     const std::string elements = m > 1 ? ", " + std::to_string(m) + "^3 elements per cell" : "";
     const std::string tiles = mapped.tiling > 1 ? ", " + std::to_string(mapped.tiling) + "^3 copies per cell" : "";
-    std::printf("msfab-verify-map: %d x %d x %d cells, %lld voxels (%d^3 per cell%s, fill %s)%s; homogenized %.3f s "
-                "(%s%s), full %.3f s (%s, %lld unknowns); %s\n",
-                coarse.nx(), coarse.ny(), coarse.nz(), static_cast<long long>(report.voxels), r, tiles.c_str(),
-                report.fill.c_str(), cases.c_str(), report.seconds_factorize_homogenized + hom_solve,
-                report.solver_homogenized.c_str(), elements.c_str(), report.seconds_factorize_full + full_solve,
-                report.solver_full.c_str(), static_cast<long long>(report.unknowns_full), out.c_str());
+    std::printf(
+        "msfab-verify-map: %d x %d x %d cells, %lld voxels (%d^3 per cell%s, fill %s)%s; homogenized %.3f s "
+        "(%s%s), full %.3f s (%s, %lld unknowns); %s\n",
+        coarse.nx(), coarse.ny(), coarse.nz(), static_cast<long long>(report.voxels), r, tiles.c_str(),
+        report.fill.c_str(), cases.c_str(), report.seconds_factorize_homogenized + hom_solve,
+        report.solver_homogenized.c_str(), elements.c_str(), report.seconds_factorize_full + full_solve,
+        report.solver_full.c_str(), static_cast<long long>(report.unknowns_full), out.c_str());
     std::printf("  edge joints: %lld (largest stiffness ratio across an edge %.3g)\n",
                 static_cast<long long>(report.edge_joints), report.edge_joint_largest_ratio);
   });

@@ -56,9 +56,9 @@ std::vector<std::uint8_t> model_voxels(const MappedDesign& mapped, const Microst
     for (std::int64_t z = 0; z < model.nz(); ++z)
       for (std::int64_t y = 0; y < NY; ++y)
         for (std::int64_t x = 0; x < NX; ++x) {
-          const std::size_t cell =
-              std::size_t(x / model.cell_voxels_x() +
-                          mapped.nx * (y / model.cell_voxels_y() + std::int64_t(mapped.ny) * (z / model.cell_voxels_z())));
+          const std::size_t cell = std::size_t(
+              x / model.cell_voxels_x() +
+              mapped.nx * (y / model.cell_voxels_y() + std::int64_t(mapped.ny) * (z / model.cell_voxels_z())));
           ids[std::size_t(x + NX * (y + NY * z))] = mapped.roles[cell] == CellRole::empty ? 0 : 1;
         }
   }

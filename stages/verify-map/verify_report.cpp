@@ -5,8 +5,7 @@
 namespace msfab {
 
 void write_verify_report(const std::string& path, const VerifyReport& r, const std::string& executable,
-                         const std::string& config_text, const std::vector<std::string>& inputs,
-                         std::uint64_t seed) {
+                         const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed) {
   ArtifactWriter out(path, kVerifyMapSchema, kVerifyMapSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
   f.write_attribute("/", "fill", r.fill);
@@ -15,9 +14,10 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_attribute("/", "cell_size", r.cell_size);
   f.write_attribute("/", "cell_voxels", static_cast<std::int32_t>(r.resolution));
   f.write_attribute("/", "tiling", static_cast<std::int32_t>(r.tiling));
-  f.write_attribute("/", "voxel_grid", std::vector<std::int64_t>{std::int64_t(r.grid[0]) * r.resolution,
-                                                                 std::int64_t(r.grid[1]) * r.resolution,
-                                                                 std::int64_t(r.grid[2]) * r.resolution});
+  f.write_attribute(
+      "/", "voxel_grid",
+      std::vector<std::int64_t>{std::int64_t(r.grid[0]) * r.resolution, std::int64_t(r.grid[1]) * r.resolution,
+                                std::int64_t(r.grid[2]) * r.resolution});
   f.write_attribute("/", "voxels", r.voxels);
   f.write_attribute("/", "material_voxels", r.material_voxels);
   f.write_attribute("/", "void_ratio", r.void_ratio);
@@ -97,8 +97,8 @@ void write_verify_report(const std::string& path, const VerifyReport& r, const s
   f.write_vector("/cases/point_loads", point_loads);
   f.write_vector("/cases/load_fallbacks", fallbacks);
   f.write_vector("/cases/loaded_fine_nodes", loaded);
-  for (const char* d : {"/cases/mean_displacement_homogenized", "/cases/mean_displacement_full",
-                        "/cases/mean_displacement_difference"})
+  for (const char* d :
+       {"/cases/mean_displacement_homogenized", "/cases/mean_displacement_full", "/cases/mean_displacement_difference"})
     f.write_attribute(d, "units", "m");
   for (const char* d : {"/cases/energy_homogenized", "/cases/energy_full"}) f.write_attribute(d, "units", "J");
 

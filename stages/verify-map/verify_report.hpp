@@ -25,7 +25,7 @@ struct VerifyCase {
 };
 
 struct VerifyReport {
-  std::string fill;  // mapped | solid | tile
+  std::string fill;         // mapped | solid | tile
   int tile_structure = -1;  // fill tile: the structure every design cell holds
   int grid[3] = {0, 0, 0};
   double cell_size = 1;
@@ -46,17 +46,17 @@ struct VerifyReport {
   std::int64_t edge_joints = 0;
   double edge_joint_largest_ratio = 0;
   std::string solver_homogenized, solver_full;  // as resolved by GridElasticity
-  std::string coarse_space_full = "none";      // matrix-free: material | lattice
+  std::string coarse_space_full = "none";       // matrix-free: material | lattice
   std::int64_t unknowns_homogenized = 0, unknowns_full = 0;
   std::int64_t point_supports = 0, moved_point_supports = 0, lost_point_supports = 0;
   double seconds_model = 0;  // voxel model, stiffness and the transfer of supports
-  double seconds_factorize_homogenized = 0, seconds_factorize_full = 0;  // assembly + factorization (matrix-free: setup)
+  double seconds_factorize_homogenized = 0,
+         seconds_factorize_full = 0;  // assembly + factorization (matrix-free: setup)
   double seconds_total = 0;
   std::vector<VerifyCase> cases;
 };
 
 void write_verify_report(const std::string& path, const VerifyReport& report, const std::string& executable,
-                         const std::string& config_text, const std::vector<std::string>& inputs,
-                         std::uint64_t seed);
+                         const std::string& config_text, const std::vector<std::string>& inputs, std::uint64_t seed);
 
 }  // namespace msfab

@@ -7,11 +7,11 @@
 #include <random>
 
 #include "core/errors.hpp"
-#include "ddfem_test_blocks.hpp"
 #include "ddfem/adaptive_levels.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarsening_error.hpp"
 #include "ddfem/mixed_level_mesh.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
 #include "solve/newton.hpp"
@@ -77,7 +77,8 @@ constexpr CoarseVariant kCoarseVariants[] = {
     {"trilinear naive", false, false}, {"enhanced naive", true, false}, {"enhanced Galerkin", true, true}};
 
 CoarseMaterialLookup variant_lookup(const Scene& s, const CoarseVariant& v, const CoarseGrid* level1) {
-  if (v.galerkin) return level1 ? galerkin_coarsening(s.material_by_id, *level1) : galerkin_coarsening(s.material_by_id);
+  if (v.galerkin)
+    return level1 ? galerkin_coarsening(s.material_by_id, *level1) : galerkin_coarsening(s.material_by_id);
   return level1 ? naive_coarsening(s.material_by_id, *level1) : naive_coarsening(s.material_by_id);
 }
 
@@ -101,7 +102,8 @@ TEST(AdaptiveMixedMesh, HangingNodesInterpolateRestPositionsAndRowsSumToOne) {
   EXPECT_LT((interpolated - Rows3(m.mesh.nodes)).cwiseAbs().maxCoeff(), 1e-15);
   // Every fine voxel is covered by exactly the volume of the elements.
   double volume = 0;
-  for (int e = 0; e < m.mesh.num_elements(); ++e) volume += std::pow(std::ldexp(s.grid.voxel_size, m.element_level[e]), 3);
+  for (int e = 0; e < m.mesh.num_elements(); ++e)
+    volume += std::pow(std::ldexp(s.grid.voxel_size, m.element_level[e]), 3);
   EXPECT_GT(volume, s.grid.count_solid() * std::pow(s.grid.voxel_size, 3));
 }
 

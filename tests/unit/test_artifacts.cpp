@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
-
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -35,8 +34,8 @@ class ScratchDir : public ::testing::Test {
  protected:
   void SetUp() override {
     static std::atomic<int> counter{0};
-    dir_ = fs::temp_directory_path() /
-           ("msfab_artifacts_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    dir_ =
+        fs::temp_directory_path() / ("msfab_artifacts_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     fs::create_directories(dir_);
   }
   void TearDown() override {
@@ -185,8 +184,8 @@ TEST_F(ArtifactH5File, GzipRoundTripIsChunkedAndSmaller) {
   ASSERT_EQ(H5Pget_layout(create.get()), H5D_CHUNKED);
   hsize_t chunk[2] = {0, 0};
   ASSERT_EQ(H5Pget_chunk(create.get(), 2, chunk), 2);
-  EXPECT_EQ(chunk[1], 3u);                  // rows stay whole
-  EXPECT_EQ(chunk[0], 64u * 1024 / 24);     // ~64 KiB per chunk
+  EXPECT_EQ(chunk[1], 3u);                      // rows stay whole
+  EXPECT_EQ(chunk[0], 64u * 1024 / 24);         // ~64 KiB per chunk
   EXPECT_GE(H5Pget_nfilters(create.get()), 2);  // shuffle + deflate
   EXPECT_LT(fs::file_size(packed) * 10, fs::file_size(plain));
 }
@@ -209,8 +208,7 @@ TEST_F(ArtifactH5File, AttributesOnRootGroupsAndDatasets) {
     H5Tset_size(type.get(), 8);
     H5Tset_strpad(type.get(), H5T_STR_NULLPAD);
     H5Id space(H5Screate(H5S_SCALAR), H5Sclose);
-    H5Id attr(H5Acreate2(out.id(), "fixed", type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
-              H5Aclose);
+    H5Id attr(H5Acreate2(out.id(), "fixed", type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
     const char fixed[8] = {'P', 'a', '\0', '\0', '\0', '\0', '\0', '\0'};
     H5Awrite(attr.get(), type.get(), fixed);
   }
@@ -221,8 +219,7 @@ TEST_F(ArtifactH5File, AttributesOnRootGroupsAndDatasets) {
   EXPECT_FALSE(in.exists("/mesh/elements/connectivity"));
   EXPECT_EQ(in.children("/"), (std::vector<std::string>{"mesh"}));
   EXPECT_EQ(in.read_string_attribute("/mesh/nodes", "units"), "m");
-  EXPECT_EQ(in.read_attribute_vector<double>("/mesh", "spacing"),
-            (std::vector<double>{0.5, 0.25, 0.125}));
+  EXPECT_EQ(in.read_attribute_vector<double>("/mesh", "spacing"), (std::vector<double>{0.5, 0.25, 0.125}));
   EXPECT_EQ(in.read_attribute<std::int32_t>("/", "count"), 12);
   EXPECT_EQ(in.read_attribute<double>("/", "count"), 12.0);  // lossless widening
   EXPECT_EQ(in.read_attribute<std::int64_t>("/", "big"), std::int64_t(1) << 40);
@@ -233,8 +230,7 @@ TEST_F(ArtifactH5File, AttributesOnRootGroupsAndDatasets) {
   EXPECT_FALSE(in.has_attribute("/mesh/nodes", "density"));
   EXPECT_FALSE(in.has_attribute("/nowhere", "units"));
 
-  const std::string narrowing =
-      input_error_message([&] { in.read_attribute<std::int32_t>("/", "big"); });
+  const std::string narrowing = input_error_message([&] { in.read_attribute<std::int32_t>("/", "big"); });
   EXPECT_NE(narrowing.find("int64"), std::string::npos) << narrowing;
   const std::string missing = input_error_message([&] { in.read_string_attribute("/mesh", "units"); });
   EXPECT_NE(missing.find(path), std::string::npos) << missing;
@@ -314,8 +310,7 @@ TEST_F(ArtifactWriterTest, RecordsProvenanceAsRootAttributes) {
     ArtifactWriter out(path, "msfab.result", 3, "msfab-simulate", config, {input}, 123456789012345ull);
     out.file().write_vector("/x", std::vector<double>{1.0});
     EXPECT_TRUE(fs::exists(out.tmp_path()));
-    EXPECT_TRUE(std::regex_match(out.tmp_path(), std::regex(R"(.*/result\.h5\.[0-9a-f]{16}\.tmp)")))
-        << out.tmp_path();
+    EXPECT_TRUE(std::regex_match(out.tmp_path(), std::regex(R"(.*/result\.h5\.[0-9a-f]{16}\.tmp)"))) << out.tmp_path();
     EXPECT_FALSE(fs::exists(path));
     out.commit();
     EXPECT_TRUE(out.committed());
@@ -327,14 +322,12 @@ TEST_F(ArtifactWriterTest, RecordsProvenanceAsRootAttributes) {
   EXPECT_EQ(in.config(), config);
   EXPECT_EQ(in.seed(), 123456789012345ull);
   EXPECT_EQ(in.producer(), std::string("msfab-simulate ") + version() + " (git " + git_revision() + ")");
-  EXPECT_TRUE(std::regex_match(in.created(), std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)")))
-      << in.created();
+  EXPECT_TRUE(std::regex_match(in.created(), std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)"))) << in.created();
   const std::vector<ArtifactInput> inputs = in.inputs();
   ASSERT_EQ(inputs.size(), 1u);
   EXPECT_EQ(inputs[0].path, input);
   EXPECT_EQ(inputs[0].sha256, sha256_hex("pretend mesh content"));
-  EXPECT_NE(in.file().read_string_attribute("/", "inputs").find(sha256_file_hex(input)),
-            std::string::npos);
+  EXPECT_NE(in.file().read_string_attribute("/", "inputs").find(sha256_file_hex(input)), std::string::npos);
   EXPECT_EQ(in.file().read_vector<double>("/x"), std::vector<double>{1.0});
 }
 
@@ -360,15 +353,13 @@ TEST_F(ArtifactWriterTest, ThrowBeforeCommitKeepsOldFileAndRemovesTmp) {
 TEST_F(ArtifactWriterTest, MissingInputOrFolderIsInputErrorAndCreatesNothing) {
   const std::string path = file("result.h5");
   const std::string missing_input = file("missing_mesh.h5");
-  const std::string message = input_error_message([&] {
-    ArtifactWriter out(path, "msfab.result", 1, "msfab-test", "", {missing_input}, 0);
-  });
+  const std::string message =
+      input_error_message([&] { ArtifactWriter out(path, "msfab.result", 1, "msfab-test", "", {missing_input}, 0); });
   EXPECT_EQ(message, missing_input + ": no such file");
   EXPECT_TRUE(temporaries().empty());
   const std::string nested = file("no/such/dir/result.h5");
-  const std::string folder = input_error_message([&] {
-    ArtifactWriter out(nested, "msfab.result", 1, "msfab-test", "", {}, 0);
-  });
+  const std::string folder =
+      input_error_message([&] { ArtifactWriter out(nested, "msfab.result", 1, "msfab-test", "", {}, 0); });
   EXPECT_NE(folder.find("does not exist"), std::string::npos) << folder;
 }
 
@@ -419,18 +410,16 @@ TEST_F(ArtifactWriterTest, TwoWritersOfOneOutputHaveTheirOwnTemporaries) {
 TEST_F(ArtifactWriterTest, OutputThatIsAnInputOrAFolderIsInputErrorAndTouchesNothing) {
   const std::string input = file("mesh.h5");
   write_bytes(input, "the only copy");
-  const std::string same = input_error_message([&] {
-    ArtifactWriter out(input, "msfab.result", 1, "msfab-test", "", {input}, 0);
-  });
+  const std::string same =
+      input_error_message([&] { ArtifactWriter out(input, "msfab.result", 1, "msfab-test", "", {input}, 0); });
   EXPECT_NE(same.find("also an input"), std::string::npos) << same;
   const std::string link = file("link.h5");
   fs::create_symlink(input, link);
   input_error_message([&] { ArtifactWriter out(link, "msfab.result", 1, "msfab-test", "", {input}, 0); });
   EXPECT_EQ(read_bytes(input), "the only copy");
   fs::create_directory(file("folder.h5"));
-  const std::string folder = input_error_message([&] {
-    ArtifactWriter out(file("folder.h5"), "msfab.result", 1, "msfab-test", "", {}, 0);
-  });
+  const std::string folder =
+      input_error_message([&] { ArtifactWriter out(file("folder.h5"), "msfab.result", 1, "msfab-test", "", {}, 0); });
   EXPECT_NE(folder.find("is a folder"), std::string::npos) << folder;
   EXPECT_TRUE(temporaries().empty());
 }
@@ -473,8 +462,7 @@ TEST_F(ArtifactWriterTest, ReadOnlyFolderIsInputError) {
 TEST_F(ArtifactReaderTest, SchemaMismatchNamesFileExpectedAndFound) {
   const std::string path = file("db.h5");
   write_small_artifact(path, "msfab.coarse_db", 1);
-  const std::string message =
-      input_error_message([&] { ArtifactReader in(path, "msfab.result", 1); });
+  const std::string message = input_error_message([&] { ArtifactReader in(path, "msfab.result", 1); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("expected schema 'msfab.result' version 1"), std::string::npos) << message;
   EXPECT_NE(message.find("found schema 'msfab.coarse_db' version 1"), std::string::npos) << message;
@@ -483,8 +471,7 @@ TEST_F(ArtifactReaderTest, SchemaMismatchNamesFileExpectedAndFound) {
 TEST_F(ArtifactReaderTest, VersionMismatchNamesFileExpectedAndFound) {
   const std::string path = file("result_v4.h5");
   write_small_artifact(path, "msfab.result", 4);
-  const std::string message =
-      input_error_message([&] { ArtifactReader in(path, "msfab.result", 1, 3); });
+  const std::string message = input_error_message([&] { ArtifactReader in(path, "msfab.result", 1, 3); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("version 1 to 3"), std::string::npos) << message;
   EXPECT_NE(message.find("found schema 'msfab.result' version 4"), std::string::npos) << message;
@@ -495,8 +482,7 @@ TEST_F(ArtifactReaderTest, TruncatedFileIsInputError) {
   const std::string path = file("truncated.h5");
   write_small_artifact(path, "msfab.result", 1);
   fs::resize_file(path, fs::file_size(path) / 2);
-  const std::string message =
-      input_error_message([&] { ArtifactReader in(path, "msfab.result", 1); });
+  const std::string message = input_error_message([&] { ArtifactReader in(path, "msfab.result", 1); });
   EXPECT_NE(message.find(path), std::string::npos) << message;
   EXPECT_NE(message.find("truncated or corrupt"), std::string::npos) << message;
 }
@@ -504,19 +490,16 @@ TEST_F(ArtifactReaderTest, TruncatedFileIsInputError) {
 TEST_F(ArtifactReaderTest, NonHdf5AndForeignFilesAreInputErrors) {
   const std::string text = file("notes.h5");
   write_bytes(text, "this is a yaml file, not hdf5\n");
-  const std::string garbage =
-      input_error_message([&] { ArtifactReader in(text, "msfab.result", 1); });
+  const std::string garbage = input_error_message([&] { ArtifactReader in(text, "msfab.result", 1); });
   EXPECT_NE(garbage.find(text), std::string::npos) << garbage;
   EXPECT_NE(garbage.find("not a valid HDF5 file"), std::string::npos) << garbage;
 
-  const std::string missing = input_error_message(
-      [&] { ArtifactReader in(file("nothing.h5"), "msfab.result", 1); });
+  const std::string missing = input_error_message([&] { ArtifactReader in(file("nothing.h5"), "msfab.result", 1); });
   EXPECT_EQ(missing, file("nothing.h5") + ": no such file");
 
   const std::string foreign = file("foreign.h5");
   H5File::create(foreign).write_vector("/data", std::vector<double>{1.0});
-  const std::string unmarked =
-      input_error_message([&] { ArtifactReader in(foreign, "msfab.result", 1); });
+  const std::string unmarked = input_error_message([&] { ArtifactReader in(foreign, "msfab.result", 1); });
   EXPECT_NE(unmarked.find("not an msfab artifact"), std::string::npos) << unmarked;
 }
 
@@ -529,9 +512,8 @@ TEST_F(ScratchDir, CheckpointIsReadOnlyByTheRunThatWroteIt) {
   const std::string path = checkpoint_path(file("run.h5"));
   EXPECT_EQ(path, file("run.h5.checkpoint.h5"));
   for (int round = 1; round <= 2; ++round)
-    write_checkpoint_file(path, "msfab.test.checkpoint", "config: 1\n# seed 7\n", [&](H5File& f) {
-      f.write_vector("/done", std::vector<double>(round, 1.5));
-    });
+    write_checkpoint_file(path, "msfab.test.checkpoint", "config: 1\n# seed 7\n",
+                          [&](H5File& f) { f.write_vector("/done", std::vector<double>(round, 1.5)); });
   EXPECT_TRUE(temporaries().empty());
   const H5File f = open_checkpoint_file(path, "msfab.test.checkpoint", "test", "config: 1\n# seed 7\n");
   EXPECT_EQ(f.read_vector<double>("/done"), std::vector<double>(2, 1.5));
@@ -563,8 +545,7 @@ TEST(PathNames, SuffixesAreDroppedInOrderAndOnlyWhenSomethingIsLeft) {
 }
 
 TEST(ArtifactInputs, FormatAndParseRoundTrip) {
-  const std::vector<ArtifactInput> inputs = {{"a/mesh file.h5", std::string(64, 'a')},
-                                             {"db.h5", std::string(64, 'b')}};
+  const std::vector<ArtifactInput> inputs = {{"a/mesh file.h5", std::string(64, 'a')}, {"db.h5", std::string(64, 'b')}};
   const std::string text = format_inputs(inputs);
   EXPECT_EQ(text, std::string(64, 'a') + "  a/mesh file.h5\n" + std::string(64, 'b') + "  db.h5\n");
   const std::vector<ArtifactInput> back = parse_inputs(text);
@@ -609,8 +590,7 @@ using Sha256File = ScratchDir;
 TEST_F(Sha256File, StreamsFilesMillionAVector) {
   const std::string path = file("a.bin");
   write_bytes(path, std::string(1000000, 'a'));  // FIPS 180-2 long message
-  EXPECT_EQ(sha256_file_hex(path),
-            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  EXPECT_EQ(sha256_file_hex(path), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
   const std::string message = input_error_message([&] { sha256_file_hex(file("none.bin")); });
   EXPECT_EQ(message, file("none.bin") + ": no such file");
 }
@@ -650,9 +630,8 @@ Eigen::Vector3i toolkit_corner(int node) { return {(node >> 2) & 1, (node >> 1) 
 
 TEST(Xdmf, VtkOrderMapsUnitCubeCorners) {
   const std::array<Eigen::Vector3i, 8> vtk_corners = {
-      Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(1, 0, 0), Eigen::Vector3i(1, 1, 0),
-      Eigen::Vector3i(0, 1, 0), Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(1, 0, 1),
-      Eigen::Vector3i(1, 1, 1), Eigen::Vector3i(0, 1, 1)};
+      Eigen::Vector3i(0, 0, 0), Eigen::Vector3i(1, 0, 0), Eigen::Vector3i(1, 1, 0), Eigen::Vector3i(0, 1, 0),
+      Eigen::Vector3i(0, 0, 1), Eigen::Vector3i(1, 0, 1), Eigen::Vector3i(1, 1, 1), Eigen::Vector3i(0, 1, 1)};
   for (int v = 0; v < 8; ++v) {
     EXPECT_EQ(toolkit_corner(kToolkitNodeAtVtkCorner[v]), vtk_corners[v]) << "VTK corner " << v;
   }
@@ -703,17 +682,14 @@ TEST_F(XdmfFiles, StaticMeshPointsAtMatchingDatasets) {
     out.write_vector("/density", std::vector<double>{1.0, 0.5});
   }
   const std::string xmf = file("result.xmf");
-  write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"displacement", "/displacement", 3}},
-                      {{"density", "/density", 1}});
+  write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"displacement", "/displacement", 3}}, {{"density", "/density", 1}});
   EXPECT_TRUE(temporaries().empty());
   const std::string xml = read_bytes(xmf);
   EXPECT_EQ(check_tag_balance(xml), "");
   EXPECT_NE(xml.find("TopologyType=\"Hexahedron\" NumberOfElements=\"2\""), std::string::npos);
   EXPECT_NE(xml.find("GeometryType=\"XYZ\""), std::string::npos);
-  EXPECT_NE(xml.find("Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\""),
-            std::string::npos);
-  EXPECT_NE(xml.find("Name=\"density\" AttributeType=\"Scalar\" Center=\"Cell\""),
-            std::string::npos);
+  EXPECT_NE(xml.find("Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\""), std::string::npos);
+  EXPECT_NE(xml.find("Name=\"density\" AttributeType=\"Scalar\" Center=\"Cell\""), std::string::npos);
 
   // Every DataItem names a dataset of exactly the stated dimensions.
   const H5File h5 = H5File::open(file("result.h5"));
@@ -756,16 +732,13 @@ TEST_F(XdmfFiles, TimeSeriesIsTemporalCollection) {
 
 TEST_F(XdmfFiles, UnsupportedComponentsThrowAndWriteNothing) {
   const std::string xmf = file("bad.xmf");
-  EXPECT_THROW(write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"weird", "/w", 2}}, {}),
-               std::invalid_argument);
+  EXPECT_THROW(write_hex_mesh_xdmf(xmf, two_hex_mesh(), {{"weird", "/w", 2}}, {}), std::invalid_argument);
   EXPECT_FALSE(fs::exists(xmf));
   EXPECT_TRUE(temporaries().empty());
 }
 
-
 // ---------------------------------------------------------------------------
 // Commit groups
-
 
 using CommitGroupTest = ScratchDir;
 
@@ -780,7 +753,6 @@ ArtifactWriter& add_member(CommitGroup& group, const std::string& path, double v
 double value_of(const std::string& path) {
   return ArtifactReader(path, "msfab.test", 1).file().read_vector<double>("/value")[0];
 }
-
 
 TEST_F(CommitGroupTest, MembersAppearTogetherAndALaterOneRecordsAnEarliersHash) {
   CommitGroup group;

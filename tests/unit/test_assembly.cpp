@@ -117,7 +117,8 @@ TEST(EnhancedElement, PassesThePatchTestAndBendsExactly) {
   Mat3 G;
   G << 0.01, -0.02, 0.005, 0.003, 0.02, -0.01, 0.007, 0.011, -0.03;
   const hex8::NodeMatrix affine = X + X * G.transpose();
-  EXPECT_NEAR(hex_energy(enhanced, linear, affine), hex_energy(plain, linear, affine), 1e-10 * hex_energy(plain, linear, affine));
+  EXPECT_NEAR(hex_energy(enhanced, linear, affine), hex_energy(plain, linear, affine),
+              1e-10 * hex_energy(plain, linear, affine));
   // Pure bending about y: u_x = -k (x - xc)(z - zc), u_z = k (x - xc)^2 / 2 at
   // the nodes. The exact energy is E k^2 I a / 2, I = b c^3 / 12; the
   // trilinear element adds parasitic shear, the enhanced one is exact.

@@ -125,8 +125,8 @@ TEST(SurfaceContact, SeparatingBodiesDuplicatesOnlyTheSharedNodes) {
   VoxelGrid grid(2, 2, 2, 0.01, 1);
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) grid.at(i, j, 1) = 2;
-  const VoxelMesh voxels = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.3),
-                                                   std::make_shared<NeoHookean>(1e6, 0.3)});
+  const VoxelMesh voxels =
+      build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.3), std::make_shared<NeoHookean>(1e6, 0.3)});
   HexMesh mesh = voxels.mesh;
   EXPECT_EQ(mesh.num_nodes(), 27);
   EXPECT_EQ(element_components(mesh), std::vector<int>(8, 0));
@@ -187,15 +187,15 @@ TEST(BodyContact, HeadOnCollisionConservesMomentumAndOrdersTheImpactModels) {
   const Collision bbi = head_on(ImpactModel::kBbi);
   std::printf("  separation speed / approach speed: complementarity %.4f, DKE %.4f, BBI %.4f\n",
               comp.relative_velocity_after, dke.relative_velocity_after, bbi.relative_velocity_after);
-  std::printf("  momentum error: %.2e %.2e %.2e; penetration %.2e %.2e %.2e m\n", comp.momentum_error, dke.momentum_error,
-              bbi.momentum_error, comp.max_penetration, dke.max_penetration, bbi.max_penetration);
+  std::printf("  momentum error: %.2e %.2e %.2e; penetration %.2e %.2e %.2e m\n", comp.momentum_error,
+              dke.momentum_error, bbi.momentum_error, comp.max_penetration, dke.max_penetration, bbi.max_penetration);
   for (const Collision* c : {&comp, &dke, &bbi}) {
     EXPECT_GT(c->contact_steps, 0);
     // Contact impulses are internal: +f on the node, -w_i f on the face.
     EXPECT_LT(c->momentum_error, 1e-9);
     EXPECT_LE(c->max_penetration, 1e-3 * 0.005);
   }
-  EXPECT_GT(comp.relative_velocity_after, 0.5);  // nearly elastic
+  EXPECT_GT(comp.relative_velocity_after, 0.5);            // nearly elastic
   EXPECT_LT(std::abs(bbi.relative_velocity_after), 0.05);  // inelastic: they move on together
   EXPECT_LT(dke.relative_velocity_after, comp.relative_velocity_after);
 }

@@ -58,7 +58,9 @@ TEST(CellMmaSubproblem, DualSolutionMeetsThePrimalOptimalityConditions) {
     const CellMmaApproximation a = random_cell(rng, d, m, x0);
     const double mu = (trial % 3 == 0) ? 0.0 : 0.5 * std::uniform_real_distribution<double>(0, 1)(rng);
     const CellMmaSolution s = solve_cell_mma(a, mu, CellMmaConstraintVec(), penalty, 1e-11);
-    ASSERT_TRUE(s.converged) << "trial " << trial << " d " << d << " m " << m << " its " << s.newton_iterations << " lambda " << s.lambda.transpose() << " x " << s.x.transpose() << " alpha " << a.alpha.transpose() << " beta " << a.beta.transpose();
+    ASSERT_TRUE(s.converged) << "trial " << trial << " d " << d << " m " << m << " its " << s.newton_iterations
+                             << " lambda " << s.lambda.transpose() << " x " << s.x.transpose() << " alpha "
+                             << a.alpha.transpose() << " beta " << a.beta.transpose();
     // Primal feasibility with the artificial slack, complementarity.
     for (int c = 0; c < m; ++c) {
       double g = -a.b[c];
@@ -77,9 +79,12 @@ TEST(CellMmaSubproblem, DualSolutionMeetsThePrimalOptimalityConditions) {
       EXPECT_GE(s.x[j], a.alpha[j]);
       EXPECT_LE(s.x[j], a.beta[j]);
       const double tol = 1e-7 * (1 + std::abs(dL));
-      if (s.x[j] > a.alpha[j] && s.x[j] < a.beta[j]) EXPECT_NEAR(dL, 0.0, tol) << "trial " << trial << " x" << j;
-      else if (s.x[j] == a.alpha[j]) EXPECT_GE(dL, -tol) << "trial " << trial << " x" << j;
-      else EXPECT_LE(dL, tol) << "trial " << trial << " x" << j;
+      if (s.x[j] > a.alpha[j] && s.x[j] < a.beta[j])
+        EXPECT_NEAR(dL, 0.0, tol) << "trial " << trial << " x" << j;
+      else if (s.x[j] == a.alpha[j])
+        EXPECT_GE(dL, -tol) << "trial " << trial << " x" << j;
+      else
+        EXPECT_LE(dL, tol) << "trial " << trial << " x" << j;
     }
     // The reported mass is the approximation's value at x.
     double mass = -a.bm;
@@ -110,7 +115,8 @@ TEST(CellMmaSubproblem, MassDerivativeMatchesFiniteDifferences) {
     bool same = s.converged && sp.converged && sm.converged && s.slack == 0 && active < free_variables;
     for (int c = 0; c < m; ++c) same = same && ((sp.lambda[c] > 0) == (sm.lambda[c] > 0));
     for (int j = 0; j < d; ++j)
-      same = same && ((sp.x[j] == a.alpha[j] || sp.x[j] == a.beta[j]) == (sm.x[j] == a.alpha[j] || sm.x[j] == a.beta[j]));
+      same =
+          same && ((sp.x[j] == a.alpha[j] || sp.x[j] == a.beta[j]) == (sm.x[j] == a.alpha[j] || sm.x[j] == a.beta[j]));
     if (!same) continue;
     const double fd = (sp.mass - sm.mass) / (2 * h);
     EXPECT_LE(s.mass_derivative, 0.0);
@@ -128,7 +134,10 @@ TEST(CellMmaSubproblem, WarmStartGivesTheSameSolution) {
     const CellMmaSolution cold = solve_cell_mma(a, 0.2, CellMmaConstraintVec(), 1e4, 1e-12);
     const CellMmaSolution near = solve_cell_mma(a, 0.21, cold.lambda, 1e4, 1e-12);
     const CellMmaSolution back = solve_cell_mma(a, 0.2, near.lambda, 1e4, 1e-12);
-    EXPECT_LE((back.x - cold.x).cwiseAbs().maxCoeff(), 1e-9) << "trial " << trial << " converged " << cold.converged << near.converged << back.converged << " its " << cold.newton_iterations << " " << back.newton_iterations << " slack " << cold.slack << " lambda " << cold.lambda.transpose() << " / " << back.lambda.transpose();
+    EXPECT_LE((back.x - cold.x).cwiseAbs().maxCoeff(), 1e-9)
+        << "trial " << trial << " converged " << cold.converged << near.converged << back.converged << " its "
+        << cold.newton_iterations << " " << back.newton_iterations << " slack " << cold.slack << " lambda "
+        << cold.lambda.transpose() << " / " << back.lambda.transpose();
     EXPECT_LE(back.newton_iterations, cold.newton_iterations + 1);
   }
 }

@@ -83,8 +83,8 @@ TEST(Config, DefaultsApplyOnlyWhenKeyIsAbsent) {
 
 TEST(Config, EffectiveTextWritesInTheDefaultsThatWereRead) {
   Config c = Config::from_string(kScene, "scene.yaml");
-  EXPECT_EQ(c.get_or<double>("grid.spacing", 9.0), 0.5);             // present: not a default
-  EXPECT_EQ(c.get_or<double>("solver.tolerance", 1e-9), 1e-9);       // a new section
+  EXPECT_EQ(c.get_or<double>("grid.spacing", 9.0), 0.5);        // present: not a default
+  EXPECT_EQ(c.get_or<double>("solver.tolerance", 1e-9), 1e-9);  // a new section
   EXPECT_EQ(c.children("materials")[1].get_or<double>("density", 1200.0 / 7), 1200.0 / 7);
   EXPECT_EQ(c.get_or<std::string>("name", "unnamed"), "bar");
   const std::string text = c.effective_text();
@@ -276,8 +276,7 @@ TEST(Config, NonFiniteAndChoiceChecks) {
 // Non-finite and overflowing numbers are refused by the reader itself, for
 // every key, in scalars and lists, from files and from --set alike.
 TEST(Config, NonFiniteAndHugeNumbersAreRefusedWhereverTheyAreRead) {
-  Config c = Config::from_string("a: .nan\nb: .inf\nc: -.inf\nd: 1e308\ne: -2e100\nf: [1, .nan]\ng: 1e100\n",
-                                 "f.yaml");
+  Config c = Config::from_string("a: .nan\nb: .inf\nc: -.inf\nd: 1e308\ne: -2e100\nf: [1, .nan]\ng: 1e100\n", "f.yaml");
   EXPECT_CONTAINS(input_error_of([&] { c.get<double>("a"); }), ("f.yaml: a = .nan: expected a finite number"));
   EXPECT_CONTAINS(input_error_of([&] { c.require_positive("b", "damping"); }), ("b = .inf: expected a finite"));
   EXPECT_CONTAINS(input_error_of([&] { c.get_or<double>("c", 1.0); }), ("c = -.inf"));
@@ -456,7 +455,9 @@ TEST(LinearSolverConfig, EarlierNamesReadAsTheCurrentOnes) {
   const Config direct = Config::from_string("linear_solver: direct\n", "h.yaml");
   EXPECT_EQ(read_linear_solver_choice(direct, {"auto", "cholmod"}, {}, keys).kind, "cholmod");
   const Config both = Config::from_string("solver: multigrid\nlinear_solver: cholmod\n", "h.yaml");
-  EXPECT_CONTAINS(input_error_of([&] { read_linear_solver_choice(both, {"auto", "cholmod"}, {}, keys); }),
+  EXPECT_CONTAINS(input_error_of([&] {
+                    read_linear_solver_choice(both, {"auto", "cholmod"}, {}, keys);
+                  }),
                   ("h.yaml: solver = multigrid: is the earlier name of linear_solver; give only one of them"));
 }
 

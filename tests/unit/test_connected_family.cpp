@@ -11,7 +11,6 @@
 #include <random>
 
 #include "core/errors.hpp"
-
 #include "families/beam_template.hpp"
 #include "gamut/structure_ops.hpp"
 #include "mapping/mismatch.hpp"

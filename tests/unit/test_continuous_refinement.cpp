@@ -200,7 +200,8 @@ TEST(ContinuousRefinement, PropertyGradientsMatchFiniteDifferences) {
           const double step = 1e-5 * C.cwiseAbs().maxCoeff();
           a(i, j) += step, b(i, j) -= step;
           const double fd = (space.properties_with_gradient(a, 0.4, nullptr)[k] -
-                             space.properties_with_gradient(b, 0.4, nullptr)[k]) / (2 * step);
+                             space.properties_with_gradient(b, 0.4, nullptr)[k]) /
+                            (2 * step);
           EXPECT_NEAR(d[k](i, j), fd, 1e-6 * d[k].cwiseAbs().maxCoeff())
               << "kind " << int(kind) << " property " << k << " entry " << i << "," << j;
         }

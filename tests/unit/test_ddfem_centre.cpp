@@ -31,8 +31,8 @@ Vec24 random_corners(std::mt19937_64& rng, double amplitude) {
 }
 
 TEST(DdfemCentre, BasisIsTheVolumetricEnergyAtTheCentre) {
-  const FineBlock block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1},
-                                          ddfem_test::two_materials(1e6, 1e6), kVoxel);
+  const FineBlock block =
+      make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, ddfem_test::two_materials(1e6, 1e6), kVoxel);
   const hex8::ElementGeometry geo = block.coarse_geometry();
   const hex8::NodeMatrix X = block.coarse_rest_positions();
   const double volume = 8 * kVoxel * kVoxel * kVoxel;
@@ -123,10 +123,11 @@ TEST(DdfemCentre, NearlyIncompressibleBlockMovesItsVolumetricStiffnessToTheCentr
   const double mu = pal[1]->shear_modulus();
   double mu_without = 0, mu_with = 0;
   for (int k = 0; k < 8; ++k) mu_without += without.mu[k] / 8, mu_with += with.mu[k] / 8;
-  std::printf("[ddfem] nu 0.45 block: heldout %.4f -> %.4f; mu_k/mu %.3f -> %.3f, mu_c/mu %.3f; lambda_k/lambda %.3f -> "
-              "%.3f, lambda_c/lambda %.3f\n",
-              without.heldout_error, with.heldout_error, mu_without / mu, mu_with / mu, with.mu_centre / mu,
-              mean_without / lambda, mean_with / lambda, with.lambda_centre / lambda);
+  std::printf(
+      "[ddfem] nu 0.45 block: heldout %.4f -> %.4f; mu_k/mu %.3f -> %.3f, mu_c/mu %.3f; lambda_k/lambda %.3f -> "
+      "%.3f, lambda_c/lambda %.3f\n",
+      without.heldout_error, with.heldout_error, mu_without / mu, mu_with / mu, with.mu_centre / mu,
+      mean_without / lambda, mean_with / lambda, with.lambda_centre / lambda);
   EXPECT_LT(with.objective, without.objective);
   EXPECT_LT(with.heldout_error, 0.8 * without.heldout_error);
   EXPECT_GT(with.lambda_centre, 0.3 * lambda);
@@ -198,14 +199,13 @@ TEST(DdfemCentre, CoarseMeshPairsCentreMaterialsWithTheCentrePoint) {
 // the centre point, so an affine deformation stores 8 times the child's
 // energy.
 TEST(DdfemCentre, Level2BlockGivesCentreChildrenTheCentrePoint) {
-  const FineBlock child_block = make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1},
-                                                ddfem_test::two_materials(1e6, 1e6), kVoxel);
+  const FineBlock child_block =
+      make_fine_block(BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, ddfem_test::two_materials(1e6, 1e6), kVoxel);
   CoarseMaterialFit child = ddfem_test::neo_hookean_level1(3e5, 1e5);
   child.mu_centre = 4e5, child.lambda_centre = 2e6;
   const std::array<const CoarseMaterialFit*, 8> children{&child, &child, &child, &child,
                                                          &child, &child, &child, &child};
-  const FineBlock block = make_block_of_coarse_materials(children, BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1},
-                                                         2 * kVoxel);
+  const FineBlock block = make_block_of_coarse_materials(children, BlockMaterials{1, 1, 1, 1, 1, 1, 1, 1}, 2 * kVoxel);
   for (int e = 0; e < block.mesh().num_elements(); ++e)
     EXPECT_EQ(block.mesh().geometries[block.mesh().element_geometry[e]].size(), 9) << e;
   Mat3 G;

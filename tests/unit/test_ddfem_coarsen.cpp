@@ -7,15 +7,15 @@
 #include <random>
 
 #include "core/errors.hpp"
-#include "ddfem_test_blocks.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarse_grid.hpp"
 #include "ddfem/coarsening_error.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "homog/periodic_homogenization.hpp"
-#include "material/voigt.hpp"
 #include "material/neo_hookean.hpp"
+#include "material/voigt.hpp"
 #include "scene/scene.hpp"
 #include "solve/newton.hpp"
 
@@ -119,7 +119,12 @@ TEST(DdfemCoarsenGrid, IdenticalBlocksShareOneMaterialEntry) {
   int calls = 0;
   auto naive = naive_coarsening(soft_stiff_palette());
   const VoxelMesh m = build_coarse_mesh(
-      c, [&](const ChildIds& ids) { ++calls; return naive(ids); }, 0, &stats);
+      c,
+      [&](const ChildIds& ids) {
+        ++calls;
+        return naive(ids);
+      },
+      0, &stats);
   EXPECT_EQ(stats.elements, 32);
   EXPECT_EQ(stats.distinct_combinations, 2);  // all-soft blocks and soft/stiff blocks
   EXPECT_EQ(calls, 2);
@@ -225,7 +230,8 @@ TEST(DdfemCoarsenBaselines, GalerkinElementIsTheFineEnergyOfTheInterpolatedField
     ASSERT_EQ(rule.size(), level == 1 ? 64 : 512);
     const VoxelMesh galerkin =
         build_coarse_mesh(c, level == 1 ? galerkin_coarsening(palette) : galerkin_coarsening(palette, l1));
-    const VoxelMesh naive = build_coarse_mesh(c, level == 1 ? naive_coarsening(palette) : naive_coarsening(palette, l1));
+    const VoxelMesh naive =
+        build_coarse_mesh(c, level == 1 ? naive_coarsening(palette) : naive_coarsening(palette, l1));
 
     const VecX xc = random_positions(galerkin.mesh, 0.004, 11);
     VecX u_coarse(xc.size());
@@ -331,8 +337,8 @@ TEST(DdfemCoarsenError, AffineFieldsInterpolateExactly) {
   Mat3 A;
   A << 0.1, -0.2, 0.05, 0.3, 0.02, -0.1, 0.07, 0.11, -0.3;
   const Vec3 b(0.01, -0.02, 0.03);
-  for (const auto& [dims, levels] : std::vector<std::pair<std::array<int, 3>, int>>{
-           {{4, 6, 4}, 1}, {{5, 6, 3}, 1}, {{8, 7, 4}, 2}}) {
+  for (const auto& [dims, levels] :
+       std::vector<std::pair<std::array<int, 3>, int>>{{{4, 6, 4}, 1}, {{5, 6, 3}, 1}, {{8, 7, 4}, 2}}) {
     const ErrorFixture f = make_error_fixture(dims[0], dims[1], dims[2], levels);
     const VecX uf = affine_field(f.fine.mesh, A, b), uc = affine_field(f.coarse_mesh.mesh, A, b);
     const VecX interp = interpolate_to_fine(f.grid, f.fine, f.coarse, f.coarse_mesh, uc);
@@ -458,18 +464,22 @@ TEST(DdfemCoarsenEndToEnd, LayeredBarNaiveAndAveragedAgainstFine) {
       EXPECT_GT(err[b], 0);
       // Both baselines are stiffer than the fine model (§2.5.2).
       EXPECT_LT(ucs.u.maxCoeff(), uf.u.maxCoeff());
-      std::printf("layered bar (%s layers): %s error %.3e, fine max ux %.3e m, coarse max ux %.3e m, coarse %d DOFs vs fine %d, "
-                  "coarsening %.2e s (grid) + %.2e s (mesh), %d combinations\n",
-                  aligned ? "aligned" : "offset", names[b], err[b], uf.u.maxCoeff(), ucs.u.maxCoeff(), ucs.dofs, uf.dofs, c.seconds,
-                  stats.seconds, stats.distinct_combinations);
+      std::printf(
+          "layered bar (%s layers): %s error %.3e, fine max ux %.3e m, coarse max ux %.3e m, coarse %d DOFs vs fine "
+          "%d, "
+          "coarsening %.2e s (grid) + %.2e s (mesh), %d combinations\n",
+          aligned ? "aligned" : "offset", names[b], err[b], uf.u.maxCoeff(), ucs.u.maxCoeff(), ucs.dofs, uf.dofs,
+          c.seconds, stats.seconds, stats.distinct_combinations);
     }
     // No coarse model does better than the best trilinear fit of the fine field.
-    const CoarseErrorFloor floor = coarse_error_floor(s.grid, fine, uf.u, c, build_coarse_mesh(c, naive_coarsening(s.material_by_id)));
+    const CoarseErrorFloor floor =
+        coarse_error_floor(s.grid, fine, uf.u, c, build_coarse_mesh(c, naive_coarsening(s.material_by_id)));
     EXPECT_LE(floor.lower_bound, floor.error);
     EXPECT_LE(floor.error, std::min(err[0], err[1]));
     EXPECT_GT(floor.lower_bound, 0.05 * floor.error);  // a certificate that says something
-    std::printf("layered bar (%s layers): best possible error on the coarse mesh %.3e (certified >= %.3e, %d iterations)\n",
-                aligned ? "aligned" : "offset", floor.error, floor.lower_bound, floor.iterations);
+    std::printf(
+        "layered bar (%s layers): best possible error on the coarse mesh %.3e (certified >= %.3e, %d iterations)\n",
+        aligned ? "aligned" : "offset", floor.error, floor.lower_bound, floor.iterations);
     if (aligned) {
       // Homogeneous blocks: both baselines are the exact material layout.
       EXPECT_NEAR(err[0], err[1], 1e-9 * err[0]);

@@ -9,11 +9,11 @@
 #include "core/errors.hpp"
 #include "ddfem/anisotropy.hpp"
 #include "ddfem/coarse_fit.hpp"
-#include "ddfem_test_blocks.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
 #include "ddfem/level2_block.hpp"
 #include "ddfem/periodic_samples.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -67,7 +67,8 @@ TEST(DdfemContext, PatchOfPeriodicCopies) {
   // Every element carries its child's material, and a voxel two voxels away
   // (one period) carries the same one.
   for (int e = 0; e < b.mesh().num_elements(); ++e) {
-    const Vec3 mid = 0.5 * (b.mesh().element_rest_positions(e).row(0) + b.mesh().element_rest_positions(e).row(7)).transpose();
+    const Vec3 mid =
+        0.5 * (b.mesh().element_rest_positions(e).row(0) + b.mesh().element_rest_positions(e).row(7)).transpose();
     const int i = static_cast<int>(std::floor(mid.x() / kVoxel)), j = static_cast<int>(std::floor(mid.y() / kVoxel)),
               k = static_cast<int>(std::floor(mid.z() / kVoxel));
     const int child = 4 * ((i % 2 + 2) % 2) + 2 * ((j % 2 + 2) % 2) + ((k % 2 + 2) % 2);
@@ -143,8 +144,8 @@ TEST(DdfemContext, HomogeneousBlockIsReproducedExactly) {
   const ForceSampleSet set = sample_force_space(b, o);
   EXPECT_EQ(set.dropped, 0);
   int checked = 0;
-  const double worst = worst_affine_energy_error(
-      set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b, &checked);
+  const double worst =
+      worst_affine_energy_error(set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b, &checked);
   std::printf("[ddfem-context] homogeneous block: %d stretch/shear samples, worst relative energy difference %.2e\n",
               checked, worst);
   EXPECT_EQ(checked, 2 * 2 * 3 * 6);  // 2 kinds x 2 signs x 3 magnitudes x 6 directions
@@ -194,10 +195,11 @@ TEST(DdfemContext, LayeredBlockMovesTowardVoigtAlongTheLayers) {
   for (const auto* fit : {&fit_patch, &fit_periodic}) {
     const double along_context = along(*fit, alone);
     const double across_context = coarse_axial_modulus(*fit, alone, 2);
-    std::printf("[ddfem-context] layered block, axial modulus / Voigt: along layers alone %.3f, in context (%s) "
-                "%.3f; across in context %.3f; Reuss %.3f\n",
-                along_alone / voigt, fit == &fit_patch ? "patch" : "periodic", along_context / voigt,
-                across_context / voigt, reuss / voigt);
+    std::printf(
+        "[ddfem-context] layered block, axial modulus / Voigt: along layers alone %.3f, in context (%s) "
+        "%.3f; across in context %.3f; Reuss %.3f\n",
+        along_alone / voigt, fit == &fit_patch ? "patch" : "periodic", along_context / voigt, across_context / voigt,
+        reuss / voigt);
     EXPECT_GT(along_context, along_alone * 1.2);
     EXPECT_GT(along_context, reuss);
     EXPECT_LT(along_context, voigt * 1.05);
@@ -219,9 +221,9 @@ TEST(DdfemPeriodic, HomogeneousBlockIsExactAndTheFluctuationMinimizes) {
   EXPECT_EQ(set.dropped, 0);
   EXPECT_EQ(set.attempted, (6 * 4 + 12) * 2 * 3);
   int checked = 0;
-  EXPECT_LT(worst_affine_energy_error(set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b,
-                                      &checked),
-            1e-12);
+  EXPECT_LT(
+      worst_affine_energy_error(set, homogeneous_fit(8, pal[2]->shear_modulus(), pal[2]->lame_lambda()), b, &checked),
+      1e-12);
   // Relaxed bending: below the unrelaxed (w = 0) energy, and a minimum.
   const PeriodicBlockSolver solver(b, 1e-12);
   const ElasticAssembler assembler(b.mesh());
@@ -286,7 +288,8 @@ TEST(DdfemContext, Level2BlockInContextAndPeriodic) {
   const CoarseMaterialFit l1 = ddfem_test::neo_hookean_level1(mu, lambda);
   std::array<const CoarseMaterialFit*, 8> children;
   children.fill(&l1);
-  const FineBlock patch = make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel, 1);
+  const FineBlock patch =
+      make_block_of_coarse_materials(children, BlockMaterials{1, 2, 3, 4, 5, 6, 7, 8}, 2 * kVoxel, 1);
   ASSERT_EQ(patch.mesh().num_elements(), 64);
   for (int e = 0; e < 64; ++e) {
     EXPECT_EQ(patch.mesh().element_material[e], patch.child_of_element(e));
@@ -334,7 +337,8 @@ TEST(DdfemPeriodic, MixedBlocksAffineOnlyDropsTheNonAffineSamplesOfMixedBlocks) 
     EXPECT_EQ(parameters(with_flag), parameters(mixed ? affine_only : all)) << (mixed ? "mixed" : "uniform");
     double largest_change = 0;
     const auto a = parameters(all), f = parameters(affine_only);
-    for (size_t i = 0; i < a.size(); ++i) largest_change = std::max(largest_change, std::abs(a[i] - f[i]) / pal[1]->shear_modulus());
+    for (size_t i = 0; i < a.size(); ++i)
+      largest_change = std::max(largest_change, std::abs(a[i] - f[i]) / pal[1]->shear_modulus());
     EXPECT_GT(largest_change, 1e-3) << "the non-affine samples must matter for the test to mean anything";
   }
 }

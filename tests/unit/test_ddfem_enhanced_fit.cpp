@@ -85,9 +85,10 @@ TEST(DdfemEnhancedFit, NearlyIncompressibleBlockKeepsItsMaterial) {
     mu_t += trilinear.mu[k] / (8 * mu), mu_e += enhanced.mu[k] / (8 * mu);
     lambda_t += trilinear.lambda[k] / (8 * lambda), lambda_e += enhanced.lambda[k] / (8 * lambda);
   }
-  std::printf("[ddfem] nu 0.45 block, trilinear -> enhanced fit: heldout %.4f -> %.4f, mu_k/mu %.3f -> %.3f, "
-              "lambda_k/lambda %.3f -> %.3f (%d rounds)\n",
-              trilinear.heldout_error, enhanced.heldout_error, mu_t, mu_e, lambda_t, lambda_e, enhanced.bubble_rounds);
+  std::printf(
+      "[ddfem] nu 0.45 block, trilinear -> enhanced fit: heldout %.4f -> %.4f, mu_k/mu %.3f -> %.3f, "
+      "lambda_k/lambda %.3f -> %.3f (%d rounds)\n",
+      trilinear.heldout_error, enhanced.heldout_error, mu_t, mu_e, lambda_t, lambda_e, enhanced.bubble_rounds);
   EXPECT_LT(enhanced.heldout_error, 0.7 * trilinear.heldout_error);
   EXPECT_GT(lambda_e, lambda_t + 0.1);
   EXPECT_NEAR(lambda_e, 1.0, 0.15);

@@ -9,11 +9,11 @@
 #include "core/errors.hpp"
 #include "ddfem/anisotropy.hpp"
 #include "ddfem/coarse_fit.hpp"
-#include "ddfem_test_blocks.hpp"
 #include "ddfem/fine_block.hpp"
 #include "ddfem/force_samples.hpp"
 #include "ddfem/level2_block.hpp"
 #include "ddfem/nnls.hpp"
+#include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -265,7 +265,8 @@ TEST(DdfemFit, EachResidualMinimizesItsOwnDataTerm) {
   auto data_terms = [&](const CoarseMaterialFit& fit) {
     Terms t;
     for (const ForceSample& s : samples.samples) {
-      const double V1 = coarse_energy(fit, block.coarse_geometry(), block.coarse_rest_positions(), s.corner_displacement);
+      const double V1 =
+          coarse_energy(fit, block.coarse_geometry(), block.coarse_rest_positions(), s.corner_displacement);
       if (!std::isfinite(V1)) continue;  // inverted for the coarse element: not fitted by either
       t.absolute += (V1 - s.energy) * (V1 - s.energy);
       t.relative += (V1 - s.energy) * (V1 - s.energy) / (s.energy * s.energy);

@@ -64,7 +64,8 @@ double relaxed_block_energy(const FineBlock& block, const Vec24& u) {
   VecX x = VecX::Zero(n);
   std::vector<bool> fixed(n, false);
   for (int c = 0; c < 8; ++c)
-    for (int a = 0; a < 3; ++a) x[3 * block.corner_nodes[c] + a] = u[3 * c + a], fixed[3 * block.corner_nodes[c] + a] = true;
+    for (int a = 0; a < 3; ++a)
+      x[3 * block.corner_nodes[c] + a] = u[3 * c + a], fixed[3 * block.corner_nodes[c] + a] = true;
   std::vector<int> free;
   for (int i = 0; i < n; ++i)
     if (!fixed[i]) free.push_back(i);

@@ -42,7 +42,8 @@ TEST(MatchedCoarsening, UniformResponseEqualsTheAssembledElements) {
   for (int c = 0; c < 8; ++c) X.row(c) = Vec3(2.0 * (c >> 2 & 1), 1.0 * (c >> 1 & 1), 0.5 * (c & 1)).transpose();
   for (bool enhanced : {false, true}) {
     const hex8::QuadratureRule rule = hex8::gauss_rule(enhanced ? 4 : 2);
-    const hex8::ElementGeometry geo = enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule);
+    const hex8::ElementGeometry geo =
+        enhanced ? hex8::enhanced_element_geometry(X, rule) : hex8::element_geometry(X, rule);
     std::vector<Mat6> C;
     QuadratureMaterials m;
     for (int q = 0; q < geo.size(); ++q) {
@@ -208,7 +209,8 @@ TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffnes
   EXPECT_EQ(checked.replaced_blocks, 1);
   const int e = checked.mesh.voxel_element[checked.grid.index(1, 0, 0)];
   const QuadratureMaterials& m = checked.mesh.mesh.materials[checked.mesh.mesh.element_material[e]];
-  const std::vector<Mat6> C = matched_point_stiffness(palette, std::vector<int>(checker.begin(), checker.end()), 2, true);
+  const std::vector<Mat6> C =
+      matched_point_stiffness(palette, std::vector<int>(checker.begin(), checker.end()), 2, true);
   for (int q = 0; q < 8; ++q) EXPECT_LE((rest_voigt_stiffness(*m.at_point[q]) - C[q]).norm(), 1e-8 * C[q].norm());
   // The fit the plain lookup used is stiff everywhere.
   const int p = plain.mesh.voxel_element[plain.grid.index(1, 0, 0)];

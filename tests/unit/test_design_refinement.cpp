@@ -51,8 +51,7 @@ loads: [{objective: compliance, forces: [{node: [4, 0, 0], force: [1, 0, 0]}]}]
     VecX& f = s.loads[0].force;
     f.setZero();
     for (int j = 0; j <= 2; ++j)
-      for (int k = 0; k <= 2; ++k)
-        f[s.grid.node_index(4, j, k) * 3] = (j == 1 ? 1.0 : 0.5) * (k == 1 ? 1.0 : 0.5);
+      for (int k = 0; k <= 2; ++k) f[s.grid.node_index(4, j, k) * 3] = (j == 1 ? 1.0 : 0.5) * (k == 1 ? 1.0 : 0.5);
   };
   // F = 4 sigma with sigma = 1: compliance F^2 L / (E A) = 16 * 4 / (1000 * 4).
   const double exact = 16.0 * 4.0 / (1000.0 * 4.0);
@@ -85,7 +84,8 @@ loads:
     targets: [{node: [3, 2, 2], displacement: [0, 1.0e-6, 0]}]
 mass: {target: 4, weight: 0.1}
 filter: {radius: 1.5}
-)", 2);
+)",
+                                       2);
   ASSERT_EQ(sc.setup.fem_grid.cells(), 8 * 12);
   CellMaterialSettings ms{"analytic3d", sc.E0, sc.decades, sc.nu, 3, 1e-9, nullptr};
   const auto model = make_cell_material_model(ms);
@@ -141,8 +141,7 @@ loads:
     CellMaterialSettings ms{"simp3d", sc.E0, sc.decades, sc.nu, 3, 1e-9, nullptr};
     const auto model = make_cell_material_model(ms);
     TopologyObjective obj(sc.setup, *model);
-    compliance[s] =
-        obj.evaluate(MatX::Constant(Eigen::Index(obj.design_cells().size()), 1, 0.6), &gradient[s]).elastic;
+    compliance[s] = obj.evaluate(MatX::Constant(Eigen::Index(obj.design_cells().size()), 1, 0.6), &gradient[s]).elastic;
   }
   EXPECT_NEAR(compliance[1], compliance[0], 1e-7 * compliance[0]);
   EXPECT_LT((gradient[1] - gradient[0]).norm(), 1e-6 * gradient[0].norm());

@@ -43,7 +43,9 @@ VoxelStiffnessField dirichlet_random_field(int nx, int ny, int nz, unsigned seed
   return f;
 }
 
-std::int64_t node_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k); }
+std::int64_t node_of(int nx, int ny, int i, int j, int k) {
+  return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k);
+}
 
 // Clamp the nodes with x index < layers entirely, plus the y component of
 // every other node of the far bottom edge (partly fixed nodes).

@@ -54,7 +54,8 @@ TEST(DynamicsConfigs, PlantIsHeldAtItsPotOnly) {
   const HexMesh& mesh = scene.model.mesh;
   int held = 0;
   for (int node = 0; node < mesh.num_nodes(); ++node) {
-    const bool fixed = scene.model.fixed[3 * node] && scene.model.fixed[3 * node + 1] && scene.model.fixed[3 * node + 2];
+    const bool fixed =
+        scene.model.fixed[3 * node] && scene.model.fixed[3 * node + 1] && scene.model.fixed[3 * node + 2];
     const double z = scene.initial_positions(3 * node + 2);
     EXPECT_EQ(fixed, z <= 0.006 + 1e-12) << "node " << node << " at z = " << z;
     held += fixed;

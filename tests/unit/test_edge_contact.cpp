@@ -71,7 +71,8 @@ Vec3 total_momentum(const NewmarkIntegrator& sim) {
 TEST(EdgeContact, ClosestLineParametersAreTheCommonPerpendicular) {
   double alpha = 0, beta = 0;
   // The x axis from 0 to 1 and a line along y through (0.3, ., 1).
-  ASSERT_TRUE(closest_line_parameters(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.3, -1, 1), Vec3(0.3, 1, 1), 0.05, alpha, beta));
+  ASSERT_TRUE(
+      closest_line_parameters(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.3, -1, 1), Vec3(0.3, 1, 1), 0.05, alpha, beta));
   EXPECT_NEAR(alpha, 0.3, 1e-14);
   EXPECT_NEAR(beta, 0.5, 1e-14);
   // Skew lines in general position: the connecting vector is perpendicular
@@ -82,7 +83,8 @@ TEST(EdgeContact, ClosestLineParametersAreTheCommonPerpendicular) {
   EXPECT_NEAR(d.dot(a1 - a0), 0.0, 1e-13);
   EXPECT_NEAR(d.dot(b1 - b0), 0.0, 1e-13);
   // Parallel within the sine bound: no common normal.
-  EXPECT_FALSE(closest_line_parameters(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1.01, 0), 0.05, alpha, beta));
+  EXPECT_FALSE(
+      closest_line_parameters(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1.01, 0), 0.05, alpha, beta));
 }
 
 TEST(EdgeContact, NoPairsOnABodyAtRestAndFourOnCrossingBars) {

@@ -151,7 +151,8 @@ TEST(StructureDistance, BlurMakesOneVoxelDifferencesSmall) {
         for (int i = 0; i < n; ++i) ids[std::size_t(i) + n * (j + std::size_t(n) * k)] = 1;
     return ids;
   };
-  const double raw = structure_distance(smoothed_field(plate(3), n, {1, 0.0}), smoothed_field(plate(4), n, {1, 0.0})).distance;
+  const double raw =
+      structure_distance(smoothed_field(plate(3), n, {1, 0.0}), smoothed_field(plate(4), n, {1, 0.0})).distance;
   const double smooth = structure_distance(smoothed_field(plate(3), n), smoothed_field(plate(4), n)).distance;
   EXPECT_NEAR(raw, 0.25, 1e-12);  // sqrt(1/16)
   EXPECT_LT(smooth, 0.6 * raw);
@@ -376,8 +377,8 @@ TEST(GaussianMixture, BicFindsTwoAndThreeSeparatedBlobs) {
   EXPECT_EQ(sizes, (std::vector<int>{100, 150}));
 
   std::vector<int> truth3;
-  const MatX X3 = blobs({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(15, 0, 0), Eigen::Vector3d(5, 10, 3)},
-                        {120, 80, 60}, 1.0, &truth3, 2);
+  const MatX X3 = blobs({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(15, 0, 0), Eigen::Vector3d(5, 10, 3)}, {120, 80, 60},
+                        1.0, &truth3, 2);
   const GmmSelection s3 = select_gaussian_mixture(X3, 1, 5, {});
   EXPECT_EQ(s3.best.weights.size(), 3);
   EXPECT_TRUE(same_partition(s3.best.labels, truth3));
@@ -391,8 +392,8 @@ TEST(GaussianMixture, BicFindsTwoAndThreeSeparatedBlobs) {
 TEST(GaussianMixture, LogLikelihoodNeverDecreases) {
   // Overlapping blobs and too many components: a long EM run.
   std::vector<int> truth;
-  const MatX X = blobs({Eigen::Vector2d(0, 0), Eigen::Vector2d(2.5, 1), Eigen::Vector2d(-1, 3)}, {100, 100, 100}, 1.0,
-                       &truth, 5);
+  const MatX X =
+      blobs({Eigen::Vector2d(0, 0), Eigen::Vector2d(2.5, 1), Eigen::Vector2d(-1, 3)}, {100, 100, 100}, 1.0, &truth, 5);
   GmmOptions o;
   o.components = 4;
   o.restarts = 3;
@@ -413,8 +414,8 @@ TEST(GaussianMixture, LogLikelihoodNeverDecreases) {
 
 TEST(GaussianMixture, SameSeedSameResultForAnyThreadCount) {
   std::vector<int> truth;
-  const MatX X = blobs({Eigen::Vector2d(0, 0), Eigen::Vector2d(4, 0), Eigen::Vector2d(0, 5)}, {80, 70, 60}, 1.0,
-                       &truth, 9);
+  const MatX X =
+      blobs({Eigen::Vector2d(0, 0), Eigen::Vector2d(4, 0), Eigen::Vector2d(0, 5)}, {80, 70, 60}, 1.0, &truth, 9);
   GmmOptions o;
   o.components = 3;
   o.restarts = 5;

@@ -32,8 +32,8 @@ Synthetic synthetic_family(int members, std::uint64_t seed) {
   for (int i = 0; i < members; ++i) {
     const double a = uniform(), b = uniform(), c = uniform();
     s.parameters.row(i) = (base + 0.05 * a * s.dir_a + 0.03 * b * s.dir_b + 0.04 * c * s.dir_c).transpose();
-    s.properties(i, 0) = -1.0 + 0.8 * a;   // log10 E
-    s.properties(i, 1) = -0.3 - 0.2 * b;   // ν
+    s.properties(i, 0) = -1.0 + 0.8 * a;  // log10 E
+    s.properties(i, 1) = -0.3 - 0.2 * b;  // ν
   }
   return s;
 }
@@ -84,7 +84,8 @@ TEST(FamilySelection, WindowAndSpace) {
   set.space = "cubic3d";
   set.E_stiff = 2.0;
   set.nx = set.ny = set.nz = 8;
-  const double props[4][4] = {{0.2, -0.3, 0.1, 0.3}, {0.2, 0.35, 0.1, 0.3}, {1.0, -0.1, 0.1, 0.5}, {0.4, -0.6, 0.1, 0.2}};
+  const double props[4][4] = {
+      {0.2, -0.3, 0.1, 0.3}, {0.2, 0.35, 0.1, 0.3}, {1.0, -0.1, 0.1, 0.5}, {0.4, -0.6, 0.1, 0.2}};
   for (const auto& p : props) {
     Microstructure m;
     m.properties = (VecX(4) << p[0], p[1], p[2], p[3]).finished();

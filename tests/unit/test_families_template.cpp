@@ -1,11 +1,11 @@
 // Microstructure templates: skeleton by thinning, path simplification,
 // beam rasterization, and fitting a template to a structure.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <cstdio>
 #include <random>
-#include <omp.h>
 
 #include "core/errors.hpp"
 #include "families/beam_template.hpp"
@@ -124,7 +124,8 @@ TEST(FamiliesSkeleton, SquareFrameKeepsItsLoop) {
   // once the tolerance passes the corners' rounding by thinning.
   EXPECT_EQ(simplify_polyline(paths[0].points, 1.5 / n).size(), 5u);
   const auto kept = simplify_polyline(paths[0].points, 0.02);
-  std::printf("[ measured ] square frame: %zu loop voxels, %zu points kept at 0.02\n", paths[0].points.size() - 1, kept.size());
+  std::printf("[ measured ] square frame: %zu loop voxels, %zu points kept at 0.02\n", paths[0].points.size() - 1,
+              kept.size());
   EXPECT_GE(kept.size(), 5u);
   EXPECT_LE(kept.size(), 9u);
   // A solid block with the same outline has no loop.
@@ -182,12 +183,14 @@ TEST(FamiliesSkeleton, FundamentalSegmentsOfASymmetricFrame) {
   const int n = 24;
   const auto one = fundamental_segments(skeleton_segments(rasterize_template(frame, n)));
   ASSERT_EQ(one.size(), 1u);
-  for (const Vec3& p : {one[0].a, one[0].b}) std::printf("[ measured ] frame segment end (%.4f %.4f %.4f)\n", p.x(), p.y(), p.z());
+  for (const Vec3& p : {one[0].a, one[0].b})
+    std::printf("[ measured ] frame segment end (%.4f %.4f %.4f)\n", p.x(), p.y(), p.z());
   EXPECT_NEAR((one[0].b - one[0].a).norm(), 1.0, 0.5 / n);
   frame.beams.push_back({Vec3(0, 0, 0), Vec3(0.5, 0.5, 0.5), 0.05, 0.05, 0});
   const auto all = skeleton_segments(rasterize_template(frame, n));
   const auto two = fundamental_segments(all);
-  std::printf("[ measured ] frame + diagonals: %zu skeleton segments, %zu in the fundamental domain\n", all.size(), two.size());
+  std::printf("[ measured ] frame + diagonals: %zu skeleton segments, %zu in the fundamental domain\n", all.size(),
+              two.size());
   EXPECT_EQ(two.size(), 2u);
   for (const Segment& s : two) {
     const Vec3 m = 0.5 * (s.a + s.b);
@@ -385,11 +388,12 @@ TEST(FamiliesFit, RecoversAKnownBeamFromPerturbedParameters) {
   const TemplateFit fit = refine_template(target, start);
   const Beam& f = fit.fitted.beams[0];
   const Beam& t = truth.beams[0];
-  std::printf("[ measured ] one beam: |da| %.3f |db| %.3f voxels, dr0 %.3f dr1 %.3f voxels, dtheta %.3f, "
-              "objective %.3g -> %.3g in %zu steps, voxel difference %.4f (start %.4f)\n",
-              (f.a - t.a).norm() / h, (f.b - t.b).norm() / h, (f.r0 - t.r0) / h, (f.r1 - t.r1) / h, f.theta - t.theta,
-              fit.objective.front(), fit.objective.back(), fit.objective.size() - 1, fit.voxel_difference,
-              voxel_difference(target, start));
+  std::printf(
+      "[ measured ] one beam: |da| %.3f |db| %.3f voxels, dr0 %.3f dr1 %.3f voxels, dtheta %.3f, "
+      "objective %.3g -> %.3g in %zu steps, voxel difference %.4f (start %.4f)\n",
+      (f.a - t.a).norm() / h, (f.b - t.b).norm() / h, (f.r0 - t.r0) / h, (f.r1 - t.r1) / h, f.theta - t.theta,
+      fit.objective.front(), fit.objective.back(), fit.objective.size() - 1, fit.voxel_difference,
+      voxel_difference(target, start));
   EXPECT_LT((f.a - t.a).norm(), h);
   EXPECT_LT((f.b - t.b).norm(), h);
   EXPECT_LT(std::abs(f.r0 - t.r0), h);
@@ -425,11 +429,12 @@ TEST(FamiliesFit, RecoversAJointOfTwoBeams) {
   const TemplateFit fit = refine_template(target, start);
   const Beam &f0 = fit.fitted.beams[0], &f1 = fit.fitted.beams[1];
   const Beam &t0 = truth.beams[0], &t1 = truth.beams[1];
-  std::printf("[ measured ] two beams: free ends %.3f %.3f voxels, joint ends %.3f %.3f voxels, "
-              "sections %.3f %.3f %.3f %.3f voxels, voxel difference %.4f (start %.4f) in %zu steps\n",
-              (f0.a - t0.a).norm() / h, (f1.b - t1.b).norm() / h, (f0.b - t0.b).norm() / h, (f1.a - t1.a).norm() / h,
-              (f0.r0 - t0.r0) / h, (f0.r1 - t0.r1) / h, (f1.r0 - t1.r0) / h, (f1.r1 - t1.r1) / h, fit.voxel_difference,
-              voxel_difference(target, start), fit.objective.size() - 1);
+  std::printf(
+      "[ measured ] two beams: free ends %.3f %.3f voxels, joint ends %.3f %.3f voxels, "
+      "sections %.3f %.3f %.3f %.3f voxels, voxel difference %.4f (start %.4f) in %zu steps\n",
+      (f0.a - t0.a).norm() / h, (f1.b - t1.b).norm() / h, (f0.b - t0.b).norm() / h, (f1.a - t1.a).norm() / h,
+      (f0.r0 - t0.r0) / h, (f0.r1 - t0.r1) / h, (f1.r0 - t1.r0) / h, (f1.r1 - t1.r1) / h, fit.voxel_difference,
+      voxel_difference(target, start), fit.objective.size() - 1);
   EXPECT_LT((f0.a - t0.a).norm(), h);
   EXPECT_LT((f1.b - t1.b).norm(), h);
   EXPECT_LT((f0.b - t0.b).norm(), 2 * h);
@@ -516,10 +521,11 @@ TEST(FamiliesFit, FitFromItsOwnSkeleton) {
   truth.beams.push_back({Vec3(0, 0, 0), Vec3(0.5, 0.5, 0.5), 0.045, 0.045, 0});
   const VoxelGrid target = rasterize_template(truth, n);
   const TemplateFit fit = fit_template(target);
-  std::printf("[ measured ] own skeleton: %zu beams, objective %.3g -> %.3g in %zu steps, voxel difference %.4f, "
-              "solid fraction %.4f\n",
-              fit.fitted.beams.size(), fit.objective.front(), fit.objective.back(), fit.objective.size() - 1,
-              fit.voxel_difference, double(solid_count(target)) / target.size());
+  std::printf(
+      "[ measured ] own skeleton: %zu beams, objective %.3g -> %.3g in %zu steps, voxel difference %.4f, "
+      "solid fraction %.4f\n",
+      fit.fitted.beams.size(), fit.objective.front(), fit.objective.back(), fit.objective.size() - 1,
+      fit.voxel_difference, double(solid_count(target)) / target.size());
   for (const Beam& b : fit.fitted.beams)
     std::printf("[ measured ]   beam (%.3f %.3f %.3f)-(%.3f %.3f %.3f) r %.4f %.4f theta %.3f\n", b.a.x(), b.a.y(),
                 b.a.z(), b.b.x(), b.b.y(), b.b.z(), b.r0, b.r1, b.theta);
@@ -561,10 +567,11 @@ TEST(FamiliesFit, FitsTemplateDrawnCellsFromTheirSkeletons) {
     truth.beams.push_back(c.beam);
     const VoxelGrid target = rasterize_template(truth, n);
     const TemplateFit fit = fit_template(target);
-    std::printf("[ measured ] %s: %zu beams, voxel difference %.4f, objective %.3g (the drawing template's %.3g), "
-                "%d steps, %d evaluations\n",
-                c.name, fit.fitted.beams.size(), fit.voxel_difference, fit.objective.back(),
-                template_objective(target, truth), fit.steps, fit.evaluations);
+    std::printf(
+        "[ measured ] %s: %zu beams, voxel difference %.4f, objective %.3g (the drawing template's %.3g), "
+        "%d steps, %d evaluations\n",
+        c.name, fit.fitted.beams.size(), fit.voxel_difference, fit.objective.back(), template_objective(target, truth),
+        fit.steps, fit.evaluations);
     EXPECT_LT(fit.voxel_difference, 0.02) << c.name;
     EXPECT_DOUBLE_EQ(fit.objective.back(), template_objective(target, fit.fitted)) << c.name;
     for (std::size_t i = 1; i < fit.objective.size(); ++i) EXPECT_LE(fit.objective[i], fit.objective[i - 1]) << c.name;

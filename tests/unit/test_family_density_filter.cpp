@@ -35,7 +35,7 @@ loads:
   - {objective: compliance, forces: [{box: {min: [6, 0, 0], max: [6, 2, 0]}, force: [0, 0, -1], distribute: total}]}
 filter: {radius: 1.5}
 )" + extra,
-                                                 "test"),
+                                               "test"),
                            1e6, 4);
 }
 
@@ -83,8 +83,7 @@ TEST(FamilyDensityFilter, ObjectiveAndMassGradientsMatchFiniteDifferences) {
   for (Eigen::Index i = 0; i < q.size(); ++i) q(i % q.rows(), i / q.rows()) = u(rng);
   // The physical rho is the family's at the filtered parameters, whatever q's rho column holds.
   const MatX p = obj.physical(q);
-  for (Eigen::Index r = 0; r < p.rows(); ++r)
-    EXPECT_DOUBLE_EQ(p(r, 2), model->density(p.row(r).transpose(), nullptr));
+  for (Eigen::Index r = 0; r < p.rows(); ++r) EXPECT_DOUBLE_EQ(p(r, 2), model->density(p.row(r).transpose(), nullptr));
   MatX g;
   const ObjectiveValue v = obj.evaluate(q, &g);
   ASSERT_GT(v.mass, 0.0);

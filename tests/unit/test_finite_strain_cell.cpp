@@ -62,7 +62,8 @@ TEST(FiniteStrainCell, GradientHessianAndAxialForceMatchFiniteDifferences) {
   EXPECT_LT(worst_g, 1e-7);
   EXPECT_LT(worst_H, 1e-6);
   EXPECT_LT((Hd - Hd.transpose()).cwiseAbs().maxCoeff(), 1e-12 * Hd.cwiseAbs().maxCoeff());
-  const double fd_s = (model.energy(s + eps, z, nullptr, nullptr) - model.energy(s - eps, z, nullptr, nullptr)) / (2 * eps);
+  const double fd_s =
+      (model.energy(s + eps, z, nullptr, nullptr) - model.energy(s - eps, z, nullptr, nullptr)) / (2 * eps);
   EXPECT_NEAR(dE_ds, fd_s, 1e-7 * std::abs(fd_s));
 }
 

@@ -52,7 +52,8 @@ TEST(GamutLevelSet, BallIsItsSignedDistance) {
 
 TEST(GamutLevelSet, BoxIn2DAndBallIn4D) {
   // 2D box [0.2, 0.7] x [0.3, 0.8].
-  const auto box = fill(2, 20000, 3, [](const VecX& p) { return p[0] > 0.2 && p[0] < 0.7 && p[1] > 0.3 && p[1] < 0.8; });
+  const auto box =
+      fill(2, 20000, 3, [](const VecX& p) { return p[0] > 0.2 && p[0] < 0.7 && p[1] > 0.3 && p[1] < 0.8; });
   LevelSetOptions o;
   o.cells = 48;
   const GamutLevelSet ls = GamutLevelSet::from_points(box, o);

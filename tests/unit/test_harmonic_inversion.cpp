@@ -53,9 +53,8 @@ void expect_input_error(const std::function<void()>& call, const std::vector<std
 class TempCsv {
  public:
   explicit TempCsv(const std::string& text) {
-    path_ = ::testing::TempDir() + "msfab_marker_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" + std::to_string(::getpid()) +
-            "_" + std::to_string(counter_++) + ".csv";
+    path_ = ::testing::TempDir() + "msfab_marker_" + ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+            "_" + std::to_string(::getpid()) + "_" + std::to_string(counter_++) + ".csv";
     std::ofstream(path_) << text;
   }
   ~TempCsv() { std::remove(path_.c_str()); }
@@ -95,8 +94,7 @@ TEST(HarmonicInversion, SingleModeExactWithoutNoise) {
     EXPECT_NEAR(got.phase, m.theta, 1e-9);
     EXPECT_NEAR(fit.offset, 0.3, 1e-9);
     EXPECT_LT(fit.rms_residual, 1e-10);
-    EXPECT_NEAR(fit.value(0.37), 0.3 + 1.5 * std::exp(-0.8 * 0.37) * std::sin(2 * kPi * 3.2 * 0.37 + 0.7),
-                1e-9);
+    EXPECT_NEAR(fit.value(0.37), 0.3 + 1.5 * std::exp(-0.8 * 0.37) * std::sin(2 * kPi * 3.2 * 0.37 + 0.7), 1e-9);
   }
 }
 

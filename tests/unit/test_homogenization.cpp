@@ -144,8 +144,8 @@ TEST(Homogenization, ConvergesUnderRefinementOfTheSameSphere) {
     const auto t0 = std::chrono::steady_clock::now();
     const HomogenizationResult r = homogenize(sphere_inclusion(n, 0.3), pal);
     m.push_back(cubic_moduli(r.C));
-    std::printf("[homogenization] sphere n=%d: E %.6g nu %.6f G %.6g (%.2f s)\n", n, m.back().E, m.back().nu, m.back().G,
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::printf("[homogenization] sphere n=%d: E %.6g nu %.6f G %.6g (%.2f s)\n", n, m.back().E, m.back().nu,
+                m.back().G, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   const double d1 = std::abs(m[1].E - m[0].E), d2 = std::abs(m[2].E - m[1].E);
   EXPECT_LT(d2, d1);
@@ -246,7 +246,8 @@ TEST(Homogenization, CyclicSymmetryTwoSolvesEqualSixSolves) {
     EXPECT_TRUE(b.symmetric_cases) << solver;
     EXPECT_LT((a.C - b.C).norm(), 1e-10 * a.C.norm()) << solver;
     for (int m = 0; m < 6; ++m)
-      EXPECT_LT((a.fluctuation[m] - b.fluctuation[m]).norm(), 1e-8 * a.fluctuation[m].norm() + 1e-14) << solver << " case " << m;
+      EXPECT_LT((a.fluctuation[m] - b.fluctuation[m]).norm(), 1e-8 * a.fluctuation[m].norm() + 1e-14)
+          << solver << " case " << m;
     if (solver == "matrix-free") {
       EXPECT_LT(b.iterations, 0.5 * a.iterations);
     }

@@ -5,7 +5,6 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
-
 #include <random>
 #include <string>
 #include <vector>
@@ -56,13 +55,11 @@ SpMat grid_stiffness(int k) {
           for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
               const int nx = x + dx, ny = y + dy, nz = z + dz;
-              if ((dx == 0 && dy == 0 && dz == 0) || nx < 0 || ny < 0 || nz < 0 || nx >= k ||
-                  ny >= k || nz >= k) {
+              if ((dx == 0 && dy == 0 && dz == 0) || nx < 0 || ny < 0 || nz < 0 || nx >= k || ny >= k || nz >= k) {
                 continue;
               }
               const Vec3 d = Vec3(dx, dy, dz).normalized();
-              const Mat3 block = (0.5 * Mat3::Identity() + d * d.transpose()) /
-                                 Vec3(dx, dy, dz).squaredNorm();
+              const Mat3 block = (0.5 * Mat3::Identity() + d * d.transpose()) / Vec3(dx, dy, dz).squaredNorm();
               diagonal += block;
               const int b = node(nx, ny, nz);
               for (int j = 0; j < 3; ++j) {
@@ -99,13 +96,9 @@ VecX sparse_reference_solve(const SpMat& A, const VecX& b) {
   return ldlt.solve(b);
 }
 
-double relative_error(const VecX& x, const VecX& reference) {
-  return (x - reference).norm() / reference.norm();
-}
+double relative_error(const VecX& x, const VecX& reference) { return (x - reference).norm() / reference.norm(); }
 
-double eigen_residual(const SpMat& A, const VecX& x, const VecX& b) {
-  return (b - A * x).norm() / b.norm();
-}
+double eigen_residual(const SpMat& A, const VecX& x, const VecX& b) { return (b - A * x).norm() / b.norm(); }
 
 LinearSolverOptions pcg_options(const std::string& preconditioner) {
   LinearSolverOptions options;
@@ -224,8 +217,7 @@ TEST(LinearSolver, RefactorizeNewValuesOnSamePattern) {
       ASSERT_TRUE(solver->factorize(A_round)) << name << " round " << round;
       const VecX x = solver->solve(b);
       const VecX reference = sparse_reference_solve(A_round, b);
-      EXPECT_LT(relative_error(x, reference), name == "cholmod" ? 1e-8 : 1e-5)
-          << name << " round " << round;
+      EXPECT_LT(relative_error(x, reference), name == "cholmod" ? 1e-8 : 1e-5) << name << " round " << round;
       EXPECT_LE(eigen_residual(A_round, x, b), 1e-8 * (1 + 1e-6)) << name << " round " << round;
     }
     // A different pattern must be rejected rather than silently misused.

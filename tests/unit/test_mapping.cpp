@@ -91,7 +91,9 @@ std::int64_t brute_total(const VoxelModel& model) {
   const MappedDesign& m = model.mapping();
   std::vector<std::vector<int>> layers(static_cast<std::size_t>(NZ));
   for (std::int64_t z = 0; z < NZ; ++z) model.layer(z, layers[std::size_t(z)]);
-  auto id = [&](std::int64_t x, std::int64_t y, std::int64_t z) { return layers[std::size_t(z)][std::size_t(x + NX * y)]; };
+  auto id = [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return layers[std::size_t(z)][std::size_t(x + NX * y)];
+  };
   std::int64_t pairs = 0;
   for (std::int64_t z = 0; z < NZ; ++z)
     for (std::int64_t y = 0; y < NY; ++y)
@@ -560,7 +562,8 @@ TEST(Mapping, VoxelFileReadsBackAsTheAssembledModel) {
     const std::vector<int> layer = in.layer(Z);
     ASSERT_EQ(layer.size(), 72u);
     for (std::int64_t Y = 0; Y < 6; ++Y)
-      for (std::int64_t X = 0; X < 12; ++X) ASSERT_EQ(layer[std::size_t(X + 12 * Y)], small.id(X, Y, Z)) << X << " " << Y << " " << Z;
+      for (std::int64_t X = 0; X < 12; ++X)
+        ASSERT_EQ(layer[std::size_t(X + 12 * Y)], small.id(X, Y, Z)) << X << " " << Y << " " << Z;
   }
   // The rows are pack_voxels of each layer, as stored.
   const H5File f = H5File::open(path);
@@ -656,18 +659,19 @@ TEST(Mapping, BadInputsAreInputErrorsNamingTheFile) {
   Design simp = d2;
   simp.space = "simp2d";
   mapping_expect_input_error([&] { check_mapping_inputs(simp, "d.h5", set2d, "s.h5"); },
-                     "d.h5: design space 'simp2d' is not a gamut space");
+                             "d.h5: design space 'simp2d' is not a gamut space");
   Design ortho = d2;
   ortho.space = "orthotropic2d";
   mapping_expect_input_error([&] { check_mapping_inputs(ortho, "d.h5", set2d, "s.h5"); },
-                     "s.h5: microstructure space 'cubic2d' differs from the design's 'orthotropic2d'");
+                             "s.h5: microstructure space 'cubic2d' differs from the design's 'orthotropic2d'");
   MicrostructureSet empty = set2d;
   empty.items.clear();
-  mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", empty, "s.h5"); }, "s.h5: the microstructure set holds no structures");
+  mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", empty, "s.h5"); },
+                             "s.h5: the microstructure set holds no structures");
   MicrostructureSet flat_as_3d = set3d;
   flat_as_3d.space = "cubic2d";
   mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", flat_as_3d, "s.h5"); },
-                     "s.h5: 3D structures (4 x 4 x 4 voxels) for the 2D design d.h5");
+                             "s.h5: 3D structures (4 x 4 x 4 voxels) for the 2D design d.h5");
   Design d3 = mapping_random_design(set3d, 2, 2, 2, 4);
   MicrostructureSet flat = set2d;
   flat.space = "cubic3d";
@@ -677,7 +681,8 @@ TEST(Mapping, BadInputsAreInputErrorsNamingTheFile) {
   mapping_expect_input_error([&] { check_mapping_inputs(d2, "d.h5", renamed, "s.h5"); }, "property names");
 
   // Files: a missing one, and a microstructures artifact given as the design.
-  mapping_expect_input_error([&] { read_design_artifact(mapping_scratch("missing.h5").string()); }, "missing.h5: no such file");
+  mapping_expect_input_error([&] { read_design_artifact(mapping_scratch("missing.h5").string()); },
+                             "missing.h5: no such file");
   const std::string structures = mapping_scratch("set.microstructures.h5").string();
   write_microstructures_artifact(structures, set2d, "test", "", {}, 0);
   mapping_expect_input_error([&] { read_design_artifact(structures); }, "expected schema 'msfab.design'");

@@ -10,7 +10,6 @@
 #include <algorithm>
 
 #include "core/errors.hpp"
-
 #include "fem/voxel_stiffness_field.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/linear_isotropic.hpp"
@@ -22,7 +21,9 @@ namespace msfab {
 namespace {
 
 std::int64_t voxel_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx) * (j + std::int64_t(ny) * k); }
-std::int64_t components_node_of(int nx, int ny, int i, int j, int k) { return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k); }
+std::int64_t components_node_of(int nx, int ny, int i, int j, int k) {
+  return i + std::int64_t(nx + 1) * (j + std::int64_t(ny + 1) * k);
+}
 
 // A comb: a solid back plate at x < 2 and teeth along x, one voxel thick
 // in y with one-voxel gaps between them, so that every coarse hat function
@@ -143,7 +144,8 @@ TEST(MaterialComponents, OnlyNodesThatTouchMaterialCarryRows) {
   // Against a direct solve of the whole grid, fixed values prescribed
   // through b = s u on every fixed unknown, void nodes included.
   VecX b = VecX::Zero(3 * std::int64_t(nx + 1) * (ny + 1) * (nz + 1));
-  for (Eigen::Index d = 0; d < b.size(); ++d) b[d] = fixed[std::size_t(d)] ? mg.fixed_scale() * 1e-3 * double(d % 7) : 1e-4;
+  for (Eigen::Index d = 0; d < b.size(); ++d)
+    b[d] = fixed[std::size_t(d)] ? mg.fixed_scale() * 1e-3 * double(d % 7) : 1e-4;
   const VecX x = mg.solve(b);
   Eigen::SimplicialLDLT<SpMat> direct(mg.fine_operator());
   ASSERT_EQ(direct.info(), Eigen::Success);

@@ -92,8 +92,8 @@ std::vector<NamedMaterial> all_models() {
       {"anisotropic_spring", spring},
       {"neo_hookean+spring", std::make_shared<MaterialSum>(std::vector<MaterialPtr>{nh, spring})},
       {"green_anisotropic", std::make_shared<GreenAnisotropic>(orthotropic_test_C())},
-      {"neo_hookean+green_anisotropic",
-       std::make_shared<MaterialSum>(std::vector<MaterialPtr>{nh, std::make_shared<GreenAnisotropic>(orthotropic_test_C())})},
+      {"neo_hookean+green_anisotropic", std::make_shared<MaterialSum>(std::vector<MaterialPtr>{
+                                            nh, std::make_shared<GreenAnisotropic>(orthotropic_test_C())})},
   };
 }
 
@@ -134,8 +134,10 @@ TEST(MaterialDerivatives, StressMatchesFiniteDifferenceOfEnergy) {
     for (const Mat3& F : test_deformations()) {
       const Mat3 P = m->stress(F);
       const Mat3 fd = fd_stress(*m, F);
-      EXPECT_LE((P - fd).norm(), kFdRel * P.norm() + kFdAbs)
-          << label << "\nF=\n" << F << "\nP=\n" << P << "\nfd=\n" << fd;
+      EXPECT_LE((P - fd).norm(), kFdRel * P.norm() + kFdAbs) << label << "\nF=\n"
+                                                             << F << "\nP=\n"
+                                                             << P << "\nfd=\n"
+                                                             << fd;
     }
 }
 
@@ -246,7 +248,7 @@ TEST(MaterialNeoHookean, UniaxialStretchMatchesAnalyticStress) {
     EXPECT_LE(std::abs(P(2, 2)), 1e-9 * kE);
     EXPECT_NEAR(P(0, 0), mu * (a - 1.0 / a) + lambda * std::log(J) / a, 1e-9 * kE);
     // Lateral contraction under tension, expansion under compression.
-    EXPECT_EQ(b < 1.0, a > 1.0) << "a=" << a << " b=" << b;
+    EXPECT_EQ(b<1.0, a> 1.0) << "a=" << a << " b=" << b;
     // The lateral balance itself, written out: mu (b - 1/b) + lambda log J / b = 0.
     EXPECT_NEAR(mu * (b - 1.0 / b) + lambda * std::log(J) / b, 0.0, 1e-9 * kE);
   }
@@ -370,8 +372,7 @@ TEST(MaterialVoigt, ConversionsRoundTripAndAreWorkConjugate) {
     const Mat3 sym_a = 0.5 * (a + a.transpose()), sigma = 0.5 * (b + b.transpose());
     EXPECT_LE((voigt_to_stress(stress_to_voigt(sigma)) - sigma).norm(), 1e-14);
     // sigma : eps = s . e, which is what makes Psi = 1/2 e^T C e consistent.
-    EXPECT_NEAR(stress_to_voigt(sigma).dot(strain_to_voigt(sym_a)), (sigma.array() * sym_a.array()).sum(),
-                1e-13);
+    EXPECT_NEAR(stress_to_voigt(sigma).dot(strain_to_voigt(sym_a)), (sigma.array() * sym_a.array()).sum(), 1e-13);
     // The 6x9 operator maps any displacement gradient to its Voigt strain.
     EXPECT_LE((voigt_strain_operator() * flat(a) - strain_to_voigt(a)).norm(), 1e-14);
   }
@@ -468,10 +469,10 @@ TEST(MaterialSum, AddsEnergiesStressesAndModuli) {
   const Mat3 F = shear_xy(0.2) * Eigen::Vector3d(1.1, 0.95, 1.0).asDiagonal();
   EXPECT_NEAR(sum.energy(F), nh->energy(F) + lin->energy(F) + spring->energy(F), 1e-9 * kE);
   EXPECT_LE((sum.stress(F) - nh->stress(F) - lin->stress(F) - spring->stress(F)).norm(), 1e-9 * kE);
-  EXPECT_LE((sum.stress_derivative(F) - nh->stress_derivative(F) - lin->stress_derivative(F) -
-             spring->stress_derivative(F))
-                .norm(),
-            1e-9 * kE);
+  EXPECT_LE(
+      (sum.stress_derivative(F) - nh->stress_derivative(F) - lin->stress_derivative(F) - spring->stress_derivative(F))
+          .norm(),
+      1e-9 * kE);
   EXPECT_DOUBLE_EQ(sum.shear_modulus(), nh->shear_modulus() + lin->shear_modulus());
   EXPECT_DOUBLE_EQ(sum.lame_lambda(), nh->lame_lambda() + lin->lame_lambda());
   EXPECT_EQ(sum.name(), "sum(neo_hookean+linear_isotropic+anisotropic_spring)");

@@ -2,11 +2,10 @@
 // relative Hausdorff mode distance, and dynamics-aware coarsening (§4.3).
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <array>
 #include <cmath>
 #include <cstdio>
-
-#include <Eigen/Eigenvalues>
 
 #include "core/errors.hpp"
 #include "dynamics/dac_calibration.hpp"
@@ -54,7 +53,8 @@ Body cantilever(int n, double E = kBeamE) { return voxel_box(10 * n, n, n, kWidt
 
 double euler_bernoulli_f1() {
   const double I = std::pow(kWidth, 4) / 12.0, A = kWidth * kWidth;
-  return 1.875104068711961 * 1.875104068711961 / (2 * kModalPi) * std::sqrt(kBeamE * I / (kRho * A * std::pow(kLength, 4)));
+  return 1.875104068711961 * 1.875104068711961 / (2 * kModalPi) *
+         std::sqrt(kBeamE * I / (kRho * A * std::pow(kLength, 4)));
 }
 
 struct Dense {
@@ -193,7 +193,8 @@ TEST(ModalAnalysis, RepeatedBendingModesGetAxisAlignedBasis) {
   std::vector<int> mirror(static_cast<size_t>(b.mesh.num_nodes()), -1);
   for (int n = 0; n < b.mesh.num_nodes(); ++n)
     for (int m = 0; m < b.mesh.num_nodes(); ++m)
-      if ((b.mesh.nodes.row(m) - Eigen::RowVector3d(b.mesh.nodes(n, 0), b.mesh.nodes(n, 1), kWidth - b.mesh.nodes(n, 2)))
+      if ((b.mesh.nodes.row(m) -
+           Eigen::RowVector3d(b.mesh.nodes(n, 0), b.mesh.nodes(n, 1), kWidth - b.mesh.nodes(n, 2)))
               .norm() < 1e-9)
         mirror[static_cast<size_t>(n)] = m;
   auto parity_error = [&](int mode, double parity) {  // parity of u_x, u_y; u_z has the opposite
@@ -313,7 +314,8 @@ TEST(ModeShapeDistance, IdenticalZeroAndCoarseBeamModesClose) {
   EXPECT_GT(cross, 0.05) << "y bending must differ from z bending";
   const auto matches = match_modes(sf, rf.modes, sc, rc.modes, 2);
   for (int i = 0; i < 4; ++i) {
-    std::printf("  coarse mode %d -> fine mode %d at %.4f\n", i + 1, matches[i].reference_mode + 1, matches[i].distance);
+    std::printf("  coarse mode %d -> fine mode %d at %.4f\n", i + 1, matches[i].reference_mode + 1,
+                matches[i].distance);
     EXPECT_EQ(matches[static_cast<size_t>(i)].reference_mode, i);
   }
 }
@@ -364,7 +366,8 @@ TEST(DacCoarsening, PicksCoarsestLevelWithinShapeTolerance) {
 
 TEST(FrequencyExtrapolation, RecoversLimitAndOrderOfAPowerLaw) {
   // f(h) = 97 + 40 h^1.6 on halving and on unequal refinement ratios.
-  for (const std::array<double, 3>& h : {std::array<double, 3>{2, 1, 0.5}, std::array<double, 3>{1, 1.0 / 2, 1.0 / 3}}) {
+  for (const std::array<double, 3>& h :
+       {std::array<double, 3>{2, 1, 0.5}, std::array<double, 3>{1, 1.0 / 2, 1.0 / 3}}) {
     std::array<double, 3> f{};
     for (int i = 0; i < 3; ++i) f[i] = 97 + 40 * std::pow(h[i], 1.6);
     const FrequencyLimit r = extrapolate_frequency(f, h);
@@ -381,8 +384,8 @@ TEST(FrequencyExtrapolation, RecoversLimitAndOrderOfAPowerLaw) {
 
 TEST(FrequencyExtrapolation, ClaimsNoLimitOutsideTheAsymptoticRange) {
   // Oscillating, growing and stalled changes: the finest value, not monotone.
-  for (const std::array<double, 3>& f : {std::array<double, 3>{100, 90, 95}, std::array<double, 3>{100, 99, 97},
-                                         std::array<double, 3>{100, 100, 99}}) {
+  for (const std::array<double, 3>& f :
+       {std::array<double, 3>{100, 90, 95}, std::array<double, 3>{100, 99, 97}, std::array<double, 3>{100, 100, 99}}) {
     const FrequencyLimit r = extrapolate_frequency(f, {2, 1, 0.5});
     EXPECT_FALSE(r.monotone) << f[0] << " " << f[1] << " " << f[2];
     EXPECT_EQ(r.limit, f[2]);

@@ -93,14 +93,12 @@ std::unique_ptr<VoxelStiffness> voxel_stiffness(int n, int clamped_layers = 1) {
   problem->load.resize(dofs);
   for (int i = 0; i < dofs; ++i) {
     problem->load[i] = (i % 3 == 2 ? -1.0 : 0.0) + 0.5 * noise(rng);
-    if (problem->fixed[static_cast<std::size_t>(i)])
-      problem->load[i] = 1e-3 * diagonal * noise(rng);
+    if (problem->fixed[static_cast<std::size_t>(i)]) problem->load[i] = 1e-3 * diagonal * noise(rng);
   }
   return problem;
 }
 
-LinearSolverOptions multigrid_options(const VoxelStiffness& problem, double tolerance,
-                                      int coarse_unknowns = 3000) {
+LinearSolverOptions multigrid_options(const VoxelStiffness& problem, double tolerance, int coarse_unknowns = 3000) {
   LinearSolverOptions options;
   options.node_positions = problem.nodes;
   options.pcg_tolerance = tolerance;
@@ -320,8 +318,7 @@ TEST(MultigridInput, MissingOrBadGeometryThrowsInputError) {
   expect_input_error(off_lattice, "off the regular lattice");
 
   LinearSolverOptions too_few = multigrid_options(*problem, 1e-8);
-  too_few.node_positions =
-      std::make_shared<const NodeArray>(problem->nodes->topRows(problem->nodes->rows() - 1));
+  too_few.node_positions = std::make_shared<const NodeArray>(problem->nodes->topRows(problem->nodes->rows() - 1));
   expect_input_error(too_few, "rows");
 
   // Nodes on a lattice, but not in the matrix's order: the matrix then
@@ -379,8 +376,8 @@ TEST(MultigridNewton, LargeStretchMatchesCholmod) {
   for (const NewtonIteration& step : multigrid.history) {
     linear_iterations = std::max(linear_iterations, step.linear_iterations);
   }
-  std::printf("[ pcg-mg   ] Newton: %d iterations (CHOLMOD: %d), at most %d CG iterations each\n",
-              multigrid.iterations, direct.iterations, linear_iterations);
+  std::printf("[ pcg-mg   ] Newton: %d iterations (CHOLMOD: %d), at most %d CG iterations each\n", multigrid.iterations,
+              direct.iterations, linear_iterations);
   EXPECT_LT((multigrid.x - direct.x).norm(), 1e-7 * direct.x.norm());
   EXPECT_GT(linear_iterations, 1);
   EXPECT_LT(linear_iterations, 60);

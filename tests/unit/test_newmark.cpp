@@ -48,8 +48,8 @@ DynamicsModel block_model(const BlockSpec& s) {
 }
 
 Vec3 center_of_mass(const NewmarkIntegrator& sim) {
-  const MassProperties p = mass_properties(sim.scalar_mass_matrix(), Eigen::Map<const NodeArray>(
-                                                                          sim.positions().data(), sim.positions().size() / 3, 3));
+  const MassProperties p = mass_properties(
+      sim.scalar_mass_matrix(), Eigen::Map<const NodeArray>(sim.positions().data(), sim.positions().size() / 3, 3));
   return p.center;
 }
 
@@ -403,8 +403,8 @@ TEST(Newmark, DropTestReboundOrdersTheImpactModels) {
               100 * dke.rebound, 100 * bbi.rebound);
   std::printf("  contact-node normal speed after impact: complementarity %.3e, DKE %.3e, BBI %.3e m/s\n",
               comp.normal_velocity_after_impact, dke.normal_velocity_after_impact, bbi.normal_velocity_after_impact);
-  EXPECT_GT(comp.rebound, 0.5e-2);   // nearly elastic
-  EXPECT_LT(bbi.rebound, 0.05e-2);   // no visible rebound
+  EXPECT_GT(comp.rebound, 0.5e-2);  // nearly elastic
+  EXPECT_LT(bbi.rebound, 0.05e-2);  // no visible rebound
   EXPECT_GT(dke.rebound, bbi.rebound);
   EXPECT_LT(dke.rebound, comp.rebound);
   // Force-carrying contact nodes end the impact step at rest along the normal.
@@ -416,8 +416,8 @@ TEST(Newmark, DropTestReboundOrdersTheImpactModels) {
 namespace {
 
 struct SpinRun {
-  double momentum_drift;   // largest |L(t) - L(0)| / |L(0)| about the centre of mass
-  double elastic_fraction; // elastic energy at the end over that at the start
+  double momentum_drift;    // largest |L(t) - L(0)| / |L(0)| about the centre of mass
+  double elastic_fraction;  // elastic energy at the end over that at the start
 };
 
 // A stretched 3x2x2 Neo-Hookean bar set spinning about z in free space (no
@@ -451,7 +451,8 @@ SpinRun spinning_bar(double h, int steps) {
     const VecX p = sim.mass_matrix() * sim.velocities();
     const Vec3 com = center_of_mass(sim);
     Vec3 L = Vec3::Zero();
-    for (int i = 0; i < model.mesh.num_nodes(); ++i) L += (sim.positions().segment<3>(3 * i) - com).cross(p.segment<3>(3 * i));
+    for (int i = 0; i < model.mesh.num_nodes(); ++i)
+      L += (sim.positions().segment<3>(3 * i) - com).cross(p.segment<3>(3 * i));
     return L;
   };
   const Vec3 L0 = momentum();

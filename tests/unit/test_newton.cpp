@@ -28,7 +28,8 @@ HexMesh irregular_mesh(const MaterialPtr& mat) {
       for (int k = 0; k < 3; ++k) {
         Vec3 p(i, j, k);
         const int interior_dirs = (i == 1) + (j == 1) + (k == 1);
-        if (interior_dirs > 0) p += 0.15 * Vec3(std::sin(3.0 * id(i, j, k)), std::cos(5.0 * id(i, j, k)), std::sin(7.0 * id(i, j, k)));
+        if (interior_dirs > 0)
+          p += 0.15 * Vec3(std::sin(3.0 * id(i, j, k)), std::cos(5.0 * id(i, j, k)), std::sin(7.0 * id(i, j, k)));
         nodes.row(id(i, j, k)) = p.transpose();
       }
   std::vector<std::array<int, 8>> els;
@@ -88,9 +89,7 @@ struct CubeBetweenPlates {
 
 }  // namespace
 
-TEST(Newton, PatchTestLinearMaterialIrregularMesh) {
-  run_patch_test(std::make_shared<LinearIsotropic>(1e6, 0.3), 1.0);
-}
+TEST(Newton, PatchTestLinearMaterialIrregularMesh) { run_patch_test(std::make_shared<LinearIsotropic>(1e6, 0.3), 1.0); }
 
 TEST(Newton, PatchTestNeoHookeanHomogeneousLargeDeformation) {
   // A homogeneous deformation is an exact equilibrium of any hyperelastic
@@ -173,10 +172,11 @@ TEST(Newton, CantileverTipDeflectionConvergesToTimoshenko) {
     const auto res = solve_static(asmb, DC, f, opt);
     ASSERT_TRUE(res.converged) << res.failure;
     double w = 0;
-    for (size_t k = 0; k < sel.nodes.size(); ++k) w += sel.weight[k] * (asmb.rest_positions() - res.x)[3 * sel.nodes[k] + 2];
+    for (size_t k = 0; k < sel.nodes.size(); ++k)
+      w += sel.weight[k] * (asmb.rest_positions() - res.x)[3 * sel.nodes[k] + 2];
     const double err = std::abs(w - w_ref) / w_ref;
-    std::printf("cantilever %2d elements through the thickness: tip deflection %.6e, Timoshenko %.6e, error %.3e\n",
-                n, w, w_ref, err);
+    std::printf("cantilever %2d elements through the thickness: tip deflection %.6e, Timoshenko %.6e, error %.3e\n", n,
+                w, w_ref, err);
     errors.push_back(err);
   }
   for (size_t i = 1; i < errors.size(); ++i) EXPECT_LT(errors[i], errors[i - 1]);
@@ -213,8 +213,11 @@ TEST(Newton, SmallLoadCantileverConvergesInAFewIterations) {
                   neo ? "Neo-Hookean" : "linear", tolerance, res.converged ? "converged" : "not converged",
                   res.iterations);
       std::string residuals;
-      for (std::size_t i = 0; i < res.history.size() && i < 12; ++i)
-        { char item[48]; std::snprintf(item, sizeof item, " %.2e/%g", res.history[i].residual, res.history[i].step_length); residuals += item; }
+      for (std::size_t i = 0; i < res.history.size() && i < 12; ++i) {
+        char item[48];
+        std::snprintf(item, sizeof item, " %.2e/%g", res.history[i].residual, res.history[i].step_length);
+        residuals += item;
+      }
       EXPECT_TRUE(res.converged) << res.failure << "; residuals:" << residuals;
       EXPECT_LE(res.iterations, neo ? 5 : 3) << (neo ? "Neo-Hookean" : "linear") << ", tolerance " << tolerance;
     }
@@ -251,7 +254,8 @@ HardCaseOutcome compress_block(const std::vector<MaterialPtr>& palette, const Vo
   for (int e = 0; e < vm.mesh.num_elements(); ++e) {
     hex8::NodeMatrix x;
     for (int i = 0; i < 8; ++i) x.row(i) = out.result.x.segment<3>(3 * vm.mesh.elements[e][i]).transpose();
-    for (const auto& D : vm.mesh.geometries[0].dNdX) out.min_J = std::min(out.min_J, hex8::deformation_gradient(x, D).determinant());
+    for (const auto& D : vm.mesh.geometries[0].dNdX)
+      out.min_J = std::min(out.min_J, hex8::deformation_gradient(x, D).determinant());
   }
   return out;
 }
@@ -274,9 +278,9 @@ TEST(NewtonHardCases, StiffnessContrast1e3And1e4) {
   for (double contrast : {1e3, 1e4}) {
     VoxelGrid grid(4, 4, 8, 0.01, 1);
     paint_layers(grid, 2, {0.01, 0.01}, {1, 2});
-    const auto o = compress_block({nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
-                                   std::make_shared<NeoHookean>(1e5 * contrast, 0.45)},
-                                  grid, 0.2, 1);
+    const auto o = compress_block(
+        {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e5 * contrast, 0.45)}, grid,
+        0.2, 1);
     expect_sane(o);
     EXPECT_TRUE(o.result.converged) << "contrast " << contrast << ": " << o.result.failure;
   }

@@ -181,8 +181,8 @@ TEST(PeriodicMultigrid, ExtremeContrastFallsBackToDoublePrecisionSmoothers) {
   EXPECT_LT(cubic_deviation(r.C), 1e-6);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6>(r.C).eigenvalues().minCoeff(), 0.0);
   const CubicModuli m = cubic_moduli(r.C);
-  std::printf("[periodic-mg] 2-voxel bars in void 1e-9, 40^3: E %.6g nu %.6f G %.6g, %d iterations\n", m.E, m.nu,
-              m.G, r.iterations);
+  std::printf("[periodic-mg] 2-voxel bars in void 1e-9, 40^3: E %.6g nu %.6f G %.6g, %d iterations\n", m.E, m.nu, m.G,
+              r.iterations);
 
   // The solver itself: it switched, and the solution meets the tolerance on
   // the exact (double, matrix-free) operator.

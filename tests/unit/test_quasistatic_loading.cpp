@@ -32,7 +32,8 @@ struct QuasistaticBody {
 
 // A solid nx x ny x nz block of 1 cm voxels with its lower corner at
 // `origin`, Neo-Hookean rubber, loaded by its weight (rho = 1000 kg/m^3).
-std::unique_ptr<QuasistaticBody> make_block(int nx, int ny, int nz, const Vec3& origin, double E = 1e6, double nu = 0.3) {
+std::unique_ptr<QuasistaticBody> make_block(int nx, int ny, int nz, const Vec3& origin, double E = 1e6,
+                                            double nu = 0.3) {
   auto s = std::make_unique<QuasistaticBody>();
   s->grid = VoxelGrid(nx, ny, nz, kH, 1);
   s->grid.origin = origin;
@@ -245,7 +246,8 @@ LedgeCase run_ledge(double ground_z) {
   opt.relative_tolerance = 1e-11;
   c.r = solve_quasistatic_loading(*c.s->assembler, c.obstacles, c.s->force, VecX(), opt);
   for (int i = 0; i < c.s->vm.mesh.num_nodes(); ++i)
-    if (c.s->vm.mesh.nodes(i, 0) == 10 * kH && c.s->vm.mesh.nodes(i, 2) == 2 * kH) c.tip_drop = std::max(c.tip_drop, c.s->rest[3 * i + 2] - c.r.x[3 * i + 2]);
+    if (c.s->vm.mesh.nodes(i, 0) == 10 * kH && c.s->vm.mesh.nodes(i, 2) == 2 * kH)
+      c.tip_drop = std::max(c.tip_drop, c.s->rest[3 * i + 2] - c.r.x[3 * i + 2]);
   return c;
 }
 

@@ -36,8 +36,8 @@ struct PressedMesh {
 std::unique_ptr<PressedMesh> pressed_mesh(const VoxelGrid& grid, bool separate, double top_load, double load_from_x) {
   auto owner = std::make_unique<PressedMesh>();
   PressedMesh& p = *owner;
-  const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.3),
-                                               std::make_shared<NeoHookean>(1e6, 0.3)});
+  const VoxelMesh vm =
+      build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1e6, 0.3), std::make_shared<NeoHookean>(1e6, 0.3)});
   p.mesh = vm.mesh;
   if (separate) {
     std::vector<int> body;
@@ -50,10 +50,12 @@ std::unique_ptr<PressedMesh> pressed_mesh(const VoxelGrid& grid, bool separate, 
   p.force = VecX::Zero(p.mesh.num_dofs());
   const double top = p.mesh.bbox_max().z();
   int loaded = 0;
-  for (int i = 0; i < p.mesh.num_nodes(); ++i) loaded += p.mesh.nodes(i, 2) > top - 1e-12 && p.mesh.nodes(i, 0) >= load_from_x - 1e-12;
+  for (int i = 0; i < p.mesh.num_nodes(); ++i)
+    loaded += p.mesh.nodes(i, 2) > top - 1e-12 && p.mesh.nodes(i, 0) >= load_from_x - 1e-12;
   for (int i = 0; i < p.mesh.num_nodes(); ++i) {
     p.force[3 * i + 2] = -9.81 * node_mass[i];
-    if (p.mesh.nodes(i, 2) > top - 1e-12 && p.mesh.nodes(i, 0) >= load_from_x - 1e-12) p.force[3 * i + 2] -= top_load / loaded;
+    if (p.mesh.nodes(i, 2) > top - 1e-12 && p.mesh.nodes(i, 0) >= load_from_x - 1e-12)
+      p.force[3 * i + 2] -= top_load / loaded;
   }
   return owner;
 }
@@ -89,7 +91,8 @@ TEST(QuasistaticSelfContact, BodiesTiedWhereTheyTouchEqualTheFusedBody) {
   // slab to the ground.
   const QuasistaticResult sunk = solve_quasistatic_loading(*apart.assembler, {floor_plane()}, apart.force, VecX(), opt);
   double highest_grounded = 0;  // rest height of the highest node on the ground
-  for (const ContactVertex& v : sunk.contacts) highest_grounded = std::max(highest_grounded, apart.mesh.nodes(v.node, 2));
+  for (const ContactVertex& v : sunk.contacts)
+    highest_grounded = std::max(highest_grounded, apart.mesh.nodes(v.node, 2));
   EXPECT_GT(highest_grounded, 0.5 * kEdge);  // the bar's underside (rest z = 1 cm) ended on the ground
   opt.self_contact = true;
   const QuasistaticResult tied = solve_quasistatic_loading(*apart.assembler, {floor_plane()}, apart.force, VecX(), opt);
@@ -138,14 +141,16 @@ TEST(QuasistaticSelfContact, ACShapePressedShutRestsOnItsLowerArm) {
   Vec3 reactions = Vec3::Zero(), load = Vec3::Zero();
   for (const ContactVertex& v : shut.contacts) reactions += v.reaction;
   for (int i = 0; i < c.mesh.num_nodes(); ++i) load += c.force.segment<3>(3 * i);
-  std::printf("  without self-contact a node ends %.3e m behind a face; with it %.3e m (%zu ties); "
-              "ground reactions + load = %.2e N of %.3f N\n",
-              deepest(folded.x), deepest(shut.x), shut.self_contacts.size(), (reactions + load).norm(), load.norm());
+  std::printf(
+      "  without self-contact a node ends %.3e m behind a face; with it %.3e m (%zu ties); "
+      "ground reactions + load = %.2e N of %.3f N\n",
+      deepest(folded.x), deepest(shut.x), shut.self_contacts.size(), (reactions + load).norm(), load.norm());
   EXPECT_GT(deepest(folded.x), 0.1 * kEdge);  // the arm goes through
   EXPECT_LE(deepest(shut.x), 1e-2 * kEdge);   // the line search's depth bound
   EXPECT_GT(shut.self_contacts.size(), 0u);
   // Ties are internal: the ground carries the whole load.
   EXPECT_LT((reactions + load).norm(), 1e-7 * load.norm());
   // No tie pulls (the solver releases those that would).
-  for (const SelfContactTie& t : shut.self_contacts) EXPECT_GE(tie_push(t, shut.x), -1e-7 * load.norm()) << "node " << t.node;
+  for (const SelfContactTie& t : shut.self_contacts)
+    EXPECT_GE(tie_push(t, shut.x), -1e-7 * load.norm()) << "node " << t.node;
 }

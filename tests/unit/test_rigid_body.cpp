@@ -65,8 +65,8 @@ Momenta fe_momenta(const SpMat& M3, double mass, const VecX& q, const VecX& v) {
 }
 
 // A rigid FE state: rest nodes moved by x = t + Q (X - c0), spinning at omega.
-void rigid_fe_state(const HexMesh& mesh, const Vec3& c0, const Mat3& Q, const Vec3& t, const Vec3& u,
-                    const Vec3& omega, VecX* q, VecX* v) {
+void rigid_fe_state(const HexMesh& mesh, const Vec3& c0, const Mat3& Q, const Vec3& t, const Vec3& u, const Vec3& omega,
+                    VecX* q, VecX* v) {
   const int n = mesh.num_nodes();
   q->resize(3 * n);
   v->resize(3 * n);
@@ -133,10 +133,12 @@ TEST(RigidBody, PrincipalFrameFollowsARotatedBodyAndAcceptsTheDofMatrix) {
   HexMesh mesh = box_mesh();
   const Mat3 Q = rotation(0.8, Vec3(1, -2, 0.5));
   const Vec3 shift(-1.0, 2.0, 0.3);
-  for (int i = 0; i < mesh.num_nodes(); ++i) mesh.nodes.row(i) = (Q * mesh.nodes.row(i).transpose() + shift).transpose();
+  for (int i = 0; i < mesh.num_nodes(); ++i)
+    mesh.nodes.row(i) = (Q * mesh.nodes.row(i).transpose() + shift).transpose();
   const SpMat m = box_scalar_mass(mesh);
   const RigidBody body = make_rigid_body(m, mesh.nodes);
-  const RigidBody body3 = make_rigid_body(expand_to_dofs(m), VecX(Eigen::Map<const VecX>(mesh.nodes.data(), 3 * mesh.num_nodes())));
+  const RigidBody body3 =
+      make_rigid_body(expand_to_dofs(m), VecX(Eigen::Map<const VecX>(mesh.nodes.data(), 3 * mesh.num_nodes())));
   const double scale = body.inertia.maxCoeff();
   const double mass = kRho * 6 * std::pow(kVoxel, 3);
   const Vec3 expected = mass * kVoxel * kVoxel * Vec3(5, 10, 13) / 12;
@@ -214,8 +216,8 @@ TEST(RigidBody, HandOffOfADeformedStatePreservesMomentaExactly) {
   project_to_fe(body, s, &q2, &v2);
   const Momenta after = fe_momenta(M3, body.mass, q2, v2);
   const double dl = (after.linear - s.l).norm() / s.l.norm(), dpi = (after.angular - s.pi).norm() / s.pi.norm();
-  std::printf("deformed hand-off: relative momentum change linear %.2e, angular %.2e; centre moved %.2e m\n", dl,
-              dpi, (after.center - s.t).norm());
+  std::printf("deformed hand-off: relative momentum change linear %.2e, angular %.2e; centre moved %.2e m\n", dl, dpi,
+              (after.center - s.t).norm());
   EXPECT_LT(dl, 1e-13);
   EXPECT_LT(dpi, 1e-12);
   EXPECT_LT((after.center - s.t).norm(), 1e-14);
@@ -262,9 +264,10 @@ TEST(RigidBody, DmvTumblingBodyConservesEnergyAndMomentum) {
       max_orth = std::max(max_orth, orthogonality_error(s.R));
       min_m2 = std::min(min_m2, body_angular_momentum(s)(1));
     }
-    std::printf("DMV tumbling, h = %g, %d steps: max relative energy error %.2e, |R^T R - 1| <= %.2e, "
-                "|dpi| = %.2e\n",
-                h, steps, max_dE, max_orth, (s.pi - pi0).norm());
+    std::printf(
+        "DMV tumbling, h = %g, %d steps: max relative energy error %.2e, |R^T R - 1| <= %.2e, "
+        "|dpi| = %.2e\n",
+        h, steps, max_dE, max_orth, (s.pi - pi0).norm());
     EXPECT_LT(min_m2, -2.5);  // it did tumble: the body momentum flipped
     EXPECT_LT(max_dE, 1e-12);
     EXPECT_LT(max_orth, 1e-14);
@@ -282,7 +285,8 @@ TEST(RigidBody, DmvMatchesTheSymmetricTopAtSecondOrder) {
   s0.pi = Vec3(1.0, 2.0, -0.5);
   const double T = 2.0;
   const double m3 = (s0.R.transpose() * s0.pi)(2);
-  const Mat3 exact = rotation(T * s0.pi.norm() / I(0), s0.pi) * s0.R * rotation(T * (1 / I(2) - 1 / I(0)) * m3, Vec3::UnitZ());
+  const Mat3 exact =
+      rotation(T * s0.pi.norm() / I(0), s0.pi) * s0.R * rotation(T * (1 / I(2) - 1 / I(0)) * m3, Vec3::UnitZ());
   double prev = 0;
   for (const int steps : {50, 100, 200, 400}) {
     const double err = (run_dmv(body, s0, T, steps).R - exact).norm();

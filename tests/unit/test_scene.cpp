@@ -114,7 +114,7 @@ TEST(Scene, FaceLoadsIntegrateTractionOverTheFace) {
   const StaticConditions sc = build_static_conditions(s, vm);
   double fz = 0;
   for (int n = 0; n < vm.mesh.num_nodes(); ++n) fz += sc.force[3 * n + 2];
-  EXPECT_NEAR(fz, -100 * 1.0 * 1.0, 1e-12);  // face is 1 m x 1 m
+  EXPECT_NEAR(fz, -100 * 1.0 * 1.0, 1e-12);      // face is 1 m x 1 m
   EXPECT_EQ(sc.dirichlet.count_fixed(), 3 * 9);  // 3 x 3 nodes on x = 0
 }
 
@@ -141,7 +141,8 @@ TEST(Scene, DisconnectedPartWithoutSupportIsRejected) {
 
 TEST(Scene, RotationConditionTurnsTheFace) {
   Config cfg = Config::from_string(kScene, "test");
-  cfg.apply_override("boundary=[{region: {face: xmin}, rotation: {axis: [1, 0, 0], center: [0, 0.5, 0.5], angle_deg: 90}}]");
+  cfg.apply_override(
+      "boundary=[{region: {face: xmin}, rotation: {axis: [1, 0, 0], center: [0, 0.5, 0.5], angle_deg: 90}}]");
   const Scene s = read_scene(cfg);
   const VoxelMesh vm = build_voxel_mesh(s.grid, s.material_by_id);
   const StaticConditions sc = build_static_conditions(s, vm);
@@ -157,8 +158,9 @@ TEST(Scene, RotationConditionTurnsTheFace) {
 
 TEST(Scene, CheckerAndRandomFieldLayoutItemsPaintTheGrid) {
   Config cfg = Config::from_string(kScene, "test");
-  cfg.apply_override("materials=[{id: 1, model: neo-hookean, E: 1.0e5, nu: 0.45}, "
-                     "{id: 3, model: neo-hookean, E: 1.0e7, nu: 0.45}]");
+  cfg.apply_override(
+      "materials=[{id: 1, model: neo-hookean, E: 1.0e5, nu: 0.45}, "
+      "{id: 3, model: neo-hookean, E: 1.0e7, nu: 0.45}]");
   cfg.apply_override("layout=[{checker: {cell: 0.5, ids: [1, 3]}}]");
   Scene s = read_scene(cfg);
   EXPECT_NO_THROW(cfg.check_no_unknown_keys());
@@ -167,7 +169,8 @@ TEST(Scene, CheckerAndRandomFieldLayoutItemsPaintTheGrid) {
   EXPECT_EQ(s.grid.at(1, 1, 0), 1);
   EXPECT_EQ(s.grid.at(1, 1, 1), 3);
 
-  cfg.apply_override("layout=[{random_field: {ids: [1, 3], seed: 7}}, {box: {min: [0, 0, 0], max: [0.5, 1, 1]}, id: 0}]");
+  cfg.apply_override(
+      "layout=[{random_field: {ids: [1, 3], seed: 7}}, {box: {min: [0, 0, 0], max: [0.5, 1, 1]}, id: 0}]");
   s = read_scene(cfg);
   EXPECT_NO_THROW(cfg.check_no_unknown_keys());
   VoxelGrid expected(4, 2, 2, 0.5, 0);

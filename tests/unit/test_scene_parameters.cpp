@@ -49,7 +49,8 @@ TEST(ParameterExpression, ReportsWhatIsWrong) {
 
 TEST(ParameterExpression, TellsExpressionsFromWordsAndPaths) {
   EXPECT_TRUE(looks_like_expression("a", kValues));
-  EXPECT_TRUE(looks_like_expression("hinge_heigth + 0.002", kValues));  // misspelled: still an expression, then an error
+  EXPECT_TRUE(
+      looks_like_expression("hinge_heigth + 0.002", kValues));  // misspelled: still an expression, then an error
   EXPECT_FALSE(looks_like_expression("rigur", kValues));
   EXPECT_FALSE(looks_like_expression("bbi", kValues));
   EXPECT_FALSE(looks_like_expression("flipper-param", kValues));
@@ -124,10 +125,9 @@ TEST(SceneParameters, NodesMoveContinuouslyWithFixedConnectivity) {
   // Parameters changed by far less than a voxel: no remeshing, nodes move
   // by a proportionally small amount, the press keeps the same nodes.
   for (double d : {1e-6, 1e-4, 7e-4}) {
-    const DynamicsScene s = read(text, {"parameters.length=" + text_of(0.012 + d),
-                                        "reference_parameters.length=0.012",
-                                        "parameters.hinge=" + text_of(0.004 + d / 2),
-                                        "reference_parameters.hinge=0.004"});
+    const DynamicsScene s =
+        read(text, {"parameters.length=" + text_of(0.012 + d), "reference_parameters.length=0.012",
+                    "parameters.hinge=" + text_of(0.004 + d / 2), "reference_parameters.hinge=0.004"});
     ASSERT_EQ(s.model.mesh.num_nodes(), ref.model.mesh.num_nodes());
     ASSERT_EQ(s.model.mesh.elements, ref.model.mesh.elements);
     const double moved = (s.model.mesh.nodes - ref.model.mesh.nodes).cwiseAbs().maxCoeff();
@@ -166,8 +166,9 @@ std::string error_of(const std::string& text, const std::vector<std::string>& ov
 TEST(SceneParameters, ErrorsNameFileKeyPathAndExpression) {
   const std::string ok = scene_text();
   const std::string unknown = std::string(ok).replace(ok.find("\"hinge + 0.002\"]}"), 15, "\"hinje + 0.002\"");
-  EXPECT_NE(error_of(unknown).find("param.yaml: geometry.boxes[2].max[2] = \"hinje + 0.002\": unknown parameter 'hinje'"),
-            std::string::npos)
+  EXPECT_NE(
+      error_of(unknown).find("param.yaml: geometry.boxes[2].max[2] = \"hinje + 0.002\": unknown parameter 'hinje'"),
+      std::string::npos)
       << error_of(unknown);
   const std::string malformed = std::string(ok).replace(ok.find("\"2 * hinge\""), 11, "\"2 * (hinge\"");
   EXPECT_NE(error_of(malformed).find("obstacles[1].max[2] = \"2 * (hinge\": missing ')'"), std::string::npos)

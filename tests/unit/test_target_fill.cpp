@@ -91,7 +91,7 @@ TEST(TargetFill, CoverageIsTheSmallestGapAmongTheNearestStructures) {
   const CellCoverage c = cell_coverage(d, set, k2());
   EXPECT_LT(c.gap[0], 1e-12);  // the set's own structure
   EXPECT_EQ(c.best[0], 0);
-  EXPECT_EQ(c.best[2], -1);    // not a design cell
+  EXPECT_EQ(c.best[2], -1);  // not a design cell
   const double to0 = relative_stiffness_gap(kSpace, set.items[0].properties, d.raw.row(1).transpose());
   const double to1 = relative_stiffness_gap(kSpace, set.items[1].properties, d.raw.row(1).transpose());
   EXPECT_DOUBLE_EQ(c.gap[1], std::min(to0, to1));
@@ -253,7 +253,8 @@ TEST(TargetFill, FaceConnectorsAreSymmetricAndHeldByTheContinuousStep) {
   for (int v = 0; v < problem.variables(); ++v) frozen += problem.frozen(v);
   EXPECT_GT(frozen, 0);
   std::vector<double> x(std::size_t(problem.variables()));
-  for (std::size_t i = 0; i < x.size(); ++i) x[i] = problem.frozen(int(i)) ? 1.0 : 0.3 + 0.4 * std::abs(std::sin(1.3 * double(i)));
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] = problem.frozen(int(i)) ? 1.0 : 0.3 + 0.4 * std::abs(std::sin(1.3 * double(i)));
   std::vector<double> g;
   problem.objective(x, &g);
   double gmax = 0;

@@ -3,16 +3,15 @@
 // baseline against the published 88-line code, solver agreement, and
 // Ipopt on a gamut-constrained cantilever.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <random>
 
 #include "core/errors.hpp"
 #include "io/config.hpp"
-#include <omp.h>
-
 #include "topopt/cell_grid.hpp"
-#include "topopt/cell_mma.hpp"
 #include "topopt/cell_material.hpp"
+#include "topopt/cell_mma.hpp"
 #include "topopt/simp_mma.hpp"
 #include "topopt/topology_objective.hpp"
 #include "topopt/topology_optimizers.hpp"
@@ -35,8 +34,10 @@ GamutLevelSet synthetic_gamut(int dim_properties, unsigned seed) {
     bool ok = true;
     for (int a = 0; a < dim_properties - 1; ++a) {
       const bool modulus = dim_properties == 5 ? (a == 0 || a == 1 || a == 3) : (a == 0 || a == 2);
-      if (modulus) ok = ok && p[a] <= 1 - 0.6 * (1 - rho) && p[a] >= 0.2;
-      else ok = ok && p[a] >= 0.35 && p[a] <= 0.75;
+      if (modulus)
+        ok = ok && p[a] <= 1 - 0.6 * (1 - rho) && p[a] >= 0.2;
+      else
+        ok = ok && p[a] >= 0.35 && p[a] <= 0.75;
     }
     if (ok) points.push_back(p);
   }
@@ -320,7 +321,8 @@ supports:
   - {node: [60, 0], fix: [y]}
 loads: [{objective: compliance, forces: [{node: [0, 20], force: [0, -1]}]}]
 mass: {volume_fraction: 0.5}
-filter: {radius: )" + std::to_string(rmin) + "}\n");
+filter: {radius: )" + std::to_string(rmin) +
+                               "}\n");
   return sc;
 }
 

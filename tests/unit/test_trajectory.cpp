@@ -230,8 +230,7 @@ TEST_F(TrajectoryArtifact, RoundTripIsBitwiseExact) {
   const std::string path = file("run.h5");
   const std::string xmf = write_trajectory_artifact(path, t, provenance);
   EXPECT_EQ(xmf, file("run.xmf"));
-  for (const auto& entry : fs::directory_iterator(dir_))
-    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+  for (const auto& entry : fs::directory_iterator(dir_)) EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
 
   expect_identical(t, read_trajectory_artifact(path));
 

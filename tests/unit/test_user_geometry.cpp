@@ -23,7 +23,8 @@ namespace {
 // The 12 triangles of the box [lo, hi], outward normals.
 TriangleSurface box_surface(const Vec3& lo, const Vec3& hi) {
   TriangleSurface s;
-  for (int c = 0; c < 8; ++c) s.vertices.emplace_back(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z());
+  for (int c = 0; c < 8; ++c)
+    s.vertices.emplace_back(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z());
   const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
   for (const auto& q : quads) {
     s.triangles.push_back({q[0], q[1], q[2]});
@@ -40,7 +41,8 @@ TriangleSurface reversed_orientation(TriangleSurface s) {
 // The octahedron |x - c|_1 <= r, outward normals.
 TriangleSurface octahedron(const Vec3& c, double r) {
   TriangleSurface s;
-  s.vertices = {c + Vec3(r, 0, 0), c - Vec3(r, 0, 0), c + Vec3(0, r, 0), c - Vec3(0, r, 0), c + Vec3(0, 0, r), c - Vec3(0, 0, r)};
+  s.vertices = {c + Vec3(r, 0, 0), c - Vec3(r, 0, 0), c + Vec3(0, r, 0),
+                c - Vec3(0, r, 0), c + Vec3(0, 0, r), c - Vec3(0, 0, r)};
   for (int sx = 0; sx < 2; ++sx)
     for (int sy = 0; sy < 2; ++sy)
       for (int sz = 0; sz < 2; ++sz) {
@@ -58,11 +60,11 @@ TriangleSurface octahedron(const Vec3& c, double r) {
 TriangleSurface bumpy_sphere(const Vec3& centre, double radius, double bump, std::uint64_t seed) {
   const double g = (1 + std::sqrt(5.0)) / 2;
   TriangleSurface s;
-  s.vertices = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  s.triangles = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                 {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  s.vertices = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  s.triangles = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                 {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                 {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (int level = 0; level < 3; ++level) {
     std::map<std::pair<int, int>, int> middle;
     auto mid = [&](int a, int b) {
@@ -115,7 +117,8 @@ std::string ascii_stl(const TriangleSurface& s) {
   for (const auto& t : s.triangles) {
     o << "  facet normal 0 0 0\n    outer loop\n";
     for (int c = 0; c < 3; ++c)
-      o << "      vertex " << s.vertices[t[c]].x() << " " << s.vertices[t[c]].y() << " " << s.vertices[t[c]].z() << "\n";
+      o << "      vertex " << s.vertices[t[c]].x() << " " << s.vertices[t[c]].y() << " " << s.vertices[t[c]].z()
+        << "\n";
     o << "    endloop\n  endfacet\n";
   }
   o << "endsolid part\n";
@@ -138,8 +141,8 @@ std::string binary_stl(const TriangleSurface& s, const std::string& header = "bi
 }
 
 std::string npy_file_bytes(const std::string& descr, bool fortran, const std::string& shape, const std::string& data) {
-  std::string header = "{'descr': '" + descr + "', 'fortran_order': " + (fortran ? "True" : "False") +
-                       ", 'shape': " + shape + ", }";
+  std::string header =
+      "{'descr': '" + descr + "', 'fortran_order': " + (fortran ? "True" : "False") + ", 'shape': " + shape + ", }";
   while ((10 + header.size() + 1) % 64 != 0) header += ' ';
   header += '\n';
   std::string out = "\x93NUMPY";
@@ -240,7 +243,8 @@ TEST(SurfaceMeshIo, AsciiAndBinaryStlAndObjGiveTheSameSurface) {
   for (const Vec3& v : box.vertices) obj << "v " << v.x() << " " << v.y() << " " << v.z() << "\nvn 0 0 1\n";
   // Quads as "v/vt/vn" with negative (relative) indices: two triangles each.
   const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) obj << "f " << q[0] - 8 << "/1/1 " << q[1] - 8 << "//1 " << q[2] + 1 << " " << q[3] + 1 << "\n";
+  for (const auto& q : quads)
+    obj << "f " << q[0] - 8 << "/1/1 " << q[1] - 8 << "//1 " << q[2] + 1 << " " << q[3] + 1 << "\n";
   const TriangleSurface o = merge_equal_vertices(parse_obj(obj.str(), "c.obj"));
   for (const TriangleSurface* s : {&a, &b, &o}) {
     EXPECT_EQ(s->vertices.size(), 8u);
@@ -262,10 +266,13 @@ TEST(SurfaceMeshIo, MalformedFilesNameTheFileAndLine) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message([] { parse_stl("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n", "p.stl"); }).find("p.stl: line 4"),
+  EXPECT_NE(message([] {
+              parse_stl("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n", "p.stl");
+            }).find("p.stl: line 4"),
             std::string::npos);
-  EXPECT_NE(message([] { parse_stl("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "p.stl"); }).find("truncated"),
-            std::string::npos);
+  EXPECT_NE(
+      message([] { parse_stl("solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n", "p.stl"); }).find("truncated"),
+      std::string::npos);
   EXPECT_NE(message([] { parse_stl("hello", "p.stl"); }).find("neither a binary STL"), std::string::npos);
   EXPECT_NE(message([] { parse_stl("solid empty\nendsolid\n", "p.stl"); }).find("no triangles"), std::string::npos);
   EXPECT_NE(message([] { parse_obj("v 0 0 0\nv 1 0 0\nf 1 2 3\n", "q.obj"); }).find("q.obj: line 3: vertex index 3"),
@@ -305,8 +312,11 @@ TEST(VoxelArrayIo, NpyInCAndFortranOrderAndEveryIntegerWidth) {
             std::vector<int>(expected.begin(), expected.begin() + nx * ny));
 
   EXPECT_THROW(parse_npy_voxel_ids(npy_file_bytes("|u1", false, "(3, 2, 4)", c_u1), "a.npy", nx, ny, nz), InputError);
-  EXPECT_THROW(parse_npy_voxel_ids(npy_file_bytes("<f8", false, "(2, 3, 4)", std::string(192, '\0')), "a.npy", nx, ny, nz), InputError);
-  EXPECT_THROW(parse_npy_voxel_ids(npy_file_bytes("|u1", false, "(2, 3, 4)", c_u1.substr(1)), "a.npy", nx, ny, nz), InputError);
+  EXPECT_THROW(
+      parse_npy_voxel_ids(npy_file_bytes("<f8", false, "(2, 3, 4)", std::string(192, '\0')), "a.npy", nx, ny, nz),
+      InputError);
+  EXPECT_THROW(parse_npy_voxel_ids(npy_file_bytes("|u1", false, "(2, 3, 4)", c_u1.substr(1)), "a.npy", nx, ny, nz),
+               InputError);
   EXPECT_THROW(parse_npy_voxel_ids("not numpy", "a.npy", nx, ny, nz), InputError);
   std::string negative = c_i4;
   negative[0] = char(0xff), negative[1] = char(0xff), negative[2] = char(0xff), negative[3] = char(0xff);
@@ -327,9 +337,9 @@ TEST(VoxelArrayIo, RawFilesNeedTheirDtypeAndExactSize) {
   const std::string path = write_temp("ids.raw", bytes);
   const std::vector<int> ids = read_voxel_ids(path, 2, 3, 4, "uint16");
   for (int v = 0; v < 24; ++v) EXPECT_EQ(ids[v], v % 3);
-  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4), InputError);            // no dtype
-  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4, "float32"), InputError); // not an id type
-  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4, "uint8"), InputError);   // 48 bytes, 24 expected
+  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4), InputError);             // no dtype
+  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4, "float32"), InputError);  // not an id type
+  EXPECT_THROW(read_voxel_ids(path, 2, 3, 4, "uint8"), InputError);    // 48 bytes, 24 expected
   std::filesystem::remove(path);
 }
 
@@ -338,11 +348,13 @@ TEST(UserGeometry, SceneLayoutFromStlAndNpyEqualsTheBoxScene) {
   // The STL in millimetres, placed by scale and offset.
   TriangleSurface mm = box_surface(1e3 * (lo - Vec3(0.001, 0, 0)), 1e3 * (hi - Vec3(0.001, 0, 0)));
   const std::string stl = write_temp("box.stl", binary_stl(mm));
-  const std::string common = "grid: {size: [6, 8, 4], voxel_size: 0.001}\n"
-                             "materials: [{id: 1, model: linear, E: 1.0e6, nu: 0.3}, {id: 2, model: linear, E: 1.0e7, nu: 0.3}]\n"
-                             "boundary: [{region: {face: zmin}, fix: [x, y, z]}]\n";
+  const std::string common =
+      "grid: {size: [6, 8, 4], voxel_size: 0.001}\n"
+      "materials: [{id: 1, model: linear, E: 1.0e6, nu: 0.3}, {id: 2, model: linear, E: 1.0e7, nu: 0.3}]\n"
+      "boundary: [{region: {face: zmin}, fix: [x, y, z]}]\n";
   const Scene boxes = read_scene(Config::from_string(
-      common + "layout: [{fill: 1}, {box: {min: [0.001, 0.002, 0], max: [0.004, 0.006, 0.003]}, id: 2}]\n", "box.yaml"));
+      common + "layout: [{fill: 1}, {box: {min: [0.001, 0.002, 0], max: [0.004, 0.006, 0.003]}, id: 2}]\n",
+      "box.yaml"));
   const Scene from_stl = read_scene(Config::from_string(
       common + "layout: [{fill: 1}, {mesh: {file: " + stl + ", scale: 0.001, offset: [0.001, 0, 0]}, id: 2}]\n",
       "stl.yaml"));
@@ -353,7 +365,8 @@ TEST(UserGeometry, SceneLayoutFromStlAndNpyEqualsTheBoxScene) {
     for (int j = 0; j < 8; ++j)
       for (int k = 0; k < 4; ++k) data += char(boxes.grid.at(i, j, k));
   const std::string array = write_temp("ids.npy", npy_file_bytes("|u1", false, "(6, 8, 4)", data));
-  const Scene from_npy = read_scene(Config::from_string(common + "layout: [{voxels: {file: " + array + "}}]\n", "npy.yaml"));
+  const Scene from_npy =
+      read_scene(Config::from_string(common + "layout: [{voxels: {file: " + array + "}}]\n", "npy.yaml"));
   EXPECT_EQ(from_npy.grid.ids, boxes.grid.ids);
 
   // An id outside the palette, a surface with a hole and a surface outside
@@ -366,15 +379,15 @@ TEST(UserGeometry, SceneLayoutFromStlAndNpyEqualsTheBoxScene) {
   holed.triangles.pop_back();
   const std::string holed_stl = write_temp("holed.stl", binary_stl(holed));
   try {
-    read_scene(Config::from_string(common + "layout: [{fill: 1}, {mesh: {file: " + holed_stl + ", scale: 0.001}, id: 2}]\n",
-                                   "stl.yaml"));
+    read_scene(Config::from_string(
+        common + "layout: [{fill: 1}, {mesh: {file: " + holed_stl + ", scale: 0.001}, id: 2}]\n", "stl.yaml"));
     ADD_FAILURE() << "an open surface was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("does not enclose a volume: 3 triangle edges"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(read_scene(Config::from_string(
-                   common + "layout: [{fill: 1}, {mesh: {file: " + stl + ", scale: 0.001, offset: [1, 0, 0]}, id: 2}]\n",
-                   "stl.yaml")),
+  EXPECT_THROW(read_scene(Config::from_string(common + "layout: [{fill: 1}, {mesh: {file: " + stl +
+                                                  ", scale: 0.001, offset: [1, 0, 0]}, id: 2}]\n",
+                                              "stl.yaml")),
                InputError);
   for (const std::string& p : {stl, array, bad_array, holed_stl}) std::filesystem::remove(p);
 }

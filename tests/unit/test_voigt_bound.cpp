@@ -54,9 +54,9 @@ TEST(VoigtBound, ConditionsAreZeroOnTheBoundAndMeasureTheExcessPerMode) {
     const MatX Cs = stiff_tensor(dim);
     const VoigtBound bound(Cs, MatX::Zero(Cs.rows(), Cs.cols()), VoigtBoundModes::cubic);
     ASSERT_EQ(bound.count(), 3);
-    EXPECT_LT(bound.evaluate(Cs, 1.0).cwiseAbs().maxCoeff(), 1e-12);         // the solid
-    EXPECT_LT(bound.evaluate(0.5 * Cs, 0.5).cwiseAbs().maxCoeff(), 1e-12);   // SIMP p = 1
-    const VecX g = bound.evaluate(0.5 * Cs, 0.4);  // 0.1 of the solid too stiff in every mode
+    EXPECT_LT(bound.evaluate(Cs, 1.0).cwiseAbs().maxCoeff(), 1e-12);        // the solid
+    EXPECT_LT(bound.evaluate(0.5 * Cs, 0.5).cwiseAbs().maxCoeff(), 1e-12);  // SIMP p = 1
+    const VecX g = bound.evaluate(0.5 * Cs, 0.4);                           // 0.1 of the solid too stiff in every mode
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(g[i], 0.1, 1e-12);
   }
   const MatX Cs = stiff_tensor(2);
@@ -185,7 +185,9 @@ material: {E: 1.0e6, nu: 0.3}
 supports: [{box: {min: [0, 0], max: [0, 12]}}]
 loads: [{objective: compliance, forces: [{box: {min: [12, 0], max: [24, 0]}, force: [0, -1], distribute: total}]}]
 filter: {radius: 1.5}
-)", "test"), 0, 4);
+)",
+                                                               "test"),
+                                           0, 4);
   const GamutLevelSet cubic = generous_gamut(4);
   CellMaterialSettings ms;
   ms.space = space;
