@@ -62,6 +62,14 @@ CoarseGrid group_blocks(const VoxelGrid& g) {
   return c;
 }
 
+// The fine voxel grid every level of a hierarchy refers back to.
+void set_fine_frame(CoarseGrid& c, int nx, int ny, int nz, double voxel_size) {
+  c.fine_nx = nx;
+  c.fine_ny = ny;
+  c.fine_nz = nz;
+  c.fine_voxel_size = voxel_size;
+}
+
 }  // namespace
 
 int CoarseGrid::num_elements() const {
@@ -81,10 +89,7 @@ CoarseGrid coarsen_grid(const VoxelGrid& fine) {
   const auto t0 = Clock::now();
   CoarseGrid c = group_blocks(fine);
   c.level = 1;
-  c.fine_nx = fine.nx;
-  c.fine_ny = fine.ny;
-  c.fine_nz = fine.nz;
-  c.fine_voxel_size = fine.voxel_size;
+  set_fine_frame(c, fine.nx, fine.ny, fine.nz, fine.voxel_size);
   c.seconds = seconds_since(t0);
   return c;
 }
@@ -93,10 +98,7 @@ CoarseGrid coarsen_grid(const CoarseGrid& coarse) {
   const auto t0 = Clock::now();
   CoarseGrid c = group_blocks(coarse.as_voxel_grid());
   c.level = coarse.level + 1;
-  c.fine_nx = coarse.fine_nx;
-  c.fine_ny = coarse.fine_ny;
-  c.fine_nz = coarse.fine_nz;
-  c.fine_voxel_size = coarse.fine_voxel_size;
+  set_fine_frame(c, coarse.fine_nx, coarse.fine_ny, coarse.fine_nz, coarse.fine_voxel_size);
   c.seconds = seconds_since(t0);
   return c;
 }

@@ -232,19 +232,16 @@ std::vector<ForcePattern> make_force_patterns(const FineBlock& block, const Forc
       add(kind, d, family_second(kind, t), [&](const Vec3& r) { return family_field(kind, d, t, r); });
   }
   // Pinching: the two corners of each cube edge pushed towards each other.
-  for (int a = 0; a < 8; ++a)
-    for (int bit = 0; bit < 3; ++bit) {
-      const int b = a | (1 << bit);
-      if (b == a) continue;
-      ForcePattern p;
-      p.kind = ForceKind::pinch;
-      p.direction = Vec3::Unit(2 - bit);  // bit 2 is x, bit 0 is z
-      p.second = block.coarse_rest_positions().row(a).transpose();
-      p.force.setZero(3 * n);
-      p.force.segment<3>(3 * block.corner_nodes[a]) = p.direction / std::sqrt(2.0);
-      p.force.segment<3>(3 * block.corner_nodes[b]) = -p.direction / std::sqrt(2.0);
-      patterns.push_back(std::move(p));
-    }
+  for_each_cube_edge([&](int a, int b, const Vec3& e) {
+    ForcePattern p;
+    p.kind = ForceKind::pinch;
+    p.direction = e;
+    p.second = block.coarse_rest_positions().row(a).transpose();
+    p.force.setZero(3 * n);
+    p.force.segment<3>(3 * block.corner_nodes[a]) = p.direction / std::sqrt(2.0);
+    p.force.segment<3>(3 * block.corner_nodes[b]) = -p.direction / std::sqrt(2.0);
+    patterns.push_back(std::move(p));
+  });
   return patterns;
 }
 

@@ -174,6 +174,16 @@ inline constexpr std::array<ForceKind, 4> kSmoothFamilies{ForceKind::stretch, Fo
 inline Vec3 family_second(ForceKind kind, const Vec3& t) {
   return kind == ForceKind::shear || kind == ForceKind::bend ? t : Vec3::Zero();
 }
+// The pinching pairs in pattern order: every edge of the cube as corners
+// a < b that differ in one bit, with the edge's axis (bit 2 is x, bit 0 is z).
+template <class Visit>
+void for_each_cube_edge(Visit&& visit) {
+  for (int a = 0; a < 8; ++a)
+    for (int bit = 0; bit < 3; ++bit) {
+      const int b = a | (1 << bit);
+      if (b != a) visit(a, b, Vec3(Vec3::Unit(2 - bit)));
+    }
+}
 // Sampling directions: axes then the seeded Fibonacci hemisphere.
 std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, std::uint64_t seed);
 

@@ -60,18 +60,14 @@ std::vector<ForcePattern> make_corner_displacement_patterns(const FineBlock& blo
     for (ForceKind kind : kSmoothFamilies)
       add(kind, d, family_second(kind, t), [&](const Vec3& r) { return family_field(kind, d, t, r); });
   }
-  for (int a = 0; a < 8; ++a)
-    for (int bit = 0; bit < 3; ++bit) {
-      const int b = a | (1 << bit);
-      if (b == a) continue;
-      const Vec3 e = Vec3::Unit(2 - bit);  // bit 2 is x, bit 0 is z
-      add(ForceKind::pinch, e, X.row(a).transpose(), [&](const Vec3& r) -> Vec3 {
-        const Vec3 at = center + h * r;
-        if ((at - X.row(a).transpose()).norm() < 1e-9 * h) return e;
-        if ((at - X.row(b).transpose()).norm() < 1e-9 * h) return -e;
-        return Vec3::Zero();
-      });
-    }
+  for_each_cube_edge([&](int a, int b, const Vec3& e) {
+    add(ForceKind::pinch, e, X.row(a).transpose(), [&](const Vec3& r) -> Vec3 {
+      const Vec3 at = center + h * r;
+      if ((at - X.row(a).transpose()).norm() < 1e-9 * h) return e;
+      if ((at - X.row(b).transpose()).norm() < 1e-9 * h) return -e;
+      return Vec3::Zero();
+    });
+  });
   return patterns;
 }
 

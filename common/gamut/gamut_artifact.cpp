@@ -33,10 +33,7 @@ void write_gamut_artifact(const std::string& path, const Gamut& g, const std::st
 }
 
 void write_gamut(H5File& f, const Gamut& g) {
-  f.write_attribute("/", "space", g.space);
-  f.write_attribute("/", "property_names", format_name_list(g.property_names));
-  f.write_attribute("/", "E_stiff", g.E_stiff);
-  f.write_attribute("/", "decades", g.decades);
+  write_space_label(f, g);
   const GamutLevelSet& ls = g.level_set;
   std::vector<hsize_t> shape(ls.dimension(), hsize_t(ls.cells()));
   f.write_dataset("/level_set/phi", ls.values(), shape);
@@ -99,10 +96,7 @@ Gamut read_gamut_artifact(const std::string& path) {
   const ArtifactReader in(path, kGamutSchema, kGamutSchemaVersion);
   const H5File& f = in.file();
   Gamut g;
-  g.space = f.read_string_attribute("/", "space");
-  g.property_names = parse_name_list(f.read_string_attribute("/", "property_names"));
-  g.E_stiff = f.read_attribute<double>("/", "E_stiff");
-  g.decades = f.read_attribute<double>("/", "decades");
+  static_cast<SpaceLabel&>(g) = read_space_label(f);
   const int d = f.read_attribute<std::int32_t>("/level_set", "dimension");
   if (d != static_cast<int>(g.property_names.size()))
     throw InputError(path + ": /level_set dimension " + std::to_string(d) + " differs from the " +

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gamut/level_set.hpp"
+#include "gamut/space_label.hpp"
 
 namespace msfab {
 
@@ -24,10 +25,7 @@ struct GamutCycle {
   double seconds = 0;                            // wall time of the cycle
 };
 
-struct Gamut {
-  std::string space;  // MaterialSpace kind name
-  std::vector<std::string> property_names;
-  double E_stiff = 0, decades = 4;
+struct Gamut : SpaceLabel {
   GamutLevelSet level_set;
   std::vector<GamutCycle> history;
   // The base materials as tensors of the space (3 x 3 plane-strain in-plane

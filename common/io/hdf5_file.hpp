@@ -32,27 +32,17 @@ class AtomicFile;
 // The element types a dataset or numeric attribute may have.
 enum class H5Dtype { kFloat64, kInt32, kInt64, kUInt8, kUInt64 };
 
+// The dtype of a supported element type; any other T fails to compile.
 template <class T>
-struct H5DtypeOf;  // undefined: T is not a supported element type
-template <>
-struct H5DtypeOf<double> {
-  static constexpr H5Dtype value = H5Dtype::kFloat64;
-};
-template <>
-struct H5DtypeOf<std::int32_t> {
-  static constexpr H5Dtype value = H5Dtype::kInt32;
-};
-template <>
-struct H5DtypeOf<std::int64_t> {
-  static constexpr H5Dtype value = H5Dtype::kInt64;
-};
-template <>
-struct H5DtypeOf<std::uint8_t> {
-  static constexpr H5Dtype value = H5Dtype::kUInt8;
-};
-template <>
-struct H5DtypeOf<std::uint64_t> {
-  static constexpr H5Dtype value = H5Dtype::kUInt64;
+struct H5DtypeOf {
+  static_assert(std::is_same_v<T, double> || std::is_same_v<T, std::int32_t> || std::is_same_v<T, std::int64_t> ||
+                    std::is_same_v<T, std::uint8_t> || std::is_same_v<T, std::uint64_t>,
+                "T is not a supported HDF5 element type");
+  static constexpr H5Dtype value = std::is_same_v<T, double>         ? H5Dtype::kFloat64
+                                   : std::is_same_v<T, std::int32_t> ? H5Dtype::kInt32
+                                   : std::is_same_v<T, std::int64_t> ? H5Dtype::kInt64
+                                   : std::is_same_v<T, std::uint8_t> ? H5Dtype::kUInt8
+                                                                     : H5Dtype::kUInt64;
 };
 
 const char* dtype_name(H5Dtype dtype);  // "float64", "int32", ...

@@ -53,6 +53,25 @@ struct LinearSolverKeys {
 LinearSolverChoice read_linear_solver_choice(const Config& config, const std::vector<std::string>& offered,
                                              const LinearSolverChoice& defaults, const LinearSolverKeys& keys = {});
 
+// Between a choice and a solver's options, which name the limits
+// pcg_tolerance, pcg_max_iterations and pcg_max_iterations_key
+// (LinearSolverOptions; a template because solve/ sits beside io/, not
+// below it).
+template <class SolverOptions>
+LinearSolverChoice linear_solver_defaults(const std::string& kind, const SolverOptions& options) {
+  LinearSolverChoice defaults;
+  defaults.kind = kind;
+  defaults.tolerance = options.pcg_tolerance;
+  defaults.max_iterations = options.pcg_max_iterations;
+  return defaults;
+}
+template <class SolverOptions>
+void apply_linear_solver_limits(const LinearSolverChoice& choice, SolverOptions& options) {
+  options.pcg_tolerance = choice.tolerance;
+  options.pcg_max_iterations = choice.max_iterations;
+  options.pcg_max_iterations_key = choice.max_iterations_key;
+}
+
 // The choice with its kind replaced by a command-line option (--solver);
 // the same checks, the message naming the option.
 void override_linear_solver_kind(LinearSolverChoice& choice, const std::string& kind,

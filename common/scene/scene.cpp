@@ -437,19 +437,13 @@ Scene read_scene(const Config& config) {
     o.load_steps = c.get_or<int>("load_steps", o.load_steps);
     if (o.load_steps < 1) c.fail("load_steps", "must be at least 1");
     o.max_step_halvings = c.get_or<int>("max_step_halvings", o.max_step_halvings);
-    LinearSolverChoice defaults;
-    defaults.kind = o.linear_solver;
-    defaults.tolerance = o.linear.pcg_tolerance;
-    defaults.max_iterations = o.linear.pcg_max_iterations;
     LinearSolverKeys keys;
     keys.legacy_tolerance = "pcg_tolerance";
     keys.legacy_max_iterations = "pcg_max_iterations";
-    const LinearSolverChoice linear =
-        read_linear_solver_choice(c, {"auto", "cholmod", "pcg", "pcg-mg"}, defaults, keys);
+    const LinearSolverChoice linear = read_linear_solver_choice(
+        c, {"auto", "cholmod", "pcg", "pcg-mg"}, linear_solver_defaults(o.linear_solver, o.linear), keys);
     o.linear_solver = linear.kind;
-    o.linear.pcg_tolerance = linear.tolerance;
-    o.linear.pcg_max_iterations = linear.max_iterations;
-    o.linear.pcg_max_iterations_key = linear.max_iterations_key;
+    apply_linear_solver_limits(linear, o.linear);
     o.linear.pcg_preconditioner = c.get_or<std::string>("pcg_preconditioner", o.linear.pcg_preconditioner);
     o.auto_iterative_dofs = c.get_or<int>("auto_iterative_dofs", o.auto_iterative_dofs);
   }

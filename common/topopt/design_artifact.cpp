@@ -71,10 +71,7 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
   check_sizes(d, path);
   ArtifactWriter out(path, kDesignSchema, kDesignSchemaVersion, executable, config_text, inputs, seed);
   H5File& f = out.file();
-  f.write_attribute("/", "space", d.space);
-  f.write_attribute("/", "property_names", format_name_list(d.property_names));
-  f.write_attribute("/", "E_stiff", d.E_stiff);
-  f.write_attribute("/", "decades", d.decades);
+  write_space_label(f, d);
   f.write_attribute("/", "dimension", static_cast<std::int32_t>(d.dimension));
   f.write_attribute("/", "grid", std::vector<std::int32_t>{d.nx, d.ny, d.nz});
   f.write_attribute("/", "cell_size", d.cell_size);
@@ -133,10 +130,7 @@ Design read_design_artifact(const std::string& path) {
   const ArtifactReader in(path, kDesignSchema, kDesignSchemaVersion);
   const H5File& f = in.file();
   Design d;
-  d.space = f.read_string_attribute("/", "space");
-  d.property_names = parse_name_list(f.read_string_attribute("/", "property_names"));
-  d.E_stiff = f.read_attribute<double>("/", "E_stiff");
-  d.decades = f.read_attribute<double>("/", "decades");
+  static_cast<SpaceLabel&>(d) = read_space_label(f);
   d.dimension = f.read_attribute<std::int32_t>("/", "dimension");
   const auto grid = f.read_attribute_vector<std::int32_t>("/", "grid");
   if (grid.size() != 3) throw InputError(path + ": attribute grid must have 3 entries");

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "gamut/space_label.hpp"
 
 namespace msfab {
 
@@ -30,12 +31,10 @@ struct DesignHistoryEntry {
   double seconds = 0;        // wall time since the start
 };
 
-struct Design {
-  std::string space;  // cubic3d | cubic2d | orthotropic2d | isotropic2d | isotropic3d | analytic2d | analytic3d |
-                      // simp2d | simp3d
-  std::vector<std::string> property_names;
-  double E_stiff = 0, decades = 4;  // the normalization (MaterialSpace)
-  int dimension = 2;                // 2 or 3
+// The space (SpaceLabel::space) is one of cubic3d | cubic2d | orthotropic2d |
+// isotropic2d | isotropic3d | analytic2d | analytic3d | simp2d | simp3d.
+struct Design : SpaceLabel {
+  int dimension = 2;  // 2 or 3
   int nx = 0, ny = 0, nz = 1;
   double cell_size = 1.0;       // cell edge length (m)
   MatX unit;                    // cells x properties, normalized parameters

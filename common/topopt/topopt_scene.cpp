@@ -276,17 +276,12 @@ TopoptScene read_topopt_scene(const Config& config, double gamut_E_stiff, double
   read_mass_terms(config, g, scene);
   s.filter_radius = config.get_or<double>("filter.radius", 0.0);
   if (!(s.filter_radius >= 0)) config.fail("filter.radius", "must be >= 0");
-  LinearSolverChoice defaults;
-  defaults.tolerance = s.solver_options.pcg_tolerance;
-  defaults.max_iterations = s.solver_options.pcg_max_iterations;
   LinearSolverKeys keys;
   keys.legacy_kind = "solver";
-  const LinearSolverChoice linear =
-      read_linear_solver_choice(config, {"auto", "cholmod", "pcg-mg", "matrix-free"}, defaults, keys);
+  const LinearSolverChoice linear = read_linear_solver_choice(config, {"auto", "cholmod", "pcg-mg", "matrix-free"},
+                                                              linear_solver_defaults("auto", s.solver_options), keys);
   s.solver = linear.kind;
-  s.solver_options.pcg_tolerance = linear.tolerance;
-  s.solver_options.pcg_max_iterations = linear.max_iterations;
-  s.solver_options.pcg_max_iterations_key = linear.max_iterations_key;
+  apply_linear_solver_limits(linear, s.solver_options);
   return scene;
 }
 
