@@ -156,8 +156,10 @@ QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& 
   options.load_steps = scene.preload_steps;
   options.threads = 1;  // as the Newmark factorization: same bits for any --threads
   options.self_contact = scene.press_self_contact;
-  return solve_quasistatic_loading(sim.assembler(), sim.model().obstacles, scale * load + sim.gravity_force(),
-                                   scene.initial_positions, options);
+  QuasistaticResult r = solve_quasistatic_loading(sim.assembler(), sim.model().obstacles,
+                                                  scale * load + sim.gravity_force(), scene.initial_positions, options);
+  if (!r.converged) throw NumericalError(r.failure + "\n" + format_quasistatic_history(r.history));
+  return r;
 }
 
 // press.stop_at_touch: the largest fraction of the load whose equilibrium
@@ -237,6 +239,39 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
   return q;
 }
 
+// One elastic step of length h, retaken as two halves, recursively down to
+// h / 2^levels, where it fails or where a contact event falls in it (the
+// active contacts start or stop: a touch-down, a push-off, a lift-off).
+// The impulses and the friction of the event then act over the short steps
+// in which it happens instead of over a whole step. With levels = 0 it is
+// sim.step(). Returns the last (sub)step's report with the Newton
+// iterations, sweeps and seconds of every try; `steps` counts the steps
+// kept.
+StepReport elastic_step(NewmarkIntegrator& sim, double h, int levels, bool active_before, std::int64_t& steps) {
+  const VecX q = sim.positions(), v = sim.velocities();
+  const double t = sim.time();
+  sim.set_time_step(h);
+  const StepReport whole = sim.try_step();
+  const bool event = whole.converged && (whole.active_contacts > 0) != active_before;
+  if (levels == 0 || (whole.converged && !event)) {
+    if (!whole.converged) throw NumericalError(whole.failure);
+    ++steps;
+    return whole;
+  }
+  sim.set_state(q, v, t);
+  const StepReport first = elastic_step(sim, h / 2, levels - 1, active_before, steps);
+  StepReport second = elastic_step(sim, h / 2, levels - 1, first.active_contacts > 0, steps);
+  sim.set_time_step(h);
+  for (const StepReport* r : {&whole, &first}) {
+    second.newton_iterations += r->newton_iterations;
+    second.contact_rounds += r->contact_rounds;
+    second.gauss_seidel_sweeps += r->gauss_seidel_sweeps;
+    second.seconds += r->seconds;
+  }
+  second.max_penetration = std::max(second.max_penetration, first.max_penetration);
+  return second;
+}
+
 }  // namespace
 
 Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& callbacks) {
@@ -249,6 +284,7 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
   out.material_names.push_back("void");
   for (const SceneMaterial& m : scene.materials) out.material_names.push_back(m.name);
   out.time_step = scene.newmark.time_step;
+  out.event_substeps = scene.event_substeps;
   out.impact_model = impact_model_name(scene.model.impact);
 
   NewmarkIntegrator sim(scene.model, scene.newmark);
@@ -272,7 +308,7 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
   const RigidBody& body = rec.body();
   const double horizon = scene.rigid.lookahead_steps * h;
   const double margin = 0.05 * sim.element_size();
-  bool rigid = false, touching = false;
+  bool rigid = false, touching = false, active_before = false;
   RigidState state;
   double time = 0;
   for (int k = 1; k <= steps; ++k) {
@@ -298,7 +334,8 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
       rigid = false;
       rec.event(time, "elastic", "contact ahead: projected back to the FE model (B.23)");
     }
-    const StepReport r = sim.step();
+    const StepReport r = elastic_step(sim, h, scene.event_substeps, active_before, out.elastic_steps);
+    active_before = r.active_contacts > 0;
     time = sim.time();
     out.seconds_elastic += r.seconds;
     rec.sample(SimulationPhase::kElastic, sim.positions(), sim.velocities(), r, time);

@@ -253,6 +253,8 @@ void read_simulation_settings(const Config& sim, bool has_friction_table, Dynami
         << kMaxTimeSteps << " are allowed (use a larger time_step or a shorter duration)";
     sim.fail("time_step", msg.str());
   }
+  s.event_substeps = sim.get_or<int>("event_substeps", 0);
+  if (s.event_substeps < 0 || s.event_substeps > 12) sim.fail("event_substeps", "must be 0..12");
   s.output_every = sim.get_or<int>("output_every", 10);
   if (s.output_every < 1) sim.fail("output_every", "must be >= 1");
   model.body_contact = sim.get_or<bool>("body_contact", s.body_names.size() > 1);

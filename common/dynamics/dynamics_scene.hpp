@@ -56,6 +56,10 @@ struct DynamicsScene {
   DynamicsModel model;
   VecX initial_positions, initial_velocities;
   NewmarkOptions newmark;
+  // Elastic steps in which a contact event falls (the active contacts start
+  // or stop) or that fail are retaken as two halves, recursively, down to
+  // time_step / 2^event_substeps (`simulation.event_substeps`; 0: never).
+  int event_substeps = 0;
   double duration = 0;
   int output_every = 1;
   Preload preload = Preload::kNone;

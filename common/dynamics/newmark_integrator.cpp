@@ -16,6 +16,7 @@
 #include "fem/hex_boundary.hpp"
 #include "material/scaled_material.hpp"
 #include "solve/cholmod_solver.hpp"
+#include "solve/regularized_step.hpp"
 
 namespace msfab {
 
@@ -158,6 +159,12 @@ NewmarkIntegrator::NewmarkIntegrator(const DynamicsModel& model, const NewmarkOp
 }
 
 NewmarkIntegrator::~NewmarkIntegrator() = default;
+
+void NewmarkIntegrator::set_time_step(double h) {
+  if (!(h > 0) || !std::isfinite(h))
+    throw InputError("dynamics: time_step must be positive (got " + std::to_string(h) + ")");
+  options_.time_step = h;
+}
 
 void NewmarkIntegrator::apply_fixed(VecX& x) const {
   if (model_.fixed.empty()) return;
@@ -327,6 +334,26 @@ void NewmarkIntegrator::set_applied_load(const VecX& load, std::function<double(
 }
 
 StepReport NewmarkIntegrator::step() {
+  StepReport report = try_step();
+  if (!report.converged) throw NumericalError(report.failure);
+  return report;
+}
+
+StepReport NewmarkIntegrator::try_step() {
+  // The state (q, v, t) changes only when a step is taken, so a step that
+  // fails leaves the integrator where it was, ready for another try.
+  try {
+    StepReport report = take_step();
+    report.converged = true;
+    return report;
+  } catch (const NumericalError& e) {
+    StepReport report;
+    report.failure = e.what();
+    return report;
+  }
+}
+
+StepReport NewmarkIntegrator::take_step() {
   const auto t0 = std::chrono::steady_clock::now();
   StepReport report;
   const double h = options_.time_step;
@@ -453,14 +480,17 @@ int NewmarkIntegrator::solve_step(VecX& delta, const std::vector<Contact>& conta
     if (c > 5 && residual <= kStallFactor * options_.newton_tolerance && residual > 0.9 * history[c - 6]) return it - 1;
 
     assemble_jacobian(K);
-    double shift = 0;
-    while (!solver_->factorize(jacobian_, shift)) {
-      shift = shift == 0 ? 1e-10 * jacobian_.diagonal().cwiseAbs().maxCoeff() : 10 * shift;
-      if (shift > jacobian_.diagonal().cwiseAbs().maxCoeff())
-        throw NumericalError("dynamics: the Newmark Jacobian is not positive definite at t = " + std::to_string(time_) +
-                             " s; reduce the time step");
-    }
-    const VecX delta_free = delta - solver_->solve(f);
+    // The inertia term keeps the Jacobian far from singular, so the shift
+    // starts lower than the static solver's and goes up to the diagonal.
+    RegularizationSchedule schedule;
+    schedule.first_shift = 1e-10;
+    const RegularizedStep newton_step = solve_regularized_step(
+        *solver_, jacobian_, jacobian_.diagonal().cwiseAbs().maxCoeff(), [&](double, VecX& b) { b = f; },
+        [](VecX&) { return true; }, rhs_, step_, "dynamics: ", schedule);
+    if (!newton_step.ok)
+      throw NumericalError("dynamics: the Newmark Jacobian is not positive definite at t = " + std::to_string(time_) +
+                           " s; reduce the time step");
+    const VecX delta_free = delta - step_;
     VecX candidate = delta_free;
     if (m > 0) {
       ContactProblem problem;

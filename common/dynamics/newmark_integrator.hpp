@@ -70,6 +70,8 @@ struct Energies {
 };
 
 struct StepReport {
+  bool converged = false;
+  std::string failure;  // why the step was not taken (try_step), when not converged
   int newton_iterations = 0;
   int contact_rounds = 0;
   int contacts = 0;         // in the contact set
@@ -97,6 +99,14 @@ class NewmarkIntegrator {
   // One time step; NumericalError with the residual history if Newton or
   // the contact solve does not converge.
   StepReport step();
+  // The same step, reporting failure as solve_static and the quasistatic
+  // press do: converged = false with the reason, the state unchanged (so a
+  // caller may retry, e.g. with a smaller time step).
+  StepReport try_step();
+  // The length of the next steps (InputError unless positive and finite);
+  // the run's event substeps change it around contact events.
+  void set_time_step(double h);
+  double time_step() const { return options_.time_step; }
 
   const VecX& positions() const { return q_; }
   const VecX& velocities() const { return v_; }
@@ -129,6 +139,7 @@ class NewmarkIntegrator {
   // Phi(delta) = 1/2 delta^T (M + h/2 D) delta - b^T delta + h^2/4 (E(q^t + delta) - f_g^T delta),
   // whose gradient is the residual of (B.6) with D held at q^t.
   double step_potential(const VecX& delta) const;
+  StepReport take_step();  // throws NumericalError where the step cannot be taken
   void apply_fixed(VecX& x) const;
   // The unknowns the contacts touch (fixed ones left out), sorted.
   std::vector<int> contact_unknowns(const std::vector<Contact>& contacts) const;
@@ -150,6 +161,7 @@ class NewmarkIntegrator {
   SpMat damping_, inertia_, jacobian_;
   std::vector<int> fixed_value_index_, fixed_diagonal_index_;
   std::unique_ptr<CholmodSolver> solver_;
+  VecX rhs_, step_;   // the Newton system's right-hand side and solution (work vectors)
   VecX lumped_mass_;  // per node, the DKE projection's metric
   VecX gravity_force_;
   VecX applied_load_;

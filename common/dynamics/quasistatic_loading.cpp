@@ -550,13 +550,17 @@ QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, c
   };
   const LoadContinuationResult loaded = continue_load(continuation);
   if (!loaded.converged) {
-    std::ostringstream msg;
-    msg << "quasistatic loading failed at load factor " << loaded.failed_at << " after " << loaded.halvings
-        << " load-step halvings: " << loaded.why << "\n"
-        << format_quasistatic_history(press.result().history);
-    throw NumericalError(msg.str());
+    QuasistaticResult failed = press.result();  // restored to the last converged load factor
+    failed.load_steps = loaded.load_steps;
+    std::ostringstream why;
+    why << "quasistatic loading failed at load factor " << loaded.failed_at << " after " << loaded.halvings
+        << " load-step halvings: " << loaded.why;
+    failed.failure = why.str();
+    return failed;
   }
-  return press.finish(loaded.load_steps);
+  QuasistaticResult done = press.finish(loaded.load_steps);
+  done.converged = true;
+  return done;
 }
 
 }  // namespace msfab

@@ -73,6 +73,8 @@ struct QuasistaticIteration {
 };
 
 struct QuasistaticResult {
+  bool converged = false;
+  std::string failure;                        // why it stopped, when not converged
   VecX x;                                     // equilibrium positions (3N, node-major)
   std::vector<ContactVertex> contacts;        // active vertices, ascending node order
   std::vector<SelfContactTie> self_contacts;  // nodes tied to faces, with their reactions
@@ -88,8 +90,10 @@ struct QuasistaticResult {
 // x0 (3N; rest positions when empty), which must not penetrate an obstacle
 // deeper than penetration_tolerance * dx.
 // Throws InputError for mismatched sizes, non-finite values, invalid
-// options or obstacles, an inverted or penetrating initial state; throws
-// NumericalError (with the iteration history) when no equilibrium is found.
+// options or obstacles, an inverted or penetrating initial state. Never
+// throws when no equilibrium is found, as solve_static: the result says
+// converged = false with the reason, the history and the positions of the
+// last converged load factor, and callers decide.
 QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, const std::vector<Obstacle>& obstacles,
                                             const VecX& force, const VecX& x0 = VecX(),
                                             const QuasistaticOptions& options = {});

@@ -368,6 +368,8 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
   f.write_attribute("/", "scene", t.scene);
   f.write_attribute("/", "impact_model", t.impact_model);
   f.write_attribute("/", "time_step", t.time_step);
+  f.write_attribute("/", "event_substeps", static_cast<std::int32_t>(t.event_substeps));
+  f.write_attribute("/", "elastic_steps", t.elastic_steps);
 
   // write_hex_mesh reads only the nodes, elements and tags of a HexMesh.
   HexMesh mesh;
@@ -434,6 +436,10 @@ Trajectory read_trajectory_artifact(const std::string& path) {
   t.scene = f.read_string_attribute("/", "scene");
   t.impact_model = f.read_string_attribute("/", "impact_model");
   t.time_step = f.read_attribute<double>("/", "time_step");
+  if (f.has_attribute("/", "elastic_steps")) {  // written since event substeps exist
+    t.event_substeps = f.read_attribute<std::int32_t>("/", "event_substeps");
+    t.elastic_steps = f.read_attribute<std::int64_t>("/", "elastic_steps");
+  }
 
   StoredHexMesh mesh = read_hex_mesh(f, "/mesh");
   if (mesh.element_tag.size() != mesh.elements.size())

@@ -87,6 +87,8 @@ struct Trajectory {
   // Wall time by phase (s) and in total.
   double seconds_quasistatic = 0, seconds_elastic = 0, seconds_rigid = 0, seconds_total = 0;
   double time_step = 0;
+  int event_substeps = 0;          // the scene's refinement levels around contact events
+  std::int64_t elastic_steps = 0;  // Newmark steps taken, substeps counted one each
   std::string impact_model;
   TrajectoryCoarsening coarsening;
   TrajectoryComparison comparison;

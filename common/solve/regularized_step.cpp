@@ -5,21 +5,14 @@
 #include "core/errors.hpp"
 
 namespace msfab {
-namespace {
-
-constexpr int kMaxFactorizations = 12;
-constexpr double kFirstShift = 1e-8;  // relative to the system's scale
-constexpr double kShiftGrowth = 10;
-
-}  // namespace
 
 RegularizedStep solve_regularized_step(LinearSolver& solver, const SpMat& K, double scale,
                                        const std::function<void(double, VecX&)>& right_hand_side,
                                        const std::function<bool(VecX&)>& accept, VecX& rhs, VecX& step,
-                                       const char* context) {
+                                       const char* context, const RegularizationSchedule& schedule) {
   RegularizedStep out;
-  for (int attempt = 0; attempt < kMaxFactorizations && !out.ok; ++attempt) {
-    if (attempt > 0) out.shift = (out.shift == 0) ? kFirstShift * scale : out.shift * kShiftGrowth;
+  for (int attempt = 0; attempt < schedule.max_factorizations && !out.ok; ++attempt) {
+    if (attempt > 0) out.shift = (out.shift == 0) ? schedule.first_shift * scale : out.shift * schedule.growth;
     if (!solver.factorize(K, out.shift)) continue;
     right_hand_side(out.shift, rhs);
     try {

@@ -583,3 +583,34 @@ TEST(Newmark, RejectsBadInput) {
   model.density[0] = 0;
   EXPECT_THROW(NewmarkIntegrator(model, opt), InputError);
 }
+
+TEST(Newmark, AFailedStepIsReportedAndLeavesTheStateAsItWas) {
+  // One Newton iteration is never enough (convergence is checked from the
+  // second on): try_step reports it, step throws it, and neither moves the
+  // state, so a caller can retry.
+  const DynamicsModel model = clamped_linear_bar(0, 0);
+  NewmarkOptions opt;
+  opt.time_step = 1e-4;
+  opt.max_newton_iterations = 1;
+  NewmarkIntegrator sim(model, opt);
+  const NewmarkMode mode = lowest_mode(sim);
+  const VecX q0 = sim.assembler().rest_positions() + 1e-4 * mode.shape;
+  const VecX v0 = 0.1 * mode.shape;
+  sim.set_state(q0, v0, 0.5);
+  const StepReport failed = sim.try_step();
+  EXPECT_FALSE(failed.converged);
+  EXPECT_NE(failed.failure.find("did not converge"), std::string::npos) << failed.failure;
+  EXPECT_EQ((sim.positions() - q0).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((sim.velocities() - v0).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(sim.time(), 0.5);
+  EXPECT_THROW(sim.step(), NumericalError);
+  EXPECT_EQ(sim.time(), 0.5);
+
+  opt.max_newton_iterations = 60;
+  NewmarkIntegrator retry(model, opt);
+  retry.set_state(q0, v0, 0.5);
+  const StepReport taken = retry.try_step();
+  EXPECT_TRUE(taken.converged) << taken.failure;
+  EXPECT_TRUE(taken.failure.empty());
+  EXPECT_GT(retry.time(), 0.5);
+}
