@@ -85,12 +85,8 @@ void print_summary(const DynamicsScene& scene, const Trajectory& t) {
               elastic_steps ? double(newton) / elastic_steps : 0.0,
               elastic_steps ? 1e3 * step_seconds / elastic_steps : 0.0, rigid_steps);
   if (t.event_substeps > 0)
-    std::printf(
-        "  event substeps (down to h / %d): %lld Newmark steps taken for the %d elastic ones
-        ",
-            1
-            << t.event_substeps,
-        static_cast<long long>(t.elastic_steps), elastic_steps);
+    std::printf("  event substeps (down to h / %d): %lld Newmark steps for the %d elastic steps\n",
+                1 << t.event_substeps, static_cast<long long>(t.elastic_steps), elastic_steps);
   std::printf("  centre of mass: start (%.5f, %.5f, %.5f) m, end (%.5f, %.5f, %.5f) m, highest z %.5f m\n",
               first.center_of_mass.x(), first.center_of_mass.y(), first.center_of_mass.z(), last.center_of_mass.x(),
               last.center_of_mass.y(), last.center_of_mass.z(), max_z);
