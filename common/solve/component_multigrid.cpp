@@ -250,23 +250,24 @@ bool ComponentMultigrid::factorize() {
 }
 
 void ComponentMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
-  if (index + 1 == levels_.size()) {
-    solution = coarse_solver_.solve(rhs);
-    return;
-  }
-  Level& level = *levels_[index];
-  Level& coarse = *levels_[index + 1];
-  const ComponentTransfer& transfer = components_->transfers()[index + 1];
-  level.smoother.smooth(rhs, solution, /*zero_start=*/true);
-  const int corrections = index == 0 ? 1 : kCoarseCorrections;
-  const auto is_free = [&level](int row, int d) { return !level.decoupled[3 * std::size_t(row) + std::size_t(d)]; };
-  for (int c = 0; c < corrections; ++c) {
-    level.smoother.residual(rhs, solution, level.residual);
-    component_restrict(transfer, level.residual, is_free, coarse.rhs, threads_);
-    cycle(index + 1, coarse.rhs, coarse.solution);
-    component_add_prolongation(transfer, coarse.solution, is_free, solution, threads_);
-  }
-  level.smoother.smooth(rhs, solution, /*zero_start=*/false);
+  // The component levels: their smoothers, the component transfers over the
+  // unknowns that are not decoupled, the sparse Cholesky on the coarsest.
+  struct Levels : multigrid_cycle::SmoothedLevels<decltype(levels_)> {
+    ComponentMultigrid& s;
+    auto free_in(std::size_t i) const {
+      const Level& level = *s.levels_[i];
+      return [&level](int row, int d) { return !level.decoupled[3 * std::size_t(row) + std::size_t(d)]; };
+    }
+    bool is_coarsest(std::size_t i) const { return i + 1 == s.levels_.size(); }
+    void solve_coarsest(std::size_t, const VecX& b, VecX& x) { x = s.coarse_solver_.solve(b); }
+    void restrict_to_coarse(std::size_t i, const VecX& r, VecX& coarse_rhs) {
+      component_restrict(s.components_->transfers()[i + 1], r, free_in(i), coarse_rhs, s.threads_);
+    }
+    void add_prolongation(std::size_t i, const VecX& coarse_x, VecX& x) {
+      component_add_prolongation(s.components_->transfers()[i + 1], coarse_x, free_in(i), x, s.threads_);
+    }
+  } levels{{levels_}, *this};
+  multigrid_cycle::cycle(levels, index, rhs, solution);
 }
 
 }  // namespace msfab

@@ -135,26 +135,22 @@ bool MultigridSolver::factorize(const SpMat& A, double shift) {
 }
 
 void MultigridSolver::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
-  if (index + 1 == levels_.size()) {
-    solution = coarse_solver_.solve(rhs);
-    return;
-  }
-  Level& level = *levels_[index];
-  Level& coarse = *levels_[index + 1];
-  const int threads = options_.threads;
-  level.smoother.smooth(rhs, solution, /*zero_start=*/true);
-  // Below the finest level two coarse corrections per visit (a W-cycle):
-  // the repeated correction is cheap there and keeps the cycle close to a
-  // two-grid method. Repeating the same symmetric correction keeps the
-  // cycle symmetric.
-  const int corrections = index == 0 ? 1 : kCoarseCorrections;
-  for (int c = 0; c < corrections; ++c) {
-    level.smoother.residual(rhs, solution, level.residual);
-    level.to_coarse->restrict_to_coarse(level.residual, level.decoupled, coarse.rhs, threads);
-    cycle(index + 1, coarse.rhs, coarse.solution);
-    level.to_coarse->add_prolongation(coarse.solution, level.decoupled, solution, threads);
-  }
-  level.smoother.smooth(rhs, solution, /*zero_start=*/false);
+  // The assembled levels: Chebyshev / block-Jacobi smoothing, lattice
+  // transfers that skip decoupled unknowns, CHOLMOD on the coarsest.
+  struct Levels : multigrid_cycle::SmoothedLevels<decltype(levels_)> {
+    MultigridSolver& s;
+    bool is_coarsest(std::size_t i) const { return i + 1 == s.levels_.size(); }
+    void solve_coarsest(std::size_t, const VecX& b, VecX& x) { x = s.coarse_solver_.solve(b); }
+    void restrict_to_coarse(std::size_t i, const VecX& r, VecX& coarse_rhs) {
+      const Level& level = *s.levels_[i];
+      level.to_coarse->restrict_to_coarse(r, level.decoupled, coarse_rhs, s.options_.threads);
+    }
+    void add_prolongation(std::size_t i, const VecX& coarse_x, VecX& x) {
+      const Level& level = *s.levels_[i];
+      level.to_coarse->add_prolongation(coarse_x, level.decoupled, x, s.options_.threads);
+    }
+  } levels{{levels_}, *this};
+  multigrid_cycle::cycle(levels, index, rhs, solution);
 }
 
 VecX MultigridSolver::apply_preconditioner(const VecX& r) {

@@ -290,72 +290,82 @@ void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
 }
 
 void PeriodicGridMultigrid::cycle(std::size_t index, const VecX& rhs, VecX& solution) {
-  Level& level = *levels_[index];
-  const int threads = options_.threads;
-  if (level.coarsest) {
-    VecX r = rhs;
-    project_zero_mean(r, threads);
-    const Eigen::Index N = r.size();
-    solution.resize(N);
-    solution.head<3>().setZero();
-    solution.tail(N - 3) = coarse_solver_.solve(r.tail(N - 3));
-    project_zero_mean(solution, threads);
-    return;
-  }
-  // Finest level: K x is applied whole before each smoothing pass and read back by rows.
-  const auto fine_product = fine_rows();
-  const auto apply_fine = [this](const VecX& x) { multiply(x, fine_product_); };
-  auto smooth = [&](bool zero_start) {
-    if (index == 0)
-      chebyshev::smooth(level.nodes(), fine_inverse_.data(), fine_max_eigenvalue_, options_.smoother_degree,
-                        fine_product, apply_fine, rhs, solution, zero_start, step_, next_, threads);
-    else
-      level.smoother.smooth(rhs, solution, zero_start);
-  };
-  Level& coarse = *levels_[index + 1];
-  const int team = resolve_thread_count(threads);
-  smooth(true);
-  const int corrections = index == 0 ? 1 : kCoarseCorrections;
-  for (int c = 0; c < corrections; ++c) {
-    if (index == 0) {
-      apply_fine(solution);
-      chebyshev::residual(level.nodes(), fine_product, rhs, solution, level.residual, threads);
-    } else
-      level.smoother.residual(rhs, solution, level.residual);
+  // The periodic grid levels: the finest matrix-free (K x applied whole
+  // before each smoothing pass and read back by rows), the others
+  // assembled; full-weighting transfers on the periodic lattice; the
+  // coarsest solved with its first node pinned, on zero-mean vectors.
+  struct Levels : multigrid_cycle::SmoothedLevels<decltype(levels_)> {
+    PeriodicGridMultigrid& s;
+    int threads = s.options_.threads;
+    int team = resolve_thread_count(threads);
+    bool is_coarsest(std::size_t i) const { return s.levels_[i]->coarsest; }
+    void solve_coarsest(std::size_t, const VecX& b, VecX& x) {
+      VecX r = b;
+      project_zero_mean(r, threads);
+      const Eigen::Index N = r.size();
+      x.resize(N);
+      x.head<3>().setZero();
+      x.tail(N - 3) = s.coarse_solver_.solve(r.tail(N - 3));
+      project_zero_mean(x, threads);
+    }
+    void apply_fine(const VecX& x) { s.multiply(x, s.fine_product_); }
+    void smooth(std::size_t i, const VecX& b, VecX& x, bool zero_start) {
+      if (i == 0)
+        chebyshev::smooth(
+            s.levels_[0]->nodes(), s.fine_inverse_.data(), s.fine_max_eigenvalue_, s.options_.smoother_degree,
+            s.fine_rows(), [this](const VecX& y) { apply_fine(y); }, b, x, zero_start, s.step_, s.next_, threads);
+      else
+        SmoothedLevels::smooth(i, b, x, zero_start);
+    }
+    void residual(std::size_t i, const VecX& b, const VecX& x, VecX& r) {
+      if (i == 0) {
+        apply_fine(x);
+        chebyshev::residual(s.levels_[0]->nodes(), s.fine_rows(), b, x, r, threads);
+      } else {
+        SmoothedLevels::residual(i, b, x, r);
+      }
+    }
     // Restriction P^T r: each coarse node gathers the fine nodes within one
     // fine spacing of its point, weight 1 or 1/2 per axis.
-    coarse.rhs.resize(3 * Eigen::Index(coarse.nodes()));
-    parallel_row_ranges(coarse.nodes(), team, [&](int begin, int end) {
-      for (int P = begin; P < end; ++P) {
-        const auto C = coarse.coords(P);
-        Vec3 sum = Vec3::Zero();
-        for (int dz = -1; dz <= 1; ++dz)
-          for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-              const double w = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
-              sum += w * level.residual.segment<3>(3 * level.node(2 * C[0] + dx, 2 * C[1] + dy, 2 * C[2] + dz));
-            }
-        coarse.rhs.segment<3>(3 * P) = sum;
-      }
-    });
-    cycle(index + 1, coarse.rhs, coarse.solution);
+    void restrict_to_coarse(std::size_t i, const VecX& r, VecX& coarse_rhs) {
+      const Level& level = *s.levels_[i];
+      const Level& coarse = *s.levels_[i + 1];
+      coarse_rhs.resize(3 * Eigen::Index(coarse.nodes()));
+      parallel_row_ranges(coarse.nodes(), team, [&](int begin, int end) {
+        for (int P = begin; P < end; ++P) {
+          const auto C = coarse.coords(P);
+          Vec3 sum = Vec3::Zero();
+          for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+              for (int dx = -1; dx <= 1; ++dx) {
+                const double w = (dx ? 0.5 : 1.0) * (dy ? 0.5 : 1.0) * (dz ? 0.5 : 1.0);
+                sum += w * r.segment<3>(3 * level.node(2 * C[0] + dx, 2 * C[1] + dy, 2 * C[2] + dz));
+              }
+          coarse_rhs.segment<3>(3 * P) = sum;
+        }
+      });
+    }
     // Prolongation x += P x_c: a fine node interpolates the coarse nodes of
     // its enclosing coarse cell (1, 2, 4 or 8 of them).
-    parallel_row_ranges(level.nodes(), team, [&](int begin, int end) {
-      for (int p = begin; p < end; ++p) {
-        const auto f = level.coords(p);
-        Vec3 sum = Vec3::Zero();
-        const int ox = f[0] % 2, oy = f[1] % 2, oz = f[2] % 2;
-        const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
-        for (int cz = 0; cz <= oz; ++cz)
-          for (int cy = 0; cy <= oy; ++cy)
-            for (int cx = 0; cx <= ox; ++cx)
-              sum += coarse.solution.segment<3>(3 * coarse.node(f[0] / 2 + cx, f[1] / 2 + cy, f[2] / 2 + cz));
-        solution.segment<3>(3 * p) += w * sum;
-      }
-    });
-  }
-  smooth(false);
+    void add_prolongation(std::size_t i, const VecX& coarse_x, VecX& x) {
+      const Level& level = *s.levels_[i];
+      const Level& coarse = *s.levels_[i + 1];
+      parallel_row_ranges(level.nodes(), team, [&](int begin, int end) {
+        for (int p = begin; p < end; ++p) {
+          const auto f = level.coords(p);
+          Vec3 sum = Vec3::Zero();
+          const int ox = f[0] % 2, oy = f[1] % 2, oz = f[2] % 2;
+          const double w = (ox ? 0.5 : 1.0) * (oy ? 0.5 : 1.0) * (oz ? 0.5 : 1.0);
+          for (int cz = 0; cz <= oz; ++cz)
+            for (int cy = 0; cy <= oy; ++cy)
+              for (int cx = 0; cx <= ox; ++cx)
+                sum += coarse_x.segment<3>(3 * coarse.node(f[0] / 2 + cx, f[1] / 2 + cy, f[2] / 2 + cz));
+          x.segment<3>(3 * p) += w * sum;
+        }
+      });
+    }
+  } levels{{levels_}, *this};
+  multigrid_cycle::cycle(levels, index, rhs, solution);
 }
 
 VecX PeriodicGridMultigrid::apply_preconditioner(const VecX& r) {
