@@ -12,8 +12,13 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
+#include <sys/resource.h>
 
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <mutex>
+#include <new>
 #endif
 
 namespace msfab {
@@ -22,11 +27,58 @@ namespace msfab {
 
 namespace {
 
+// A kB figure of a /proc file ("MemAvailable:", "VmData:"), or -1.
+long long proc_kilobytes(const char* file, const std::string& key) {
+  std::ifstream in(file);
+  std::string word;
+  while (in >> word)
+    if (word == key) {
+      long long kb = -1;
+      in >> kb;
+      return kb;
+    }
+  return -1;
+}
+
+// While a file is read, the heap may grow by at most 256 MiB plus a
+// thousand times the file's size, and by at most half the memory available
+// when the read starts (RLIMIT_DATA, restored afterwards). A truncated or
+// corrupt .vdb can make OpenVDB take garbage for a buffer's size; without
+// the bound that allocation succeeds on an overcommitting system and the
+// process is killed once the buffer is filled (24 GB of a half-written
+// 3 kB file was seen), with it the allocation throws std::bad_alloc, which
+// is reported as an unreadable file (exit 2). No grid expands its file a
+// thousand-fold: blocks of one value are stored as tiles, not voxels.
+class HeapBudget {
+ public:
+  explicit HeapBudget(std::uintmax_t file_bytes) {
+    const long long available = proc_kilobytes("/proc/meminfo", "MemAvailable:");
+    const long long used = proc_kilobytes("/proc/self/status", "VmData:");
+    if (available <= 0 || used < 0 || getrlimit(RLIMIT_DATA, &saved_) != 0) return;
+    const double growth = std::min(0.5 * 1024.0 * double(available), 256.0 * 1024 * 1024 + 1000.0 * double(file_bytes));
+    const rlim_t budget = static_cast<rlim_t>(1024.0 * double(used) + growth);
+    if (saved_.rlim_cur != RLIM_INFINITY && saved_.rlim_cur <= budget) return;
+    rlimit bounded = saved_;
+    bounded.rlim_cur = saved_.rlim_max == RLIM_INFINITY ? budget : std::min<rlim_t>(budget, saved_.rlim_max);
+    active_ = setrlimit(RLIMIT_DATA, &bounded) == 0;
+  }
+  ~HeapBudget() {
+    if (active_) setrlimit(RLIMIT_DATA, &saved_);
+  }
+  HeapBudget(const HeapBudget&) = delete;
+  HeapBudget& operator=(const HeapBudget&) = delete;
+
+ private:
+  rlimit saved_{};
+  bool active_ = false;
+};
+
 // The grid `name` of the file, or its only grid when `name` is empty.
 openvdb::GridBase::Ptr read_named_grid(const std::string& path, const std::string& name) {
   static std::once_flag registered;
   std::call_once(registered, [] { openvdb::initialize(); });
   require_regular_file(path);
+  const HeapBudget budget(std::filesystem::file_size(path));
   try {
     openvdb::io::File file(path);
     file.open(/*delayLoad=*/false);
@@ -49,6 +101,10 @@ openvdb::GridBase::Ptr read_named_grid(const std::string& path, const std::strin
     return grid;
   } catch (const openvdb::Exception& e) {
     throw InputError(path + ": not a readable OpenVDB file: " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw InputError(path +
+                     ": not a readable OpenVDB file: reading it would take more memory than such a file can hold "
+                     "(truncated or corrupt?)");
   }
 }
 
