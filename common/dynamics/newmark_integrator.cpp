@@ -99,8 +99,7 @@ HexMesh scale_materials(const HexMesh& mesh, const std::vector<double>& factor) 
 
 NewmarkIntegrator::NewmarkIntegrator(const DynamicsModel& model, const NewmarkOptions& options)
     : model_(model), options_(options), assembler_((validate_dynamics_model(model), model.mesh)) {
-  if (!(options.time_step > 0) || !std::isfinite(options.time_step))
-    throw InputError("dynamics: time_step must be positive (got " + std::to_string(options.time_step) + ")");
+  set_time_step(options.time_step);
   const HexMesh& mesh = model.mesh;
   const int n = mesh.num_dofs();
 
