@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "ddfem/level2_block.hpp"
 #include "io/artifact.hpp"
+#include "io/field_table.hpp"
 #include "material/neo_hookean.hpp"
 
 namespace msfab {
@@ -76,6 +77,13 @@ void write_palette(H5File& f, const CoarseDatabase& db) {
   f.write_attribute("/palette", "ids", "row i is palette id i + 1; id 0 is void");
 }
 
+// The fit's statistics, one dataset each under `<prefix>/fit`.
+using Fit = CoarseMaterialFit;
+const FieldOf<Fit> kFitStatistics[] = {
+    MSFAB_FIELD(Fit, residual),        MSFAB_FIELD(Fit, heldout_error),    MSFAB_FIELD(Fit, heldout_energy_error),
+    MSFAB_FIELD(Fit, seconds),         MSFAB_FIELD(Fit, samples_train),    MSFAB_FIELD(Fit, samples_heldout),
+    MSFAB_FIELD(Fit, samples_dropped), MSFAB_FIELD(Fit, samples_attempted)};
+
 // `<prefix>/fit/*`: one row per entry, one column per quadrature point.
 void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMaterialFit>& entries) {
   const std::int64_t K = static_cast<std::int64_t>(entries.size());
@@ -83,8 +91,7 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic> entry_ids(K, 8);
   MatX mu(K, P), lambda(K, P), C(K, P), v(K, 3 * P);
   MatX centre(K, 2);
-  VecX residual(K), heldout(K), heldout_energy(K), seconds(K);
-  std::vector<int> fitted(K), train(K), held(K), dropped(K), attempted(K);
+  std::vector<int> fitted(K);
   // One element for the whole database; unfitted entries carry no parameters.
   bool enhanced = false;
   for (const CoarseMaterialFit& fit : entries) enhanced = enhanced || (fit.fitted && fit.enhanced);
@@ -99,11 +106,7 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
       v.block<1, 3>(e, 3 * k) = fit.v[k].transpose();
     }
     centre(e, 0) = fit.mu_centre, centre(e, 1) = fit.lambda_centre;
-    residual[e] = fit.residual, heldout[e] = fit.heldout_error, heldout_energy[e] = fit.heldout_energy_error;
-    seconds[e] = fit.seconds;
     fitted[e] = fit.fitted;
-    train[e] = fit.samples_train, held[e] = fit.samples_heldout;
-    dropped[e] = fit.samples_dropped, attempted[e] = fit.samples_attempted;
   }
   const std::string g = prefix + "/fit";
   f.write_matrix(g + "/ids", entry_ids);
@@ -121,14 +124,7 @@ void write_fits(H5File& f, const std::string& prefix, const std::vector<CoarseMa
   f.write_attribute(g, "points", P);
   // The element the fits are for; databases without the attribute are trilinear.
   f.write_attribute(g, "element", std::string(enhanced ? "enhanced" : "trilinear"));
-  f.write_vector(g + "/residual", residual);
-  f.write_vector(g + "/heldout_error", heldout);
-  f.write_vector(g + "/heldout_energy_error", heldout_energy);
-  f.write_vector(g + "/seconds", seconds);
-  f.write_vector(g + "/samples_train", train);
-  f.write_vector(g + "/samples_heldout", held);
-  f.write_vector(g + "/samples_dropped", dropped);
-  f.write_vector(g + "/samples_attempted", attempted);
+  write_column_fields(f, g, entries, kFitStatistics);
 }
 
 // A level-1 database's combinations and fits under `prefix`.
@@ -236,6 +232,7 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
   const std::string g = prefix + "/fit";
   const auto entry_ids = f.read_matrix<int>(g + "/ids");
   const std::int64_t K = entry_ids.rows();
+  if (K < 1 || K > max_rows) bad(path, g + "/ids must have between 1 and " + std::to_string(max_rows) + " rows");
   const auto fitted = f.read_vector<int>(g + "/fitted");
   const MatX mu = f.read_matrix<double>(g + "/mu"), lambda = f.read_matrix<double>(g + "/lambda"),
              C = f.read_matrix<double>(g + "/C"), v = f.read_matrix<double>(g + "/v");
@@ -249,7 +246,6 @@ std::vector<CoarseMaterialFit> read_fits(const H5File& f, const std::string& pat
     centre = f.read_matrix<double>(g + "/centre");
     shape_ok(path, g + "/centre", centre.rows(), centre.cols(), K, 2);
   }
-  if (K < 1 || K > max_rows) bad(path, g + "/ids must have between 1 and " + std::to_string(max_rows) + " rows");
   shape_ok(path, g + "/ids", K, entry_ids.cols(), K, 8);
   shape_ok(path, g + "/fitted", fitted.size(), 1, K, 1);
   shape_ok(path, g + "/mu", mu.rows(), mu.cols(), K, P);

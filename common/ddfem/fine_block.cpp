@@ -87,6 +87,21 @@ int FineBlock::lattice_node(int i, int j, int k) const {
   return voxels.lattice_node[size_t(i + context) + n * (size_t(j + context) + n * size_t(k + context))];
 }
 
+namespace {
+// A block's frame, before its voxels are set.
+FineBlock empty_block(const char* what, double voxel_size, int voxels_per_edge, int coarse_points_per_axis,
+                      const BlockMaterials& ids) {
+  check_voxel_size(what, voxel_size);
+  FineBlock block;
+  block.voxel_size = voxel_size;
+  block.voxels_per_edge = voxels_per_edge;
+  block.coarse_points_per_axis = coarse_points_per_axis;
+  block.material_ids = ids;
+  block.child_material.assign(8, nullptr);
+  return block;
+}
+}  // namespace
+
 FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialPtr>& palette, double voxel_size,
                           int coarse_points_per_axis, int context) {
   if (context < 0 || context > 4) {
@@ -96,13 +111,8 @@ FineBlock make_fine_block(const BlockMaterials& ids, const std::vector<MaterialP
   }
   if (coarse_points_per_axis != 2 && coarse_points_per_axis != 4)
     throw InputError("fine block: the coarse element takes 2 or 4 Gauss points per axis");
-  check_voxel_size("fine block", voxel_size);
-  FineBlock block;
-  block.voxel_size = voxel_size;
-  block.coarse_points_per_axis = coarse_points_per_axis;
-  block.material_ids = ids;
+  FineBlock block = empty_block("fine block", voxel_size, 2, coarse_points_per_axis, ids);
   block.context = context;
-  block.child_material.assign(8, nullptr);
   const int n = 2 + 2 * context;
   VoxelGrid grid(n, n, n, voxel_size, 0);
   grid.origin = Vec3::Constant(-context * voxel_size);
@@ -155,13 +165,7 @@ FineBlock make_voxel_block(const std::vector<int>& voxel_ids, const std::vector<
     os << "voxel block: needs " << N * N * N << " voxel ids, got " << voxel_ids.size();
     throw InputError(os.str());
   }
-  check_voxel_size("voxel block", voxel_size);
-  FineBlock block;
-  block.voxel_size = voxel_size;
-  block.voxels_per_edge = N;
-  block.coarse_points_per_axis = N;
-  block.material_ids = label;
-  block.child_material.assign(8, nullptr);
+  FineBlock block = empty_block("voxel block", voxel_size, N, N, label);
   VoxelGrid grid(N, N, N, voxel_size, 0);
   bool any_solid = false;
   for (int v = 0; v < N * N * N; ++v) {

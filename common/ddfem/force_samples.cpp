@@ -476,40 +476,51 @@ void check_sampling_options(const ForceSamplingOptions& options) {
   if (!(options.max_strain > 0.0)) throw InputError("force sampling: max_strain must be > 0");
 }
 
-ForceSampleSet sample_force_space(const FineBlock& block, const ForceSamplingOptions& options) {
+ForceSampleSet sample_patterns(std::vector<ForcePattern> patterns, const ForceSamplingOptions& options,
+                               const std::function<double(int pattern)>& scale, const PatternSolve& solve) {
   check_sampling_options(options);
-  const auto t0 = std::chrono::steady_clock::now();
   ForceSampleSet set;
-  set.patterns = make_force_patterns(block, options);
-  const BlockSolver solver(block, options.newton_tolerance);
+  set.patterns = std::move(patterns);
   for (int p = 0; p < static_cast<int>(set.patterns.size()); ++p) {
-    const VecX& unit = set.patterns[p].force;
-    const double peak = solver.linear_peak_strain(unit);
-    if (!(peak > 0.0)) continue;
-    const double full = options.max_strain / peak;
+    const double full = scale(p);
+    if (!(full > 0.0)) continue;
     for (int sign : {1, -1}) {
-      // Magnitudes in increasing order, each started from the previous
-      // converged state: a continuation that keeps Newton short.
-      VecX start;
+      VecX state;
       for (int m = 1; m <= options.magnitudes; ++m) {
-        const double load = sign * full * m / options.magnitudes;
-        ++set.attempted;
-        const BlockSolver::Solution s = solver.solve(load * unit, start);
-        if (!s.converged) {
-          ++set.dropped;  // the next magnitude starts again from the last converged state
-          continue;
-        }
-        start = s.x;
         ForceSample sample;
         sample.pattern = p;
-        sample.load = load;
-        sample.corner_displacement = solver.corner_displacements(s.x);
-        sample.energy = s.energy;
-        sample.newton_iterations = s.iterations;
-        set.samples.push_back(sample);
+        sample.load = sign * full * m / options.magnitudes;
+        ++set.attempted;
+        if (solve(p, sample.load, state, sample))
+          set.samples.push_back(sample);
+        else
+          ++set.dropped;  // the next magnitude starts again from the last kept state
       }
     }
   }
+  return set;
+}
+
+ForceSampleSet sample_force_space(const FineBlock& block, const ForceSamplingOptions& options) {
+  check_sampling_options(options);
+  const auto t0 = std::chrono::steady_clock::now();
+  const BlockSolver solver(block, options.newton_tolerance);
+  std::vector<ForcePattern> patterns = make_force_patterns(block, options);
+  // Each pattern's largest load makes its linear response peak at max_strain.
+  const auto scale = [&](int p) {
+    const double peak = solver.linear_peak_strain(patterns[p].force);
+    return peak > 0.0 ? options.max_strain / peak : 0.0;
+  };
+  const auto solve = [&](int p, double load, VecX& start, ForceSample& sample) {
+    const BlockSolver::Solution s = solver.solve(load * patterns[p].force, start);
+    if (!s.converged) return false;
+    start = s.x;
+    sample.corner_displacement = solver.corner_displacements(s.x);
+    sample.energy = s.energy;
+    sample.newton_iterations = s.iterations;
+    return true;
+  };
+  ForceSampleSet set = sample_patterns(patterns, options, scale, solve);
   set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return set;
 }

@@ -7,6 +7,7 @@
 // coarse element's u^1 = r(u^0) of Eq. 2.8) and the fine elastic energy V^0.
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -189,6 +190,16 @@ std::vector<Vec3> sampling_directions(bool include_axes, int sphere_directions, 
 
 // InputError unless magnitudes >= 1 and max_strain > 0.
 void check_sampling_options(const ForceSamplingOptions& options);
+
+// The continuation every sampler runs: for each pattern p whose scale(p) is
+// > 0, in both signs, magnitudes m = 1..options.magnitudes at the load
+// sign scale(p) m / magnitudes in increasing order, each started from the
+// state the last kept sample left (`state`, empty at first: a continuation
+// that keeps Newton short). solve() fills the sample and returns false to
+// drop it (a solve that did not converge), leaving `state` as it was.
+using PatternSolve = std::function<bool(int pattern, double load, VecX& state, ForceSample& sample)>;
+ForceSampleSet sample_patterns(std::vector<ForcePattern> patterns, const ForceSamplingOptions& options,
+                               const std::function<double(int pattern)>& scale, const PatternSolve& solve);
 
 // Runs every pattern at options.magnitudes magnitudes in both signs. Each
 // pattern's largest load is scaled so its linear response peaks at

@@ -224,8 +224,7 @@ double PeriodicBlockSolver::relax(const Vec24& u1, VecX& w, int* iterations) con
 ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOptions& options) {
   check_sampling_options(options);
   const auto t0 = std::chrono::steady_clock::now();
-  ForceSampleSet set;
-  set.patterns = make_corner_displacement_patterns(block, options);
+  std::vector<ForcePattern> patterns = make_corner_displacement_patterns(block, options);
   const PeriodicBlockSolver solver(block, options.newton_tolerance);
   // A deformation the block takes without strain (a slab's void layers
   // opening, children hinged at an edge) stores round-off, not energy: its
@@ -235,31 +234,20 @@ ForceSampleSet sample_periodic(const FineBlock& block, const ForceSamplingOption
   // child's share.
   const double mu_max = stiffest_point_mu(block);
   const double volume = std::pow(block.edge(), 3);
-  for (int p = 0; p < static_cast<int>(set.patterns.size()); ++p) {
-    const Vec24 unit = set.patterns[p].force;
-    for (int sign : {1, -1}) {
-      VecX w;  // continuation in the magnitude
-      for (int m = 1; m <= options.magnitudes; ++m) {
-        const double load = sign * options.max_strain * m / options.magnitudes;
-        ++set.attempted;
-        VecX trial = w;
-        int its = 0;
-        const double E = solver.relax(load * unit, trial, &its);
-        if (!std::isfinite(E) || !(E > 1e-8 * mu_max * volume * load * load)) {
-          ++set.dropped;
-          continue;
-        }
-        w = trial;
-        ForceSample s;
-        s.pattern = p;
-        s.load = load;
-        s.corner_displacement = solver.corner_displacements(load * unit, w);
-        s.energy = E;
-        s.newton_iterations = its;
-        set.samples.push_back(s);
-      }
-    }
-  }
+  const auto solve = [&](int p, double load, VecX& w, ForceSample& sample) {
+    const Vec24 unit = patterns[p].force;
+    VecX trial = w;
+    int its = 0;
+    const double E = solver.relax(load * unit, trial, &its);
+    if (!std::isfinite(E) || !(E > 1e-8 * mu_max * volume * load * load)) return false;
+    w = trial;
+    sample.corner_displacement = solver.corner_displacements(load * unit, w);
+    sample.energy = E;
+    sample.newton_iterations = its;
+    return true;
+  };
+  ForceSampleSet set = sample_patterns(
+      patterns, options, [&](int) { return options.max_strain; }, solve);
   set.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return set;
 }

@@ -516,19 +516,13 @@ DirichletConditions contact_dirichlet(const QuasistaticResult& result, const Vec
 }
 
 std::string format_quasistatic_history(const std::vector<QuasistaticIteration>& history, size_t max_lines) {
-  std::ostringstream out;
-  out << "  step  load    iter  residual    energy         alpha      shift     active  -rel  +act\n";
-  const size_t first = history.size() > max_lines ? history.size() - max_lines : 0;
-  if (first > 0) out << "  ... (" << first << " earlier iterations)\n";
-  char line[200];
-  for (size_t i = first; i < history.size(); ++i) {
-    const auto& h = history[i];
-    std::snprintf(line, sizeof line, "  %4d  %.4f  %4d  %.4e  % .6e  %.3e  %.2e  %6d  %4d  %4d\n", h.load_step,
-                  h.load_factor, h.iteration, h.residual, h.energy, h.step_length, h.shift, h.active, h.released,
-                  h.activated);
-    out << line;
-  }
-  return out.str();
+  return format_iteration_table(
+      history, max_lines, "  step  load    iter  residual    energy         alpha      shift     active  -rel  +act\n",
+      [](const QuasistaticIteration& h) {
+        char contact[64];
+        std::snprintf(contact, sizeof contact, "  %6d  %4d  %4d\n", h.active, h.released, h.activated);
+        return newton_iteration_columns(h) + contact;
+      });
 }
 
 QuasistaticResult solve_quasistatic_loading(const ElasticAssembler& assembler, const std::vector<Obstacle>& obstacles,

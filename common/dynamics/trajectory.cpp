@@ -8,12 +8,37 @@
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "io/field_table.hpp"
 #include "io/mesh_io.hpp"
 #include "io/xdmf.hpp"
 
 namespace msfab {
 
 namespace {
+
+// Attribute tables: each field is written and read under one name.
+const FieldOf<Trajectory> kTimingFields[] = {{"quasistatic", &Trajectory::seconds_quasistatic},
+                                                    {"elastic", &Trajectory::seconds_elastic},
+                                                    {"rigid", &Trajectory::seconds_rigid},
+                                                    {"total", &Trajectory::seconds_total}};
+using Coarsening = TrajectoryCoarsening;
+const FieldOf<Coarsening> kCoarseningFields[] = {
+    MSFAB_FIELD(Coarsening, level),         MSFAB_FIELD(Coarsening, material), MSFAB_FIELD(Coarsening, database),
+    MSFAB_FIELD(Coarsening, element),       MSFAB_FIELD(Coarsening, fallback), MSFAB_FIELD(Coarsening, fallback_blocks),
+    MSFAB_FIELD(Coarsening, fine_elements), MSFAB_FIELD(Coarsening, seconds)};
+const FieldOf<Coarsening> kCoarseningCheckFields[] = {
+    MSFAB_FIELD(Coarsening, check_tolerance), MSFAB_FIELD(Coarsening, checked_blocks),
+    MSFAB_FIELD(Coarsening, replaced_blocks), MSFAB_FIELD(Coarsening, window),
+    MSFAB_FIELD(Coarsening, unresolved_windows)};
+using Comparison = TrajectoryComparison;
+const FieldOf<Comparison> kComparisonFields[] = {MSFAB_FIELD(Comparison, reference),
+                                                        MSFAB_FIELD(Comparison, error_at_release),
+                                                        MSFAB_FIELD(Comparison, error_max),
+                                                        MSFAB_FIELD(Comparison, error_mean),
+                                                        MSFAB_FIELD(Comparison, error_final),
+                                                        MSFAB_FIELD(Comparison, max_center_of_mass_distance),
+                                                        MSFAB_FIELD(Comparison, fine_seconds_per_step),
+                                                        MSFAB_FIELD(Comparison, seconds_per_step)};
 
 constexpr const char* kSchema = "msfab.trajectory";
 constexpr int kSchemaVersion = 1;
@@ -386,42 +411,21 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
 
   f.create_group("/timings");
   f.write_attribute("/timings", "units", "s");
-  f.write_attribute("/timings", "quasistatic", t.seconds_quasistatic);
-  f.write_attribute("/timings", "elastic", t.seconds_elastic);
-  f.write_attribute("/timings", "rigid", t.seconds_rigid);
-  f.write_attribute("/timings", "total", t.seconds_total);
+  write_attribute_fields(f, "/timings", t, kTimingFields);
   if (t.coarsening.level > 0) {
     const TrajectoryCoarsening& c = t.coarsening;
     f.create_group("/coarsening");
-    f.write_attribute("/coarsening", "level", c.level);
-    f.write_attribute("/coarsening", "material", c.material);
-    f.write_attribute("/coarsening", "database", c.database);
-    f.write_attribute("/coarsening", "element", c.element);
-    f.write_attribute("/coarsening", "fallback", c.fallback);
-    f.write_attribute("/coarsening", "fallback_blocks", c.fallback_blocks);
-    f.write_attribute("/coarsening", "check_tolerance", c.check_tolerance);
-    f.write_attribute("/coarsening", "checked_blocks", c.checked_blocks);
-    f.write_attribute("/coarsening", "replaced_blocks", c.replaced_blocks);
-    f.write_attribute("/coarsening", "window", c.window);
-    f.write_attribute("/coarsening", "unresolved_windows", c.unresolved_windows);
-    f.write_attribute("/coarsening", "fine_elements", c.fine_elements);
-    f.write_attribute("/coarsening", "seconds", c.seconds);
+    write_attribute_fields(f, "/coarsening", c, kCoarseningFields);
+    write_attribute_fields(f, "/coarsening", c, kCoarseningCheckFields);
   }
   if (!t.comparison.reference.empty()) {
     const TrajectoryComparison& c = t.comparison;
     f.create_group("/comparison");
-    f.write_attribute("/comparison", "reference", c.reference);
     f.write_attribute("/comparison", "error_definition",
                       std::string("per frame: mean distance of this run's displacements, interpolated trilinearly to "
                                   "the fine nodes, to the fine run's, over the longest side of the rest box (thesis "
                                   "2.5.2)"));
-    f.write_attribute("/comparison", "error_at_release", c.error_at_release);
-    f.write_attribute("/comparison", "error_max", c.error_max);
-    f.write_attribute("/comparison", "error_mean", c.error_mean);
-    f.write_attribute("/comparison", "error_final", c.error_final);
-    f.write_attribute("/comparison", "max_center_of_mass_distance", c.max_center_of_mass_distance);
-    f.write_attribute("/comparison", "fine_seconds_per_step", c.fine_seconds_per_step);
-    f.write_attribute("/comparison", "seconds_per_step", c.seconds_per_step);
+    write_attribute_fields(f, "/comparison", c, kComparisonFields);
   }
   writer.commit();
 
@@ -465,38 +469,17 @@ Trajectory read_trajectory_artifact(const std::string& path) {
   read_frames(f, t);
   read_events(f, t);
 
-  t.seconds_quasistatic = f.read_attribute<double>("/timings", "quasistatic");
-  t.seconds_elastic = f.read_attribute<double>("/timings", "elastic");
-  t.seconds_rigid = f.read_attribute<double>("/timings", "rigid");
-  t.seconds_total = f.read_attribute<double>("/timings", "total");
+  read_attribute_fields(f, "/timings", t, kTimingFields);
   if (f.exists("/coarsening")) {
     TrajectoryCoarsening& c = t.coarsening;
-    c.level = f.read_attribute<int>("/coarsening", "level");
-    c.material = f.read_string_attribute("/coarsening", "material");
-    c.database = f.read_string_attribute("/coarsening", "database");
-    c.element = f.read_string_attribute("/coarsening", "element");
-    c.fallback = f.read_string_attribute("/coarsening", "fallback");
-    c.fallback_blocks = f.read_attribute<int>("/coarsening", "fallback_blocks");
-    if (f.has_attribute("/coarsening", "check_tolerance")) {  // written since the check's counts are recorded
-      c.check_tolerance = f.read_attribute<double>("/coarsening", "check_tolerance");
-      c.checked_blocks = f.read_attribute<int>("/coarsening", "checked_blocks");
-      c.replaced_blocks = f.read_attribute<int>("/coarsening", "replaced_blocks");
-      c.window = f.read_attribute<int>("/coarsening", "window");
-      c.unresolved_windows = f.read_attribute<int>("/coarsening", "unresolved_windows");
-    }
-    c.fine_elements = f.read_attribute<int>("/coarsening", "fine_elements");
-    c.seconds = f.read_attribute<double>("/coarsening", "seconds");
+    read_attribute_fields(f, "/coarsening", c, kCoarseningFields);
+    // Written since the check's counts are recorded.
+    if (f.has_attribute("/coarsening", "check_tolerance"))
+      read_attribute_fields(f, "/coarsening", c, kCoarseningCheckFields);
   }
   if (f.exists("/comparison")) {
     TrajectoryComparison& c = t.comparison;
-    c.reference = f.read_string_attribute("/comparison", "reference");
-    c.error_at_release = f.read_attribute<double>("/comparison", "error_at_release");
-    c.error_max = f.read_attribute<double>("/comparison", "error_max");
-    c.error_mean = f.read_attribute<double>("/comparison", "error_mean");
-    c.error_final = f.read_attribute<double>("/comparison", "error_final");
-    c.max_center_of_mass_distance = f.read_attribute<double>("/comparison", "max_center_of_mass_distance");
-    c.fine_seconds_per_step = f.read_attribute<double>("/comparison", "fine_seconds_per_step");
-    c.seconds_per_step = f.read_attribute<double>("/comparison", "seconds_per_step");
+    read_attribute_fields(f, "/comparison", c, kComparisonFields);
   }
   return t;
 }

@@ -2,8 +2,16 @@
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "io/field_table.hpp"
 
 namespace msfab {
+
+namespace {
+const FieldOf<GamutCycle> kHistoryFields[] = {
+    MSFAB_FIELD(GamutCycle, cycle),          MSFAB_FIELD(GamutCycle, samples),
+    MSFAB_FIELD(GamutCycle, discrete_added), MSFAB_FIELD(GamutCycle, continuous_added),
+    MSFAB_FIELD(GamutCycle, coverage),       MSFAB_FIELD(GamutCycle, seconds)};
+}  // namespace
 
 double coverage(const GamutLevelSet& ls) {
   const int d = ls.dimension(), n = ls.cells();
@@ -54,20 +62,7 @@ void write_gamut(H5File& f, const Gamut& g) {
                       "base-material tensors (Voigt, engineering shear; 2D: plane-strain xx, yy, xy block; soft zero "
                       "for void): every structure has C <= rho stiff + (1 - rho) soft");
   }
-  std::vector<std::int32_t> cycle, samples, discrete, continuous;
-  std::vector<double> cover, seconds;
-  for (const GamutCycle& c : g.history) {
-    cycle.push_back(c.cycle), samples.push_back(c.samples), discrete.push_back(c.discrete_added);
-    continuous.push_back(c.continuous_added), cover.push_back(c.coverage), seconds.push_back(c.seconds);
-  }
-  if (!cycle.empty()) {
-    f.write_vector("/history/cycle", cycle);
-    f.write_vector("/history/samples", samples);
-    f.write_vector("/history/discrete_added", discrete);
-    f.write_vector("/history/continuous_added", continuous);
-    f.write_vector("/history/coverage", cover);
-    f.write_vector("/history/seconds", seconds);
-  }
+  write_column_fields(f, "/history", g.history, kHistoryFields);
 }
 
 namespace {
@@ -110,16 +105,7 @@ Gamut read_gamut_artifact(const std::string& path) {
     g.bound_stiff = read_bound_tensor(f, path, "/bound/stiff", m);
     g.bound_soft = read_bound_tensor(f, path, "/bound/soft", m);
   }
-  if (f.exists("/history/cycle")) {
-    const auto cycle = f.read_vector<std::int32_t>("/history/cycle");
-    const auto samples = f.read_vector<std::int32_t>("/history/samples");
-    const auto discrete = f.read_vector<std::int32_t>("/history/discrete_added");
-    const auto continuous = f.read_vector<std::int32_t>("/history/continuous_added");
-    const auto cover = f.read_vector<double>("/history/coverage");
-    const auto seconds = f.read_vector<double>("/history/seconds");
-    for (std::size_t i = 0; i < cycle.size(); ++i)
-      g.history.push_back({cycle[i], samples.at(i), discrete.at(i), continuous.at(i), cover.at(i), seconds.at(i)});
-  }
+  g.history = read_column_fields(f, "/history", kHistoryFields);
   return g;
 }
 

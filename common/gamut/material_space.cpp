@@ -108,18 +108,20 @@ VecX MaterialSpace::properties_with_gradient(const MatX& C, double rho, std::vec
   return p;
 }
 
+template <class Density, class Modulus, class Poisson>
+VecX MaterialSpace::map_coordinates(const VecX& x, const char* what, Density density, Modulus modulus,
+                                    Poisson poisson) const {
+  if (x.size() != dimension()) throw std::invalid_argument(std::string("MaterialSpace::") + what + ": wrong dimension");
+  VecX y(x.size());
+  for (int i = 0; i < x.size(); ++i)
+    y[i] = i == x.size() - 1 ? density(x[i]) : is_modulus(i) ? modulus(x[i]) : poisson(x[i]);
+  return y;
+}
+
 VecX MaterialSpace::unit_derivative(const VecX& raw) const {
-  if (raw.size() != dimension()) throw std::invalid_argument("MaterialSpace::unit_derivative: wrong dimension");
-  VecX d(raw.size());
-  for (int i = 0; i < raw.size(); ++i) {
-    if (i == raw.size() - 1)
-      d[i] = 1;
-    else if (is_modulus(i))
-      d[i] = 1 / (raw[i] * std::log(10.0) * decades_);
-    else
-      d[i] = 1 / (nu_high() - nu_low());
-  }
-  return d;
+  return map_coordinates(
+      raw, "unit_derivative", [](double) { return 1.0; }, [&](double E) { return 1 / (E * std::log(10.0) * decades_); },
+      [&](double) { return 1 / (nu_high() - nu_low()); });
 }
 
 Mat6 MaterialSpace::tensor_3d(const VecX& raw) const {
@@ -153,31 +155,17 @@ Mat3 MaterialSpace::tensor_2d(const VecX& raw) const {
 }
 
 VecX MaterialSpace::normalize(const VecX& raw) const {
-  if (raw.size() != dimension()) throw std::invalid_argument("MaterialSpace::normalize: wrong dimension");
-  VecX u(raw.size());
-  for (int i = 0; i < raw.size(); ++i) {
-    if (i == raw.size() - 1)
-      u[i] = raw[i];
-    else if (is_modulus(i))
-      u[i] = 1 + std::log10(raw[i] / E_stiff_) / decades_;
-    else
-      u[i] = (raw[i] - nu_low()) / (nu_high() - nu_low());
-  }
-  return u;
+  return map_coordinates(
+      raw, "normalize", [](double rho) { return rho; },
+      [&](double E) { return 1 + std::log10(E / E_stiff_) / decades_; },
+      [&](double nu) { return (nu - nu_low()) / (nu_high() - nu_low()); });
 }
 
 VecX MaterialSpace::denormalize(const VecX& u) const {
-  if (u.size() != dimension()) throw std::invalid_argument("MaterialSpace::denormalize: wrong dimension");
-  VecX raw(u.size());
-  for (int i = 0; i < u.size(); ++i) {
-    if (i == u.size() - 1)
-      raw[i] = u[i];
-    else if (is_modulus(i))
-      raw[i] = E_stiff_ * std::pow(10.0, (u[i] - 1) * decades_);
-    else
-      raw[i] = nu_low() + u[i] * (nu_high() - nu_low());
-  }
-  return raw;
+  return map_coordinates(
+      u, "denormalize", [](double rho) { return rho; },
+      [&](double unit) { return E_stiff_ * std::pow(10.0, (unit - 1) * decades_); },
+      [&](double unit) { return nu_low() + unit * (nu_high() - nu_low()); });
 }
 
 }  // namespace msfab

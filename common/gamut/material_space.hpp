@@ -67,6 +67,10 @@ class MaterialSpace {
   double E_stiff_, decades_;
   double nu_low() const { return -1.0; }
   double nu_high() const { return kind_ == MaterialSpaceKind::cubic3d ? 0.5 : 1.0; }
+  // x with each coordinate mapped by its kind: the last (density) by
+  // `density`, moduli by `modulus`, Poisson ratios by `poisson`.
+  template <class Density, class Modulus, class Poisson>
+  VecX map_coordinates(const VecX& x, const char* what, Density density, Modulus modulus, Poisson poisson) const;
 };
 
 }  // namespace msfab

@@ -213,15 +213,25 @@ struct Reader<double> {
   }
 };
 
-template <>
-struct Reader<std::int64_t> {
-  static constexpr const char* name = "an integer";
-  static std::int64_t read(const std::string& where, const std::string& path, const YAML::Node& node) {
-    std::int64_t v = 0;
-    if (!node.IsScalar() || is_quoted(node) || !parse_int64(node.Scalar(), v)) type_error(where, path, node, name);
+// An unquoted scalar that `parse` accepts (a quoted "3" is a string, not a
+// number), or a type error expecting `Name`.
+template <class T, bool (*parse)(const std::string&, T&), const char* Name>
+struct UnquotedScalarReader {
+  static constexpr const char* name = Name;
+  static T read(const std::string& where, const std::string& path, const YAML::Node& node) {
+    T v{};
+    if (!node.IsScalar() || is_quoted(node) || !parse(node.Scalar(), v)) type_error(where, path, node, name);
     return v;
   }
 };
+constexpr char kAnInteger[] = "an integer", kANonNegativeInteger[] = "a non-negative integer",
+               kTrueOrFalse[] = "true or false";
+template <>
+struct Reader<std::int64_t> : UnquotedScalarReader<std::int64_t, parse_int64, kAnInteger> {};
+template <>
+struct Reader<std::uint64_t> : UnquotedScalarReader<std::uint64_t, parse_uint64, kANonNegativeInteger> {};
+template <>
+struct Reader<bool> : UnquotedScalarReader<bool, parse_bool, kTrueOrFalse> {};
 
 template <>
 struct Reader<int> {
@@ -231,26 +241,6 @@ struct Reader<int> {
     if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
       throw InputError(where + ": " + path + " = " + node.Scalar() + ": integer out of range");
     return static_cast<int>(v);
-  }
-};
-
-template <>
-struct Reader<std::uint64_t> {
-  static constexpr const char* name = "a non-negative integer";
-  static std::uint64_t read(const std::string& where, const std::string& path, const YAML::Node& node) {
-    std::uint64_t v = 0;
-    if (!node.IsScalar() || is_quoted(node) || !parse_uint64(node.Scalar(), v)) type_error(where, path, node, name);
-    return v;
-  }
-};
-
-template <>
-struct Reader<bool> {
-  static constexpr const char* name = "true or false";
-  static bool read(const std::string& where, const std::string& path, const YAML::Node& node) {
-    bool v = false;
-    if (!node.IsScalar() || is_quoted(node) || !parse_bool(node.Scalar(), v)) type_error(where, path, node, name);
-    return v;
   }
 };
 

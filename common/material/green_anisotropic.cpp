@@ -30,20 +30,23 @@ Mat9 right_product(const Mat3& B) {
   return M;
 }
 
-}  // namespace
-
-GreenAnisotropic::GreenAnisotropic(const Mat6& C) {
+// C finite, symmetric and positive semidefinite, or InputError.
+const Mat6& checked_semidefinite(const Mat6& C) {
   if (!C.allFinite()) throw InputError("green_anisotropic: stiffness matrix C is not finite");
   const double scale = C.cwiseAbs().maxCoeff();
   if ((C - C.transpose()).cwiseAbs().maxCoeff() > 1e-10 * scale)
     throw InputError("green_anisotropic: stiffness matrix C is not symmetric");
-  C_ = 0.5 * (C + C.transpose());
-  const double smallest = Eigen::SelfAdjointEigenSolver<Mat6>(C_, Eigen::EigenvaluesOnly).eigenvalues()[0];
+  const Mat6 symmetric = 0.5 * (C + C.transpose());
+  const double smallest = Eigen::SelfAdjointEigenSolver<Mat6>(symmetric, Eigen::EigenvaluesOnly).eigenvalues()[0];
   if (smallest < -1e-10 * scale)
     throw InputError("green_anisotropic: stiffness matrix C is not positive semidefinite (eigenvalue " +
                      std::to_string(smallest) + ")");
-  isotropic_projection(C_, &mu_, &lambda_);
+  return C;
 }
+
+}  // namespace
+
+GreenAnisotropic::GreenAnisotropic(const Mat6& C) : StiffnessMaterial(checked_semidefinite(C)) {}
 
 void GreenAnisotropic::evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const {
   const Vec6 e = strain_to_voigt(0.5 * (F.transpose() * F - Mat3::Identity()));

@@ -7,25 +7,17 @@
 // model is meant as the anisotropic part beside an isotropic Neo-Hookean
 // one (MaterialSum), which keeps the sum stable under large compression,
 // where St. Venant-Kirchhoff alone softens.
-#include "material/material.hpp"
+#include "material/stiffness_material.hpp"
 
 namespace msfab {
 
-class GreenAnisotropic final : public Material {
+class GreenAnisotropic final : public StiffnessMaterial {
  public:
   // Throws InputError unless C is finite, symmetric and positive semidefinite.
   explicit GreenAnisotropic(const Mat6& C);
 
   void evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const override;
-  double shear_modulus() const override { return mu_; }
-  double lame_lambda() const override { return lambda_; }
   std::string name() const override { return "green_anisotropic"; }
-
-  const Mat6& stiffness() const { return C_; }
-
- private:
-  Mat6 C_;
-  double mu_, lambda_;
 };
 
 }  // namespace msfab

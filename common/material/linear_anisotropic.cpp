@@ -4,12 +4,16 @@
 
 namespace msfab {
 
-LinearAnisotropic::LinearAnisotropic(const Mat6& C) {
+namespace {
+const Mat6& checked(const Mat6& C) {
   check_stiffness(C);
-  C_ = 0.5 * (C + C.transpose());
+  return C;
+}
+}  // namespace
+
+LinearAnisotropic::LinearAnisotropic(const Mat6& C) : StiffnessMaterial(checked(C)) {
   const Eigen::Matrix<double, 6, 9> B = voigt_strain_operator();
   dPdF_ = B.transpose() * C_ * B;
-  isotropic_projection(C_, &mu_, &lambda_);
 }
 
 void LinearAnisotropic::evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const {

@@ -4,27 +4,21 @@
 //   Psi = 1/2 e^T C e,  sigma_voigt = C e,  P = voigt_to_stress(C e) (symmetric),
 //   dP/dF = B^T C B with B = voigt_strain_operator(), constant.
 // shear_modulus()/lame_lambda() are those of the isotropic projection of C.
-#include "material/material.hpp"
+#include "material/stiffness_material.hpp"
 
 namespace msfab {
 
-class LinearAnisotropic final : public Material {
+class LinearAnisotropic final : public StiffnessMaterial {
  public:
   // Throws InputError unless C is finite, symmetric and positive definite.
   explicit LinearAnisotropic(const Mat6& C);
 
   void evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF) const override;
-  double shear_modulus() const override { return mu_; }
-  double lame_lambda() const override { return lambda_; }
   std::string name() const override { return "linear_anisotropic"; }
   bool frame_indifferent() const override { return false; }
 
-  const Mat6& stiffness() const { return C_; }
-
  private:
-  Mat6 C_;
   Mat9 dPdF_;
-  double mu_, lambda_;
 };
 
 }  // namespace msfab

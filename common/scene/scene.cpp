@@ -263,6 +263,54 @@ std::string paint_vdb_file(const Config& item, VoxelGrid& grid, int id) {
   return path;
 }
 
+// A boundary or load entry with its config path and region read.
+template <class Entry>
+Entry entry_on_region(const Config& entry, const VoxelGrid& grid) {
+  Entry e;
+  e.where = entry.path();
+  e.region = read_region(entry, grid);
+  return e;
+}
+
+// One entry of `boundary`: a region fixed in some components, moved by a
+// displacement, or turned about an axis.
+BoundaryCondition read_boundary_condition(const Config& b, const VoxelGrid& grid) {
+  auto bc = entry_on_region<BoundaryCondition>(b, grid);
+  const bool has_disp = b.has("displacement"), has_rot = b.has("rotation");
+  if (has_disp) bc.displacement = read_vec3(b, "displacement");
+  if (has_rot) {
+    const Config r = b.child("rotation");
+    bc.has_rotation = true;
+    bc.rotation_axis = read_vec3(r, "axis");
+    if (bc.rotation_axis.norm() == 0) r.fail("axis", "rotation axis must be non-zero");
+    bc.rotation_axis.normalize();
+    bc.rotation_center = read_vec3(r, "center");
+    bc.rotation_angle = r.require_finite("angle_deg") * kPi / 180.0;
+  }
+  if (b.has("fix")) {
+    for (const std::string& comp : b.get<std::vector<std::string>>("fix")) {
+      if (comp != "x" && comp != "y" && comp != "z") b.fail("fix", "components are x, y, z; found '" + comp + "'");
+      bc.fix[comp[0] - 'x'] = true;
+    }
+  } else if (has_disp || has_rot) {
+    bc.fix[0] = bc.fix[1] = bc.fix[2] = true;
+  } else {
+    b.fail("", "a boundary condition needs 'fix', 'displacement' or 'rotation'");
+  }
+  return bc;
+}
+
+// One entry of `loads`: a total force on a region, or a traction on a face.
+Load read_load(const Config& l, const VoxelGrid& grid) {
+  auto load = entry_on_region<Load>(l, grid);
+  const bool f = l.has("force"), t = l.has("traction");
+  if (f == t) l.fail("", "a load needs exactly one of 'force' (total, N) or 'traction' (Pa)");
+  load.is_traction = t;
+  load.value = read_vec3(l, t ? "traction" : "force");
+  if (t && load.region.kind != Region::Kind::Face) l.fail("traction", "a traction needs a face region");
+  return load;
+}
+
 }  // namespace
 
 std::vector<PaletteEntry> read_materials(const Config& config, std::vector<MaterialPtr>* material_by_id) {
@@ -383,48 +431,10 @@ Scene read_scene(const Config& config) {
   s.geometry_files = paint_layout(config, s.grid, s.material_by_id);
   if (s.grid.count_solid() == 0) config.fail("layout", "the layout leaves every voxel void (empty grid)");
 
-  if (config.has("boundary")) {
-    for (const Config& b : config.children("boundary")) {
-      BoundaryCondition bc;
-      bc.where = b.path();
-      bc.region = read_region(b, s.grid);
-      const bool has_disp = b.has("displacement"), has_rot = b.has("rotation");
-      if (has_disp) bc.displacement = read_vec3(b, "displacement");
-      if (has_rot) {
-        const Config r = b.child("rotation");
-        bc.has_rotation = true;
-        bc.rotation_axis = read_vec3(r, "axis");
-        if (bc.rotation_axis.norm() == 0) r.fail("axis", "rotation axis must be non-zero");
-        bc.rotation_axis.normalize();
-        bc.rotation_center = read_vec3(r, "center");
-        bc.rotation_angle = r.require_finite("angle_deg") * kPi / 180.0;
-      }
-      if (b.has("fix")) {
-        for (const std::string& comp : b.get<std::vector<std::string>>("fix")) {
-          if (comp != "x" && comp != "y" && comp != "z") b.fail("fix", "components are x, y, z; found '" + comp + "'");
-          bc.fix[comp[0] - 'x'] = true;
-        }
-      } else if (has_disp || has_rot) {
-        bc.fix[0] = bc.fix[1] = bc.fix[2] = true;
-      } else {
-        b.fail("", "a boundary condition needs 'fix', 'displacement' or 'rotation'");
-      }
-      s.boundary.push_back(bc);
-    }
-  }
-  if (config.has("loads")) {
-    for (const Config& l : config.children("loads")) {
-      Load load;
-      load.where = l.path();
-      load.region = read_region(l, s.grid);
-      const bool f = l.has("force"), t = l.has("traction");
-      if (f == t) l.fail("", "a load needs exactly one of 'force' (total, N) or 'traction' (Pa)");
-      load.is_traction = t;
-      load.value = read_vec3(l, t ? "traction" : "force");
-      if (t && load.region.kind != Region::Kind::Face) l.fail("traction", "a traction needs a face region");
-      s.loads.push_back(load);
-    }
-  }
+  if (config.has("boundary"))
+    for (const Config& b : config.children("boundary")) s.boundary.push_back(read_boundary_condition(b, s.grid));
+  if (config.has("loads"))
+    for (const Config& l : config.children("loads")) s.loads.push_back(read_load(l, s.grid));
   if (config.has("gravity")) s.gravity = read_vec3(config, "gravity");
 
   if (config.has("solver")) {

@@ -41,6 +41,20 @@ void parallel_row_ranges(int n, int team, RangeBody&& body) {
   }
 }
 
+// y += m x for a 3x3 block m stored row by row, or y += m^T x.
+template <class Value>
+inline void add_block_product(const Value* m, const double* x, double& y0, double& y1, double& y2) {
+  y0 += double(m[0]) * x[0] + double(m[1]) * x[1] + double(m[2]) * x[2];
+  y1 += double(m[3]) * x[0] + double(m[4]) * x[1] + double(m[5]) * x[2];
+  y2 += double(m[6]) * x[0] + double(m[7]) * x[1] + double(m[8]) * x[2];
+}
+template <class Value>
+inline void add_transposed_block_product(const Value* m, const double* x, double& y0, double& y1, double& y2) {
+  y0 += double(m[0]) * x[0] + double(m[3]) * x[1] + double(m[6]) * x[2];
+  y1 += double(m[1]) * x[0] + double(m[4]) * x[1] + double(m[7]) * x[2];
+  y2 += double(m[2]) * x[0] + double(m[5]) * x[1] + double(m[8]) * x[2];
+}
+
 // Block row i of M times x: out[a] = sum_j M_ij(a, :) x_j, with the values
 // taken from `values` (laid out like M.values; float for a compact copy).
 template <class Value>
@@ -48,11 +62,7 @@ inline void block_row_product(const BlockMatrix& M, const Value* values, int i, 
   double y0 = 0.0, y1 = 0.0, y2 = 0.0;
   const int* column = M.column.data();
   for (int slot = M.row_start[i]; slot < M.row_start[i + 1]; ++slot) {
-    const Value* m = values + 9 * std::size_t(slot);
-    const double* xj = x + 3 * std::size_t(column[slot]);
-    y0 += double(m[0]) * xj[0] + double(m[1]) * xj[1] + double(m[2]) * xj[2];
-    y1 += double(m[3]) * xj[0] + double(m[4]) * xj[1] + double(m[5]) * xj[2];
-    y2 += double(m[6]) * xj[0] + double(m[7]) * xj[1] + double(m[8]) * xj[2];
+    add_block_product(values + 9 * std::size_t(slot), x + 3 * std::size_t(column[slot]), y0, y1, y2);
   }
   out[0] = y0;
   out[1] = y1;

@@ -14,15 +14,10 @@ void ChebyshevSmoother::upper_row_product(int i, const double* x, double out[3])
   for (int slot = pattern_->row_start[i]; slot < pattern_->row_start[i + 1]; ++slot) {
     const float* m = values_.data() + 9 * std::size_t(block_of_slot_[std::size_t(slot)]);
     const double* xj = x + 3 * std::size_t(column[slot]);
-    if (column[slot] >= i) {
-      y0 += double(m[0]) * xj[0] + double(m[1]) * xj[1] + double(m[2]) * xj[2];
-      y1 += double(m[3]) * xj[0] + double(m[4]) * xj[1] + double(m[5]) * xj[2];
-      y2 += double(m[6]) * xj[0] + double(m[7]) * xj[1] + double(m[8]) * xj[2];
-    } else {
-      y0 += double(m[0]) * xj[0] + double(m[3]) * xj[1] + double(m[6]) * xj[2];
-      y1 += double(m[1]) * xj[0] + double(m[4]) * xj[1] + double(m[7]) * xj[2];
-      y2 += double(m[2]) * xj[0] + double(m[5]) * xj[1] + double(m[8]) * xj[2];
-    }
+    if (column[slot] >= i)
+      add_block_product(m, xj, y0, y1, y2);
+    else
+      add_transposed_block_product(m, xj, y0, y1, y2);
   }
   out[0] = y0;
   out[1] = y1;

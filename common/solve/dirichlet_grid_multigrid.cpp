@@ -71,6 +71,15 @@ bool DirichletGridMultigrid::supports(int nx, int ny, int nz) {
 
 DirichletGridMultigrid::~DirichletGridMultigrid() = default;
 
+DirichletMultigridOptions dirichlet_multigrid_options(const LinearSolverOptions& options) {
+  DirichletMultigridOptions mg;
+  mg.tolerance = options.pcg_tolerance, mg.max_iterations = options.pcg_max_iterations;
+  mg.max_iterations_key = options.pcg_max_iterations_key;
+  mg.smoother_degree = options.mg_smoother_degree, mg.coarse_unknowns = options.mg_coarse_unknowns;
+  mg.threads = options.threads;
+  return mg;
+}
+
 DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vector<char> fixed,
                                                const DirichletMultigridOptions& options)
     : fixed_(std::move(fixed)), options_(options) {

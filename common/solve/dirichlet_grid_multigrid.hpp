@@ -58,6 +58,9 @@ struct DirichletMultigridOptions {
   bool material_coarse_space = false;
 };
 
+// The CG limits, smoother, coarse size and threads of a pcg-mg configuration.
+DirichletMultigridOptions dirichlet_multigrid_options(const LinearSolverOptions& options);
+
 class DirichletGridMultigrid {
  public:
   // Node (i, j, k) = i + (nx+1) (j + (ny+1) k), 3 unknowns per node;

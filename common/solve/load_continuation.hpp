@@ -5,8 +5,11 @@
 // retried at half its size from the state before it, at most
 // `max_halvings` times in a row; after a success the increment grows back
 // (doubling, up to 1 / steps).
+#include <cstdio>
 #include <functional>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace msfab {
 
@@ -33,5 +36,29 @@ struct LoadContinuationResult {
 // When it does not converge, the state is restored to the last converged
 // increment's.
 LoadContinuationResult continue_load(const LoadContinuation& c);
+
+// The columns an iteration table of a Newton continuation starts with: load
+// step, load factor, iteration, residual, energy, step length and shift.
+template <class Iteration>
+std::string newton_iteration_columns(const Iteration& h) {
+  char line[160];
+  std::snprintf(line, sizeof line, "  %4d  %.4f  %4d  %.4e  % .6e  %.3e  %.2e", h.load_step, h.load_factor, h.iteration,
+                h.residual, h.energy, h.step_length, h.shift);
+  return line;
+}
+
+// The iteration table of a continuation: `header`, then one line per
+// iteration from format_line(iteration), the last max_lines of them, with a
+// line saying how many earlier ones were left out.
+template <class Iteration, class FormatLine>
+std::string format_iteration_table(const std::vector<Iteration>& history, std::size_t max_lines, const char* header,
+                                   FormatLine format_line) {
+  std::ostringstream out;
+  out << header;
+  const std::size_t first = history.size() > max_lines ? history.size() - max_lines : 0;
+  if (first > 0) out << "  ... (" << first << " earlier iterations)\n";
+  for (std::size_t i = first; i < history.size(); ++i) out << format_line(history[i]);
+  return out.str();
+}
 
 }  // namespace msfab

@@ -54,18 +54,9 @@ int DirichletConditions::count_fixed() const {
 }
 
 std::string format_history(const std::vector<NewtonIteration>& history, size_t max_lines) {
-  std::ostringstream out;
-  out << "  step  load    iter  residual     energy         alpha      shift\n";
-  const size_t first = history.size() > max_lines ? history.size() - max_lines : 0;
-  if (first > 0) out << "  ... (" << first << " earlier iterations)\n";
-  char line[160];
-  for (size_t i = first; i < history.size(); ++i) {
-    const auto& h = history[i];
-    std::snprintf(line, sizeof line, "  %4d  %.4f  %4d  %.4e  % .6e  %.3e  %.2e\n", h.load_step, h.load_factor,
-                  h.iteration, h.residual, h.energy, h.step_length, h.shift);
-    out << line;
-  }
-  return out.str();
+  return format_iteration_table(history, max_lines,
+                                "  step  load    iter  residual     energy         alpha      shift\n",
+                                [](const NewtonIteration& h) { return newton_iteration_columns(h) + "\n"; });
 }
 
 std::string static_linear_solver(double dofs, const NewtonOptions& options) {

@@ -2,6 +2,7 @@
 
 #include "core/errors.hpp"
 #include "io/artifact.hpp"
+#include "io/field_table.hpp"
 #include "io/xdmf.hpp"
 
 namespace msfab {
@@ -11,6 +12,11 @@ bool is_gamut_space(const std::string& space) {
 }
 
 namespace {
+using HistoryEntry = DesignHistoryEntry;
+const FieldOf<HistoryEntry> kHistoryFields[] = {
+    MSFAB_FIELD(HistoryEntry, iteration), MSFAB_FIELD(HistoryEntry, objective), MSFAB_FIELD(HistoryEntry, elastic),
+    MSFAB_FIELD(HistoryEntry, max_violation), MSFAB_FIELD(HistoryEntry, seconds)};
+
 void check_sizes(const Design& d, const std::string& where) {
   auto fail = [&](const std::string& what) { throw InputError(where + ": " + what); };
   if (d.dimension != 2 && d.dimension != 3) fail("dimension must be 2 or 3");
@@ -89,19 +95,7 @@ void write_design_artifact(const std::string& path, const Design& d, const std::
     f.write_matrix("/nodes/displacement", d.displacement);
     f.write_attribute("/nodes/displacement", "units", "m");
   }
-  std::vector<std::int32_t> iteration;
-  std::vector<double> objective, elastic, violation, seconds;
-  for (const auto& h : d.history) {
-    iteration.push_back(h.iteration), objective.push_back(h.objective), elastic.push_back(h.elastic);
-    violation.push_back(h.max_violation), seconds.push_back(h.seconds);
-  }
-  if (!iteration.empty()) {
-    f.write_vector("/history/iteration", iteration);
-    f.write_vector("/history/objective", objective);
-    f.write_vector("/history/elastic", elastic);
-    f.write_vector("/history/max_violation", violation);
-    f.write_vector("/history/seconds", seconds);
-  }
+  write_column_fields(f, "/history", d.history, kHistoryFields);
   if (!d.family_names.empty()) {
     f.write_matrix("/family/unit", d.family_unit);
     f.write_attribute("/family/unit", "meaning",
@@ -146,16 +140,7 @@ Design read_design_artifact(const std::string& path) {
   const auto phi = f.read_vector<double>("/cells/phi");
   d.phi = Eigen::Map<const VecX>(phi.data(), Eigen::Index(phi.size()));
   if (f.exists("/nodes/displacement")) d.displacement = f.read_matrix<double>("/nodes/displacement");
-  if (f.exists("/history/iteration")) {
-    const auto it = f.read_vector<std::int32_t>("/history/iteration");
-    const auto obj = f.read_vector<double>("/history/objective");
-    const auto el = f.read_vector<double>("/history/elastic");
-    const auto vi = f.read_vector<double>("/history/max_violation");
-    const auto se = f.read_vector<double>("/history/seconds");
-    if (obj.size() != it.size() || el.size() != it.size() || vi.size() != it.size() || se.size() != it.size())
-      throw InputError(path + ": /history datasets differ in length");
-    for (std::size_t i = 0; i < it.size(); ++i) d.history.push_back({it[i], obj[i], el[i], vi[i], se[i]});
-  }
+  d.history = read_column_fields(f, "/history", kHistoryFields);
   if (f.exists("/family")) {
     d.family_names = parse_name_list(f.read_string_attribute("/family", "names"));
     d.family_unit = f.read_matrix<double>("/family/unit");

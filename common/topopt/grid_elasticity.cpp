@@ -81,13 +81,7 @@ GridElasticity::GridElasticity(const CellGrid& grid, std::vector<char> fixed, co
       throw InputError("solver matrix-free needs even grid dimensions, not " + std::to_string(grid_.nx()) + " x " +
                        std::to_string(grid_.ny()) + " x " + std::to_string(grid_.nz()) + "; use pcg-mg");
     validate_linear_solver_options(options_);
-    DirichletMultigridOptions mg;
-    mg.tolerance = options_.pcg_tolerance;
-    mg.max_iterations = options_.pcg_max_iterations;
-    mg.max_iterations_key = options_.pcg_max_iterations_key;
-    mg.smoother_degree = options_.mg_smoother_degree;
-    mg.coarse_unknowns = options_.mg_coarse_unknowns;
-    mg.threads = options_.threads;
+    DirichletMultigridOptions mg = dirichlet_multigrid_options(options_);
     mg.material_coarse_space = material_coarse_space;
     // The solver keeps the only copy of the flags (fixed() reads it there).
     matrix_free_ = std::make_unique<DirichletGridMultigrid>(grid_.nx(), grid_.ny(), grid_.nz(), std::move(fixed_), mg);
