@@ -11,13 +11,12 @@ namespace msfab {
 namespace {
 constexpr const char* kSchema = "msfab.dac_model";
 constexpr int kVersion = 1;
-const FieldOf<DacModel> kFields[] = {
-    MSFAB_FIELD(DacModel, material),       MSFAB_FIELD(DacModel, reference_modulus),
-    MSFAB_FIELD(DacModel, youngs_modulus), MSFAB_FIELD(DacModel, damping_a),
-    MSFAB_FIELD(DacModel, damping_b),      MSFAB_FIELD(DacModel, target_frequency),
-    MSFAB_FIELD(DacModel, target_decay),   MSFAB_FIELD(DacModel, target_eigenvalue),
-    MSFAB_FIELD(DacModel, voxel_size),     MSFAB_FIELD(DacModel, elements),
-    MSFAB_FIELD(DacModel, marker_rms)};
+const FieldOf<DacModel> kFields[] = {MSFAB_FIELD(DacModel, material),       MSFAB_FIELD(DacModel, reference_modulus),
+                                     MSFAB_FIELD(DacModel, youngs_modulus), MSFAB_FIELD(DacModel, damping_a),
+                                     MSFAB_FIELD(DacModel, damping_b),      MSFAB_FIELD(DacModel, target_frequency),
+                                     MSFAB_FIELD(DacModel, target_decay),   MSFAB_FIELD(DacModel, target_eigenvalue),
+                                     MSFAB_FIELD(DacModel, voxel_size),     MSFAB_FIELD(DacModel, elements),
+                                     MSFAB_FIELD(DacModel, marker_rms)};
 }  // namespace
 
 void write_dac_model_artifact(const std::string& path, const DacModel& m, const std::string& executable,

@@ -18,9 +18,9 @@ namespace {
 
 // Attribute tables: each field is written and read under one name.
 const FieldOf<Trajectory> kTimingFields[] = {{"quasistatic", &Trajectory::seconds_quasistatic},
-                                                    {"elastic", &Trajectory::seconds_elastic},
-                                                    {"rigid", &Trajectory::seconds_rigid},
-                                                    {"total", &Trajectory::seconds_total}};
+                                             {"elastic", &Trajectory::seconds_elastic},
+                                             {"rigid", &Trajectory::seconds_rigid},
+                                             {"total", &Trajectory::seconds_total}};
 using Coarsening = TrajectoryCoarsening;
 const FieldOf<Coarsening> kCoarseningFields[] = {
     MSFAB_FIELD(Coarsening, level),         MSFAB_FIELD(Coarsening, material), MSFAB_FIELD(Coarsening, database),
@@ -32,13 +32,13 @@ const FieldOf<Coarsening> kCoarseningCheckFields[] = {
     MSFAB_FIELD(Coarsening, unresolved_windows)};
 using Comparison = TrajectoryComparison;
 const FieldOf<Comparison> kComparisonFields[] = {MSFAB_FIELD(Comparison, reference),
-                                                        MSFAB_FIELD(Comparison, error_at_release),
-                                                        MSFAB_FIELD(Comparison, error_max),
-                                                        MSFAB_FIELD(Comparison, error_mean),
-                                                        MSFAB_FIELD(Comparison, error_final),
-                                                        MSFAB_FIELD(Comparison, max_center_of_mass_distance),
-                                                        MSFAB_FIELD(Comparison, fine_seconds_per_step),
-                                                        MSFAB_FIELD(Comparison, seconds_per_step)};
+                                                 MSFAB_FIELD(Comparison, error_at_release),
+                                                 MSFAB_FIELD(Comparison, error_max),
+                                                 MSFAB_FIELD(Comparison, error_mean),
+                                                 MSFAB_FIELD(Comparison, error_final),
+                                                 MSFAB_FIELD(Comparison, max_center_of_mass_distance),
+                                                 MSFAB_FIELD(Comparison, fine_seconds_per_step),
+                                                 MSFAB_FIELD(Comparison, seconds_per_step)};
 
 constexpr const char* kSchema = "msfab.trajectory";
 constexpr int kSchemaVersion = 1;
