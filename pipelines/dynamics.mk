@@ -13,12 +13,14 @@
 #   make -f Makefile.pipeline design-jump-onto   MPI ranks; docs/design_loop.md): flip to land upright, jump onto
 #   make -f Makefile.pipeline design-jump-over   a platform, over a wall, throw the catapult's cube at a target
 #   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores)
+#   make -f Makefile.pipeline design-strips      a side-view strip of each final jump of the design loops run so
+#                                                far (out/design/*.strip.png, python3 -m msfab strip)
 #   make -f Makefile.pipeline bench-dac-plant    DAC against accurate and convergent meshes on the plant-like
 #   make -f Makefile.pipeline bench-dac-jumper   scene and the flipper jumper (tools/bench_dac_*.sh; minutes;
 #                                                figures in docs/BENCHMARKS.md, "Dynamics")
 #
 # Writes out/dynamics/*.trajectory.h5 with .xmf time series and PNG plots,
-# out/design/*.jump_design.h5.
+# out/design/*.jump_design.h5 with the final design's run beside it (*.final.trajectory.h5).
 DYN := $(OUT)/dynamics
 
 $(DYN)/drop_face_%.trajectory.h5: configs/dynamics/block_drop_face.yaml $(STAGE_ID)/msfab-dynamics.id
@@ -53,6 +55,10 @@ $(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(STAGE_ID)/msfab-jump-des
 	@mkdir -p $(@D)
 	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-jump-design --config $< --out $@
 
+# The final run is written with the design artifact.
+$(OUT)/design/%.strip.png: $(OUT)/design/%.jump_design.h5
+	PYTHONPATH=$(CURDIR)/python $(PYTHON) -m msfab strip $(OUT)/design/$*.final.trajectory.h5 $@ --frames 10
+
 $(OUT)/design/flipper.jump_design.h5: configs/dynamics/flipper_param.yaml
 $(OUT)/design/jump_onto.jump_design.h5: configs/dynamics/jumper_onto.yaml
 $(OUT)/design/jump_over.jump_design.h5: configs/dynamics/jumper_over.yaml
@@ -69,6 +75,12 @@ design-flipper: stages $(OUT)/design/flipper.jump_design.h5
 design-jump-onto: stages $(OUT)/design/jump_onto.jump_design.h5
 design-jump-over: stages $(OUT)/design/jump_over.jump_design.h5
 design-catapult: stages $(OUT)/design/catapult.jump_design.h5
+.PHONY: design-strips
+design-strips:
+	@test -n "$(wildcard $(OUT)/design/*.jump_design.h5)" || \
+	  { echo "msfab: no design loop has run yet (make -f Makefile.pipeline design-flipper, ...)" >&2; exit 2; }
+	@$(MAKE) -f $(firstword $(MAKEFILE_LIST)) --no-print-directory \
+	  $(patsubst %.jump_design.h5,%.strip.png,$(wildcard $(OUT)/design/*.jump_design.h5))
 bench-dac-plant: stages
 	bash tools/bench_dac_plant.sh $(BIN) $(OUT)/bench/dac_plant
 bench-dac-jumper: stages

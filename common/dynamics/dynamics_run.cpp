@@ -290,6 +290,7 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
   out.time_step = scene.newmark.time_step;
   out.event_substeps = scene.event_substeps;
   out.impact_model = impact_model_name(scene.model.impact);
+  out.obstacles = scene.model.obstacles;
 
   NewmarkIntegrator sim(scene.model, scene.newmark);
   Recorder rec(scene, sim, out);

@@ -245,6 +245,32 @@ void write_events(H5File& f, const std::vector<TrajectoryEvent>& events) {
   f.write_attribute("/events", "detail", join_lines(details));
 }
 
+// One row per obstacle: its kind ("ground" or "box"), name and surface as
+// escaped lines, and the box corners (a ground: its height in the z of both).
+void write_obstacles(H5File& f, const std::vector<Obstacle>& obstacles) {
+  if (obstacles.empty()) return;
+  f.create_group("/obstacles");
+  std::vector<std::string> kinds, names, surfaces;
+  NodeArray lo(Eigen::Index(obstacles.size()), 3), hi(Eigen::Index(obstacles.size()), 3);
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const Obstacle& o = obstacles[i];
+    const bool ground = o.kind == Obstacle::Kind::kGround;
+    kinds.push_back(ground ? "ground" : "box");
+    names.push_back(o.name);
+    surfaces.push_back(o.surface);
+    const Vec3 a = ground ? Vec3(0, 0, o.ground_z) : o.lo, b = ground ? Vec3(0, 0, o.ground_z) : o.hi;
+    lo.row(Eigen::Index(i)) = a.transpose();
+    hi.row(Eigen::Index(i)) = b.transpose();
+  }
+  f.write_attribute("/obstacles", "kind", join_lines(kinds));
+  f.write_attribute("/obstacles", "name", join_lines(names));
+  f.write_attribute("/obstacles", "surface", join_lines(surfaces));
+  f.write_matrix("/obstacles/lo", lo);
+  f.write_attribute("/obstacles/lo", "units", "m");
+  f.write_matrix("/obstacles/hi", hi);
+  f.write_attribute("/obstacles/hi", "units", "m");
+}
+
 void write_sidecar(const std::string& path, const Trajectory& t) {
   XdmfHexMesh mesh;
   mesh.h5_file = file_name_of(path);
@@ -373,6 +399,38 @@ void read_events(const H5File& f, Trajectory& t) {
   for (std::size_t i = 0; i < time.size(); ++i) t.events[i] = {time[i], kinds[i], details[i]};
 }
 
+void read_obstacles(const H5File& f, Trajectory& t) {
+  const NodeArray lo = f.read_matrix<double>("/obstacles/lo", 3), hi = f.read_matrix<double>("/obstacles/hi", 3);
+  const std::size_t n = std::size_t(lo.rows());
+  if (std::size_t(hi.rows()) != n)
+    throw InputError(f.path() + ": dataset '/obstacles/hi' has " + std::to_string(hi.rows()) + " rows, expected " +
+                     std::to_string(n) + " (one per row of /obstacles/lo)");
+  const auto lines = [&](const char* name) {
+    std::vector<std::string> items;
+    if (!split_lines(f.read_string_attribute("/obstacles", name), n, items))
+      throw InputError(f.path() + ": attribute '" + name + "' of '/obstacles' does not hold " + std::to_string(n) +
+                       " escaped lines (one per row of /obstacles/lo)");
+    return items;
+  };
+  const std::vector<std::string> kinds = lines("kind"), names = lines("name"), surfaces = lines("surface");
+  t.obstacles.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Obstacle& o = t.obstacles[i];
+    if (kinds[i] != "ground" && kinds[i] != "box")
+      throw InputError(f.path() + ": attribute 'kind' of '/obstacles', row " + std::to_string(i) + ": '" + kinds[i] +
+                       "' is neither ground nor box");
+    o.kind = kinds[i] == "ground" ? Obstacle::Kind::kGround : Obstacle::Kind::kBox;
+    o.name = names[i];
+    o.surface = surfaces[i];
+    if (o.kind == Obstacle::Kind::kGround) {
+      o.ground_z = lo(Eigen::Index(i), 2);
+    } else {
+      o.lo = lo.row(Eigen::Index(i)).transpose();
+      o.hi = hi.row(Eigen::Index(i)).transpose();
+    }
+  }
+}
+
 }  // namespace
 
 const char* phase_name(SimulationPhase phase) {
@@ -408,6 +466,7 @@ std::string write_trajectory_artifact(const std::string& path, const Trajectory&
   write_body_centers(f, t);
   write_frames(f, t);
   write_events(f, t.events);
+  write_obstacles(f, t.obstacles);
 
   f.create_group("/timings");
   f.write_attribute("/timings", "units", "s");
@@ -468,6 +527,7 @@ Trajectory read_trajectory_artifact(const std::string& path) {
   }
   read_frames(f, t);
   read_events(f, t);
+  if (f.exists("/obstacles")) read_obstacles(f, t);  // recorded since 2026-12-05
 
   read_attribute_fields(f, "/timings", t, kTimingFields);
   if (f.exists("/coarsening")) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "dynamics/obstacles.hpp"
 #include "fem/hex_mesh.hpp"
 
 namespace msfab {
@@ -84,6 +85,10 @@ struct Trajectory {
   std::vector<TrajectorySample> samples;     // one per step (and the initial state)
   std::vector<TrajectoryFrame> frames;       // at output times
   std::vector<TrajectoryEvent> events;
+  // The scene's static obstacles (ground, boxes), so that pictures of the
+  // run can show what it jumped onto or over; empty in files written before
+  // they were recorded.
+  std::vector<Obstacle> obstacles;
   // Wall time by phase (s) and in total.
   double seconds_quasistatic = 0, seconds_elastic = 0, seconds_rigid = 0, seconds_total = 0;
   double time_step = 0;

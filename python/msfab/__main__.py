@@ -1,4 +1,5 @@
-"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE | report OUT.html PATH... | stack OUT.npy IMAGE..."""
+"""python3 -m msfab info FILE | export FILE OUT [--frame K] | inputs FILE | report OUT.html PATH... | stack OUT.npy IMAGE...
+| strip TRAJECTORY.h5 OUT.png"""
 
 import argparse
 import sys
@@ -57,6 +58,13 @@ def stack(args):
     print(f"{args.out}: {ids.shape[0]} x {ids.shape[1]} x {ids.shape[2]} voxels, voxels per id {counts}")
 
 
+def strip(args):
+    from .strip import draw_strip
+    drawn = draw_strip(args.file, args.out, frames=args.frames, view=args.view, ground=args.ground)
+    print(f"{args.out}: {len(drawn['times'])} moments from {drawn['times'][0]:.4f} to {drawn['times'][-1]:.4f} s, "
+          f"obstacles {drawn['obstacles']}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m msfab", description="Read and export msfab artifacts.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -85,6 +93,13 @@ def main(argv=None):
     p.add_argument("paths", nargs="+", help="artifacts, or folders searched for *.h5")
     p.add_argument("--title", default="msfab report")
     p.set_defaults(run=report)
+    p = sub.add_parser("strip", help="a side view of a trajectory at several moments, with its obstacles (PNG)")
+    p.add_argument("file", help="an msfab.trajectory artifact")
+    p.add_argument("out", help="the PNG to write")
+    p.add_argument("--frames", type=int, default=8, help="moments drawn, spread evenly in time (default 8)")
+    p.add_argument("--view", default="y", help="the axis looked along: x, y or z (default y)")
+    p.add_argument("--ground", type=float, help="draw a ground at this height (runs that recorded no obstacles)")
+    p.set_defaults(run=strip)
     args = parser.parse_args(argv)
     try:
         return args.run(args) or 0

@@ -172,6 +172,12 @@ DesignEvaluator::DesignEvaluator(const DesignProblem& problem) : problem_(proble
   }
 }
 
+Trajectory DesignEvaluator::run_trajectory(const std::vector<double>& values, double until) const {
+  DynamicsScene scene = build_scene(problem_, values);
+  scene.duration = std::min(scene.duration, until);
+  return run_dynamics_scene(scene);
+}
+
 Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index,
                                      double modulus_scale) const {
   const auto t0 = std::chrono::steady_clock::now();

@@ -9,6 +9,7 @@
 #include "design_config.hpp"
 #include "dynamics/jump_outcome.hpp"
 #include "dynamics/obstacles.hpp"
+#include "dynamics/trajectory.hpp"
 
 namespace msfab {
 
@@ -45,6 +46,11 @@ class DesignEvaluator {
   // penalty values; bad input still throws. `modulus_scale` multiplies
   // every material's modulus (print variation).
   Evaluation evaluate(const std::vector<double>& parameters, int start, int index, double modulus_scale = 1.0) const;
+
+  // The whole run of a design, with the scene's output frames, up to
+  // `until` seconds (or the scene's duration if that is shorter): the
+  // record pictures of the jump are drawn from. Not stopped by the observer.
+  Trajectory run_trajectory(const std::vector<double>& parameters, double until) const;
 
   int elements() const { return elements_; }
   // Peak memory of one evaluation at the initial design (dynamics_peak_bytes).

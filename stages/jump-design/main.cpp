@@ -15,6 +15,9 @@
 //      fraction of samples that still meet the goal
 //   5. write `msfab.jump_design` (every evaluation, initial and final
 //      designs, the variation samples) and print initial against final
+//   6. run the final design once more, whole, to its landing and `settle`
+//      after it, and write that run as `msfab.trajectory` (frames of the
+//      jump for pictures and ParaView)
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
@@ -30,6 +33,9 @@
 #include "design_report.hpp"
 #include "design_robustness.hpp"
 #include "design_search.hpp"
+#include "dynamics/trajectory.hpp"
+#include "io/atomic_file.hpp"
+#include "io/path_names.hpp"
 #include "parallel/fan_out.hpp"
 #include "parallel/mpi_session.hpp"
 
@@ -41,6 +47,9 @@ int main(int argc, char** argv) {
   StageApp app("msfab-jump-design", "Design loop for jumping mechanisms with COBYLA over dynamics runs (thesis 4.5.1)");
   app.set_rank(rank);
   app.add_common_options();
+  std::string trajectory_path;
+  app.cli().add_option("--trajectory", trajectory_path,
+                       "the final design's run (default: <out without .jump_design.h5>.final.trajectory.h5)");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
@@ -50,6 +59,13 @@ int main(int argc, char** argv) {
     ctx.finish_config();
     const DesignEvaluator evaluator(problem);
     ctx.check_out_folder();
+    if (trajectory_path.empty())
+      trajectory_path = without_suffix(out, {".jump_design.h5", ".h5"}) + ".final.trajectory.h5";
+    try {  // checked before any work, on every rank
+      AtomicFile probe(trajectory_path);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--trajectory ") + e.what());
+    }
     ctx.check_memory(omp_get_max_threads() * evaluator.peak_bytes(),
                      "one simulation of " + std::to_string(evaluator.elements()) + " elements per thread (" +
                          std::to_string(omp_get_max_threads()) + " threads)",
@@ -83,6 +99,19 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       write_jump_design_artifact(out, problem, run, ctx.config.resolved_text(), ctx.options.seed);
       print_design_summary(problem, run, out);
+    }
+
+    // 6. The final design's whole run.
+    if (rank == 0) {
+      const Evaluation& best = run.evaluations[run.final];
+      const Trajectory t = evaluator.run_trajectory(best.parameters, best.outcome.landing_time + problem.settle);
+      TrajectoryProvenance provenance;
+      provenance.executable = "msfab-jump-design";
+      provenance.config_text = ctx.config.resolved_text();
+      provenance.seed = ctx.options.seed;
+      write_trajectory_artifact(trajectory_path, t, provenance);
+      spdlog::info("final design's run ({} frames to {:.4f} s): {}", t.frames.size(),
+                   t.samples.empty() ? 0.0 : t.samples.back().time, trajectory_path);
     }
   });
   return code;

@@ -42,6 +42,28 @@ check "final design no worse than the initial one" -- awk -v a="$initial" -v b="
 check "final design within 2 mm of the target" -- awk -v b="$final" 'BEGIN { exit !(b < 2e-3) }'
 check "it landed" -- bash -c "h5dump -d /final/outcome '$WORK/one.h5' | grep -q '(0): 1, 1,'"
 
+# The final design's whole run: a trajectory with the scene's ground, which
+# passes through the centre of mass the search measured at the landing.
+check "the final design's run is written beside the artifact" -- test -s "$WORK/one.final.trajectory.h5"
+check "... and reproduces the landing the search measured" -- env PYTHONPATH="$SRC/python" PYTHONDONTWRITEBYTECODE=1 \
+  /usr/bin/python3 -c "
+import sys, h5py, numpy as np
+d = h5py.File('$WORK/one.h5')
+cols = d.attrs['outcome_columns']
+cols = (cols.decode() if isinstance(cols, bytes) else cols).split(',')
+o = dict(zip([c.strip() for c in cols], d['/final/outcome'][()]))
+t = h5py.File('$WORK/one.final.trajectory.h5')
+time, com = t['/samples/time'][()], t['/samples/center_of_mass'][()]
+k = int(np.argmin(np.abs(time - o['landing_time'])))
+ok = abs(time[k] - o['landing_time']) < 1e-12 and np.abs(com[k] - [o['com_landing_x'], o['com_landing_y'], o['com_landing_z']]).max() < 1e-12
+ok = ok and time[-1] >= o['landing_time'] and len(t['/frames/time']) > 2
+sys.exit(0 if ok else 1)"
+check "python3 -m msfab strip draws it with the ground" -- bash -c "cd '$WORK' && env PYTHONPATH='$SRC/python' \
+  PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m msfab strip one.final.trajectory.h5 strip.png --frames 5 | grep -q \"obstacles \\['ground'\\]\""
+check "... as a PNG" -- bash -c "head -c 8 '$WORK/strip.png' | od -An -c | grep -q 'P   N   G'"
+expect_exit 2 "--trajectory .*nowhere" -- "$DESIGN" --config "$WORK/design.yaml" --trajectory "$WORK/nowhere/x.h5" \
+  --out "$WORK/bad.h5"
+
 check "two ranks" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 "$DESIGN" --config "$WORK/design.yaml" \
   --out "$WORK/two.h5" --quiet
 same() {

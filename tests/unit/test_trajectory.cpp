@@ -116,6 +116,16 @@ Trajectory synthetic_trajectory() {
   }
   t.events = {{t.time_step, "contact", "4 nodes, max penetration 1e-6 m"},
               {3 * t.time_step, "rigid", "line one\nline two, with a \\ backslash"}};
+  Obstacle ground;
+  ground.name = "floor";
+  ground.ground_z = -1.0 / 3.0;
+  ground.surface = "table";
+  Obstacle wall;
+  wall.kind = Obstacle::Kind::kBox;
+  wall.name = "wall, tall";
+  wall.lo = Vec3(0.02, -0.05, 0);
+  wall.hi = Vec3(0.02 + 1.0 / 7.0, 0.05, std::sqrt(2e-4));
+  t.obstacles = {ground, wall};
   t.seconds_quasistatic = 0.125 / 3;
   t.seconds_elastic = std::sqrt(0.5);
   t.seconds_rigid = 1e-5 / 7;
@@ -171,6 +181,16 @@ void expect_identical(const Trajectory& a, const Trajectory& b) {
     EXPECT_SAME_DOUBLE(a.events[i].time, b.events[i].time);
     EXPECT_EQ(a.events[i].kind, b.events[i].kind);
     EXPECT_EQ(a.events[i].detail, b.events[i].detail);
+  }
+  ASSERT_EQ(a.obstacles.size(), b.obstacles.size());
+  for (std::size_t i = 0; i < a.obstacles.size(); ++i) {
+    const Obstacle &x = a.obstacles[i], &y = b.obstacles[i];
+    EXPECT_EQ(x.kind, y.kind);
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.surface, y.surface);
+    EXPECT_SAME_DOUBLE(x.ground_z, y.ground_z);
+    expect_same_vec3(x.lo, y.lo);
+    expect_same_vec3(x.hi, y.hi);
   }
   EXPECT_SAME_DOUBLE(a.seconds_quasistatic, b.seconds_quasistatic);
   EXPECT_SAME_DOUBLE(a.seconds_elastic, b.seconds_elastic);
@@ -274,6 +294,7 @@ TEST_F(TrajectoryArtifact, EmptyTrajectoryRoundTrips) {
   t.frames.clear();
   t.events.clear();
   t.material_names.clear();
+  t.obstacles.clear();
   const std::string path = file("empty.h5");
   const std::string xmf = write_trajectory_artifact(path, t, {});
   expect_identical(t, read_trajectory_artifact(path));
@@ -362,6 +383,15 @@ TEST_F(TrajectoryArtifact, DamagedFileNamesFileAndDataset) {
   message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
   EXPECT_NE(message.find("'kind'"), std::string::npos) << message;
   EXPECT_NE(message.find("/events"), std::string::npos) << message;
+
+  write_trajectory_artifact(path, synthetic_trajectory(), {});
+  {
+    H5File f = H5File::open(path, H5File::Mode::kReadWrite);
+    f.write_attribute("/obstacles", "kind", "ground\ncone");
+  }
+  message = trajectory_input_error_message([&] { read_trajectory_artifact(path); });
+  EXPECT_NE(message.find(path), std::string::npos) << message;
+  EXPECT_NE(message.find("'cone' is neither ground nor box"), std::string::npos) << message;
 }
 
 }  // namespace
