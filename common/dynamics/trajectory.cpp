@@ -385,14 +385,21 @@ void read_frames(const H5File& f, Trajectory& t) {
   }
 }
 
+// The `count` escaped lines of attribute `name` of `group` (join_lines);
+// `per` says what each line belongs to, for the error.
+std::vector<std::string> read_lines_attribute(const H5File& f, const std::string& group, const char* name,
+                                              std::size_t count, const std::string& per) {
+  std::vector<std::string> items;
+  if (!split_lines(f.read_string_attribute(group, name), count, items))
+    throw InputError(f.path() + ": attribute '" + name + "' of '" + group + "' does not hold " + std::to_string(count) +
+                     " escaped lines (one per " + per + ")");
+  return items;
+}
+
 void read_events(const H5File& f, Trajectory& t) {
   const std::vector<double> time = f.read_vector<double>("/events/time");
   const auto lines = [&](const char* name) {
-    std::vector<std::string> items;
-    if (!split_lines(f.read_string_attribute("/events", name), time.size(), items))
-      throw InputError(f.path() + ": attribute '" + name + "' of '/events' does not hold " +
-                       std::to_string(time.size()) + " escaped lines (one per /events/time)");
-    return items;
+    return read_lines_attribute(f, "/events", name, time.size(), "/events/time");
   };
   const std::vector<std::string> kinds = lines("kind"), details = lines("detail");
   t.events.resize(time.size());
@@ -406,11 +413,7 @@ void read_obstacles(const H5File& f, Trajectory& t) {
     throw InputError(f.path() + ": dataset '/obstacles/hi' has " + std::to_string(hi.rows()) + " rows, expected " +
                      std::to_string(n) + " (one per row of /obstacles/lo)");
   const auto lines = [&](const char* name) {
-    std::vector<std::string> items;
-    if (!split_lines(f.read_string_attribute("/obstacles", name), n, items))
-      throw InputError(f.path() + ": attribute '" + name + "' of '/obstacles' does not hold " + std::to_string(n) +
-                       " escaped lines (one per row of /obstacles/lo)");
-    return items;
+    return read_lines_attribute(f, "/obstacles", name, n, "row of /obstacles/lo");
   };
   const std::vector<std::string> kinds = lines("kind"), names = lines("name"), surfaces = lines("surface");
   t.obstacles.resize(n);

@@ -11,6 +11,8 @@ written before obstacles were recorded are drawn with the ground at z = 0
 only if --ground is given.
 """
 
+import re
+
 import numpy as np
 
 from .artifact import ArtifactError, open_artifact
@@ -30,13 +32,18 @@ def boundary_faces(elements):
     return faces[np.sort(first[count == 1])]
 
 
+def _escaped_lines(text):
+    """The lines the writer joined with line breaks, "\\" and "\\n" escaped inside them."""
+    unescape = lambda m: "\n" if m.group(1) == "n" else m.group(1)  # noqa: E731
+    return [re.sub(r"\\(.)", unescape, line) for line in text.split("\n")]
+
+
 def obstacles_of(a):
     """[(kind, name, lo, hi)] from /obstacles; empty when the run recorded none."""
     if "/obstacles/lo" not in a:
         return []
     attrs = a.attrs("/obstacles")
-    kinds = str(attrs["kind"]).split("\n")
-    names = str(attrs["name"]).split("\n")
+    kinds, names = _escaped_lines(str(attrs["kind"])), _escaped_lines(str(attrs["name"]))
     lo, hi = np.asarray(a["/obstacles/lo"], float), np.asarray(a["/obstacles/hi"], float)
     if not (len(kinds) == len(names) == len(lo) == len(hi)):
         raise ArtifactError(f"{a.path}: /obstacles: {len(kinds)} kinds, {len(names)} names, {len(lo)} rows of lo, "
@@ -51,8 +58,7 @@ def pick_frames(times, count):
     if len(times) <= count:
         return list(range(len(times)))
     wanted = np.linspace(times[0], times[-1], count)
-    picked = sorted({int(np.argmin(np.abs(times - t))) for t in wanted})
-    return picked
+    return sorted({int(np.argmin(np.abs(times - t))) for t in wanted})
 
 
 def draw_strip(path, out_png, frames=8, view="y", ground=None):
