@@ -15,6 +15,7 @@
 #   make -f Makefile.pipeline ddfem-table-level2-variants  level 2 sampled on fine voxels, and with corner moves in the lookup
 #   make -f Makefile.pipeline ddfem-table-checked   matched coarsening, and DDFEM lookups checked against each block's own C^H
 #   make -f Makefile.pipeline ddfem-table-adaptive-checked  adaptive coarsening with the checked lookup
+#   make -f Makefile.pipeline ddfem-table-adaptive-level1db  the same, level-1 cells from the full level-1 database
 #   make -f Makefile.pipeline ddfem-table-windowed  matched materials carried onto each cell's stiffness among its real neighbours
 #   make -f Makefile.pipeline ddfem-table-window-checked  DDFEM lookups checked against each cell's stiffness among its real neighbours
 #   make -f Makefile.pipeline ddfem-table-dynamics  DDFEM in dynamics: the fibre bar fine, level 1 and 2, trajectory error and speed
@@ -47,7 +48,7 @@ $(OUT)/ddfem/%.level2.coarse_db.h5: configs/ddfem/%_level2.yaml $(OUT)/ddfem/%.k
 	  --set base_database=$(OUT)/ddfem/$*.k$(K1).coarse_db.h5 --out $@ --resume
 
 .PHONY: ddfem-db-tiny ddfem-db-level1 ddfem-db-level2 ddfem-table ddfem-table-periodic ddfem-table-centre ddfem-table-void \
-        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants ddfem-table-checked ddfem-table-adaptive-checked ddfem-table-windowed ddfem-table-window-checked \
+        ddfem-table-adaptive ddfem-table-adaptive-enhanced ddfem-table-floor ddfem-table-enhanced ddfem-table-mixed ddfem-table-level2-variants ddfem-table-checked ddfem-table-adaptive-checked ddfem-table-adaptive-level1db ddfem-table-windowed ddfem-table-window-checked \
         ddfem-table-dynamics
 ddfem-db-tiny: stages $(OUT)/ddfem/tiny.coarse_db.h5
 ddfem-db-level1: stages $(OUT)/ddfem/palette3.coarse_db.h5
@@ -218,6 +219,16 @@ ddfem-table-adaptive-checked: stages $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(
 	DATABASE1=$(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 BENCH_SECTION=ddfem-adaptive-checked \
 	  COARSE_ARGS="--coarse-fallback $(FALLBACK) --coarse-check $(CHECK)" \
 	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-$(ENHANCED_DB)-$(FALLBACK)-checked docs/BENCHMARKS.md \
+	  $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+
+# The same with the full level-1 database for the adaptive runs' level-1
+# cells and solve (--level1-database) instead of level 2's compressed base
+# (docs/ddfem.md, "Adaptive coarsening", the estimate's shared error).
+ddfem-table-adaptive-level1db: stages $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
+	DATABASE1=$(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5 BENCH_SECTION=ddfem-adaptive-level1db \
+	  COARSE_ARGS="--coarse-fallback $(FALLBACK) --coarse-check $(CHECK)" \
+	  ADAPTIVE_ARGS="--level1-database $(OUT)/ddfem/$(ENHANCED_DB).coarse_db.h5" \
+	  bash tools/bench_adaptive.sh $(BIN) $(OUT)/bench/ddfem-adaptive-$(ENHANCED_DB)-$(FALLBACK)-level1db docs/BENCHMARKS.md \
 	  $(OUT)/ddfem/$(ENHANCED_DB).level2.coarse_db.h5
 
 # The thesis's own settings (docs/ddfem.md, "The thesis's settings"), level 1:

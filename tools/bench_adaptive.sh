@@ -10,7 +10,8 @@
 # nu = 0.45); DATABASE1 (environment, optional) a level-1 one for the uniform
 # level-1 rows. Naive coarsening at both levels is measured too. TARGETS (environment) lists the target errors (default
 # "0.02 0.01 0.005 0.002"); COARSE_ARGS, extra msfab-simulate arguments of
-# the database runs (e.g. "--coarse-fallback galerkin"); PYTHON, a python3
+# the database runs (e.g. "--coarse-fallback galerkin"); ADAPTIVE_ARGS, extra
+# arguments of the adaptive runs only (e.g. "--level1-database DB"); PYTHON, a python3
 # with matplotlib (Debian python3-matplotlib). Writes the section
 # bench:$BENCH_SECTION (default ddfem-adaptive) of BENCHMARKS.md,
 # OUTDIR/adaptive.csv and docs/images/$BENCH_SECTION.png.
@@ -21,6 +22,7 @@ SCENES=("$@")
 [ ${#SCENES[@]} -gt 0 ] || SCENES=(bending twisting pushing layers1 checker random3 sole bridge_arch skeleton holes3)
 read -r -a TARGET_LIST <<< "${TARGETS:-0.02 0.01 0.005 0.002}"
 read -r -a COARSE_ARG_LIST <<< "${COARSE_ARGS:-}"
+read -r -a ADAPTIVE_ARG_LIST <<< "${ADAPTIVE_ARGS:-}"
 SECTION=${BENCH_SECTION:-ddfem-adaptive}
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
@@ -70,7 +72,7 @@ for scene in "${SCENES[@]}"; do
   for target in "${TARGET_LIST[@]}"; do
     echo "bench: $scene adaptive $target ..." >&2
     f="$OUTDIR/$scene-A$target.h5"
-    run "$f" --config "$cfg" --target-error "$target" --database "$DB2" "${COARSE_ARG_LIST[@]}" --reference "$fine" ||
+    run "$f" --config "$cfg" --target-error "$target" --database "$DB2" "${COARSE_ARG_LIST[@]}" "${ADAPTIVE_ARG_LIST[@]}" --reference "$fine" ||
       continue
     e=$(attr "$f" /coarsening error_vs_fine) p=$(attr "$f" /coarsening predicted_error) t=$(coarse_seconds "$f")
     rows+=$(awk -v s="$scene" -v g="$target" -v p="$p" -v e="$e" -v t="$t" -v tf="$tf" -v l="$(levels "$f")" \
@@ -84,7 +86,7 @@ printf "%s" "$csv" > "$OUTDIR/adaptive.csv"
   echo "bench: no plot (python3 with matplotlib needed)" >&2
 
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB2")${DATABASE1:+ (level 2) and $(basename "$DATABASE1") (level 1)}${COARSE_ARGS:+, database runs with $COARSE_ARGS}.
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB2")${DATABASE1:+ (level 2) and $(basename "$DATABASE1") (level 1)}${COARSE_ARGS:+, database runs with $COARSE_ARGS}${ADAPTIVE_ARGS:+, adaptive runs with $(echo "$ADAPTIVE_ARGS" | sed 's|[^ ]*/||g')}.
 
 | scene | model | target | predicted | error | met | elements fine/L1/L2 | s | fine s | speedup |
 |---|---|---|---|---|---|---|---|---|---|

@@ -428,6 +428,36 @@ void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
   }
 }
 
+void check_level1_substitute(const CoarseDatabase& substitute, const std::string& substitute_path,
+                             const CoarseDatabase& level2, const std::string& level2_path) {
+  const std::string both = substitute_path + " (level-1 database) and " + level2_path + " (level-2 database): ";
+  if (substitute.level != 1)
+    throw InputError(substitute_path + ": level: a level-" + std::to_string(substitute.level) +
+                     " database cannot stand in for a level-1 base");
+  if (level2.level != 2 || !level2.level1) throw InputError(level2_path + ": level: not a level-2 database");
+  const CoarseDatabase& base = *level2.level1;
+  if (substitute.num_materials() != base.num_materials())
+    throw InputError(both + "materials: " + std::to_string(substitute.num_materials()) + " against " +
+                     std::to_string(base.num_materials()) + " in the level-2 database's base");
+  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
+  for (int i = 0; i < base.num_materials(); ++i) {
+    const DbMaterial &a = substitute.materials[i], &b = base.materials[i];
+    if (!same(a.E, b.E) || !same(a.nu, b.nu)) {
+      std::ostringstream os;
+      os << both << "materials: id " << i + 1 << " is E " << a.E << ", nu " << a.nu << " in the first and E " << b.E
+         << ", nu " << b.nu << " in the second's base";
+      throw InputError(os.str());
+    }
+  }
+  if (substitute.void_children != base.void_children)
+    throw InputError(both + "void_children: " + (substitute.void_children ? "true" : "false") + " against " +
+                     (base.void_children ? "true" : "false") + " in the level-2 database's base");
+  if (substitute.enhanced_element() != base.enhanced_element())
+    throw InputError(
+        both + "element: fitted for the " + std::string(substitute.enhanced_element() ? "enhanced" : "trilinear") +
+        " coarse element, the level-2 database's base for the " + (base.enhanced_element() ? "enhanced" : "trilinear"));
+}
+
 CoarseMaterialLookup database_coarsening(const CoarseDatabase& db, CoarseMaterialLookup fallback) {
   return [&db, fallback](const ChildIds& ids) {
     BlockMaterials b;

@@ -92,6 +92,12 @@ CoarseDatabase read_coarse_db(const std::string& path);
 void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
                          const std::vector<MaterialPtr>& scene_palette, const std::vector<int>& used_ids);
 
+// A level-1 database that may stand in for a level-2 database's compressed
+// level-1 base (adaptive coarsening's level-1 cells): level 1, the same
+// palette (E and nu per id), void children and coarse element as the base.
+// InputError naming both files and the field that differs.
+void check_level1_substitute(const CoarseDatabase& substitute, const std::string& substitute_path,
+                             const CoarseDatabase& level2, const std::string& level2_path);
 // Level-1 lookup for build_coarse_mesh: the database fit where it has one,
 // `fallback` (naive coarsening) for the rest (blocks with a void child in a
 // database without void children, and blocks that could not be fitted).

@@ -13,10 +13,10 @@ namespace {
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-// The materials of the uniform models: the database's lookups with the
+// The materials of the uniform models: the databases' lookups with the
 // level-2 model's element, fallback and check.
-CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2) {
-  return ddfem_lookup(*level2.database->level1, scene.material_by_id, level2.level1, 1, level2, nullptr);
+CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2, const CoarseDatabase& level1_db) {
+  return ddfem_lookup(level1_db, scene.material_by_id, level2.level1, 1, level2, nullptr);
 }
 
 CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseModel& level2) {
@@ -68,7 +68,8 @@ AdaptiveResultOnMesh adaptive_result_on_mesh(const AdaptiveModel& model, const E
   return r;
 }
 
-CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2) {
+CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2,
+                            const CoarseDatabase& level1_db) {
   if (!level2.database || level2.database->level != 2)
     throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
   const auto t0 = std::chrono::steady_clock::now();
@@ -79,7 +80,7 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
   m.element = level2.element;
   m.fallback = level2.fallback;
   m.check_tolerance = level2.check_tolerance;
-  m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, level2), 0, &m.stats, m.element == "enhanced");
+  m.mesh = build_coarse_mesh(m.grid, level1_lookup(scene, level2, level1_db), 0, &m.stats, m.element == "enhanced");
   m.conditions = coarse_static_conditions(scene, fine, m.grid, m.mesh);
   m.seconds = seconds_since(t0);
   return m;
@@ -93,7 +94,7 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
 
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
                                    const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
-                                   double target_error) {
+                                   const CoarseDatabase& level1_db, double target_error) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!level2.database || level2.database->level != 2)
     throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
@@ -110,7 +111,7 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   // The mixed mesh, with the same materials as the uniform models. A node
   // the scene fixes must not hang on free corners: the cells around it are
   // meshed fine (face conditions fix whole faces, so this is rare).
-  const CoarseMaterialLookup lookup1 = level1_lookup(scene, level2);
+  const CoarseMaterialLookup lookup1 = level1_lookup(scene, level2, level1_db);
   const CoarseMaterialLookup lookup2 = level2_lookup(scene, level2);
   std::vector<int>& levels = m.choice.cell_level;
   for (;;) {

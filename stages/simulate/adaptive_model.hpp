@@ -21,9 +21,12 @@ struct AdaptiveModel {
   double seconds = 0;                    // estimate, choice and mesh (not the two solves)
 };
 
-// The uniform level-1 model of the scene with the level-1 materials of the
-// level-2 model's database (the database's compressed level-1 entries).
-CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2);
+// The uniform level-1 model of the scene with the materials of `level1_db`:
+// the level-2 model's database's own (compressed) level-1 base, or a
+// level-1 database checked to stand in for it (--level1-database). The
+// level-1 cells of the adaptive model take the same materials.
+CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const CoarseModel& level2,
+                            const CoarseDatabase& level1_db);
 
 // Positions (3 per node) to start Newton from on a finer model whose rest
 // nodes are the rows of `rest`: the coarser uniform model `from`'s solution
@@ -31,10 +34,10 @@ CoarseModel level1_model_of(const Scene& scene, const VoxelMesh& fine, const Coa
 VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& rest);
 
 // `level2` / `level1` are the uniform models and x2 / x1 their solutions
-// (positions).
+// (positions); `level1_db` the database level1 was built with.
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
                                    const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
-                                   double target_error);
+                                   const CoarseDatabase& level1_db, double target_error);
 
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine

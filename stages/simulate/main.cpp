@@ -130,6 +130,10 @@ int main(int argc, char** argv) {
       "--target-error", target_error,
       "adaptive coarsening: the mean-vertex error (thesis 2.5.2) to stay within, choosing fine, level 1 or level 2 "
       "per 4x4x4 cell (needs a level-2 --database)");
+  std::string level1_database;
+  app.cli().add_option("--level1-database", level1_database,
+                       "adaptive coarsening: a level-1 coarse_db of the same palette and element for the level-1 "
+                       "cells and solve, instead of the level-2 database's compressed level-1 base");
   std::string reference;
   app.cli().add_option("--reference", reference,
                        "a fine msfab.result of the same scene to compare with instead of solving it again");
@@ -142,6 +146,8 @@ int main(int argc, char** argv) {
     const Scene scene = read_scene(ctx.config);
     ctx.finish_config();
     const bool adaptive = target_option->count() > 0;
+    if (!level1_database.empty() && !adaptive)
+      throw InputError("--level1-database: applies to --target-error only (uniform level 1 takes --database)");
     check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level},
                        compare_fine);
 
@@ -179,14 +185,27 @@ int main(int argc, char** argv) {
     NewtonOptions warm_newton = scene.newton;
     warm_newton.load_steps = 1;
     VecX adaptive_start;
+    std::shared_ptr<const CoarseDatabase> adaptive_level1_db;  // kept while the models built from it are in use
     if (adaptive) {
+      // The level-1 materials: the level-2 database's own base unless a
+      // level-1 database stands in for it. Where the base is compressed, the
+      // uniform level-1 and level-2 models share its lookup error, which
+      // their difference (the estimate) cannot see (docs/ddfem.md).
+      std::shared_ptr<const CoarseDatabase> level1_db = coarse.database->level1;
+      if (!level1_database.empty()) {
+        auto db = std::make_shared<CoarseDatabase>(read_coarse_db(level1_database));
+        check_level1_substitute(*db, level1_database, *coarse.database, coarsening.database);
+        level1_db = db;
+      }
+      adaptive_level1_db = level1_db;
       const NewtonResult solve2 =
           solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
-      const CoarseModel level1 = level1_model_of(scene, fine, coarse);
+      const CoarseModel level1 = level1_model_of(scene, fine, coarse, *level1_db);
       const NewtonResult solve1 = solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, warm_newton,
                                                  "level-1 load", start_from(coarse, solve2.x, level1.mesh.mesh.nodes));
       uniform_seconds = solve2.timings.total + solve1.timings.total;
-      adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, target_error);
+      adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, *level1_db,
+                                     target_error);
       adaptive_start = start_from(level1, solve1.x, adapted.mixed.constraints->unknown_rest);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
@@ -289,6 +308,7 @@ int main(int argc, char** argv) {
     record.seed = ctx.options.seed;
     record.inputs = scene.geometry_files;
     if (!coarsening.database.empty()) record.inputs.push_back(coarsening.database);
+    if (!level1_database.empty()) record.inputs.push_back(level1_database);
     if (!reference.empty()) record.inputs.push_back(reference);
     if (coarsened) {
       record.coarsen_level = coarsening.level;
@@ -314,6 +334,7 @@ int main(int argc, char** argv) {
       record.predicted_error = adapted.choice.predicted_error;
       record.uniform_solve_seconds = uniform_seconds;
       record.level_difference = adapted.level_difference;
+      record.level1_database = level1_database;
       record.elements_per_level = adapted.mixed.elements_per_level;
       record.coarsening_seconds = coarse.seconds + adapted.seconds;
     }

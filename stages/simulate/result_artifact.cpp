@@ -100,6 +100,7 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
       f.write_attribute("/coarsening", "predicted_error", r.predicted_error);
       f.write_attribute("/coarsening", "uniform_solve_seconds", r.uniform_solve_seconds);
       f.write_attribute("/coarsening", "level_difference", r.level_difference);
+      f.write_attribute("/coarsening", "level1_database", r.level1_database);
       f.write_attribute("/coarsening", "elements_per_level",
                         std::vector<int>(r.elements_per_level.begin(), r.elements_per_level.end()));
     }

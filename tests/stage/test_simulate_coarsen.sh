@@ -95,6 +95,19 @@ expect_exit 2 "needs --coarse-material ddfem" -- \
   "$SIM" --config "$BAR" --target-error 0.01 --coarse-material naive --out "$WORK/o.h5"
 expect_exit 2 "level-1 database cannot coarsen to level 2" -- \
   "$SIM" --config "$BAR" --target-error 0.01 --database "$WORK/db.h5" --out "$WORK/o.h5"
+# --level1-database: the level-1 cells and solve take another level-1
+# database. db2.h5 was built over db.h5 itself (uncompressed), so standing
+# db.h5 in for its base must change nothing.
+"$SIM" --config "$BAR" --target-error 0.004 --database "$WORK/db2.h5" --level1-database "$WORK/db.h5" --threads 1 \
+  --out "$WORK/adaptive_level1db.h5" --quiet >/dev/null
+check "a level-1 database equal to the base changes nothing" -- \
+  h5diff -d 0 "$WORK/adaptive_threads1.h5" "$WORK/adaptive_level1db.h5" /displacement
+check "the result records the level-1 database" -- \
+  bash -c "h5dump -a /coarsening/level1_database '$WORK/adaptive_level1db.h5' | grep -q db.h5"
+expect_exit 2 "cannot stand in for a level-1 base" -- "$SIM" --config "$BAR" --target-error 0.01 \
+  --database "$WORK/db2.h5" --level1-database "$WORK/db2.h5" --out "$WORK/o.h5"
+expect_exit 2 "applies to --target-error only" -- "$SIM" --config "$BAR" --coarsen 1 --database "$WORK/db.h5" \
+  --level1-database "$WORK/db.h5" --out "$WORK/o.h5"
 
 # The enhanced coarse element (condensed bubble modes) does not lock in
 # bending: on the bending demo bar naive coarsening gets closer to the fine
@@ -148,6 +161,8 @@ check "adaptive target met on the enhanced element with fewer elements than fine
   awk -v e="$adaptive_enhanced" -v n="$elements_enhanced" 'BEGIN { exit !(e > 0 && e <= 0.02 && n < 256) }'
 check "the adaptive result records the enhanced element" -- \
   bash -c "h5dump -a /coarsening/element '$WORK/adaptive_enhanced.h5' | grep -q enhanced"
+expect_exit 2 "element: fitted for the trilinear coarse element" -- "$SIM" --config "$BAR" --target-error 0.02 \
+  --database "$WORK/db2_enhanced.h5" --level1-database "$WORK/db.h5" --out "$WORK/o.h5"
 
 # Bad requests.
 expect_exit 2 "coarse-element" -- "$SIM" --config "$BAR" --coarsen 1 --coarse-element quadratic --out "$WORK/o.h5"
