@@ -404,6 +404,17 @@ CoarseDatabase read_coarse_db(const std::string& path) {
   return db;
 }
 
+namespace {
+
+// Palettes agree to a relative 1e-9 in E and nu (values written and read
+// back through HDF5 and YAML).
+bool same_elastic_constants(const DbMaterial& m, double E, double nu) {
+  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
+  return same(m.E, E) && same(m.nu, nu);
+}
+
+}  // namespace
+
 void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
                          const std::vector<MaterialPtr>& scene_palette, const std::vector<int>& used_ids) {
   for (int id : used_ids) {
@@ -416,8 +427,7 @@ void check_scene_palette(const CoarseDatabase& db, const std::string& db_path,
     }
     const auto* nh = dynamic_cast<const NeoHookean*>(scene_palette.at(id).get());
     const DbMaterial& m = db.materials[id - 1];
-    auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
-    if (!nh || !same(nh->youngs_modulus(), m.E) || !same(nh->poisson_ratio(), m.nu)) {
+    if (!nh || !same_elastic_constants(m, nh->youngs_modulus(), nh->poisson_ratio())) {
       os << db_path << ": scene material id " << id << " ("
          << (nh ? "Neo-Hookean E " + std::to_string(nh->youngs_modulus()) + ", nu " +
                       std::to_string(nh->poisson_ratio())
@@ -439,10 +449,9 @@ void check_level1_substitute(const CoarseDatabase& substitute, const std::string
   if (substitute.num_materials() != base.num_materials())
     throw InputError(both + "materials: " + std::to_string(substitute.num_materials()) + " against " +
                      std::to_string(base.num_materials()) + " in the level-2 database's base");
-  auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b)); };
   for (int i = 0; i < base.num_materials(); ++i) {
     const DbMaterial &a = substitute.materials[i], &b = base.materials[i];
-    if (!same(a.E, b.E) || !same(a.nu, b.nu)) {
+    if (!same_elastic_constants(a, b.E, b.nu)) {
       std::ostringstream os;
       os << both << "materials: id " << i + 1 << " is E " << a.E << ", nu " << a.nu << " in the first and E " << b.E
          << ", nu " << b.nu << " in the second's base";

@@ -185,19 +185,18 @@ int main(int argc, char** argv) {
     NewtonOptions warm_newton = scene.newton;
     warm_newton.load_steps = 1;
     VecX adaptive_start;
-    std::shared_ptr<const CoarseDatabase> adaptive_level1_db;  // kept while the models built from it are in use
+    // Adaptive: the level-1 materials, the level-2 database's own base unless
+    // a level-1 database stands in for it. Where the base is compressed, the
+    // uniform level-1 and level-2 models share its lookup error, which their
+    // difference (the estimate) cannot see (docs/ddfem.md). Kept for the run.
+    std::shared_ptr<const CoarseDatabase> level1_db;
     if (adaptive) {
-      // The level-1 materials: the level-2 database's own base unless a
-      // level-1 database stands in for it. Where the base is compressed, the
-      // uniform level-1 and level-2 models share its lookup error, which
-      // their difference (the estimate) cannot see (docs/ddfem.md).
-      std::shared_ptr<const CoarseDatabase> level1_db = coarse.database->level1;
+      level1_db = coarse.database->level1;
       if (!level1_database.empty()) {
         auto db = std::make_shared<CoarseDatabase>(read_coarse_db(level1_database));
         check_level1_substitute(*db, level1_database, *coarse.database, coarsening.database);
         level1_db = db;
       }
-      adaptive_level1_db = level1_db;
       const NewtonResult solve2 =
           solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
       const CoarseModel level1 = level1_model_of(scene, fine, coarse, *level1_db);
