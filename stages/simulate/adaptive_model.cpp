@@ -1,6 +1,7 @@
 #include "adaptive_model.hpp"
 
 #include <chrono>
+#include <cmath>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -92,21 +93,13 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
   return x;
 }
 
-AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
-                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
-                                   const CoarseDatabase& level1_db, double target_error) {
+void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelMesh& fine,
+                              const StaticConditions& fine_conditions, const CoarseModel& level2,
+                              const CoarseDatabase& level1_db, double choice_target) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!level2.database || level2.database->level != 2)
-    throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
-  AdaptiveModel m;
-
-  // The estimate: the two uniform solutions' difference, energies of the finer one.
-  m.level_difference =
-      mean_vertex_error(fine.mesh, on_fine_nodes(scene, fine, level1, x1), on_fine_nodes(scene, fine, level2, x2));
-  m.level_errors = level_errors_from_difference(m.level_difference);
-  const std::vector<CellErrorModel> cells =
-      cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh, element_energies(level1.mesh.mesh, x1));
-  m.choice = choose_cell_levels(cells, m.level_errors, target_error);
+  m.choice_target = choice_target;
+  m.choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
+  m.cells_refined_for_conditions = 0;
 
   // The mixed mesh, with the same materials as the uniform models. A node
   // the scene fixes must not hang on free corners: the cells around it are
@@ -129,9 +122,37 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
     if (changed == 0) break;
     m.cells_refined_for_conditions += changed;
   }
-  m.choice.predicted_error = predicted_error(cells, m.level_errors, levels);
+  m.choice.predicted_error = predicted_error(m.cells, m.level_errors, levels);
+  m.seconds += seconds_since(t0);
+}
+
+AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
+                                   const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
+                                   const CoarseDatabase& level1_db, double target_error) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!level2.database || level2.database->level != 2)
+    throw InputError("--target-error needs --coarse-material ddfem and a level-2 --database");
+  AdaptiveModel m;
+
+  // The estimate: the two uniform solutions' difference, energies of the finer one.
+  const VecX u1 = on_fine_nodes(scene, fine, level1, x1);
+  const VecX u2 = on_fine_nodes(scene, fine, level2, x2);
+  m.level_difference = mean_vertex_error(fine.mesh, u1, u2);
+  // Richardson: with e_L ~ C h^p, u_fine ~ u1 + (u1 - u2) / (2^p - 1); the
+  // same rate as the level errors, so that both estimates agree on uniform
+  // choices.
+  const double rate = 1.0;
+  m.level_errors = level_errors_from_difference(m.level_difference, rate);
+  m.extrapolated = u1 + (u1 - u2) / (std::pow(2.0, rate) - 1.0);
+  m.cells =
+      cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh, element_energies(level1.mesh.mesh, x1));
   m.seconds = seconds_since(t0);
+  rechoose_adaptive_levels(m, scene, fine, fine_conditions, level2, level1_db, target_error);
   return m;
+}
+
+double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& u_on_fine) {
+  return mean_vertex_error(fine.mesh, model.extrapolated, u_on_fine);
 }
 
 }  // namespace msfab

@@ -3,7 +3,10 @@
 // "Adaptive coarsening"): from solves of the uniform level-2 and level-1
 // models, the level of every level-2 cell (fine, level 1 or level 2) is
 // chosen so that the estimated error meets the target, and the scene is
-// meshed with those levels, hanging nodes constrained.
+// meshed with those levels, hanging nodes constrained. After the mixed solve
+// its error is estimated a posteriori against the Richardson extrapolation
+// of the two uniform solutions; with --posterior-check a miss tightens the
+// choice and solves again.
 #include "coarse_model.hpp"
 #include "ddfem/adaptive_levels.hpp"
 #include "ddfem/mixed_level_mesh.hpp"
@@ -13,13 +16,20 @@ namespace msfab {
 
 struct AdaptiveModel {
   MixedLevelMesh mixed;
-  StaticConditions conditions;  // on the unknowns
-  LevelErrors level_errors{};   // estimated errors of the uniform models
-  double level_difference = 0;  // D: mean-vertex distance between the level-1 and level-2 solutions
+  StaticConditions conditions;        // on the unknowns
+  LevelErrors level_errors{};         // estimated errors of the uniform models
+  double level_difference = 0;        // D: mean-vertex distance between the level-1 and level-2 solutions
+  std::vector<CellErrorModel> cells;  // energy shares and element counts per level-2 cell
+  VecX extrapolated;                  // fine-node displacements u1 + (u1 - u2) / (2^p - 1), p = 1
+  double choice_target = 0;           // the target the levels were chosen for (tightened by misses)
   LevelChoice choice;
   int cells_refined_for_conditions = 0;  // level-2 cells set to level 0 so that no fixed node hangs
-  double seconds = 0;                    // estimate, choice and mesh (not the two solves)
+  double seconds = 0;                    // estimate, choice and mesh (not the solves)
 };
+
+// Mixed solves before the a-posteriori check gives up (the one with the
+// smallest estimate stands).
+constexpr int kMaxAdaptiveSolves = 3;
 
 // The uniform level-1 model of the scene with the materials of `level1_db`:
 // the level-2 model's database's own (compressed) level-1 base, or a
@@ -38,6 +48,20 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
                                    const CoarseModel& level2, const VecX& x2, const CoarseModel& level1, const VecX& x1,
                                    const CoarseDatabase& level1_db, double target_error);
+
+// Re-chooses the levels of `model` for `choice_target` (below the target the
+// previous choice was made for, after its a-posteriori check missed) and
+// meshes them again.
+void rechoose_adaptive_levels(AdaptiveModel& model, const Scene& scene, const VoxelMesh& fine,
+                              const StaticConditions& fine_conditions, const CoarseModel& level2,
+                              const CoarseDatabase& level1_db, double choice_target);
+
+// The a-posteriori error estimate of a solution of `model` (`u_on_fine`, from
+// adaptive_displacement_on_fine): its mean-vertex distance from the
+// extrapolated fine displacement. It equals the a-priori estimate for a
+// uniform level-1 or level-2 choice and, unlike it, sees errors that cells
+// of different levels make together (interfaces, errors of one sign).
+double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& u_on_fine);
 
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine

@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -134,6 +135,10 @@ int main(int argc, char** argv) {
   app.cli().add_option("--level1-database", level1_database,
                        "adaptive coarsening: a level-1 coarse_db of the same palette and element for the level-1 "
                        "cells and solve, instead of the level-2 database's compressed level-1 base");
+  bool posterior_check = false;
+  app.cli().add_flag("--posterior-check", posterior_check,
+                     "adaptive coarsening: check the mixed solution against the extrapolated fine one and, where "
+                     "it misses the target, choose finer levels and solve again (at most 3 mixed solves)");
   std::string reference;
   app.cli().add_option("--reference", reference,
                        "a fine msfab.result of the same scene to compare with instead of solving it again");
@@ -146,6 +151,7 @@ int main(int argc, char** argv) {
     const Scene scene = read_scene(ctx.config);
     ctx.finish_config();
     const bool adaptive = target_option->count() > 0;
+    if (posterior_check && !adaptive) throw InputError("--posterior-check: applies to --target-error only");
     if (!level1_database.empty() && !adaptive)
       throw InputError("--level1-database: applies to --target-error only (uniform level 1 takes --database)");
     check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level},
@@ -179,12 +185,15 @@ int main(int argc, char** argv) {
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
     const bool coarsened = coarsening.level > 0;
     AdaptiveModel adapted;
-    double uniform_seconds = 0;  // adaptive: the two uniform solves the estimate comes from
+    double uniform_seconds = 0;   // adaptive: the two uniform solves the estimate comes from
+    double rejected_seconds = 0;  // adaptive: mixed solves whose a-posteriori check missed the target
+    int adaptive_solves = 0;
+    double checked_error = 0;  // adaptive: the a-posteriori estimate of the kept solve
+    std::optional<NewtonResult> adaptive_result;
     // Each finer adaptive solve starts from the coarser solution, at full
     // load: a few Newton steps instead of the scene's load stepping from rest.
     NewtonOptions warm_newton = scene.newton;
     warm_newton.load_steps = 1;
-    VecX adaptive_start;
     // Adaptive: the level-1 materials, the level-2 database's own base unless
     // a level-1 database stands in for it. Where the base is compressed, the
     // uniform level-1 and level-2 models share its lookup error, which their
@@ -205,7 +214,54 @@ int main(int argc, char** argv) {
       uniform_seconds = solve2.timings.total + solve1.timings.total;
       adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, *level1_db,
                                      target_error);
-      adaptive_start = start_from(level1, solve1.x, adapted.mixed.constraints->unknown_rest);
+      // The mixed solve and, with --posterior-check, its a-posteriori check. The lattice multigrid
+      // needs neighbouring nodes one lattice step apart, which elements of
+      // mixed sizes are not: mixed models are factored directly (they are the
+      // smaller ones; docs/ddfem.md). A miss tightens the target of the
+      // choice by the ratio it missed by and solves again.
+      // A refinement that does not bring the estimate down means the
+      // extrapolation, not the model, dominates it (where the error falls
+      // much faster than the rate assumed, the extrapolated solution is
+      // itself off): the loop stops and keeps the round with the smallest
+      // estimate.
+      NewtonOptions mixed_newton = warm_newton;
+      if (mixed_newton.linear_solver == "auto") mixed_newton.linear_solver = "cholmod";
+      AdaptiveModel best;
+      for (;;) {
+        const ElasticAssembler mixed_assembler(adapted.mixed.mesh, adapted.mixed.constraints);
+        const NewtonResult solved =
+            solve_or_throw(mixed_assembler, adapted.conditions, mixed_newton, "adaptive load",
+                           start_from(level1, solve1.x, adapted.mixed.constraints->unknown_rest));
+        ++adaptive_solves;
+        const double estimate = a_posteriori_error(
+            fine, adapted, adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x));
+        spdlog::info(
+            "adaptive solve {}: levels chosen for {:.3g} (predicted {:.3g}), a-posteriori estimate {:.3g} "
+            "against the target {:.3g}; elements fine {} / level 1 {} / level 2 {}",
+            adaptive_solves, adapted.choice_target, adapted.choice.predicted_error, estimate, target_error,
+            adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
+            adapted.mixed.elements_per_level[2]);
+        const bool improved = !adaptive_result || estimate < checked_error;
+        if (improved) {
+          if (adaptive_result) rejected_seconds += adaptive_result->timings.total;
+          adaptive_result = solved;
+          checked_error = estimate;
+          best = adapted;
+        } else {
+          rejected_seconds += solved.timings.total;
+        }
+        if (!posterior_check || checked_error <= target_error) break;
+        if (!improved || adaptive_solves == kMaxAdaptiveSolves) {
+          spdlog::warn(
+              "adaptive: the a-posteriori estimate {:.3g} stays above the target {:.3g} after {} mixed solves; "
+              "keeping the solve with the smallest estimate",
+              checked_error, target_error, adaptive_solves);
+          break;
+        }
+        rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse, *level1_db,
+                                 adapted.choice_target * target_error / estimate);
+      }
+      adapted = std::move(best);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
     const HexMesh& solved_mesh = adaptive ? adapted.mixed.mesh : vm.mesh;
@@ -249,18 +305,13 @@ int main(int argc, char** argv) {
           "homogenized stiffness (void in the window, or a stiffness the window does not determine)",
           coarse.distinct_windows, coarse.unresolved_windows);
 
-    // 4. Newton. The lattice multigrid needs neighbouring nodes one lattice
-    // step apart, which elements of mixed sizes are not: adaptive models are
-    // factored directly (they are the smaller ones; docs/ddfem.md).
-    NewtonOptions newton = adaptive ? warm_newton : scene.newton;
-    if (adaptive && newton.linear_solver == "auto") newton.linear_solver = "cholmod";
-    const NewtonResult result = solve_or_throw(assembler, conditions, newton,
-                                               adaptive    ? "adaptive load"
-                                               : coarsened ? "coarse load"
-                                                           : "load",
-                                               adaptive_start);
+    // 4. Newton (adaptive: solved above, with its check).
+    const NewtonResult result =
+        adaptive ? *adaptive_result
+                 : solve_or_throw(assembler, conditions, scene.newton, coarsened ? "coarse load" : "load");
     // The coarse model's Newton time; adaptive runs include the uniform solves.
-    const double coarse_seconds = result.timings.total + (adaptive ? uniform_seconds + adapted.seconds : 0.0);
+    const double coarse_seconds =
+        result.timings.total + (adaptive ? uniform_seconds + rejected_seconds + adapted.seconds : 0.0);
 
     // 5. Fine reference.
     SimulationRecord record;
@@ -331,6 +382,9 @@ int main(int argc, char** argv) {
       record.adaptive = true;
       record.target_error = target_error;
       record.predicted_error = adapted.choice.predicted_error;
+      record.a_posteriori_error = checked_error;
+      record.adaptive_solves = adaptive_solves;
+      record.rejected_solve_seconds = rejected_seconds;
       record.uniform_solve_seconds = uniform_seconds;
       record.level_difference = adapted.level_difference;
       record.level1_database = level1_database;
@@ -349,11 +403,11 @@ int main(int argc, char** argv) {
                 max_u);
     if (adaptive)
       std::printf(
-          "  adaptive: target error %.3g, predicted %.3g; elements fine %d / level 1 %d / level 2 %d "
-          "(of %d fine); level-1 and level-2 solves %.3f s\n",
-          target_error, adapted.choice.predicted_error, adapted.mixed.elements_per_level[0],
-          adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2], fine.mesh.num_elements(),
-          uniform_seconds);
+          "  adaptive: target error %.3g, predicted %.3g, a-posteriori %.3g after %d mixed solve(s); elements "
+          "fine %d / level 1 %d / level 2 %d (of %d fine); level-1 and level-2 solves %.3f s\n",
+          target_error, adapted.choice.predicted_error, checked_error, adaptive_solves,
+          adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2],
+          fine.mesh.num_elements(), uniform_seconds);
     else if (coarsened)
       std::printf("  coarsening: level %d, %s materials, %s elements, %d -> %d elements, %.3f ms\n", coarsening.level,
                   coarsening.material.c_str(), coarse.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),

@@ -40,9 +40,12 @@ struct SimulationRecord {
   // Adaptive runs (--target-error; coarsen_level is 2, the coarsest level used).
   bool adaptive = false;
   double target_error = 0, predicted_error = 0;
-  double uniform_solve_seconds = 0;  // the level-2 and level-1 solves the levels are chosen from
-  double level_difference = 0;       // mean-vertex distance between those two solutions
-  std::string level1_database;       // --level1-database (empty: the level-2 database's base)
+  double a_posteriori_error = 0;      // the kept mixed solve's distance from the extrapolated fine solution
+  int adaptive_solves = 0;            // mixed solves (more than one where the a-posteriori check missed)
+  double rejected_solve_seconds = 0;  // Newton time of the mixed solves that were not kept
+  double uniform_solve_seconds = 0;   // the level-2 and level-1 solves the levels are chosen from
+  double level_difference = 0;        // mean-vertex distance between those two solutions
+  std::string level1_database;        // --level1-database (empty: the level-2 database's base)
   std::array<int, 3> elements_per_level{};
   // With --compare-fine: the fine reference run and the §2.5.2 error.
   bool compared = false;
