@@ -100,7 +100,8 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
 
 // Each voxel's material (none for void) at its 8 points of the composite rule.
 QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
-  static const MaterialPtr no_material = NeoHookean::from_lame(0.0, 0.0);
+  // Void voxels' points carry no material (null): the element skips them.
+  const MaterialPtr no_material;
   if (std::all_of(ids.begin(), ids.end(), [](int id) { return id == 0; }))
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;

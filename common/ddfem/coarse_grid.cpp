@@ -1,5 +1,6 @@
 #include "ddfem/coarse_grid.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -159,10 +160,10 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
           << composite.size() << " (8 per fine voxel)";
       throw InputError(msg.str());
     }
-    for (const MaterialPtr& p : m.at_point)
-      if (!p)
-        throw InputError("coarse mesh: the material lookup returned a null material for combination " +
-                         std::to_string(c));
+    // Null entries are points without material (void voxels of a Galerkin
+    // element); an element needs at least one point with material.
+    if (std::none_of(m.at_point.begin(), m.at_point.end(), [](const MaterialPtr& p) { return bool(p); }))
+      throw InputError("coarse mesh: the material lookup returned no material for combination " + std::to_string(c));
     mesh.materials.push_back(std::move(m));
   }
   hex8::NodeMatrix cube;

@@ -87,7 +87,7 @@ HexMesh scale_materials(const HexMesh& mesh, const std::vector<double>& factor) 
     if (inserted) {
       QuadratureMaterials q;
       for (const auto& m : mesh.materials[base].at_point)
-        q.at_point.push_back(std::make_shared<ScaledMaterial>(m, factor[e], ScaledTangent::material_psd));
+        q.at_point.push_back(m ? std::make_shared<ScaledMaterial>(m, factor[e], ScaledTangent::material_psd) : nullptr);
       scaled.materials.push_back(std::move(q));
     }
     scaled.element_material[e] = it->second;

@@ -69,10 +69,12 @@ double evaluate_with(const hex8::ElementGeometry& geo, const QuadratureMaterials
   Mat3 P;
   Mat9 H;
   for (int q = 0; q < geo.size(); ++q) {
+    const Material* material = mat.at(q);
+    if (!material) continue;
     const hex8::NodeMatrix& D = geo.dNdX[q];
     const Mat3 F = point_gradient(geo, x, q, A);
     double psi;
-    mat[q].evaluate(F, &psi, need_P ? &P : nullptr, need_H ? &H : nullptr);
+    material->evaluate(F, &psi, need_P ? &P : nullptr, need_H ? &H : nullptr);
     if (!std::isfinite(psi)) return kInfiniteEnergy;
     const double w = geo.weight[q];
     e += w * psi;
@@ -161,8 +163,10 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
   if (geo.has_enhanced_modes()) return hex_evaluate(geo, mat, x, nullptr, nullptr);
   double e = 0;
   for (int q = 0; q < geo.size(); ++q) {
+    const Material* material = mat.at(q);
+    if (!material) continue;
     double psi;
-    mat[q].evaluate(hex8::deformation_gradient(x, geo.dNdX[q]), &psi, nullptr, nullptr);
+    material->evaluate(hex8::deformation_gradient(x, geo.dNdX[q]), &psi, nullptr, nullptr);
     if (!std::isfinite(psi)) return kInfiniteEnergy;
     e += geo.weight[q] * psi;
   }

@@ -10,10 +10,12 @@
 namespace msfab {
 
 // Materials at the quadrature points of one element. A single entry applies
-// to every point.
+// to every point. A null entry is a point without material (a void voxel
+// inside a Galerkin coarse element): it adds no energy and cannot invert,
+// and is skipped rather than evaluated as a zero material.
 struct QuadratureMaterials {
   std::vector<MaterialPtr> at_point;
-  const Material& operator[](int q) const { return *at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)]; }
+  const Material* at(int q) const { return at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)].get(); }
 };
 
 // Element energy for deformed node positions x (rows = nodes). Returns +inf

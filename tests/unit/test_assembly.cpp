@@ -207,6 +207,38 @@ TEST(Assembly, InvertedElementGivesInfiniteEnergyNotNaN) {
   EXPECT_TRUE(std::isinf(E) && E > 0);
 }
 
+// A Galerkin coarse element (ddfem/baseline_coarsening.hpp) leaves the points
+// of its void voxels without material: they add no energy, and a
+// deformation that inverts the element only inside a void voxel is finite.
+TEST(Assembly, PointsWithoutMaterialAddNothingAndCannotInvert) {
+  hex8::NodeMatrix X;
+  for (int i = 0; i < 8; ++i) X.row(i) = 0.5 * (hex8::natural_node(i).transpose() + Eigen::RowVector3d::Ones());
+  const auto geo = hex8::element_geometry(X, hex8::composite_gauss_rule(2, 2));
+  const MaterialPtr solid = std::make_shared<NeoHookean>(1e3, 0.4);
+  QuadratureMaterials full, without_corner, corner_only;
+  for (int q = 0; q < geo.size(); ++q) {
+    const bool in_corner_cell = q / 8 == 7;  // the sub-cube at node 7
+    full.at_point.push_back(solid);
+    without_corner.at_point.push_back(in_corner_cell ? nullptr : solid);
+    corner_only.at_point.push_back(in_corner_cell ? solid : nullptr);
+  }
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  hex8::NodeMatrix x = X;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a) x(i, a) += u(rng);
+  const double e_full = hex_energy(geo, full, x);
+  EXPECT_NEAR(hex_energy(geo, without_corner, x) + hex_energy(geo, corner_only, x), e_full, 1e-12 * e_full);
+  expect_element_derivatives(geo, without_corner, x, 1e-6, "with void points");
+
+  // Node 7 pushed towards the centre folds its own sub-cube only.
+  hex8::NodeMatrix folded = X;
+  folded.row(7) = Eigen::RowVector3d(0.5, 0.5, 0.5);
+  EXPECT_TRUE(std::isinf(hex_energy(geo, full, folded)));
+  EXPECT_TRUE(std::isinf(hex_energy(geo, corner_only, folded)));
+  EXPECT_TRUE(std::isfinite(hex_energy(geo, without_corner, folded)));
+}
+
 TEST(Assembly, ResultsAreIndependentOfThreadCount) {
   VoxelGrid grid(6, 5, 4, 0.01, 1);
   for (size_t i = 0; i < grid.size(); i += 3) grid.ids[i] = 2;

@@ -186,12 +186,12 @@ TEST(DdfemCoarsenBaselines, AveragedUsesVolumeMeanOfLameParameters) {
   const auto averaged = averaged_coarsening(palette);
   const QuadratureMaterials half = averaged(ChildIds{1, 1, 1, 1, 2, 2, 2, 2});
   ASSERT_EQ(half.at_point.size(), 1u);
-  EXPECT_NEAR(half[0].shear_modulus(), 0.5 * (mu1 + mu2), 1e-9 * mu2);
-  EXPECT_NEAR(half[0].lame_lambda(), 0.5 * (la1 + la2), 1e-9 * la2);
+  EXPECT_NEAR(half.at(0)->shear_modulus(), 0.5 * (mu1 + mu2), 1e-9 * mu2);
+  EXPECT_NEAR(half.at(0)->lame_lambda(), 0.5 * (la1 + la2), 1e-9 * la2);
   // Void counts as zero stiffness.
   const QuadratureMaterials mostly_void = averaged(ChildIds{0, 0, 2, 0, 0, 0, 0, 0});
-  EXPECT_NEAR(mostly_void[0].shear_modulus(), mu2 / 8, 1e-9 * mu2);
-  EXPECT_NEAR(mostly_void[0].lame_lambda(), la2 / 8, 1e-9 * la2);
+  EXPECT_NEAR(mostly_void.at(0)->shear_modulus(), mu2 / 8, 1e-9 * mu2);
+  EXPECT_NEAR(mostly_void.at(0)->lame_lambda(), la2 / 8, 1e-9 * la2);
   EXPECT_THROW(averaged(ChildIds{3, 1, 1, 1, 1, 1, 1, 1}), InputError);
 
   // Naive: a void child takes the softest of its nearest solid children
@@ -268,8 +268,8 @@ TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain)
   // A homogeneous block: exactly its palette material (no anisotropic part).
   const QuadratureMaterials same = homogenized(ChildIds{2, 2, 2, 2, 2, 2, 2, 2});
   ASSERT_EQ(same.at_point.size(), 1u);
-  EXPECT_NEAR(same[0].shear_modulus(), palette[2]->shear_modulus(), 1e-8 * palette[2]->shear_modulus());
-  EXPECT_LE((same[0].stress_derivative(Mat3::Identity()) - palette[2]->stress_derivative(Mat3::Identity())).norm(),
+  EXPECT_NEAR(same.at(0)->shear_modulus(), palette[2]->shear_modulus(), 1e-8 * palette[2]->shear_modulus());
+  EXPECT_LE((same.at(0)->stress_derivative(Mat3::Identity()) - palette[2]->stress_derivative(Mat3::Identity())).norm(),
             1e-8 * palette[2]->stress_derivative(Mat3::Identity()).norm());
   // Layers normal to x (children 0-3 soft, 4-7 stiff): the tangent at rest
   // is B^T C^H B, with the laminate's series modulus across the layers and
@@ -281,7 +281,7 @@ TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain)
   options.solver = "cholmod";
   // Material Voigt order (xx, yy, zz, xy, yz, zx), checked on the physics:
   const Mat6 C = to_material_voigt_order(homogenize(cell, palette, options).C);
-  EXPECT_LE((layered[0].stress_derivative(Mat3::Identity()) - B.transpose() * C * B).norm(), 1e-8 * C.norm());
+  EXPECT_LE((layered.at(0)->stress_derivative(Mat3::Identity()) - B.transpose() * C * B).norm(), 1e-8 * C.norm());
   const double mu1 = palette[1]->shear_modulus(), mu2 = palette[2]->shear_modulus();
   EXPECT_NEAR(C(4, 4), 0.5 * (mu1 + mu2), 1e-6 * mu2);            // yz, in the layer plane: parallel
   EXPECT_NEAR(C(3, 3), 2 * mu1 * mu2 / (mu1 + mu2), 1e-6 * mu1);  // xy, across the layers: series
@@ -289,10 +289,10 @@ TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain)
   // Pure shear yz stores the parallel modulus in the element's energy.
   Mat3 F = Mat3::Identity();
   F(1, 2) = 1e-4;
-  EXPECT_NEAR(layered[0].energy(F), 0.5 * C(4, 4) * 1e-8, 1e-3 * C(4, 4) * 1e-8);
+  EXPECT_NEAR(layered.at(0)->energy(F), 0.5 * C(4, 4) * 1e-8, 1e-3 * C(4, 4) * 1e-8);
   // Rotations store no energy; a block with void falls back to naive.
   const Mat3 R = Eigen::AngleAxisd(0.9, Vec3(1, -1, 2).normalized()).toRotationMatrix();
-  EXPECT_LE(layered[0].energy(R), 1e-12 * mu2);
+  EXPECT_LE(layered.at(0)->energy(R), 1e-12 * mu2);
   EXPECT_EQ(homogenized(ChildIds{0, 2, 1, 2, 2, 2, 2, 2}).at_point.size(), 8u);
   EXPECT_THROW(homogenized(ChildIds{3, 1, 1, 1, 1, 1, 1, 1}), InputError);
 }

@@ -214,7 +214,7 @@ TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffnes
   for (int q = 0; q < 8; ++q) EXPECT_LE((rest_voigt_stiffness(*m.at_point[q]) - C[q]).norm(), 1e-8 * C[q].norm());
   // The fit the plain lookup used is stiff everywhere.
   const int p = plain.mesh.voxel_element[plain.grid.index(1, 0, 0)];
-  EXPECT_NEAR(plain.mesh.mesh.materials[plain.mesh.mesh.element_material[p]][0].shear_modulus(),
+  EXPECT_NEAR(plain.mesh.mesh.materials[plain.mesh.mesh.element_material[p]].at(0)->shear_modulus(),
               palette[2]->shear_modulus(), 1e-6 * palette[2]->shear_modulus());
 
   request.check_tolerance = -0.1;
