@@ -100,14 +100,12 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
 
 // Each voxel's material (none for void) at its 8 points of the composite rule.
 QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
-  // Void voxels' points carry no material (null): the element skips them.
-  const MaterialPtr no_material;
   if (std::all_of(ids.begin(), ids.end(), [](int id) { return id == 0; }))
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;
   m.at_point.reserve(8 * ids.size());
   for (int id : ids)
-    m.at_point.insert(m.at_point.end(), 8, id == 0 ? no_material : palette_material_checked(palette, id));
+    m.at_point.insert(m.at_point.end(), 8, id == 0 ? MaterialPtr() : palette_material_checked(palette, id));
   return m;
 }
 
