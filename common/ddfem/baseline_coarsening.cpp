@@ -2,10 +2,12 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "ddfem/galerkin_quadrature.hpp"
 #include "homog/elastic_tensor.hpp"
 #include "homog/periodic_homogenization.hpp"
 #include "material/green_anisotropic.hpp"
@@ -98,15 +100,27 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
   return QuadratureMaterials{{std::make_shared<NeoHookean>(E, nu)}};
 }
 
-// Each voxel's material (none for void) at its 8 points of the composite rule.
-QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids) {
+// Each voxel's material (none for void) at its 8 points of the composite
+// rule; reduced: at the points of the rule that integrates each material's
+// stiffness monomials as the composite rule does (ddfem/galerkin_quadrature.hpp).
+QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, bool reduced) {
   if (std::all_of(ids.begin(), ids.end(), [](int id) { return id == 0; }))
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;
   m.at_point.reserve(8 * ids.size());
   for (int id : ids)
     m.at_point.insert(m.at_point.end(), 8, id == 0 ? MaterialPtr() : palette_material_checked(palette, id));
-  return m;
+  if (!reduced) return m;
+  const int n = static_cast<int>(std::lround(std::cbrt(double(ids.size()))));
+  std::vector<int> group;
+  group.reserve(m.at_point.size());
+  for (int id : ids) group.insert(group.end(), 8, id == 0 ? -1 : id);
+  const ReducedRule r = reduced_stiffness_rule(hex8::composite_gauss_rule(n, 2), group);
+  QuadratureMaterials kept;
+  kept.at_point.reserve(r.source.size());
+  for (int q : r.source) kept.at_point.push_back(m.at_point[q]);
+  kept.rule = std::make_shared<const hex8::QuadratureRule>(r.rule);
+  return kept;
 }
 
 QuadratureMaterials homogenized_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n) {
@@ -184,14 +198,15 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
   };
 }
 
-CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette) {
-  return [palette](const ChildIds& child) { return galerkin_block(palette, block_level1(child)); };
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, bool reduced) {
+  return [palette, reduced](const ChildIds& child) { return galerkin_block(palette, block_level1(child), reduced); };
 }
 
-CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1) {
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1,
+                                         bool reduced) {
   if (level1.level != 1) throw InputError("Galerkin level-2 coarsening needs a level-1 grid");
-  return [palette, combos = level1.combinations](const ChildIds& child) {
-    return galerkin_block(palette, block_level2(child, combos));
+  return [palette, combos = level1.combinations, reduced](const ChildIds& child) {
+    return galerkin_block(palette, block_level2(child, combos), reduced);
   };
 }
 

@@ -18,7 +18,10 @@
 // Galerkin (not in the thesis; the coarse operator of geometric multigrid):
 // every fine voxel integrated by its own 2 x 2 x 2 Gauss points over the
 // coarse element's field (hex8::composite_gauss_rule(2^level, 2): 64 points
-// at level 1, 512 at level 2), void voxels with no material. The coarse
+// at level 1, 512 at level 2), void voxels with no material. By default the
+// element keeps only a subset of those points that integrates each
+// material's stiffness exactly (ddfem/galerkin_quadrature.hpp: at most 23
+// per material; "galerkin-full" keeps them all). The coarse
 // element's energy is then exactly the fine mesh's energy of the coarse
 // field interpolated to the fine nodes: each material sits where it is in
 // the block, with its own lever arm in bending, where naive coarsening moves
@@ -59,9 +62,12 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
 CoarseMaterialLookup naive_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
 
-// Galerkin: one material per point of hex8::composite_gauss_rule(2^level, 2).
-CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette);
-CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);
+// Galerkin: one material per point of hex8::composite_gauss_rule(2^level, 2),
+// or, reduced, per point of the subset of it that keeps the small-strain
+// stiffness (ddfem/galerkin_quadrature.hpp; the element carries that rule).
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, bool reduced = true);
+CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1,
+                                         bool reduced = true);
 
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette);
 CoarseMaterialLookup homogenized_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1);

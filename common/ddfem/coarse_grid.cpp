@@ -130,7 +130,7 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
   // The rules an element may carry, told apart by its number of materials:
   // the Gauss rule (or one material for all its points), the Gauss rule and
   // the centre (ddfem/coarse_fit.hpp), or one point set per fine voxel (the
-  // Galerkin element of ddfem/baseline_coarsening.hpp).
+  // Galerkin element of ddfem/baseline_coarsening.hpp); or their own.
   const hex8::QuadratureRule gauss = hex8::gauss_rule(points_per_axis);
   const hex8::QuadratureRule composite = hex8::composite_gauss_rule(grid.fine_per_cell(), 2);
   enum Rule { kGauss, kGaussCentre, kComposite, kRules };
@@ -153,7 +153,11 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
   for (size_t c = 0; c < grid.combinations.size(); ++c) {
     QuadratureMaterials m = lookup(static_cast<int>(c));
     const int n = static_cast<int>(m.at_point.size());
-    if (rule_of(n) == kRules) {
+    if (m.rule && m.rule->size() != n)
+      throw InputError("coarse mesh: the material lookup returned " + std::to_string(n) + " materials for the " +
+                       std::to_string(m.rule->size()) + " points of its own rule (combination " + std::to_string(c) +
+                       ")");
+    if (!m.rule && rule_of(n) == kRules) {
       std::ostringstream msg;
       msg << "coarse mesh: the material lookup returned " << n << " materials for combination " << c << "; expected 1, "
           << gauss.size() << " (one per quadrature point), " << gauss.size() + 1 << " (and one at the centre) or "
@@ -174,9 +178,18 @@ VoxelMesh build_coarse_mesh(const CoarseGrid& grid, const IndexedMaterialLookup&
   // Geometry 0 is the Gauss rule; the others are added as elements need them.
   mesh.geometries.assign(1, geometry(gauss));
   std::array<int, kRules> index{0, -1, -1};
+  std::vector<int> own_index(mesh.materials.size(), -1);  // materials with their own rule
   for (int e = 0; e < mesh.num_elements(); ++e) {
     const int m = mesh.element_tag[e] - 1;
     mesh.element_material[e] = m;
+    if (mesh.materials[m].rule) {
+      if (own_index[m] < 0) {
+        own_index[m] = static_cast<int>(mesh.geometries.size());
+        mesh.geometries.push_back(geometry(*mesh.materials[m].rule));
+      }
+      mesh.element_geometry[e] = own_index[m];
+      continue;
+    }
     const Rule r = rule_of(static_cast<int>(mesh.materials[m].at_point.size()));
     if (index[r] < 0) {
       index[r] = static_cast<int>(mesh.geometries.size());

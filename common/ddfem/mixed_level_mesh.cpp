@@ -60,22 +60,38 @@ struct GeometrySlots {
   bool enhanced_modes;
   HexMesh& mesh;
   std::map<std::pair<int, Rule>, int> slot = {};
+  std::map<int, int> own_slot = {};  // materials index -> geometry, for materials with their own rule
   // The mesh's geometry index for (level, rule), added on first use.
   int operator()(int level, Rule rule) {
     auto it = slot.find({level, rule});
     if (it != slot.end()) return it->second;
     const int size = 1 << level;
-    hex8::NodeMatrix cube;
-    for (int c = 0; c < 8; ++c) cube.row(c) = size * h * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
     const hex8::QuadratureRule quadrature =
         rule == kComposite ? hex8::composite_gauss_rule(size, 2) : hex8::gauss_rule(level == 2 ? 4 : 2);
-    hex8::ElementGeometry geo = enhanced_modes && level > 0 ? hex8::enhanced_element_geometry(cube, quadrature)
-                                                            : hex8::element_geometry(cube, quadrature);
-    if (rule == kGaussCentre) geo = hex8::with_centre_point(geo, cube);
+    hex8::ElementGeometry geo = build(level, quadrature);
+    if (rule == kGaussCentre) geo = hex8::with_centre_point(geo, cube(level));
     mesh.geometries.push_back(std::move(geo));
     const int index = static_cast<int>(mesh.geometries.size()) - 1;
     slot.emplace(std::make_pair(level, rule), index);
     return index;
+  }
+  // The geometry of materials[material_index]'s own rule on a level-`level` element.
+  int own(int level, int material_index) {
+    auto it = own_slot.find(material_index);
+    if (it != own_slot.end()) return it->second;
+    mesh.geometries.push_back(build(level, *mesh.materials[material_index].rule));
+    const int index = static_cast<int>(mesh.geometries.size()) - 1;
+    own_slot.emplace(material_index, index);
+    return index;
+  }
+  hex8::NodeMatrix cube(int level) const {
+    hex8::NodeMatrix x;
+    for (int c = 0; c < 8; ++c) x.row(c) = (1 << level) * h * Vec3(c >> 2 & 1, c >> 1 & 1, c & 1).transpose();
+    return x;
+  }
+  hex8::ElementGeometry build(int level, const hex8::QuadratureRule& quadrature) const {
+    return enhanced_modes && level > 0 ? hex8::enhanced_element_geometry(cube(level), quadrature)
+                                       : hex8::element_geometry(cube(level), quadrature);
   }
 };
 
@@ -181,7 +197,12 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
     const int composite = 8 * size * size * size;
     const int n = static_cast<int>(mat.at_point.size());
     Rule rule = kGauss;
-    if (n == points + 1) {
+    if (mat.rule) {
+      if (mat.rule->size() != n)
+        throw InputError("mixed-level mesh: a level-" + std::to_string(level) + " material lookup returned " +
+                         std::to_string(n) + " materials for the " + std::to_string(mat.rule->size()) +
+                         " points of its own rule");
+    } else if (n == points + 1) {
       rule = kGaussCentre;
     } else if (level > 0 && n == composite) {
       rule = kComposite;
@@ -203,7 +224,7 @@ MixedLevelMesh build_mixed_level_mesh(const VoxelGrid& fine, const std::vector<M
     const int e = mesh.num_elements();
     mesh.elements.push_back(el);
     mesh.element_material.push_back(material_index);
-    mesh.element_geometry.push_back(geometry(level, rule));
+    mesh.element_geometry.push_back(mat.rule ? geometry.own(level, material_index) : geometry(level, rule));
     mesh.element_tag.push_back(tag);
     m.element_level.push_back(level);
     ++m.elements_per_level[level];

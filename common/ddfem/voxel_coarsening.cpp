@@ -132,11 +132,16 @@ CoarseMaterialLookup baseline_coarsening(const std::string& name, const std::vec
                                          const CoarseGrid* level1, bool enhanced) {
   if (name == "naive") return level1 ? naive_coarsening(palette, *level1) : naive_coarsening(palette);
   if (name == "averaged") return level1 ? averaged_coarsening(palette, *level1) : averaged_coarsening(palette);
-  if (name == "galerkin") return level1 ? galerkin_coarsening(palette, *level1) : galerkin_coarsening(palette);
+  if (name == "galerkin" || name == "galerkin-full") {
+    const bool reduced = name == "galerkin";
+    return level1 ? galerkin_coarsening(palette, *level1, reduced) : galerkin_coarsening(palette, reduced);
+  }
   if (name == "homogenized") return level1 ? homogenized_coarsening(palette, *level1) : homogenized_coarsening(palette);
   if (name == "matched")
     return level1 ? matched_coarsening(palette, *level1, enhanced) : matched_coarsening(palette, enhanced);
-  throw InputError("coarse materials: expected naive, averaged, galerkin, homogenized or matched, got '" + name + "'");
+  throw InputError(
+      "coarse materials: expected naive, averaged, galerkin, galerkin-full, homogenized or matched, got '" + name +
+      "'");
 }
 
 CoarseMaterialLookup ddfem_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
@@ -159,14 +164,18 @@ CoarseMaterialLookup ddfem_lookup(const CoarseDatabase& db, const std::vector<Ma
 
 CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette,
                                const CoarseningRequest& request) {
-  if (request.fallback != "naive" && request.fallback != "galerkin" && request.fallback != "matched")
-    throw InputError("--coarse-fallback: expected naive, galerkin or matched, got '" + request.fallback + "'");
+  if (request.fallback != "naive" && request.fallback != "galerkin" && request.fallback != "galerkin-full" &&
+      request.fallback != "matched")
+    throw InputError("--coarse-fallback: expected naive, galerkin, galerkin-full or matched, got '" + request.fallback +
+                     "'");
   if (request.level < 1 || request.level > 2)
     throw InputError("--coarsen: level must be 0, 1 or 2, got " + std::to_string(request.level));
   if (request.material != "ddfem" && request.material != "naive" && request.material != "averaged" &&
-      request.material != "homogenized" && request.material != "galerkin" && request.material != "matched")
-    throw InputError("--coarse-material: expected ddfem, naive, averaged, homogenized, galerkin or matched, got '" +
-                     request.material + "'");
+      request.material != "homogenized" && request.material != "galerkin" && request.material != "galerkin-full" &&
+      request.material != "matched")
+    throw InputError(
+        "--coarse-material: expected ddfem, naive, averaged, homogenized, galerkin, galerkin-full or matched, got '" +
+        request.material + "'");
   if (!(request.check_tolerance >= 0) || !std::isfinite(request.check_tolerance))
     throw InputError("--coarse-check: the tolerance must be >= 0 and finite (0: no check)");
   if (request.check_tolerance > 0 && request.material != "ddfem")

@@ -15,10 +15,10 @@ namespace msfab {
 
 struct CoarseningRequest {
   int level = 0;                   // 0 = fine, 1, 2
-  std::string material = "ddfem";  // ddfem | naive | averaged | homogenized | galerkin | matched
+  std::string material = "ddfem";  // ddfem | naive | averaged | homogenized | galerkin[-full] | matched
   std::string database;            // coarse_db path (ddfem)
   // ddfem: how blocks without a fit in the database are coarsened (naive |
-  // galerkin | matched); blocks with void children are the usual ones.
+  // galerkin[-full] | matched); blocks with void children are the usual ones.
   std::string fallback = "naive";
   // trilinear | enhanced (condensed bubble modes); empty: the database's
   // element for ddfem, trilinear otherwise.

@@ -86,6 +86,7 @@ HexMesh scale_materials(const HexMesh& mesh, const std::vector<double>& factor) 
     const auto [it, inserted] = index.try_emplace({base, factor[e]}, static_cast<int>(scaled.materials.size()));
     if (inserted) {
       QuadratureMaterials q;
+      q.rule = mesh.materials[base].rule;
       for (const auto& m : mesh.materials[base].at_point)
         q.at_point.push_back(m ? std::make_shared<ScaledMaterial>(m, factor[e], ScaledTangent::material_psd) : nullptr);
       scaled.materials.push_back(std::move(q));

@@ -2,6 +2,7 @@
 // Energy, gradient and Hessian of one hexahedron whose quadrature points each
 // carry a material (a plain element uses the same material everywhere; a
 // DDFEM coarse element, Eq. 2.6-2.7, uses a different one per point).
+#include <memory>
 #include <vector>
 
 #include "fem/hex8.hpp"
@@ -13,8 +14,14 @@ namespace msfab {
 // to every point. A null entry is a point without material (a void voxel
 // inside a Galerkin coarse element): it adds no energy and cannot invert,
 // and is skipped rather than evaluated as a zero material.
+//
+// An element on none of the standard rules (the Galerkin element on fewer
+// points, ddfem/galerkin_quadrature.hpp) carries its own `rule`, one
+// material per point of it; without one the mesh builders tell the rule by
+// the number of materials.
 struct QuadratureMaterials {
   std::vector<MaterialPtr> at_point;
+  std::shared_ptr<const hex8::QuadratureRule> rule = nullptr;
   const Material* at(int q) const { return at_point[at_point.size() == 1 ? 0 : static_cast<size_t>(q)].get(); }
 };
 

@@ -26,8 +26,8 @@ struct SimulationRecord {
   std::uint64_t seed = 0;
   // Coarsened runs (level > 0): the mesh is the coarse one.
   int coarsen_level = 0;
-  std::string coarse_material;                  // ddfem | naive | averaged | homogenized | galerkin
-  std::string coarse_fallback;                  // ddfem: naive | galerkin, for blocks without a fit
+  std::string coarse_material;                  // ddfem | naive | averaged | homogenized | galerkin[-full] | matched
+  std::string coarse_fallback;                  // ddfem: naive | galerkin[-full] | matched, for blocks without a fit
   int fallback_blocks = 0;                      // ddfem: distinct blocks coarsened by the fallback
   double check_tolerance = 0;                   // ddfem: --coarse-check (0: no check)
   int checked_blocks = 0, replaced_blocks = 0;  // ddfem with a check: solid mixed blocks checked, replaced

@@ -67,7 +67,7 @@ MixedLevelMesh naive_mixed_mesh(const Scene& s, const Grids& g, const std::vecto
 
 // The coarse models a mixed mesh can hold besides the trilinear naive one:
 // the enhanced element (condensed bubbles) with naive materials, and with the
-// Galerkin element's 8 points per fine voxel.
+// Galerkin element's points (reduced: each element on a rule of its own).
 struct CoarseVariant {
   const char* name;
   bool enhanced;

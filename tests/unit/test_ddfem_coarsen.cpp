@@ -4,12 +4,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 
 #include "core/errors.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarse_grid.hpp"
 #include "ddfem/coarsening_error.hpp"
+#include "ddfem/galerkin_quadrature.hpp"
 #include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "homog/elastic_tensor.hpp"
@@ -228,8 +230,8 @@ TEST(DdfemCoarsenBaselines, GalerkinElementIsTheFineEnergyOfTheInterpolatedField
     const CoarseGrid c = level == 1 ? l1 : coarsen_grid(l1);
     const hex8::QuadratureRule rule = hex8::composite_gauss_rule(c.fine_per_cell(), 2);
     ASSERT_EQ(rule.size(), level == 1 ? 64 : 512);
-    const VoxelMesh galerkin =
-        build_coarse_mesh(c, level == 1 ? galerkin_coarsening(palette) : galerkin_coarsening(palette, l1));
+    const VoxelMesh galerkin = build_coarse_mesh(
+        c, level == 1 ? galerkin_coarsening(palette, false) : galerkin_coarsening(palette, l1, false));
     const VoxelMesh naive =
         build_coarse_mesh(c, level == 1 ? naive_coarsening(palette) : naive_coarsening(palette, l1));
 
@@ -259,6 +261,70 @@ TEST(DdfemCoarsenBaselines, GalerkinElementIsTheFineEnergyOfTheInterpolatedField
     // Naive coarsening puts each voxel's stiffness at one point: not the same energy.
     EXPECT_GT(std::abs(ElasticAssembler(naive.mesh).energy(xc) - ef), 1e-3 * ef) << "level " << level;
   }
+}
+
+// The reduced Galerkin element keeps, per material of the block, at most
+// 23 of the composite rule's points (at level 2 under a third of them): its
+// tangent at rest is the full
+// element's (the stiffness monomials are integrated exactly), trilinear and
+// with bubbles, at both levels, on a random three-phase grid with void; at
+// a finite deformation the energy differs by the quadrature error only.
+TEST(DdfemCoarsenBaselines, ReducedGalerkinElementKeepsTheStiffnessOnFewerPoints) {
+  EXPECT_EQ(hex_stiffness_monomials().size(), 23u);
+  const auto palette = soft_stiff_palette();
+  for (int level : {1, 2})
+    for (bool enhanced : {false, true}) {
+      VoxelGrid grid(level == 1 ? 4 : 8, 8, 4, 0.1, 1);
+      std::mt19937 rng(5 + level);
+      std::uniform_int_distribution<int> draw(0, 5);
+      for (int k = 0; k < grid.nz; ++k)
+        for (int j = 0; j < grid.ny; ++j)
+          for (int i = 0; i < grid.nx; ++i) {
+            const int v = draw(rng);
+            grid.at(i, j, k) = v == 0 ? 0 : (v < 3 ? 1 : 2);
+          }
+      const CoarseGrid l1 = coarsen_grid(grid);
+      const CoarseGrid c = level == 1 ? l1 : coarsen_grid(l1);
+      const VoxelMesh full = build_coarse_mesh(
+          c, level == 1 ? galerkin_coarsening(palette, false) : galerkin_coarsening(palette, l1, false), 0, nullptr,
+          enhanced);
+      const VoxelMesh reduced = build_coarse_mesh(
+          c, level == 1 ? galerkin_coarsening(palette) : galerkin_coarsening(palette, l1), 0, nullptr, enhanced);
+      ASSERT_EQ(full.mesh.num_elements(), reduced.mesh.num_elements());
+      size_t full_points = 0, reduced_points = 0;
+      for (int e = 0; e < full.mesh.num_elements(); ++e) {
+        const QuadratureMaterials& m = reduced.mesh.materials[reduced.mesh.element_material[e]];
+        ASSERT_TRUE(m.rule);
+        std::map<const Material*, int> per_material;
+        for (const MaterialPtr& p : m.at_point) {
+          ASSERT_TRUE(p);  // void points are dropped
+          ++per_material[p.get()];
+        }
+        for (const auto& [material, count] : per_material) EXPECT_LE(count, 23);
+        for (double w : m.rule->weights) EXPECT_GT(w, 0);
+        reduced_points += m.at_point.size();
+        full_points += full.mesh.materials[full.mesh.element_material[e]].at_point.size();
+      }
+      // Level 1: a material in one or two voxels keeps all their points (8
+      // per voxel integrate the 23 monomials exactly and no fewer of them do).
+      EXPECT_LT((level == 2 ? 3 : 1) * reduced_points, full_points) << "level " << level;
+
+      const ElasticAssembler af(full.mesh), ar(reduced.mesh);
+      VecX rest(full.mesh.num_dofs());
+      for (int n = 0; n < full.mesh.num_nodes(); ++n) rest.segment<3>(3 * n) = full.mesh.nodes.row(n).transpose();
+      SpMat Kf = af.pattern(), Kr = ar.pattern();
+      VecX gf, gr;
+      af.evaluate(rest, &gf, &Kf);
+      ar.evaluate(rest, &gr, &Kr);
+      const double scale = MatX(Kf).norm();
+      EXPECT_LE(MatX(Kf - Kr).norm(), 1e-10 * scale) << "level " << level << (enhanced ? " enhanced" : "");
+      // A finite deformation (strains of a few per cent): close, not equal.
+      const VecX x = random_positions(full.mesh, 0.004, 11);
+      const double ef = af.energy(x), er = ar.energy(x);
+      ASSERT_GT(ef, 0);
+      EXPECT_NEAR(er, ef, 2e-2 * ef) << "level " << level << (enhanced ? " enhanced" : "");
+      EXPECT_GT(std::abs(er - ef), 1e-14 * ef);  // the reduction is not the full rule in disguise
+    }
 }
 
 TEST(DdfemCoarsenBaselines, HomogenizedElementHasTheBlockStiffnessAtSmallStrain) {
