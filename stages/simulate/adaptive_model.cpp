@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -153,6 +154,14 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
 
 double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& u_on_fine) {
   return mean_vertex_error(fine.mesh, model.extrapolated, u_on_fine);
+}
+
+double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, double finer_predicted,
+                              const VecX& coarser_on_fine, double coarser_predicted) {
+  if (!(coarser_predicted > 0)) return std::numeric_limits<double>::infinity();
+  const double rho = std::max(finer_predicted, 0.0) / coarser_predicted;
+  if (!(rho < 1)) return std::numeric_limits<double>::infinity();
+  return rho / (1 - rho) * mean_vertex_error(fine.mesh, coarser_on_fine, finer_on_fine);
 }
 
 }  // namespace msfab

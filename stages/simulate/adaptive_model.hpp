@@ -63,6 +63,17 @@ void rechoose_adaptive_levels(AdaptiveModel& model, const Scene& scene, const Vo
 // of different levels make together (interfaces, errors of one sign).
 double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& u_on_fine);
 
+// After a refinement: a bound on the error of the finer solve from how far
+// it moved from the coarser one. With rho the ratio of their a-priori
+// estimates (the reduction the finer choice was made for), e_fine <= rho
+// e_coarse and e_coarse <= change + e_fine give e_fine <= rho / (1 - rho)
+// change (the saturation assumption of two-solution estimates). Unlike the
+// distance from the extrapolated solution it does not carry the
+// extrapolation's own error, which dominates where the two uniform levels
+// err in different directions (docs/ddfem.md). +inf where rho >= 1.
+double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, double finer_predicted,
+                              const VecX& coarser_on_fine, double coarser_predicted);
+
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine
 // solution.
