@@ -159,8 +159,11 @@ double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, con
 double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, double finer_predicted,
                               const VecX& coarser_on_fine, double coarser_predicted) {
   if (!(coarser_predicted > 0)) return std::numeric_limits<double>::infinity();
+  // Near rho = 1 the factor rho / (1 - rho) magnifies any error in the
+  // predicted ratio (its derivative is 1 / (1 - rho)^2): only a refinement
+  // that was chosen to at least halve the error gives a bound.
   const double rho = std::max(finer_predicted, 0.0) / coarser_predicted;
-  if (!(rho < 1)) return std::numeric_limits<double>::infinity();
+  if (!(rho <= 0.5)) return std::numeric_limits<double>::infinity();
   return rho / (1 - rho) * mean_vertex_error(fine.mesh, coarser_on_fine, finer_on_fine);
 }
 

@@ -70,7 +70,10 @@ double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, con
 // change (the saturation assumption of two-solution estimates). Unlike the
 // distance from the extrapolated solution it does not carry the
 // extrapolation's own error, which dominates where the two uniform levels
-// err in different directions (docs/ddfem.md). +inf where rho >= 1.
+// err in different directions (docs/ddfem.md). +inf where rho > 1/2,
+// where the factor is too sensitive to the predicted ratio (layers1, whose
+// level-1 cells are no better than its level-2 ones, was underestimated at
+// rho = 0.78).
 double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, double finer_predicted,
                               const VecX& coarser_on_fine, double coarser_predicted);
 
