@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <memory>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -23,6 +25,22 @@ CoarseMaterialLookup level1_lookup(const Scene& scene, const CoarseModel& level2
 
 CoarseMaterialLookup level2_lookup(const Scene& scene, const CoarseModel& level2) {
   return ddfem_lookup(*level2.database, scene.material_by_id, level2.level1, 2, level2, nullptr);
+}
+
+// `lookup` answering first from a uniform model's own materials (its mesh
+// holds one per combination of its grid, in order): the mixed meshes take
+// the same materials, and a checked lookup homogenizes its block, so each
+// block is looked up once per run instead of once per mesh.
+CoarseMaterialLookup reusing_materials_of(const CoarseModel& model, CoarseMaterialLookup lookup) {
+  auto known = std::make_shared<std::map<ChildIds, QuadratureMaterials>>();
+  const auto& materials = model.mesh.mesh.materials;
+  if (materials.size() == model.grid.combinations.size())
+    for (size_t c = 0; c < materials.size(); ++c) known->emplace(model.grid.combinations[c], materials[c]);
+  return [known, lookup = std::move(lookup)](const ChildIds& ids) {
+    auto it = known->find(ids);
+    if (it == known->end()) it = known->emplace(ids, lookup(ids)).first;
+    return it->second;
+  };
 }
 
 // Displacements of a coarse solution (positions x) interpolated to the fine nodes.
@@ -105,8 +123,9 @@ void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelM
   // The mixed mesh, with the same materials as the uniform models. A node
   // the scene fixes must not hang on free corners: the cells around it are
   // meshed fine (face conditions fix whole faces, so this is rare).
-  const CoarseMaterialLookup lookup1 = level1_lookup(scene, level2, level1_db);
-  const CoarseMaterialLookup lookup2 = level2_lookup(scene, level2);
+  const CoarseMaterialLookup lookup1 =
+      m.level1_materials ? m.level1_materials : level1_lookup(scene, level2, level1_db);
+  const CoarseMaterialLookup lookup2 = m.level2_materials ? m.level2_materials : level2_lookup(scene, level2);
   std::vector<int>& levels = m.choice.cell_level;
   for (;;) {
     m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels, lookup1,
@@ -145,6 +164,8 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   const double rate = 1.0;
   m.level_errors = level_errors_from_difference(m.level_difference, rate);
   m.extrapolated = u1 + (u1 - u2) / (std::pow(2.0, rate) - 1.0);
+  m.level1_materials = reusing_materials_of(level1, level1_lookup(scene, level2, level1_db));
+  m.level2_materials = reusing_materials_of(level2, level2_lookup(scene, level2));
   m.cells =
       cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh, element_energies(level1.mesh.mesh, x1));
   m.seconds = seconds_since(t0);

@@ -25,6 +25,9 @@ struct AdaptiveModel {
   LevelChoice choice;
   int cells_refined_for_conditions = 0;  // level-2 cells set to level 0 so that no fixed node hangs
   double seconds = 0;                    // estimate, choice and mesh (not the solves)
+  // The materials of level-1 and level-2 cells: the uniform models' own,
+  // looked up again only for a block they do not hold.
+  CoarseMaterialLookup level1_materials, level2_materials;
 };
 
 // Mixed solves before the a-posteriori check gives up (the one with the

@@ -236,10 +236,14 @@ int main(int argc, char** argv) {
       VecX previous_on_fine;
       double previous_predicted = 0;
       for (;;) {
+        // A choice of level-2 cells only is the uniform level-2 model: its
+        // solution is the start, and Newton has nothing left to do.
         const ElasticAssembler mixed_assembler(adapted.mixed.mesh, adapted.mixed.constraints);
-        const NewtonResult solved =
-            solve_or_throw(mixed_assembler, adapted.conditions, mixed_newton, "adaptive load",
-                           start_from(level1, solve1.x, adapted.mixed.constraints->unknown_rest));
+        const bool all_level2 = adapted.mixed.elements_per_level[0] == 0 && adapted.mixed.elements_per_level[1] == 0;
+        const NodeArray& unknown_rest = adapted.mixed.constraints->unknown_rest;
+        const NewtonResult solved = solve_or_throw(
+            mixed_assembler, adapted.conditions, mixed_newton, "adaptive load",
+            all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
         ++adaptive_solves;
         const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);
         const double extrapolated = a_posteriori_error(fine, adapted, on_fine);
