@@ -116,8 +116,22 @@ void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelM
                               const StaticConditions& fine_conditions, const CoarseModel& level2,
                               const CoarseDatabase& level1_db, double choice_target) {
   const auto t0 = std::chrono::steady_clock::now();
+  // A re-choice must refine some cell of the choice it replaces (the caller
+  // solves again because that one missed): where the tightened target
+  // refines none, it is halved until one is.
+  const std::vector<int> previous = m.choice.cell_level;
+  auto refines_a_cell = [&](const std::vector<int>& levels) {
+    for (size_t c = 0; c < levels.size(); ++c)
+      if (levels[c] < previous[c]) return true;
+    return false;
+  };
+  LevelChoice choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
+  for (int halvings = 0; !previous.empty() && !refines_a_cell(choice.cell_level) && halvings < 30; ++halvings) {
+    choice_target *= 0.5;
+    choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
+  }
   m.choice_target = choice_target;
-  m.choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
+  m.choice = std::move(choice);
   m.cells_refined_for_conditions = 0;
 
   // The mixed mesh, with the same materials as the uniform models. A node

@@ -109,6 +109,18 @@ check "posterior check: solved again past a missed estimate, kept the smallest e
   awk -v e="$(attr_of adaptive_post error_vs_fine)" -v a="$(attr_of adaptive_post a_posteriori_error)" \
   -v n="$(attr_of adaptive_post adaptive_solves)" -v a0="$plain_posterior" -v m="$post_elements" -v m0="$plain_elements" \
   'BEGIN { exit !(e > 0 && e <= 0.002 && (a0 <= 0.002 ? n == 1 : (n >= 2 && a <= a0 && a <= 0.002 && m >= m0))) }'
+# At 0.0035 the second choice was made for under half the first's predicted
+# error, so its change from the first solve bounds its error (docs/ddfem.md,
+# "The a-posteriori estimate"): the bound is the estimate kept, below the
+# target and the extrapolation distance, and above the true error.
+"$SIM" --config "$BAR" --target-error 0.0035 --posterior-check --database "$WORK/db2.h5" --reference "$WORK/fine.h5" \
+  --out "$WORK/adaptive_bound.h5" > "$WORK/bound.log" 2>&1
+echo "target 0.0035: error $(attr_of adaptive_bound error_vs_fine), a-posteriori $(attr_of adaptive_bound a_posteriori_error)" \
+  "after $(attr_of adaptive_bound adaptive_solves) mixed solves"
+check "refinement bound: the second solve's change bounds its error" -- grep -q 'from the change since solve 1' "$WORK/bound.log"
+check "refinement bound meets the target and lies above the true error" -- \
+  awk -v e="$(attr_of adaptive_bound error_vs_fine)" -v a="$(attr_of adaptive_bound a_posteriori_error)" \
+  -v n="$(attr_of adaptive_bound adaptive_solves)" 'BEGIN { exit !(n == 2 && e > 0 && e <= a && a <= 0.0035) }'
 expect_exit 2 "applies to --target-error only" -- "$SIM" --config "$BAR" --coarsen 2 --database "$WORK/db2.h5" \
   --posterior-check --out "$WORK/o.h5"
 cp "$WORK/adaptive.h5" "$WORK/adaptive_threads2.h5"
