@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <cmath>
 #include <cstdlib>
 #include <sstream>
 
@@ -101,9 +100,11 @@ QuadratureMaterials averaged_block(const std::vector<MaterialPtr>& palette, cons
 }
 
 // Each voxel's material (none for void) at its 8 points of the composite
-// rule; reduced: at the points of the rule that integrates each material's
-// stiffness monomials as the composite rule does (ddfem/galerkin_quadrature.hpp).
-QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, bool reduced) {
+// rule of the n x n x n block; reduced: at the points of the rule that
+// integrates each material's stiffness monomials as the composite rule does
+// (ddfem/galerkin_quadrature.hpp).
+QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, const std::vector<int>& ids, int n,
+                                   bool reduced) {
   if (std::all_of(ids.begin(), ids.end(), [](int id) { return id == 0; }))
     throw InputError("coarsening baseline: every voxel of the block is void");
   QuadratureMaterials m;
@@ -111,7 +112,6 @@ QuadratureMaterials galerkin_block(const std::vector<MaterialPtr>& palette, cons
   for (int id : ids)
     m.at_point.insert(m.at_point.end(), 8, id == 0 ? MaterialPtr() : palette_material_checked(palette, id));
   if (!reduced) return m;
-  const int n = static_cast<int>(std::lround(std::cbrt(double(ids.size()))));
   std::vector<int> group;
   group.reserve(m.at_point.size());
   for (int id : ids) group.insert(group.end(), 8, id == 0 ? -1 : id);
@@ -199,14 +199,14 @@ CoarseMaterialLookup averaged_coarsening(const std::vector<MaterialPtr>& palette
 }
 
 CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, bool reduced) {
-  return [palette, reduced](const ChildIds& child) { return galerkin_block(palette, block_level1(child), reduced); };
+  return [palette, reduced](const ChildIds& child) { return galerkin_block(palette, block_level1(child), 2, reduced); };
 }
 
 CoarseMaterialLookup galerkin_coarsening(const std::vector<MaterialPtr>& palette, const CoarseGrid& level1,
                                          bool reduced) {
   if (level1.level != 1) throw InputError("Galerkin level-2 coarsening needs a level-1 grid");
   return [palette, combos = level1.combinations, reduced](const ChildIds& child) {
-    return galerkin_block(palette, block_level2(child, combos), reduced);
+    return galerkin_block(palette, block_level2(child, combos), 4, reduced);
   };
 }
 

@@ -1,6 +1,5 @@
 #include "ddfem/galerkin_quadrature.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>

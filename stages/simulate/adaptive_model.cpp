@@ -1,5 +1,7 @@
 #include "adaptive_model.hpp"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -114,7 +116,7 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
 
 void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelMesh& fine,
                               const StaticConditions& fine_conditions, const CoarseModel& level2,
-                              const CoarseDatabase& level1_db, double choice_target) {
+                              double choice_target) {
   const auto t0 = std::chrono::steady_clock::now();
   // A re-choice must refine some cell of the choice it replaces (the caller
   // solves again because that one missed): where the tightened target
@@ -137,13 +139,10 @@ void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelM
   // The mixed mesh, with the same materials as the uniform models. A node
   // the scene fixes must not hang on free corners: the cells around it are
   // meshed fine (face conditions fix whole faces, so this is rare).
-  const CoarseMaterialLookup lookup1 =
-      m.level1_materials ? m.level1_materials : level1_lookup(scene, level2, level1_db);
-  const CoarseMaterialLookup lookup2 = m.level2_materials ? m.level2_materials : level2_lookup(scene, level2);
   std::vector<int>& levels = m.choice.cell_level;
   for (;;) {
-    m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels, lookup1,
-                                     lookup2, level2.element == "enhanced");
+    m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels,
+                                     m.level1_materials, m.level2_materials, level2.element == "enhanced");
     std::vector<int> unresolved;
     m.conditions =
         mixed_static_conditions(scene, fine, fine_conditions, level2.level1, level2.grid, m.mixed, &unresolved);
@@ -183,7 +182,7 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
   m.cells =
       cell_error_models(scene.grid, level2.level1, level2.grid, level1.mesh, element_energies(level1.mesh.mesh, x1));
   m.seconds = seconds_since(t0);
-  rechoose_adaptive_levels(m, scene, fine, fine_conditions, level2, level1_db, target_error);
+  rechoose_adaptive_levels(m, scene, fine, fine_conditions, level2, target_error);
   return m;
 }
 
@@ -200,6 +199,19 @@ double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, 
   const double rho = std::max(finer_predicted, 0.0) / coarser_predicted;
   if (!(rho <= 0.5)) return std::numeric_limits<double>::infinity();
   return rho / (1 - rho) * mean_vertex_error(fine.mesh, coarser_on_fine, finer_on_fine);
+}
+
+PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& on_fine,
+                                     const VecX* previous_on_fine, double previous_predicted, int previous_solve) {
+  const auto& per_level = model.mixed.elements_per_level;
+  if (per_level[1] == 0 && per_level[2] == 0) return {0.0, "the fine model"};
+  const double extrapolated = a_posteriori_error(fine, model, on_fine);
+  const double bound = previous_on_fine ? refinement_error_bound(fine, on_fine, model.choice.predicted_error,
+                                                                 *previous_on_fine, previous_predicted)
+                                        : std::numeric_limits<double>::infinity();
+  if (bound < extrapolated)
+    return {bound, fmt::format("from the change since solve {}, extrapolation {:.3g}", previous_solve, extrapolated)};
+  return {extrapolated, "against the extrapolation"};
 }
 
 }  // namespace msfab

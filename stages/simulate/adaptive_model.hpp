@@ -7,6 +7,8 @@
 // its error is estimated a posteriori against the Richardson extrapolation
 // of the two uniform solutions; with --posterior-check a miss tightens the
 // choice and solves again.
+#include <string>
+
 #include "coarse_model.hpp"
 #include "ddfem/adaptive_levels.hpp"
 #include "ddfem/mixed_level_mesh.hpp"
@@ -56,8 +58,7 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
 // previous choice was made for, after its a-posteriori check missed) and
 // meshes them again.
 void rechoose_adaptive_levels(AdaptiveModel& model, const Scene& scene, const VoxelMesh& fine,
-                              const StaticConditions& fine_conditions, const CoarseModel& level2,
-                              const CoarseDatabase& level1_db, double choice_target);
+                              const StaticConditions& fine_conditions, const CoarseModel& level2, double choice_target);
 
 // The a-posteriori error estimate of a solution of `model` (`u_on_fine`, from
 // adaptive_displacement_on_fine): its mean-vertex distance from the
@@ -79,6 +80,18 @@ double a_posteriori_error(const VoxelMesh& fine, const AdaptiveModel& model, con
 // rho = 0.78).
 double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, double finer_predicted,
                               const VecX& coarser_on_fine, double coarser_predicted);
+
+// The a-posteriori estimate of a mixed solve kept by --posterior-check: 0
+// for a choice of fine cells only (the fine model itself), else the smaller
+// of a_posteriori_error and, from the second solve on, the
+// refinement_error_bound against the previous solve (`previous_on_fine`,
+// null for the first solve, with its predicted error and number).
+struct PosteriorEstimate {
+  double value = 0;
+  std::string source;  // what `value` is, for the log
+};
+PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& on_fine,
+                                     const VecX* previous_on_fine, double previous_predicted, int previous_solve);
 
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine

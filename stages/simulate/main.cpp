@@ -20,7 +20,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -228,8 +227,7 @@ int main(int argc, char** argv) {
       // itself off): the loop stops and keeps the round with the smallest
       // estimate.
       // After a refinement the estimate is also bounded by how far the solve
-      // moved from the previous one (refinement_error_bound); the smaller
-      // of the two stands.
+      // moved from the previous one (posterior_estimate).
       NewtonOptions mixed_newton = warm_newton;
       if (mixed_newton.linear_solver == "auto") mixed_newton.linear_solver = "cholmod";
       AdaptiveModel best;
@@ -246,23 +244,16 @@ int main(int argc, char** argv) {
             all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
         ++adaptive_solves;
         const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);
-        const double extrapolated = a_posteriori_error(fine, adapted, on_fine);
-        const double bound = adaptive_solves > 1 ? refinement_error_bound(fine, on_fine, adapted.choice.predicted_error,
-                                                                          previous_on_fine, previous_predicted)
-                                                 : std::numeric_limits<double>::infinity();
-        // A choice of fine cells only is the fine model itself: no error to estimate.
-        const bool all_fine = adapted.mixed.elements_per_level[1] == 0 && adapted.mixed.elements_per_level[2] == 0;
-        const double estimate = all_fine ? 0.0 : std::min(extrapolated, bound);
+        const PosteriorEstimate posterior =
+            posterior_estimate(fine, adapted, on_fine, adaptive_solves > 1 ? &previous_on_fine : nullptr,
+                               previous_predicted, adaptive_solves - 1);
+        const double estimate = posterior.value;
         previous_on_fine = on_fine;
         previous_predicted = adapted.choice.predicted_error;
         spdlog::info(
             "adaptive solve {}: levels chosen for {:.3g} (predicted {:.3g}), a-posteriori estimate {:.3g} "
             "({}) against the target {:.3g}; elements fine {} / level 1 {} / level 2 {}",
-            adaptive_solves, adapted.choice_target, adapted.choice.predicted_error, estimate,
-            all_fine ? std::string("the fine model")
-            : bound < extrapolated
-                ? fmt::format("from the change since solve {}, extrapolation {:.3g}", adaptive_solves - 1, extrapolated)
-                : std::string("against the extrapolation"),
+            adaptive_solves, adapted.choice_target, adapted.choice.predicted_error, estimate, posterior.source,
             target_error, adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
             adapted.mixed.elements_per_level[2]);
         const bool improved = !adaptive_result || estimate < checked_error;
@@ -282,7 +273,7 @@ int main(int argc, char** argv) {
               checked_error, target_error, adaptive_solves);
           break;
         }
-        rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse, *level1_db,
+        rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
                                  adapted.choice_target * target_error / estimate);
       }
       adapted = std::move(best);
