@@ -1,5 +1,6 @@
 #include "mapping/mismatch.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <set>
@@ -186,6 +187,11 @@ void MismatchProblem::randomize(std::uint64_t seed) {
   recompute_energies();
 }
 
+void MismatchProblem::start_nearest() {
+  std::fill(choice_.begin(), choice_.end(), 0);
+  recompute_energies();
+}
+
 DescentReport MismatchProblem::descend() {
   const auto start = std::chrono::steady_clock::now();
   DescentReport report;
@@ -240,6 +246,30 @@ DescentReport MismatchProblem::descend() {
   report.final = total_now;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
+}
+
+MultiStartReport descend_from_starts(MismatchProblem& problem, std::uint64_t seed, int starts) {
+  if (starts < 1) throw std::invalid_argument("descend_from_starts: needs at least one start");
+  MultiStartReport out;
+  std::vector<std::int32_t> kept_choice;
+  for (int s = 0; s < starts; ++s) {
+    if (s == 1)
+      problem.start_nearest();
+    else
+      problem.randomize(s == 0 ? seed : hash_seed(seed, std::uint64_t(s)));
+    DescentReport report = problem.descend();
+    out.seconds += report.seconds;
+    out.finals.push_back(report.final);
+    if (s == 0 || report.final < out.kept.final) {
+      out.kept = std::move(report);
+      out.kept_start = s;
+      if (starts > 1) kept_choice = problem.choice();
+    }
+  }
+  if (starts > 1 && out.kept_start != starts - 1) {
+    for (std::int64_t c = 0; c < problem.grid().cells(); ++c) problem.assign(c, kept_choice[std::size_t(c)]);
+  }
+  return out;
 }
 
 }  // namespace msfab

@@ -100,6 +100,8 @@ class MismatchProblem {
   // Every cell an option drawn from a hash of (seed, cell): the same for a
   // seed whatever the thread count or the order cells are visited in.
   void randomize(std::uint64_t seed);
+  // Every cell its option 0: the nearest candidate, as stored.
+  void start_nearest();
 
   // I_i under the current choice (cached).
   std::int64_t energy(std::int64_t cell) const { return energy_[std::size_t(cell)]; }
@@ -127,6 +129,24 @@ class MismatchProblem {
   std::vector<std::int32_t> choice_;
   std::vector<std::int64_t> energy_;
 };
+
+// The descent from several starts, the lowest final mismatch kept (ties:
+// the earlier start). One greedy descent stops in the first local minimum
+// it meets, and where options form groups that fit among themselves (every
+// structure fits its own copies; half-shifted exemplars fit each other) a
+// random start freezes patches of each group whose borders no single-cell
+// move can mend. Start 0 is randomize(seed), so one start is the plain
+// descent; start 1 the nearest candidate everywhere (neighbours with close
+// targets then share structures); start s >= 2 randomize(hash_seed(seed, s)).
+// Each descent is sequential, so the result depends on the seed only. The
+// problem is left at the kept start's local minimum.
+struct MultiStartReport {
+  DescentReport kept;  // the kept start's descent
+  int kept_start = 0;
+  std::vector<std::int64_t> finals;  // final mismatch of every start
+  double seconds = 0;                // all starts' descents
+};
+MultiStartReport descend_from_starts(MismatchProblem& problem, std::uint64_t seed, int starts);
 
 // splitmix64-based hash of (seed, index): a reproducible stream per index.
 std::uint64_t hash_seed(std::uint64_t seed, std::uint64_t index);

@@ -37,6 +37,7 @@ candidates: 16          # nearest structures per cell
 match: all              # candidates by all properties, or by stiffness (moduli and Poisson ratios, not the density)
 # max_gap: 0.2          # keep only candidates whose property gap is at most this (or the cell's smallest)
 half_shift: true        # also offer every candidate translated by half a cell
+starts: 1               # mismatch descents (random, nearest, random...); the lowest mismatch is kept
 max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
 tiling: 1               # copies of its structure per cell edge (each cell holds tiling^3 smaller copies)
 export:
@@ -53,6 +54,7 @@ struct ExportOptions {
 
 struct Settings {
   MapperOptions mapper;
+  int starts = 1;
   int tiling = 1;
   ExportOptions exports;
 };
@@ -65,6 +67,8 @@ Settings read_settings(const Config& config) {
   if (config.has("max_gap")) s.mapper.candidates.max_gap = config.require_positive("max_gap", "property gap bound");
   if (config.has("radius")) s.mapper.candidates.radius = config.require_positive("radius", "candidate radius");
   s.mapper.half_shift = config.get_or<bool>("half_shift", true);
+  s.starts = config.get_or<int>("starts", 1);
+  if (s.starts < 1 || s.starts > 1000) config.fail("starts", "must be 1..1000");
   s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
   if (!(s.mapper.max_distance > 0)) config.fail("max_distance", "must be > 0");
   s.tiling = config.get_or<int>("tiling", 1);
@@ -125,14 +129,15 @@ int main(int argc, char** argv) {
     const CellCandidates candidates = design_candidates(design, set, settings.mapper.candidates);
     // 2. Boundary faces and the mismatch energy of every cell.
     MismatchProblem problem = mismatch_problem(design, set, candidates, settings.mapper.half_shift);
-    // 3. Random start, then greedy descent on the priority list.
-    problem.randomize(ctx.options.seed);
-    spdlog::info("initial mismatch {}", problem.total());
-    const DescentReport descent = problem.descend();
-    spdlog::info("final mismatch {} after {} moves ({} cells evaluated)", descent.final, descent.moves,
-                 descent.evaluations);
+    // 3. Greedy descent on the priority list from each start; the lowest
+    //    mismatch is kept.
+    const MultiStartReport starts = descend_from_starts(problem, ctx.options.seed, settings.starts);
+    const DescentReport& descent = starts.kept;
+    spdlog::info("final mismatch {} after {} moves ({} cells evaluated), start {} of {}", descent.final, descent.moves,
+                 descent.evaluations, starts.kept_start, settings.starts);
     // 4. The mapping artifact.
     MappedDesign mapped = mapped_design(design, set, candidates, problem, descent, settings.mapper);
+    mapped.seconds = starts.seconds;
     mapped.tiling = settings.tiling;
     const double mapping_seconds = seconds_since(start);
     write_mapped_artifact(out, mapped, "msfab-map", ctx.config.resolved_text(), {design_path, structures_path},
@@ -164,7 +169,13 @@ int main(int argc, char** argv) {
         descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;
     std::printf("  mismatch: initial %lld, final %lld (-%.1f%%), %lld moves, %lld evaluations, descent %.3f s\n",
                 static_cast<long long>(descent.initial), static_cast<long long>(descent.final), drop,
-                static_cast<long long>(descent.moves), static_cast<long long>(descent.evaluations), descent.seconds);
+                static_cast<long long>(descent.moves), static_cast<long long>(descent.evaluations), starts.seconds);
+    if (settings.starts > 1) {
+      std::string finals;
+      for (std::int64_t f : starts.finals) finals += (finals.empty() ? "" : ", ") + std::to_string(f);
+      std::printf("  starts: %d (final mismatch %s), kept start %d\n", settings.starts, finals.c_str(),
+                  starts.kept_start);
+    }
     std::printf("  distance to target: max %.4g (nearest candidate: max %.4g; %lld cells beyond max_distance %g)\n",
                 distances.max_chosen, distances.max_nearest, static_cast<long long>(distances.far_cells),
                 settings.mapper.max_distance);

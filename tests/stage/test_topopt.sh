@@ -48,6 +48,15 @@ check "cubic2d design inside its gamut" -- grep -Eq "max constraint (-|[0-9.]+e-
 check "the gamut stores its base materials for the Voigt bound" -- h5ls "$WORK/set.gamut.h5/bound/stiff"
 check "the design maps to microstructures" -- "$BIN/msfab-map" --design "$WORK/cubic.design.h5" \
   --structures "$WORK/set.microstructures.h5" --out "$WORK/cubic.mapped.h5" --quiet
+# Several descents keep the lowest mismatch: start 0 is the single start's.
+one=$("$BIN/msfab-map" --design "$WORK/cubic.design.h5" --structures "$WORK/set.microstructures.h5" --seed 5 \
+  --out "$WORK/one.mapped.h5" --quiet | grep -oE "final [0-9]+" | grep -oE "[0-9]+")
+many=$("$BIN/msfab-map" --design "$WORK/cubic.design.h5" --structures "$WORK/set.microstructures.h5" --seed 5 \
+  --set starts=6 --out "$WORK/many.mapped.h5" --quiet)
+many_final=$(grep -oE "final [0-9]+" <<<"$many" | grep -oE "[0-9]+")
+check "starts: six descents reported, the first the single start's" -- \
+  grep -Eq "starts: 6 \(final mismatch $one, [0-9]+, [0-9]+, [0-9]+, [0-9]+, [0-9]+\)" <<<"$many"
+check "starts: the kept mismatch is at most the single start's" -- test -n "$one" -a "$many_final" -le "$one"
 # Another gamut of the same material and space: its structures are not the
 # design's (refused, naming both files); a set derived from the design's
 # structures (re-homogenized) is accepted.

@@ -334,6 +334,62 @@ TEST(Mapping, GreedyNeverIncreasesAndEndsInALocalMinimum) {
   expect_descent_to_local_minimum({3, 4, 3, 3}, 3, 2, 2, 2);
 }
 
+// Several starts keep the lowest local minimum: start 0 is the plain
+// random descent, start 1 the nearest option everywhere, the problem ends
+// at the kept start's choice; on two uniform fills whose only zero-mismatch
+// states are "all one fill", the nearest start finds zero.
+TEST(Mapping, MultiStartKeepsTheLowestLocalMinimum) {
+  const FaceGrid grid{3, 5, 4, 3};
+  std::mt19937 rng(7);
+  FaceTable table(3, 3, 2, 3);
+  for (int s = 0; s < 12; ++s) table.add(mapping_random_ids(rng, 18, 2));
+  std::vector<std::int64_t> offsets{0};
+  std::vector<std::int32_t> options;
+  for (std::int64_t c = 0; c < grid.cells(); ++c) {
+    const int count = 1 + int(rng() % 4);
+    for (int o = 0; o < count; ++o) options.push_back(int(rng() % 12));
+    offsets.push_back(std::int64_t(options.size()));
+  }
+  const MismatchProblem problem(grid, table, offsets, options);
+  MismatchProblem plain = problem, nearest = problem, multi = problem;
+  plain.randomize(3);
+  const DescentReport plain_report = plain.descend();
+  nearest.start_nearest();
+  const DescentReport nearest_report = nearest.descend();
+  const MultiStartReport r = descend_from_starts(multi, 3, 6);
+  ASSERT_EQ(r.finals.size(), 6u);
+  EXPECT_EQ(r.finals[0], plain_report.final);
+  EXPECT_EQ(r.finals[1], nearest_report.final);
+  const auto lowest = std::min_element(r.finals.begin(), r.finals.end());
+  EXPECT_EQ(r.kept_start, int(lowest - r.finals.begin()));
+  EXPECT_EQ(r.kept.final, *lowest);
+  EXPECT_LE(r.kept.final, plain_report.final);
+  EXPECT_GT(*std::max_element(r.finals.begin(), r.finals.end()), *lowest) << "the starts should differ here";
+  // The problem holds the kept choice: its energies recounted give the kept total.
+  MismatchProblem fresh = multi;
+  fresh.recompute_energies();
+  EXPECT_EQ(fresh.total(), r.kept.final);
+  for (std::int64_t c = 0; c < grid.cells(); ++c) ASSERT_EQ(fresh.energy(c), multi.energy(c));
+  // One start is the plain descent.
+  MismatchProblem single = problem;
+  EXPECT_EQ(descend_from_starts(single, 3, 1).kept.final, plain_report.final);
+  EXPECT_EQ(single.choice(), plain.choice());
+
+  FaceTable fills(2, 2, 2, 3);
+  const int zero = fills.add_uniform(0), one = fills.add_uniform(1);
+  std::vector<std::int64_t> two_offsets{0};
+  std::vector<std::int32_t> two_options;
+  for (std::int64_t c = 0; c < grid.cells(); ++c) {
+    two_options.push_back(zero), two_options.push_back(one);
+    two_offsets.push_back(std::int64_t(two_options.size()));
+  }
+  MismatchProblem two(grid, fills, two_offsets, two_options);
+  const MultiStartReport t = descend_from_starts(two, 1, 2);
+  EXPECT_EQ(t.finals[1], 0);
+  EXPECT_EQ(t.kept.final, 0);
+  EXPECT_EQ(two.total(), 0);
+}
+
 TEST(Mapping, SameSeedSameMappingOnAnyThreadCount) {
   const MicrostructureSet set = random_set(60, 4, 4, 1, 3);
   const Design d = mapping_random_design(set, 9, 7, 1, 4);
