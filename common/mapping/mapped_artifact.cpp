@@ -54,6 +54,10 @@ void write_mapped_artifact(const std::string& path, const MappedDesign& m, const
   f.write_attribute("/", "max_distance", m.max_distance);
   f.write_attribute("/", "initial_mismatch", m.history.front());
   f.write_attribute("/", "final_mismatch", m.history.back());
+  f.write_attribute("/", "void_pair_cost", m.void_pair_cost);
+  f.write_attribute("/", "mismatch_pairs", m.mismatch_pairs);
+  f.write_attribute("/", "void_pairs", m.void_pairs);
+  f.write_attribute("/", "contact_pairs", m.contact_pairs);
   f.write_attribute("/", "evaluations", m.evaluations);
   f.write_attribute("/", "seconds", m.seconds);
 
@@ -111,6 +115,13 @@ MappedDesign read_mapped_artifact(const std::string& path) {
   m.radius = f.read_attribute<double>("/", "radius");
   m.half_shift = f.read_attribute<std::int32_t>("/", "half_shift") != 0;
   m.max_distance = f.read_attribute<double>("/", "max_distance");
+  // Artifacts written before the void-pair cost: plain mismatch, pairs not recorded.
+  if (f.has_attribute("/", "void_pair_cost")) {
+    m.void_pair_cost = f.read_attribute<double>("/", "void_pair_cost");
+    m.mismatch_pairs = f.read_attribute<std::int64_t>("/", "mismatch_pairs");
+    m.void_pairs = f.read_attribute<std::int64_t>("/", "void_pairs");
+    m.contact_pairs = f.read_attribute<std::int64_t>("/", "contact_pairs");
+  }
   m.evaluations = f.read_attribute<std::int64_t>("/", "evaluations");
   m.seconds = f.read_attribute<double>("/", "seconds");
   const auto roles = f.read_vector<std::uint8_t>("/cells/role");

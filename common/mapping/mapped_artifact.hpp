@@ -41,8 +41,8 @@ struct MappedDesign {
   // set whose properties are not the space's).
   std::vector<double> property_gap;
   std::vector<std::int32_t> candidates;    // per cell, candidate structures considered (0 for fixed cells)
-  std::vector<std::int64_t> mismatch;      // per cell, the final I_i
-  std::vector<std::int64_t> history;       // total mismatch I after each accepted move; [0] the initial one
+  std::vector<std::int64_t> mismatch;      // per cell, the final I_i (with a void-pair cost: its energy)
+  std::vector<std::int64_t> history;       // total I after each accepted move; [0] the initial one
   std::vector<std::int64_t> history_cell;  // the cell each move changed; [0] = -1
 
   // The settings the mapping ran with, and what it cost.
@@ -50,6 +50,10 @@ struct MappedDesign {
   double radius = 0;  // 0: none
   bool half_shift = true;
   double max_distance = 0.1;
+  double void_pair_cost = 0;  // MismatchProblem; 0 in artifacts written before it existed
+  // Voxel pairs across the faces between cells, each once: differing, void
+  // on both sides, the same material on both sides (-1: not recorded).
+  std::int64_t mismatch_pairs = -1, void_pairs = -1, contact_pairs = -1;
   std::int64_t evaluations = 0;
   double seconds = 0;
 

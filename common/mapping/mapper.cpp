@@ -101,7 +101,7 @@ CellCandidates design_candidates(const Design& design, const MicrostructureSet& 
 }
 
 MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
-                                 bool half_shift) {
+                                 bool half_shift, double void_pair_cost) {
   const int variants = half_shift ? 2 : 1;
   FaceTable table(set.nx, set.ny, set.nz, design.dimension);
   const int empty = table.add_uniform(0);
@@ -130,7 +130,7 @@ MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& 
       for (int v = 0; v < variants; ++v) options[o++] = first_entry[candidates.structure[j]] + v;
   }
   FaceGrid grid{design.dimension, design.nx, design.ny, design.nz};
-  return MismatchProblem(grid, std::move(table), std::move(offsets), std::move(options));
+  return MismatchProblem(grid, std::move(table), std::move(offsets), std::move(options), void_pair_cost);
 }
 
 MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
@@ -176,6 +176,9 @@ MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, c
   m.radius = options.candidates.radius;
   m.half_shift = options.half_shift;
   m.max_distance = options.max_distance;
+  m.void_pair_cost = options.void_pair_cost;
+  const MismatchProblem::FacePairs pairs = problem.face_pairs();
+  m.mismatch_pairs = pairs.mismatch, m.void_pairs = pairs.both_void, m.contact_pairs = pairs.contact;
   m.evaluations = report.evaluations;
   m.seconds = report.seconds;
   return m;

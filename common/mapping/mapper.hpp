@@ -24,6 +24,7 @@ namespace msfab {
 struct MapperOptions {
   CandidateOptions candidates;
   bool half_shift = true;     // also offer each candidate translated by half a cell
+  double void_pair_cost = 0;  // MismatchProblem: a both-void pair costs this much of a mismatching one
   double max_distance = 0.1;  // warn about cells whose nearest candidate is farther (normalized units)
 };
 
@@ -58,7 +59,7 @@ CellCandidates design_candidates(const Design& design, const MicrostructureSet& 
 // entry, forced solid cells one all-id-1 entry. Starts with option 0 (the
 // nearest candidate) everywhere.
 MismatchProblem mismatch_problem(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,
-                                 bool half_shift);
+                                 bool half_shift, double void_pair_cost = 0);
 
 // Step 4: the chosen structure, exemplar and distance of every cell.
 MappedDesign mapped_design(const Design& design, const MicrostructureSet& set, const CellCandidates& candidates,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <set>
 #include <stdexcept>
@@ -104,6 +105,28 @@ std::int64_t FaceTable::mismatch(int lower, int upper, int axis) const {
   return count;
 }
 
+std::int64_t FaceTable::void_pairs(int lower, int upper, int axis) const {
+  const std::uint8_t* a = face(lower, 2 * axis + 1);
+  const std::uint8_t* b = face(upper, 2 * axis);
+  const int n = face_size_[axis];
+  // As in mismatch(): a byte of a | b is zero where both ids are 0.
+  constexpr std::uint64_t kLow = 0x0101010101010101ull;
+  std::int64_t count = 0;
+  int k = 0;
+  for (; k + 8 <= n; k += 8) {
+    std::uint64_t x, y;
+    std::memcpy(&x, a + k, 8);
+    std::memcpy(&y, b + k, 8);
+    x |= y;
+    x |= x >> 4;
+    x |= x >> 2;
+    x |= x >> 1;
+    count += 8 - std::int64_t(((x & kLow) * kLow) >> 56);
+  }
+  for (; k < n; ++k) count += (a[k] | b[k]) == 0;
+  return count;
+}
+
 // ---------------------------------------------------------------------------
 // MismatchProblem
 
@@ -118,8 +141,11 @@ std::uint64_t hash_seed(std::uint64_t seed, std::uint64_t index) {
 }
 
 MismatchProblem::MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets,
-                                 std::vector<std::int32_t> options)
+                                 std::vector<std::int32_t> options, double void_pair_cost)
     : grid_(grid), table_(std::move(table)), offsets_(std::move(offsets)), options_(std::move(options)) {
+  if (!(void_pair_cost >= 0 && void_pair_cost <= 1))
+    throw std::invalid_argument("MismatchProblem: the void-pair cost must lie in [0, 1]");
+  void_cost16_ = int(std::lround(16 * void_pair_cost));
   const std::int64_t cells = grid_.cells();
   if (grid_.dimension != table_.dimension()) throw std::invalid_argument("MismatchProblem: dimensions differ");
   if (std::int64_t(offsets_.size()) != cells + 1 || offsets_[0] != 0 ||
@@ -137,7 +163,27 @@ MismatchProblem::MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std
 std::int64_t MismatchProblem::pair_mismatch(int entry, int face, std::int64_t other) const {
   const int other_entry = this->entry(other, choice_[std::size_t(other)]);
   const int axis = face / 2;
-  return face % 2 == 1 ? table_.mismatch(entry, other_entry, axis) : table_.mismatch(other_entry, entry, axis);
+  const int lower = face % 2 == 1 ? entry : other_entry, upper = face % 2 == 1 ? other_entry : entry;
+  if (void_cost16_ == 0) return table_.mismatch(lower, upper, axis);
+  return 16 * table_.mismatch(lower, upper, axis) + void_cost16_ * table_.void_pairs(lower, upper, axis);
+}
+
+MismatchProblem::FacePairs MismatchProblem::face_pairs() const {
+  FacePairs p;
+  const std::int64_t cells = grid_.cells();
+  for (std::int64_t c = 0; c < cells; ++c) {
+    const int e = entry(c, choice_[std::size_t(c)]);
+    for (int axis = 0; axis < grid_.dimension; ++axis) {
+      const std::int64_t n = grid_.neighbour(c, 2 * axis + 1);
+      if (n < 0) continue;
+      const int o = entry(n, choice_[std::size_t(n)]);
+      const std::int64_t differ = table_.mismatch(e, o, axis), both_void = table_.void_pairs(e, o, axis);
+      p.mismatch += differ;
+      p.both_void += both_void;
+      p.contact += table_.face_size(axis) - differ - both_void;
+    }
+  }
+  return p;
 }
 
 std::int64_t MismatchProblem::energy_with(std::int64_t cell, int option) const {

@@ -61,6 +61,8 @@ class FaceTable {
   // Differing voxel pairs between `lower`'s upper face and `upper`'s lower
   // face along `axis`.
   std::int64_t mismatch(int lower, int upper, int axis) const;
+  // Pairs of the same faces that are void (id 0) on both sides.
+  std::int64_t void_pairs(int lower, int upper, int axis) const;
 
  private:
   int vx_, vy_, vz_, dimension_;
@@ -84,9 +86,17 @@ struct DescentReport {
 // Which entry each cell may take: cell c's options are
 // options[offsets[c]] .. options[offsets[c + 1] - 1] (entries of the table),
 // at least one per cell; a cell with one option is fixed.
+//
+// With a void-pair cost c > 0 the energy is not the mismatch alone: a pair
+// that is void on both sides costs c of a mismatching pair, so that two
+// cells that share little material no longer count as a perfect fit (for
+// c < 1 this is (1 - c) mismatch - c solid-solid pairs + a constant per
+// face). Energies are then in sixteenths of a pair: 16 mismatch +
+// round(16 c) void pairs; c = 0 keeps I the plain mismatch.
 class MismatchProblem {
  public:
-  MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets, std::vector<std::int32_t> options);
+  MismatchProblem(FaceGrid grid, FaceTable table, std::vector<std::int64_t> offsets, std::vector<std::int32_t> options,
+                  double void_pair_cost = 0);
 
   const FaceGrid& grid() const { return grid_; }
   const FaceTable& table() const { return table_; }
@@ -112,6 +122,14 @@ class MismatchProblem {
   // Every I_i from scratch (parallel over cells).
   void recompute_energies();
 
+  // The voxel pairs across faces between cells under the current choice,
+  // each pair once: differing, void on both sides, and the rest (the same
+  // material on both sides: solid contact).
+  struct FacePairs {
+    std::int64_t mismatch = 0, both_void = 0, contact = 0;
+  };
+  FacePairs face_pairs() const;
+
   // The greedy descent of §3.5: cells in a priority list by I_i (largest
   // first, then lower index); the top cell takes the option that lowers I the
   // most (ties: the lowest option index, i.e. the nearest candidate) or, if
@@ -121,6 +139,8 @@ class MismatchProblem {
 
  private:
   std::int64_t pair_mismatch(int entry, int face, std::int64_t other) const;
+
+  int void_cost16_ = 0;  // round(16 c); 0: I is the mismatch
 
   FaceGrid grid_;
   FaceTable table_;

@@ -37,6 +37,7 @@ candidates: 16          # nearest structures per cell
 match: all              # candidates by all properties, or by stiffness (moduli and Poisson ratios, not the density)
 # max_gap: 0.2          # keep only candidates whose property gap is at most this (or the cell's smallest)
 half_shift: true        # also offer every candidate translated by half a cell
+void_pair_cost: 0       # a pair of faces void on both sides costs this much of a mismatching pair (0..1)
 starts: 1               # mismatch descents (random, nearest, random...); the lowest mismatch is kept
 max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
 tiling: 1               # copies of its structure per cell edge (each cell holds tiling^3 smaller copies)
@@ -67,6 +68,9 @@ Settings read_settings(const Config& config) {
   if (config.has("max_gap")) s.mapper.candidates.max_gap = config.require_positive("max_gap", "property gap bound");
   if (config.has("radius")) s.mapper.candidates.radius = config.require_positive("radius", "candidate radius");
   s.mapper.half_shift = config.get_or<bool>("half_shift", true);
+  s.mapper.void_pair_cost = config.get_or<double>("void_pair_cost", 0.0);
+  if (!(s.mapper.void_pair_cost >= 0 && s.mapper.void_pair_cost <= 1))
+    config.fail("void_pair_cost", "must lie in [0, 1]");
   s.starts = config.get_or<int>("starts", 1);
   if (s.starts < 1 || s.starts > 1000) config.fail("starts", "must be 1..1000");
   s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
@@ -128,7 +132,8 @@ int main(int argc, char** argv) {
     // 1. Candidates (and their half-shifted variants).
     const CellCandidates candidates = design_candidates(design, set, settings.mapper.candidates);
     // 2. Boundary faces and the mismatch energy of every cell.
-    MismatchProblem problem = mismatch_problem(design, set, candidates, settings.mapper.half_shift);
+    MismatchProblem problem =
+        mismatch_problem(design, set, candidates, settings.mapper.half_shift, settings.mapper.void_pair_cost);
     // 3. Greedy descent on the priority list from each start; the lowest
     //    mismatch is kept.
     const MultiStartReport starts = descend_from_starts(problem, ctx.options.seed, settings.starts);
@@ -167,14 +172,24 @@ int main(int argc, char** argv) {
                 settings.mapper.half_shift ? ", each with its half-shifted exemplar" : "");
     const double drop =
         descent.initial > 0 ? 100.0 * double(descent.initial - descent.final) / double(descent.initial) : 0.0;
-    std::printf("  mismatch: initial %lld, final %lld (-%.1f%%), %lld moves, %lld evaluations, descent %.3f s\n",
-                static_cast<long long>(descent.initial), static_cast<long long>(descent.final), drop,
-                static_cast<long long>(descent.moves), static_cast<long long>(descent.evaluations), starts.seconds);
+    // With a void-pair cost the descent's energy is not the mismatch
+    // (MismatchProblem): it is reported as a cost, the mismatch below.
+    const bool plain = settings.mapper.void_pair_cost == 0;
+    std::printf("  %s: initial %lld, final %lld (-%.1f%%), %lld moves, %lld evaluations, descent %.3f s\n",
+                plain ? "mismatch" : "cost (16 mismatch + 16 c void pairs)", static_cast<long long>(descent.initial),
+                static_cast<long long>(descent.final), drop, static_cast<long long>(descent.moves),
+                static_cast<long long>(descent.evaluations), starts.seconds);
+    const double face_pairs = double(mapped.mismatch_pairs + mapped.void_pairs + mapped.contact_pairs);
+    if (face_pairs > 0)
+      std::printf(
+          "  voxel pairs across cell faces: %.1f%% solid on both sides, %.1f%% differing, %.1f%% void on both\n",
+          100 * double(mapped.contact_pairs) / face_pairs, 100 * double(mapped.mismatch_pairs) / face_pairs,
+          100 * double(mapped.void_pairs) / face_pairs);
     if (settings.starts > 1) {
       std::string finals;
       for (std::int64_t f : starts.finals) finals += (finals.empty() ? "" : ", ") + std::to_string(f);
-      std::printf("  starts: %d (final mismatch %s), kept start %d\n", settings.starts, finals.c_str(),
-                  starts.kept_start);
+      std::printf("  starts: %d (final %s %s), kept start %d\n", settings.starts, plain ? "mismatch" : "cost",
+                  finals.c_str(), starts.kept_start);
     }
     std::printf("  distance to target: max %.4g (nearest candidate: max %.4g; %lld cells beyond max_distance %g)\n",
                 distances.max_chosen, distances.max_nearest, static_cast<long long>(distances.far_cells),

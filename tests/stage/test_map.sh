@@ -34,6 +34,8 @@ expect_exit 2 "set.gamut.h5: expected schema 'msfab.microstructures' version 1, 
   "$M" --design "$S" --structures "$WORK/set.gamut.h5" --out "$OUT"
 expect_exit 2 "set.yaml: not a valid HDF5 file" -- "$M" --design "$WORK/set.yaml" --structures "$S" --out "$OUT"
 expect_exit 2 "candidates = 0: must be 1..4096" -- "$M" --design "$S" --structures "$S" --out "$OUT" --set candidates=0
+expect_exit 2 "void_pair_cost = 1.5: must lie in \\[0, 1\\]" -- "$M" --design "$S" --structures "$S" --out "$OUT" \
+  --set void_pair_cost=1.5
 expect_exit 2 "starts = 0: must be 1..1000" -- "$M" --design "$S" --structures "$S" --out "$OUT" --set starts=0
 expect_exit 2 "radius = -0.1: candidate radius must be positive" -- \
   "$M" --design "$S" --structures "$S" --out "$OUT" --set radius=-0.1

@@ -57,6 +57,11 @@ many_final=$(grep -oE "final [0-9]+" <<<"$many" | grep -oE "[0-9]+")
 check "starts: six descents reported, the first the single start's" -- \
   grep -Eq "starts: 6 \(final mismatch $one, [0-9]+, [0-9]+, [0-9]+, [0-9]+, [0-9]+\)" <<<"$many"
 check "starts: the kept mismatch is at most the single start's" -- test -n "$one" -a "$many_final" -le "$one"
+check "the face pairs are reported" -- grep -Eq "voxel pairs across cell faces: [0-9.]+% solid on both sides" <<<"$many"
+costed=$("$BIN/msfab-map" --design "$WORK/cubic.design.h5" --structures "$WORK/set.microstructures.h5" --seed 5 \
+  --set void_pair_cost=0.5 --out "$WORK/costed.mapped.h5" --quiet)
+check "void_pair_cost: the descent reports a cost" -- grep -q "cost (16 mismatch + 16 c void pairs): initial" <<<"$costed"
+check "void_pair_cost: stored" -- bash -c "h5dump -a /void_pair_cost '$WORK/costed.mapped.h5' | grep -q '0.5'"
 # Another gamut of the same material and space: its structures are not the
 # design's (refused, naming both files); a set derived from the design's
 # structures (re-homogenized) is accepted.

@@ -334,6 +334,84 @@ TEST(Mapping, GreedyNeverIncreasesAndEndsInALocalMinimum) {
   expect_descent_to_local_minimum({3, 4, 3, 3}, 3, 2, 2, 2);
 }
 
+// A void-pair cost c: every cell's energy is 16 mismatching pairs + round(16 c)
+// pairs void on both sides, counted here voxel by voxel from the face
+// table; the face-pair totals partition every face; the descent ends in a
+// local minimum of that energy; c = 0 is the plain mismatch.
+TEST(Mapping, VoidPairCostCountsPairsVoidOnBothSides) {
+  const FaceGrid grid{3, 4, 3, 2};
+  std::mt19937 rng(11);
+  const int vx = 5, vy = 3, vz = 2;  // faces of 6, 10 and 15 voxels: the eight-at-a-time loop and its tail
+  FaceTable table(vx, vy, vz, 3);
+  for (int s = 0; s < 9; ++s) table.add(mapping_random_ids(rng, std::size_t(vx) * vy * vz, 2));
+  table.add_uniform(0);
+  std::vector<std::int64_t> offsets{0};
+  std::vector<std::int32_t> options;
+  for (std::int64_t c = 0; c < grid.cells(); ++c) {
+    const int count = 1 + int(rng() % 4);
+    for (int o = 0; o < count; ++o) options.push_back(int(rng() % 10));
+    offsets.push_back(std::int64_t(options.size()));
+  }
+  // Pairs between lower's upper face and upper's lower face, voxel by voxel.
+  auto count_pairs = [&](int lower, int upper, int axis, bool want_void) {
+    const std::uint8_t* a = table.face(lower, 2 * axis + 1);
+    const std::uint8_t* b = table.face(upper, 2 * axis);
+    std::int64_t n = 0;
+    for (int k = 0; k < table.face_size(axis); ++k) n += want_void ? (a[k] == 0 && b[k] == 0) : a[k] != b[k];
+    return n;
+  };
+  for (int lower = 0; lower < table.entries(); ++lower)
+    for (int upper = 0; upper < table.entries(); ++upper)
+      for (int axis = 0; axis < 3; ++axis) {
+        ASSERT_EQ(table.void_pairs(lower, upper, axis), count_pairs(lower, upper, axis, true));
+        ASSERT_EQ(table.mismatch(lower, upper, axis), count_pairs(lower, upper, axis, false));
+      }
+
+  MismatchProblem p(grid, table, offsets, options, 0.3);  // round(16 * 0.3) = 5
+  p.randomize(2);
+  auto brute_energy = [&](const MismatchProblem& q, std::int64_t cell, int option) {
+    std::int64_t e = 0;
+    for (int f = 0; f < grid.faces(); ++f) {
+      const std::int64_t n = grid.neighbour(cell, f);
+      if (n < 0) continue;
+      const int mine = q.entry(cell, option), theirs = q.entry(n, q.choice()[std::size_t(n)]);
+      const int lower = f % 2 == 1 ? mine : theirs, upper = f % 2 == 1 ? theirs : mine;
+      e += 16 * count_pairs(lower, upper, f / 2, false) + 5 * count_pairs(lower, upper, f / 2, true);
+    }
+    return e;
+  };
+  for (std::int64_t c = 0; c < grid.cells(); ++c)
+    for (int o = 0; o < p.option_count(c); ++o) ASSERT_EQ(p.energy_with(c, o), brute_energy(p, c, o));
+  const DescentReport r = p.descend();
+  for (std::size_t i = 1; i < r.history.size(); ++i) ASSERT_LT(r.history[i], r.history[i - 1]);
+  for (std::int64_t c = 0; c < grid.cells(); ++c) {
+    ASSERT_EQ(p.energy(c), brute_energy(p, c, p.choice()[std::size_t(c)]));
+    for (int o = 0; o < p.option_count(c); ++o) ASSERT_GE(p.energy_with(c, o), p.energy(c));
+  }
+  // Every face pair is counted once and falls in exactly one class.
+  const MismatchProblem::FacePairs pairs = p.face_pairs();
+  std::int64_t all = 0, differ = 0, both_void = 0;
+  for (std::int64_t c = 0; c < grid.cells(); ++c)
+    for (int axis = 0; axis < 3; ++axis) {
+      const std::int64_t n = grid.neighbour(c, 2 * axis + 1);
+      if (n < 0) continue;
+      const int lower = p.entry(c, p.choice()[std::size_t(c)]), upper = p.entry(n, p.choice()[std::size_t(n)]);
+      all += table.face_size(axis);
+      differ += count_pairs(lower, upper, axis, false);
+      both_void += count_pairs(lower, upper, axis, true);
+    }
+  EXPECT_EQ(pairs.mismatch, differ);
+  EXPECT_EQ(pairs.both_void, both_void);
+  EXPECT_EQ(pairs.mismatch + pairs.both_void + pairs.contact, all);
+  EXPECT_GT(pairs.contact, 0);
+
+  MismatchProblem plain(grid, table, offsets, options);
+  plain.randomize(2);
+  EXPECT_EQ(plain.total(), 2 * plain.face_pairs().mismatch);
+  EXPECT_THROW(MismatchProblem(grid, table, offsets, options, 1.5), std::invalid_argument);
+  EXPECT_THROW(MismatchProblem(grid, table, offsets, options, -0.1), std::invalid_argument);
+}
+
 // Several starts keep the lowest local minimum: start 0 is the plain
 // random descent, start 1 the nearest option everywhere, the problem ends
 // at the kept start's choice; on two uniform fills whose only zero-mismatch
