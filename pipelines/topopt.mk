@@ -48,11 +48,13 @@
 # the thesis's set-up).
 #   make -f Makefile.pipeline topopt-checks TWO_SCALE_FAMILY=graded_lattice_grid
 # TOPOPT_ARGS go to msfab-topopt (e.g. "--set gamut_padding=subtract", the
-# feasible set ending at the outermost structures); give such a variant its
-# own TOPOPT_DIR.
+# feasible set ending at the outermost structures), MAP_ARGS to msfab-map
+# (e.g. "--set void_pair_cost=0.5 --set starts=16", docs/mapping.md); give
+# such a variant its own TOPOPT_DIR.
 TWO_SCALE_GAMUT ?= cubic3d_bar
 TWO_SCALE_FAMILY ?=
 TOPOPT_ARGS ?=
+MAP_ARGS ?=
 BAR_GAMUT := $(OUT)/gamut/$(TWO_SCALE_GAMUT)
 MAP_ARGS_graded_lattice := --set half_shift=false --set candidates=1
 MAP_ARGS_cubic3d_bar_backbone := --set half_shift=false
@@ -125,7 +127,7 @@ MAP_EXPORTS_gripper3d := --set export.stl=true --set export.png=true
 $(TWO_SCALE_SCENES:%=$(TOPOPT_DIR)/%.mapped.h5): $(TOPOPT_DIR)/%.mapped.h5: $(TOPOPT_DIR)/%.design.h5 \
     $(TOPOPT_DIR)/%.structures.h5 $(STAGE_ID)/msfab-map.id
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/$*.structures.h5 --seed $(SEED) --set match=$(MATCH) \
-	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
+	  --set export.voxels=true $(MAP_EXPORTS_$*) $(TWO_SCALE_MAP_ARGS) $(MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
 # The three checks of Table 3.1 per scene: S.verify.h5 (one hexahedron per
 # cell), S.h4.verify.h5 and S.solid.verify.h5, differing only in settings.
@@ -142,7 +144,7 @@ $(foreach variant,_ .h4 .solid,$(eval $(call TWO_SCALE_CHECK,$(variant:_=))))
 
 $(TOPOPT_DIR)/bar.t2.mapped.h5: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 $(STAGE_ID)/msfab-map.id
 	$(BIN)/msfab-map --design $< --structures $(TOPOPT_DIR)/bar.structures.h5 --seed $(SEED) --set match=$(MATCH) --set tiling=2 \
-	  $(TWO_SCALE_MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
+	  $(TWO_SCALE_MAP_ARGS) $(MAP_ARGS) --threads $(THREADS) --out $@ $(QUIET)
 
 $(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar.design.h5 $(STAGE_ID)/msfab-verify-map.id
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \
