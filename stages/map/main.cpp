@@ -35,10 +35,10 @@ namespace {
 constexpr const char* kDefaults = R"(
 candidates: 16          # nearest structures per cell
 match: all              # candidates by all properties, or by stiffness (moduli and Poisson ratios, not the density)
-# max_gap: 0.2          # keep only candidates whose property gap is at most this (or the cell's smallest)
+max_gap: 0.5            # keep only candidates whose property gap is at most this, or the cell's smallest (0: no bound)
 half_shift: true        # also offer every candidate translated by half a cell
-void_pair_cost: 0       # a pair of faces void on both sides costs this much of a mismatching pair (0..1)
-starts: 1               # mismatch descents (random, nearest, random...); the lowest mismatch is kept
+void_pair_cost: 0.5     # a pair of faces void on both sides costs this much of a mismatching pair (0..1)
+starts: 16              # mismatch descents (random, nearest, random...); the lowest mismatch is kept
 max_distance: 0.1       # warn about cells with no candidate this close (normalized units)
 tiling: 1               # copies of its structure per cell edge (each cell holds tiling^3 smaller copies)
 export:
@@ -55,7 +55,7 @@ struct ExportOptions {
 
 struct Settings {
   MapperOptions mapper;
-  int starts = 1;
+  int starts = 16;
   int tiling = 1;
   ExportOptions exports;
 };
@@ -65,13 +65,14 @@ Settings read_settings(const Config& config) {
   s.mapper.candidates.k = config.get_or<int>("candidates", 16);
   if (s.mapper.candidates.k < 1 || s.mapper.candidates.k > 4096) config.fail("candidates", "must be 1..4096");
   s.mapper.candidates.stiffness_only = read_stiffness_only(config);
-  if (config.has("max_gap")) s.mapper.candidates.max_gap = config.require_positive("max_gap", "property gap bound");
+  s.mapper.candidates.max_gap = config.get_or<double>("max_gap", 0.5);
+  if (!(s.mapper.candidates.max_gap >= 0)) config.fail("max_gap", "must be >= 0 (0: no bound)");
   if (config.has("radius")) s.mapper.candidates.radius = config.require_positive("radius", "candidate radius");
   s.mapper.half_shift = config.get_or<bool>("half_shift", true);
-  s.mapper.void_pair_cost = config.get_or<double>("void_pair_cost", 0.0);
+  s.mapper.void_pair_cost = config.get_or<double>("void_pair_cost", 0.5);
   if (!(s.mapper.void_pair_cost >= 0 && s.mapper.void_pair_cost <= 1))
     config.fail("void_pair_cost", "must lie in [0, 1]");
-  s.starts = config.get_or<int>("starts", 1);
+  s.starts = config.get_or<int>("starts", 16);
   if (s.starts < 1 || s.starts > 1000) config.fail("starts", "must be 1..1000");
   s.mapper.max_distance = config.get_or<double>("max_distance", 0.1);
   if (!(s.mapper.max_distance > 0)) config.fail("max_distance", "must be > 0");
