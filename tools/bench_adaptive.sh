@@ -94,10 +94,11 @@ table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THRE
 | scene | model | target | predicted | a-posteriori (solves) | error | met | elements fine/L1/L2 | s | fine s | speedup |
 |---|---|---|---|---|---|---|---|---|---|---|
 ${rows}
-\"predicted\": the a-priori estimate of the levels kept; \"a-posteriori\": the kept solution's distance from the
-extrapolated fine one, with the number of mixed solves (with --posterior-check a miss solves again, finer, at most 3).
+\"predicted\": the a-priori estimate of the levels kept; \"a-posteriori\": the kept solution's a-posteriori estimate
+(its distance from the extrapolated fine one, or with --posterior-estimate newton the size of one fine Newton step
+from it), with the number of mixed solves (with --posterior-check a miss solves again, finer, at most 3).
 Seconds after the fine mesh is built: coarsening, for adaptive runs the uniform level-2 and level-1 solves the
-estimate comes from and rejected mixed solves, and Newton on the model; \"fine s\" is the fine model's Newton time in the same run.
+estimate comes from, the Newton estimate and rejected mixed solves, and Newton on the model; \"fine s\" is the fine model's Newton time in the same run.
 
 ![adaptive speed against error](images/$SECTION.png)"
 python3 "$SRC/tools/replace_bench_section.py" "$DOC" "$SECTION" "$table"

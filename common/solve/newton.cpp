@@ -71,6 +71,63 @@ double static_solve_peak_bytes(double elements, double dofs, const NewtonOptions
 
 namespace {
 
+// The linear solver options solve_static uses: the multigrid hierarchy on the
+// mesh's unknown nodes unless the caller gave a lattice.
+LinearSolverOptions static_linear_options(const ElasticAssembler& assembler, const std::string& solver_name,
+                                          const NewtonOptions& options) {
+  LinearSolverOptions linear = options.linear;
+  if (solver_name == "pcg-mg" && !linear.node_positions)
+    linear.node_positions =
+        std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
+  return linear;
+}
+
+}  // namespace
+
+NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
+                                const VecX& force, const NewtonOptions& options, const VecX& x) {
+  const int n = assembler.num_dofs();
+  if (x.size() != n || force.size() != n || static_cast<int>(dirichlet.fixed.size()) != n)
+    throw std::invalid_argument("newton_step_from: DOF vectors do not match the mesh");
+  SpMat K = assembler.pattern();
+  VecX g(n);
+  if (!std::isfinite(assembler.evaluate(x, &g, &K))) return {VecX(), "an element is inverted (det F <= 0)"};
+  g -= force;
+  const VecX target = assembler.rest_positions() + dirichlet.displacement;
+  VecX gap = VecX::Zero(n);
+  for (int i = 0; i < n; ++i)
+    if (dirichlet.fixed[i]) gap[i] = target[i] - x[i];
+  // Eliminating the fixed DOFs: K_ff dx_f = -g_f - K_fc gap_c, dx_c = gap_c.
+  const VecX Kgap = K * gap;
+  const double diag = mean_free_diagonal(K, dirichlet.fixed);
+  constrain_matrix(K, dirichlet.fixed, diag);
+  VecX rhs(n);
+  for (int i = 0; i < n; ++i) rhs[i] = dirichlet.fixed[i] ? diag * gap[i] : -g[i] - Kgap[i];
+  const std::string solver_name = static_linear_solver(n, options);
+  const auto solver = make_linear_solver(solver_name, static_linear_options(assembler, solver_name, options));
+  solver->analyze(K);
+  // Where the tangent is indefinite at x, the step is regularized as the
+  // solver's own Newton steps are (inertia correction, a growing shift until
+  // the step descends).
+  VecX step(n), work(n);
+  const RegularizedStep regularized = solve_regularized_step(
+      *solver, K, diag,
+      [&](double shift, VecX& b) {
+        for (int i = 0; i < n; ++i) b[i] = dirichlet.fixed[i] ? (diag + shift) * gap[i] : rhs[i];
+      },
+      [&](VecX& candidate) {
+        double slope = 0;
+        for (int i = 0; i < n; ++i)
+          if (!dirichlet.fixed[i]) slope += g[i] * candidate[i];
+        return gap.norm() > 0 || slope < 0;
+      },
+      work, step, "newton_step_from: ");
+  if (!regularized.ok) return {VecX(), "the tangent could not be solved even with regularization", 0.0};
+  return {std::move(step), "", regularized.shift};
+}
+
+namespace {
+
 // Newton's method on one static problem (thesis Algorithm 1): the solver,
 // work vectors and the iteration at one load factor.
 class StaticNewton {
@@ -94,12 +151,8 @@ class StaticNewton {
         Kgap_(n_),
         g_trial_(n_),
         trial_(n_) {
-    LinearSolverOptions linear = options.linear;
     const std::string solver_name = static_linear_solver(n_, options);
-    if (solver_name == "pcg-mg" && !linear.node_positions)
-      linear.node_positions =
-          std::make_shared<const NodeArray>(assembler.unknown_rest_nodes());  // the MG hierarchy's lattice
-    solver_ = make_linear_solver(solver_name, linear);
+    solver_ = make_linear_solver(solver_name, static_linear_options(assembler, solver_name, options));
     spdlog::debug("linear solver: {}", solver_->name());
     const auto t0 = Clock::now();
     solver_->analyze(K_);

@@ -80,6 +80,23 @@ struct NewtonResult {
 NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletConditions& dirichlet, const VecX& force,
                           const NewtonOptions& options, const VecX& x0 = VecX());
 
+// One full Newton step of the problem at full load from the positions x,
+// without line search, fixed DOFs moved onto their prescribed values. Near
+// this model's solution u* the step is u* - x up to terms of second order in
+// |u* - x|, so its size estimates how far an approximate solution (e.g. one
+// of a coarser model) lies from this model's own, errors of every origin
+// included. Where the tangent at x is not positive definite the step is
+// regularized as solve_static's are (a shift of the diagonal, growing until
+// the step descends) and `shift` says by how much. Where there is no step at
+// all, `failure` says why (an inverted element at x, a system that no shift
+// made solvable) and `step` is empty.
+struct NewtonStepFrom {
+  VecX step;
+  std::string failure;
+  double shift = 0;  // the regularization the step needed (0: the tangent was positive definite)
+};
+NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
+                                const VecX& force, const NewtonOptions& options, const VecX& x);
 // The linear solver solve_static runs for `dofs` unknowns: options'
 // linear_solver with "auto" resolved by auto_iterative_dofs.
 std::string static_linear_solver(double dofs, const NewtonOptions& options);

@@ -214,4 +214,18 @@ PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel&
   return {extrapolated, "against the extrapolation"};
 }
 
+PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssembler& fine_assembler,
+                                       const StaticConditions& fine_conditions, const NewtonOptions& options,
+                                       const AdaptiveModel& model, const VecX& on_fine) {
+  const auto& per_level = model.mixed.elements_per_level;
+  if (per_level[1] == 0 && per_level[2] == 0) return {0.0, "the fine model"};
+  const NewtonStepFrom newton = newton_step_from(fine_assembler, fine_conditions.dirichlet, fine_conditions.force,
+                                                 options, fine_assembler.rest_positions() + on_fine);
+  if (!newton.failure.empty()) return {0.0, "no fine Newton step: " + newton.failure, false};
+  if (newton.shift > 0)
+    return {0.0, fmt::format("the fine tangent there is not positive definite (shift {:.2e} needed)", newton.shift),
+            false};
+  return {mean_vertex_error(fine.mesh, newton.step, VecX::Zero(newton.step.size())), "a fine Newton step"};
+}
+
 }  // namespace msfab

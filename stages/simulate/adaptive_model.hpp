@@ -88,10 +88,24 @@ double refinement_error_bound(const VoxelMesh& fine, const VecX& finer_on_fine, 
 // null for the first solve, with its predicted error and number).
 struct PosteriorEstimate {
   double value = 0;
-  std::string source;  // what `value` is, for the log
+  std::string source;    // what `value` is, for the log; or why there is none
+  bool measured = true;  // false: no estimate of this kind here (`source` says why)
 };
 PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& on_fine,
                                      const VecX* previous_on_fine, double previous_predicted, int previous_solve);
+
+// The a-posteriori estimate by the fine model itself (--posterior-estimate
+// newton): the mean-vertex size of one Newton step of the fine model from
+// the mixed solution (`on_fine`, displacements at the fine nodes). That step
+// is the remaining error up to second order, whatever its origin, including
+// error the two uniform levels share, which their difference cannot see
+// (docs/ddfem.md). 0 for a choice of fine cells only. Not `measured` where
+// the fine tangent at the mixed solution is not positive definite or an
+// element is inverted there: a regularized step then measured less than half
+// the true error on bridge_arch, so it says nothing reliable about it.
+PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssembler& fine_assembler,
+                                       const StaticConditions& fine_conditions, const NewtonOptions& options,
+                                       const AdaptiveModel& model, const VecX& on_fine);
 
 // The solution of the adaptive model (positions of the unknowns) as
 // displacements at the fine mesh's nodes, for the error against the fine

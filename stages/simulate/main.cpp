@@ -139,6 +139,14 @@ int main(int argc, char** argv) {
   app.cli().add_flag("--posterior-check", posterior_check,
                      "adaptive coarsening: check the mixed solution against the extrapolated fine one and, where "
                      "it misses the target, choose finer levels and solve again (at most 3 mixed solves)");
+  std::string posterior_estimator = "extrapolation";
+  app.cli()
+      .add_option("--posterior-estimate", posterior_estimator,
+                  "adaptive coarsening: the a-posteriori estimate of a mixed solve: its distance from the "
+                  "extrapolated fine solution (extrapolation; free, blind to error the two levels share) or the "
+                  "size of one Newton step of the fine model from it (newton; one fine tangent solve per check, "
+                  "sees every error; the extrapolation where the fine tangent there is not positive definite)")
+      ->check(CLI::IsMember({"extrapolation", "newton"}));
   std::string reference;
   app.cli().add_option("--reference", reference,
                        "a fine msfab.result of the same scene to compare with instead of solving it again");
@@ -152,6 +160,8 @@ int main(int argc, char** argv) {
     ctx.finish_config();
     const bool adaptive = target_option->count() > 0;
     if (posterior_check && !adaptive) throw InputError("--posterior-check: applies to --target-error only");
+    const bool newton_estimate = posterior_estimator == "newton";
+    if (newton_estimate && !adaptive) throw InputError("--posterior-estimate: applies to --target-error only");
     if (!level1_database.empty() && !adaptive)
       throw InputError("--level1-database: applies to --target-error only (uniform level 1 takes --database)");
     check_solve_memory(ctx, scene, adaptive ? std::vector<int>{2, 1} : std::vector<int>{coarsening.level},
@@ -189,6 +199,7 @@ int main(int argc, char** argv) {
     double rejected_seconds = 0;  // adaptive: mixed solves whose a-posteriori check missed the target
     int adaptive_solves = 0;
     double checked_error = 0;     // adaptive: the a-posteriori estimate of the kept solve
+    std::string checked_source;   // adaptive: what that estimate is
     double adaptive_seconds = 0;  // adaptive: everything after the level-2 model, database reading aside
     std::optional<NewtonResult> adaptive_result;
     // Each finer adaptive solve starts from the coarser solution, at full
@@ -230,6 +241,8 @@ int main(int argc, char** argv) {
       // moved from the previous one (posterior_estimate).
       NewtonOptions mixed_newton = warm_newton;
       if (mixed_newton.linear_solver == "auto") mixed_newton.linear_solver = "cholmod";
+      std::optional<ElasticAssembler> fine_assembler;
+      if (newton_estimate) fine_assembler.emplace(fine.mesh);
       AdaptiveModel best;
       VecX previous_on_fine;
       double previous_predicted = 0;
@@ -244,9 +257,17 @@ int main(int argc, char** argv) {
             all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
         ++adaptive_solves;
         const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);
-        const PosteriorEstimate posterior =
-            posterior_estimate(fine, adapted, on_fine, adaptive_solves > 1 ? &previous_on_fine : nullptr,
-                               previous_predicted, adaptive_solves - 1);
+        // The fine model's own estimate where its tangent allows one, else
+        // the extrapolation's.
+        PosteriorEstimate posterior{0.0, "", false};
+        if (newton_estimate)
+          posterior = fine_newton_estimate(fine, *fine_assembler, fine_conditions, scene.newton, adapted, on_fine);
+        if (!posterior.measured) {
+          const std::string no_newton = posterior.source;
+          posterior = posterior_estimate(fine, adapted, on_fine, adaptive_solves > 1 ? &previous_on_fine : nullptr,
+                                         previous_predicted, adaptive_solves - 1);
+          if (newton_estimate) posterior.source += " (no Newton estimate: " + no_newton + ")";
+        }
         const double estimate = posterior.value;
         previous_on_fine = on_fine;
         previous_predicted = adapted.choice.predicted_error;
@@ -261,6 +282,7 @@ int main(int argc, char** argv) {
           if (adaptive_result) rejected_seconds += adaptive_result->timings.total;
           adaptive_result = solved;
           checked_error = estimate;
+          checked_source = posterior.source;
           best = adapted;
         } else {
           rejected_seconds += solved.timings.total;
@@ -399,6 +421,7 @@ int main(int argc, char** argv) {
       record.target_error = target_error;
       record.predicted_error = adapted.choice.predicted_error;
       record.a_posteriori_error = checked_error;
+      record.a_posteriori_source = checked_source;
       record.adaptive_solves = adaptive_solves;
       record.rejected_solve_seconds = rejected_seconds;
       record.uniform_solve_seconds = uniform_seconds;

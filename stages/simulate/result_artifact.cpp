@@ -99,6 +99,7 @@ std::string write_result_artifact(const std::string& path, const SimulationRecor
       f.write_attribute("/coarsening", "target_error", r.target_error);
       f.write_attribute("/coarsening", "predicted_error", r.predicted_error);
       f.write_attribute("/coarsening", "a_posteriori_error", r.a_posteriori_error);
+      f.write_attribute("/coarsening", "a_posteriori_source", r.a_posteriori_source);
       f.write_attribute("/coarsening", "adaptive_solves", r.adaptive_solves);
       f.write_attribute("/coarsening", "rejected_solve_seconds", r.rejected_solve_seconds);
       f.write_attribute("/coarsening", "uniform_solve_seconds", r.uniform_solve_seconds);

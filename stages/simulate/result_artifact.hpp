@@ -40,7 +40,8 @@ struct SimulationRecord {
   // Adaptive runs (--target-error; coarsen_level is 2, the coarsest level used).
   bool adaptive = false;
   double target_error = 0, predicted_error = 0;
-  double a_posteriori_error = 0;      // the kept mixed solve's distance from the extrapolated fine solution
+  double a_posteriori_error = 0;      // the kept mixed solve's a-posteriori estimate
+  std::string a_posteriori_source;    // what that estimate is (the extrapolation, a bound, a fine Newton step)
   int adaptive_solves = 0;            // mixed solves (more than one where the a-posteriori check missed)
   double rejected_solve_seconds = 0;  // Newton time of the mixed solves that were not kept
   double uniform_solve_seconds = 0;   // the level-2 and level-1 solves the levels are chosen from

@@ -342,3 +342,54 @@ TEST(Newton, IterationHookSeesEveryHistoryRecordAsItIsAdded) {
   }
   EXPECT_GT(res.load_steps, 1) << "the test should exercise a halved increment";
 }
+
+// One Newton step from an approximate solution x: on a linear material it is
+// the exact distance to the solution (the energy is quadratic), with either
+// linear solver; on a Neo-Hookean one it is that distance up to second order,
+// so the step's own error falls 4x when the perturbation halves. Prescribed
+// DOFs are moved onto their values. (The perturbation alternates from DOF to
+// DOF, strains of 1% per 0.1% of displacement: the second-order term is
+// large for its size, 11% of the step at eps = 0.002.)
+TEST(Newton, StepFromAnApproximateSolutionIsItsErrorToSecondOrder) {
+  VoxelGrid grid(8, 2, 2, 0.5, 1);
+  for (const bool neo : {false, true}) {
+    const MaterialPtr mat = neo ? MaterialPtr(std::make_shared<NeoHookean>(1000, 0.3))
+                                : MaterialPtr(std::make_shared<LinearIsotropic>(1000, 0.3));
+    const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, mat});
+    ElasticAssembler asmb(vm.mesh);
+    const Cantilever c = clamped_with_tip_load(grid, vm, 0.5);
+    const auto& [DC, f, sel] = c;
+    NewtonOptions opt;
+    opt.relative_tolerance = 1e-11;
+    const NewtonResult solved = solve_static(asmb, DC, f, opt);
+    ASSERT_TRUE(solved.converged) << solved.failure;
+    const VecX u = solved.x - asmb.rest_positions();
+    // A smooth perturbation, also on the prescribed DOFs (the step must undo it there too).
+    VecX p(u.size());
+    for (int i = 0; i < p.size(); ++i) p[i] = std::sin(0.37 * i) * u.cwiseAbs().maxCoeff();
+    std::vector<double> relative;
+    for (const double eps : {0.002, 0.001}) {
+      const VecX x = solved.x + eps * p;
+      for (const std::string solver : {"cholmod", "pcg-mg"}) {
+        if (neo && solver == "pcg-mg") continue;
+        NewtonOptions step_options;
+        step_options.linear_solver = solver;
+        step_options.linear.pcg_tolerance = 1e-12;
+        const NewtonStepFrom step = newton_step_from(asmb, DC, f, step_options, x);
+        ASSERT_TRUE(step.failure.empty()) << step.failure;
+        const double r = (x + step.step - solved.x).norm() / (eps * p).norm();
+        std::printf("newton step from the solution + %.4f p, %s, %s: |x + step - x*| / |x - x*| = %.3e\n", eps,
+                    neo ? "Neo-Hookean" : "linear", solver.c_str(), r);
+        if (!neo) {
+          EXPECT_LT(r, 1e-6) << solver;
+        }
+        if (neo && solver == "cholmod") relative.push_back(r);
+      }
+    }
+    if (neo) {
+      ASSERT_EQ(relative.size(), 2u);
+      EXPECT_LT(relative[0], 0.2);
+      EXPECT_NEAR(relative[0] / relative[1], 2.0, 0.3);  // |error of the step| ~ eps^2
+    }
+  }
+}
