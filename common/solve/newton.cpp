@@ -82,6 +82,30 @@ LinearSolverOptions static_linear_options(const ElasticAssembler& assembler, con
   return linear;
 }
 
+// The Newton step with the prescribed DOFs eliminated, K_ff dx_f = -g_f -
+// K_fc gap_c and dx_c = gap_c, regularized (solve_regularized_step) until it
+// descends where no prescribed DOF is still to be moved. K is the tangent
+// after constrain_matrix with `diag`; Kgap is the tangent times gap before
+// that (not read where gap_norm is 0). One rule for solve_static's
+// iterations and newton_step_from.
+RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, double diag,
+                                        const std::vector<char>& fixed, const VecX& g, const VecX& gap, double gap_norm,
+                                        const VecX& Kgap, VecX& rhs, VecX& dx, const char* context) {
+  const int n = static_cast<int>(g.size());
+  return solve_regularized_step(
+      solver, K, diag,
+      [&](double shift, VecX& b) {
+        for (int i = 0; i < n; ++i) b[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
+      },
+      [&](VecX& candidate) {
+        double slope = 0;
+        for (int i = 0; i < n; ++i)
+          if (!fixed[i]) slope += g[i] * candidate[i];
+        return gap_norm > 0 || slope < 0;
+      },
+      rhs, dx, context);
+}
+
 }  // namespace
 
 NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
@@ -97,31 +121,18 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   VecX gap = VecX::Zero(n);
   for (int i = 0; i < n; ++i)
     if (dirichlet.fixed[i]) gap[i] = target[i] - x[i];
-  // Eliminating the fixed DOFs: K_ff dx_f = -g_f - K_fc gap_c, dx_c = gap_c.
+  const double gap_norm = gap.norm();
   const VecX Kgap = K * gap;
   const double diag = mean_free_diagonal(K, dirichlet.fixed);
   constrain_matrix(K, dirichlet.fixed, diag);
-  VecX rhs(n);
-  for (int i = 0; i < n; ++i) rhs[i] = dirichlet.fixed[i] ? diag * gap[i] : -g[i] - Kgap[i];
   const std::string solver_name = static_linear_solver(n, options);
   const auto solver = make_linear_solver(solver_name, static_linear_options(assembler, solver_name, options));
   solver->analyze(K);
   // Where the tangent is indefinite at x, the step is regularized as the
-  // solver's own Newton steps are (inertia correction, a growing shift until
-  // the step descends).
-  VecX step(n), work(n);
-  const RegularizedStep regularized = solve_regularized_step(
-      *solver, K, diag,
-      [&](double shift, VecX& b) {
-        for (int i = 0; i < n; ++i) b[i] = dirichlet.fixed[i] ? (diag + shift) * gap[i] : rhs[i];
-      },
-      [&](VecX& candidate) {
-        double slope = 0;
-        for (int i = 0; i < n; ++i)
-          if (!dirichlet.fixed[i]) slope += g[i] * candidate[i];
-        return gap.norm() > 0 || slope < 0;
-      },
-      work, step, "newton_step_from: ");
+  // solver's own Newton steps are.
+  VecX step(n), rhs(n);
+  const RegularizedStep regularized = constrained_newton_step(*solver, K, diag, dirichlet.fixed, g, gap, gap_norm, Kgap,
+                                                              rhs, step, "newton_step_from: ");
   if (!regularized.ok) return {VecX(), "the tangent could not be solved even with regularization", 0.0};
   return {std::move(step), "", regularized.shift};
 }
@@ -311,19 +322,8 @@ bool StaticNewton::at(double s, int step, std::string& why) {
     // multiple of the identity is added, as interior-point codes do.
     t0 = Clock::now();
     constrain_matrix(K_, fixed_, diag);
-    const RegularizedStep regularized = solve_regularized_step(
-        *solver_, K_, diag,
-        [&](double shift, VecX& b) {
-          for (int i = 0; i < n_; ++i)
-            b[i] = fixed_[i] ? (diag + shift) * gap_[i] : -g_[i] - (gap_norm > 0 ? Kgap_[i] : 0.0);
-        },
-        [&](VecX& candidate) {
-          double slope = 0;
-          for (int i = 0; i < n_; ++i)
-            if (!fixed_[i]) slope += g_[i] * candidate[i];
-          return gap_norm > 0 || slope < 0;
-        },
-        rhs_, dx_, "");
+    const RegularizedStep regularized =
+        constrained_newton_step(*solver_, K_, diag, fixed_, g_, gap_, gap_norm, Kgap_, rhs_, dx_, "");
     const double shift = regularized.shift;
     result_.timings.solve += seconds_since(t0);
     spdlog::debug("linear solver {}: factorize {:.3f} s, solve {:.3f} s, {} iterations", solver_->name(),

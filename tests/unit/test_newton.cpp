@@ -347,8 +347,8 @@ TEST(Newton, IterationHookSeesEveryHistoryRecordAsItIsAdded) {
 // the exact distance to the solution (the energy is quadratic), with either
 // linear solver; on a Neo-Hookean one it is that distance up to second order,
 // so the step's own error falls 4x when the perturbation halves. Prescribed
-// DOFs are moved onto their values. (The perturbation alternates from DOF to
-// DOF, strains of 1% per 0.1% of displacement: the second-order term is
+// DOFs are moved onto their values. (The perturbation changes sign every
+// few DOFs, strains of 1% per 0.1% of displacement: the second-order term is
 // large for its size, 11% of the step at eps = 0.002.)
 TEST(Newton, StepFromAnApproximateSolutionIsItsErrorToSecondOrder) {
   VoxelGrid grid(8, 2, 2, 0.5, 1);
@@ -364,7 +364,7 @@ TEST(Newton, StepFromAnApproximateSolutionIsItsErrorToSecondOrder) {
     const NewtonResult solved = solve_static(asmb, DC, f, opt);
     ASSERT_TRUE(solved.converged) << solved.failure;
     const VecX u = solved.x - asmb.rest_positions();
-    // A smooth perturbation, also on the prescribed DOFs (the step must undo it there too).
+    // A perturbation on every DOF, the prescribed ones too (the step must undo it there as well).
     VecX p(u.size());
     for (int i = 0; i < p.size(); ++i) p[i] = std::sin(0.37 * i) * u.cwiseAbs().maxCoeff();
     std::vector<double> relative;
