@@ -3,6 +3,7 @@
 #include <omp.h>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <charconv>
 #include <cstdint>
@@ -133,34 +134,93 @@ void StageContext::check_out_folder() const {
     throw InputError(out + ": output folder does not exist");
 }
 
-StageApp::StageApp(std::string name, std::string description) : name_(std::move(name)), cli_(description, name_) {
+StageOption& StageOption::required() {
+  option_->required();
+  return *this;
+}
+
+StageOption& StageOption::type_name(const std::string& name) {
+  option_->type_name(name);
+  return *this;
+}
+
+StageOption& StageOption::one_of(const std::vector<std::string>& choices) {
+  option_->check(CLI::IsMember(choices));
+  return *this;
+}
+
+StageOption& StageOption::non_negative() {
+  option_->check(CLI::NonNegativeNumber);
+  return *this;
+}
+
+StageOption& StageOption::in_range(double min, double max) {
+  option_->check(CLI::Range(min, max));
+  return *this;
+}
+
+StageOption& StageOption::values(int count) {
+  option_->expected(count);
+  return *this;
+}
+
+bool StageOption::given() const { return option_->count() > 0; }
+
+StageApp::StageApp(std::string name, std::string description)
+    : name_(std::move(name)), cli_(std::make_unique<CLI::App>(description, name_)) {
   keep_freed_memory_for_reuse();
-  cli_.footer(
+  cli_->footer(
       "Exit codes: 0 done; 1 internal error; 2 bad usage or bad input; 3 numerical failure.\n"
       "Config keys can be overridden with --set key.path=value (value in YAML syntax).");
 }
 
+StageApp::~StageApp() = default;
+
+StageOption StageApp::option(const std::string& name, std::string& value, const std::string& help) {
+  return StageOption(cli_->add_option(name, value, help));
+}
+
+StageOption StageApp::option(const std::string& name, int& value, const std::string& help) {
+  return StageOption(cli_->add_option(name, value, help));
+}
+
+StageOption StageApp::option(const std::string& name, double& value, const std::string& help) {
+  return StageOption(cli_->add_option(name, value, help));
+}
+
+StageOption StageApp::option(const std::string& name, std::vector<double>& values, const std::string& help) {
+  return StageOption(cli_->add_option(name, values, help));
+}
+
+StageOption StageApp::option(const std::string& name, std::vector<std::string>& values, const std::string& help) {
+  return StageOption(cli_->add_option(name, values, help));
+}
+
+StageOption StageApp::flag(const std::string& name, bool& value, const std::string& help) {
+  return StageOption(cli_->add_flag(name, value, help));
+}
+
 void StageApp::add_common_options() {
-  cli_.add_option("-c,--config", options_.config_path, "YAML config file (default: built-in defaults)")
+  cli_->add_option("-c,--config", options_.config_path, "YAML config file (default: built-in defaults)")
       ->type_name("FILE");
-  cli_.add_option("--set", options_.overrides,
-                  "override a config value, e.g. --set grid.size=[8,8,8] (value in YAML syntax; repeatable)")
+  cli_->add_option("--set", options_.overrides,
+                   "override a config value, e.g. --set grid.size=[8,8,8] (value in YAML syntax; repeatable)")
       ->allow_extra_args(false)
       ->type_name("KEY=VALUE");
-  cli_.add_option("-o,--out", options_.out, "output path")->type_name("PATH");
-  cli_.add_option("-j,--threads", options_.threads, "worker threads (default: OMP_NUM_THREADS or all cores)")
+  cli_->add_option("-o,--out", options_.out, "output path")->type_name("PATH");
+  cli_->add_option("-j,--threads", options_.threads, "worker threads (default: OMP_NUM_THREADS or all cores)")
       ->type_name("N")
       ->check(integer_validator(true, kMaxThreads));
-  cli_.add_option("--seed", options_.seed, "global random seed (default: 0)")
+  cli_->add_option("--seed", options_.seed, "global random seed (default: 0)")
       ->type_name("N")
       ->check(integer_validator(false, std::numeric_limits<std::uint64_t>::max()));
-  cli_.add_option("--log-level", options_.log_level, "how much to log (default: info)")
+  cli_->add_option("--log-level", options_.log_level, "how much to log (default: info)")
       ->type_name("LEVEL")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
-  cli_.add_flag("-q,--quiet", options_.quiet, "only warnings and errors; no progress display");
-  cli_.add_option("--memory-limit", options_.memory_limit,
-                  "memory a run may use, e.g. 64G (default: what the system has available); a run estimated "
-                  "above it is refused before it starts")
+  cli_->add_flag("-q,--quiet", options_.quiet, "only warnings and errors; no progress display");
+  cli_->add_option("--memory-limit", options_.memory_limit,
+                   "memory a run may use, e.g. 64G (default: what the system has available); a run estimated "
+                   "above it is refused before it starts")
       ->type_name("SIZE")
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
@@ -172,9 +232,9 @@ void StageApp::add_common_options() {
             return {};
           },
           ""));
-  cli_.add_flag("--print-config", options_.print_config,
-                "print the effective config (the file, --set overrides and the defaults this stage reads) as YAML "
-                "and exit without running");
+  cli_->add_flag("--print-config", options_.print_config,
+                 "print the effective config (the file, --set overrides and the defaults this stage reads) as YAML "
+                 "and exit without running");
   add_version_option();
 }
 
@@ -184,7 +244,7 @@ void StageApp::add_version_option() {
     text += "\nstage identity " + std::string(stage_identity()) + "\n  (SHA-256 of the " +
             std::to_string(stage_identity_source_count()) +
             " source files it is built from; the pipeline reruns this stage's artifacts when it changes)";
-  cli_.set_version_flag("--version", text);
+  cli_->set_version_flag("--version", text);
 }
 
 void StageApp::set_default_config(std::string yaml_text) { default_config_ = std::move(yaml_text); }
@@ -199,10 +259,10 @@ Config StageApp::load_config() const {
 
 int StageApp::run(int argc, const char* const* argv, const std::function<void(StageContext&)>& body) {
   try {
-    cli_.parse(argc, argv);
+    cli_->parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) {
-      cli_.exit(e);  // --help / --version print to stdout
+      cli_->exit(e);  // --help / --version print to stdout
       return kExitOk;
     }
     print_error(name_, std::string(e.what()) + "\nRun with --help for more information.");
@@ -217,7 +277,7 @@ int StageApp::run(int argc, const char* const* argv, const std::function<void(St
     if (options_.threads > 0) omp_set_num_threads(options_.threads);
 
     StageContext ctx{name_, load_config(), options_, quoted_command_line(argc, argv)};
-    if (!options_.out.empty()) check_output_path(cli_, options_.out);
+    if (!options_.out.empty()) check_output_path(*cli_, options_.out);
     spdlog::debug("{} {} (revision {}), {} threads, seed {}", name_, version(), git_revision(), omp_get_max_threads(),
                   options_.seed);
     spdlog::debug("command line: {}", ctx.command_line);

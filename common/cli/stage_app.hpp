@@ -4,7 +4,7 @@
 //   int main(int argc, char** argv) {
 //     msfab::StageApp app("msfab-simulate", "static and dynamic FEM on a scene");
 //     app.add_common_options();
-//     app.cli().add_flag("--resume", resume, "continue from the last checkpoint");
+//     app.flag("--resume", resume, "continue from the last checkpoint");
 //     return app.run(argc, argv, [&](msfab::StageContext& ctx) {
 //       double E = ctx.config.require_positive("E", "Young's modulus");
 //       ctx.finish_config();   // unknown keys refused; --print-config stops here
@@ -17,14 +17,22 @@
 // an exit code: 0 ok, 2 bad usage or input (CLI11 errors, InputError),
 // 3 NumericalError, 1 anything else. Errors go to stderr as
 // "<stage>: error: <message>".
-#include <CLI/CLI.hpp>
+//
+// CLI11 stays behind this interface (stage_app.cpp): its header costs 6 s
+// of CPU per file that includes it, and every stage's main would.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "io/config.hpp"
+
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace msfab {
 
@@ -76,13 +84,46 @@ struct StageContext {
   void check_memory(double estimated_bytes, const std::string& what, const std::string& remedy) const;
 };
 
+// A stage-specific option, for chaining its settings:
+//   app.option("--scene", scene_path, "voxel scene").type_name("FILE").required();
+class StageOption {
+ public:
+  explicit StageOption(CLI::Option* option) : option_(option) {}
+
+  StageOption& required();
+  // The value's name in --help. Values of FILE, PATH, DIR and TEXT options
+  // (TEXT: any string option not renamed) are checked against --out, which
+  // must not overwrite them.
+  StageOption& type_name(const std::string& name);
+  StageOption& one_of(const std::vector<std::string>& choices);
+  StageOption& non_negative();
+  StageOption& in_range(double min, double max);
+  // A list option that takes exactly `count` values.
+  StageOption& values(int count);
+  // After parsing: whether the option was on the command line.
+  bool given() const;
+
+ private:
+  CLI::Option* option_;
+};
+
 class StageApp {
  public:
   StageApp(std::string name, std::string description);
+  ~StageApp();
+  StageApp(const StageApp&) = delete;
+  StageApp& operator=(const StageApp&) = delete;
 
-  // The CLI11 app, for stage-specific options.
-  CLI::App& cli() { return cli_; }
   const std::string& name() const { return name_; }
+
+  // Stage-specific options and flags (a name such as "--scene", "-s,--scene"
+  // or a positional "artifact"), written into `value` when parsed.
+  StageOption option(const std::string& name, std::string& value, const std::string& help);
+  StageOption option(const std::string& name, int& value, const std::string& help);
+  StageOption option(const std::string& name, double& value, const std::string& help);
+  StageOption option(const std::string& name, std::vector<double>& values, const std::string& help);
+  StageOption option(const std::string& name, std::vector<std::string>& values, const std::string& help);
+  StageOption flag(const std::string& name, bool& value, const std::string& help);
 
   // --config, --set, --out, --threads, --seed, --log-level, --quiet,
   // --memory-limit, --print-config, --version (--help is always there).
@@ -104,7 +145,7 @@ class StageApp {
   Config load_config() const;
 
   std::string name_;
-  CLI::App cli_;
+  std::unique_ptr<CLI::App> cli_;
   StageOptions options_;
   std::optional<std::string> default_config_;
   int rank_ = 0;

@@ -80,10 +80,9 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string structures_path;
-  app.cli()
-      .add_option("--structures", structures_path, "msfab.microstructures artifact the pattern indexes")
-      ->type_name("FILE")
-      ->required();
+  app.option("--structures", structures_path, "msfab.microstructures artifact the pattern indexes")
+      .type_name("FILE")
+      .required();
   return app.run(argc, argv, [&](StageContext& ctx) {
     Config& config = ctx.config;
     const std::string out = ctx.require_out();

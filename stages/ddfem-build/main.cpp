@@ -71,11 +71,10 @@ int main(int argc, char** argv) {
   app.set_default_config(kDefaultBuildConfig);
   bool resume = false;
   int max_rounds = 0;
-  app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config required)");
-  app.cli()
-      .add_option("--max-rounds", max_rounds,
-                  "stop after this many rounds, keeping the checkpoint (for time-limited batch jobs); 0 = all")
-      ->check(CLI::NonNegativeNumber);
+  app.flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config required)");
+  app.option("--max-rounds", max_rounds,
+             "stop after this many rounds, keeping the checkpoint (for time-limited batch jobs); 0 = all")
+      .non_negative();
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t0 = std::chrono::steady_clock::now();

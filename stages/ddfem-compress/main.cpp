@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string input;
-  app.cli().add_option("--database", input, "full coarse_db from msfab-ddfem-build")->required();
+  app.option("--database", input, "full coarse_db from msfab-ddfem-build").required();
   return app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const int k = ctx.config.require_positive<int>("representatives", "number of representatives");

@@ -139,16 +139,14 @@ int main(int argc, char** argv) {
   app.set_default_config(kDefaultDynamicsScene);
   std::vector<double> marker;
   std::string marker_csv;
-  app.cli()
-      .add_option("--marker", marker, "rest position X Y Z of a tracked node (the node nearest to it)")
-      ->expected(3);
-  app.cli().add_option("--marker-csv", marker_csv, "write the tracked node's position at every step as CSV (t,x,y,z)");
+  app.option("--marker", marker, "rest position X Y Z of a tracked node (the node nearest to it)").values(3);
+  app.option("--marker-csv", marker_csv, "write the tracked node's position at every step as CSV (t,x,y,z)");
   CoarseningRequest coarsening;
-  add_coarsening_options(app.cli(), coarsening, false);
+  add_coarsening_options(app, coarsening, false);
   std::string reference;
-  app.cli().add_option("--reference", reference,
-                       "a msfab.trajectory of the same scene run fine (same time step and frames): report this "
-                       "run's difference from it frame by frame and the speedup");
+  app.option("--reference", reference,
+             "a msfab.trajectory of the same scene run fine (same time step and frames): report this "
+             "run's difference from it frame by frame and the speedup");
   return app.run(argc, argv, [&](StageContext& ctx) {
     if (marker_csv.empty() != marker.empty()) throw InputError("--marker and --marker-csv go together");
     const std::string& out = ctx.require_out();

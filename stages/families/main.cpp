@@ -244,11 +244,8 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string structures_path, gamut_path;
-  app.cli()
-      .add_option("--structures", structures_path, "msfab.microstructures artifact (3D cubic)")
-      ->type_name("FILE")
-      ->required();
-  app.cli().add_option("--gamut", gamut_path, "msfab.gamut artifact, for selection.boundary_margin")->type_name("FILE");
+  app.option("--structures", structures_path, "msfab.microstructures artifact (3D cubic)").type_name("FILE").required();
+  app.option("--gamut", gamut_path, "msfab.gamut artifact, for selection.boundary_margin").type_name("FILE");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
     const Settings settings = read_settings(ctx.config);

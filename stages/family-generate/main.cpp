@@ -234,16 +234,11 @@ int main(int argc, char** argv) {
   std::string families_path;
   int family = 0, sweep = 0;
   std::vector<std::string> reduced_options;
-  app.cli()
-      .add_option("--families", families_path, "msfab.families artifact (without it: the config's templates)")
-      ->type_name("FILE");
-  app.cli().add_option("--family", family, "family number, from 1 (with --families)");
-  app.cli()
-      .add_option("--reduced", reduced_options, "reduced parameters r1,r2 in [-1, 1] (repeatable)")
-      ->type_name("R1,R2");
-  app.cli()
-      .add_option("--sweep", sweep, "each reduced parameter over N values in [-1, 1], the others 0")
-      ->type_name("N");
+  app.option("--families", families_path, "msfab.families artifact (without it: the config's templates)")
+      .type_name("FILE");
+  app.option("--family", family, "family number, from 1 (with --families)");
+  app.option("--reduced", reduced_options, "reduced parameters r1,r2 in [-1, 1] (repeatable)").type_name("R1,R2");
+  app.option("--sweep", sweep, "each reduced parameter over N values in [-1, 1], the others 0").type_name("N");
   return app.run(argc, argv, [&](StageContext& ctx) {
     int resolution = ctx.config.get_or<int>("resolution", 0);
     if (resolution < 0 || resolution > 512) ctx.config.fail("resolution", "must be 0..512 (0: the input set's)");

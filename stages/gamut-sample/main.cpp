@@ -86,13 +86,12 @@ int main(int argc, char** argv) {
   bool resume = false;
   int max_cycles = 0;
   std::string structures_path;
-  app.cli().add_flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config and seed required)");
-  app.cli()
-      .add_option("--max-cycles", max_cycles,
-                  "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
-      ->check(CLI::NonNegativeNumber);
-  app.cli().add_option("--structures", structures_path,
-                       "the microstructures artifact (default: <out without .gamut.h5>.microstructures.h5)");
+  app.flag("--resume", resume, "continue from <out>.checkpoint.h5 (same config and seed required)");
+  app.option("--max-cycles", max_cycles,
+             "stop after this many cycles in this run, keeping the checkpoint (batch jobs); 0 = all")
+      .non_negative();
+  app.option("--structures", structures_path,
+             "the microstructures artifact (default: <out without .gamut.h5>.microstructures.h5)");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();

@@ -102,8 +102,8 @@ int main(int argc, char** argv) {
   StageApp app("msfab-homogenize", "Periodic homogenization of a voxel cell: C^H, G, cubic moduli (thesis 3.2)");
   app.add_common_options();
   std::string structures;
-  app.cli().add_option("--structures", structures,
-                       "batch mode: homogenize every structure of this msfab.microstructures artifact");
+  app.option("--structures", structures,
+             "batch mode: homogenize every structure of this msfab.microstructures artifact");
   // The defaults depend on the mode, and are needed before parsing.
   bool batch = false;
   for (int i = 1; i < argc; ++i) batch = batch || std::string(argv[i]).rfind("--structures", 0) == 0;

@@ -58,11 +58,11 @@ int main(int argc, char** argv) {
   StageApp app("msfab-inspect", "Show the provenance and contents of an msfab artifact");
   std::string path, schema;
   int version = 0;
-  app.cli().add_option("artifact", path, "artifact file (.h5)")->required();
-  app.cli().add_option("--schema", schema, "fail (exit 2) unless the artifact has this schema, e.g. msfab.result");
-  app.cli().add_option("--schema-version", version, "with --schema: the supported schema_version (default: any)");
+  app.option("artifact", path, "artifact file (.h5)").required();
+  app.option("--schema", schema, "fail (exit 2) unless the artifact has this schema, e.g. msfab.result");
+  app.option("--schema-version", version, "with --schema: the supported schema_version (default: any)");
   bool no_config = false;
-  app.cli().add_flag("--no-config", no_config, "leave out the config the artifact was made with");
+  app.flag("--no-config", no_config, "leave out the config the artifact was made with");
   app.add_version_option();
   return app.run(argc, argv, [&](StageContext&) {
     std::string found_schema;

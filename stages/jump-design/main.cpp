@@ -48,8 +48,8 @@ int main(int argc, char** argv) {
   app.set_rank(rank);
   app.add_common_options();
   std::string trajectory_path;
-  app.cli().add_option("--trajectory", trajectory_path,
-                       "the final design's run (default: <out without .jump_design.h5>.final.trajectory.h5)");
+  app.option("--trajectory", trajectory_path,
+             "the final design's run (default: <out without .jump_design.h5>.final.trajectory.h5)");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();

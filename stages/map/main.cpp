@@ -95,14 +95,10 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string design_path, structures_path;
-  app.cli()
-      .add_option("--design", design_path, "msfab.design artifact (the optimized cells)")
-      ->type_name("FILE")
-      ->required();
-  app.cli()
-      .add_option("--structures", structures_path, "msfab.microstructures artifact of the same space")
-      ->type_name("FILE")
-      ->required();
+  app.option("--design", design_path, "msfab.design artifact (the optimized cells)").type_name("FILE").required();
+  app.option("--structures", structures_path, "msfab.microstructures artifact of the same space")
+      .type_name("FILE")
+      .required();
   return app.run(argc, argv, [&](StageContext& ctx) {
     const Settings settings = read_settings(ctx.config);
     ctx.finish_config();

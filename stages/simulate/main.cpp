@@ -124,32 +124,31 @@ int main(int argc, char** argv) {
   app.set_default_config(kDefaultSimulateScene);
   CoarseningRequest coarsening;
   bool compare_fine = false;
-  add_coarsening_options(app.cli(), coarsening, true);
-  app.cli().add_flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
+  add_coarsening_options(app, coarsening, true);
+  app.flag("--compare-fine", compare_fine, "also solve the fine model; report error and speedup");
   double target_error = 0;
-  auto* target_option = app.cli().add_option(
+  const StageOption target_option = app.option(
       "--target-error", target_error,
       "adaptive coarsening: the mean-vertex error (thesis 2.5.2) to stay within, choosing fine, level 1 or level 2 "
       "per 4x4x4 cell (needs a level-2 --database)");
   std::string level1_database;
-  app.cli().add_option("--level1-database", level1_database,
-                       "adaptive coarsening: a level-1 coarse_db of the same palette and element for the level-1 "
-                       "cells and solve, instead of the level-2 database's compressed level-1 base");
+  app.option("--level1-database", level1_database,
+             "adaptive coarsening: a level-1 coarse_db of the same palette and element for the level-1 "
+             "cells and solve, instead of the level-2 database's compressed level-1 base");
   bool posterior_check = false;
-  app.cli().add_flag("--posterior-check", posterior_check,
-                     "adaptive coarsening: check the mixed solution against the extrapolated fine one and, where "
-                     "it misses the target, choose finer levels and solve again (at most 3 mixed solves)");
+  app.flag("--posterior-check", posterior_check,
+           "adaptive coarsening: check the mixed solution against the extrapolated fine one and, where "
+           "it misses the target, choose finer levels and solve again (at most 3 mixed solves)");
   std::string posterior_estimator = "extrapolation";
-  app.cli()
-      .add_option("--posterior-estimate", posterior_estimator,
-                  "adaptive coarsening: the a-posteriori estimate of a mixed solve: its distance from the "
-                  "extrapolated fine solution (extrapolation; free, blind to error the two levels share) or the "
-                  "size of one Newton step of the fine model from it (newton; one fine tangent solve per check, "
-                  "sees every error; the extrapolation where the fine tangent there is not positive definite)")
-      ->check(CLI::IsMember({"extrapolation", "newton"}));
+  app.option("--posterior-estimate", posterior_estimator,
+             "adaptive coarsening: the a-posteriori estimate of a mixed solve: its distance from the "
+             "extrapolated fine solution (extrapolation; free, blind to error the two levels share) or the "
+             "size of one Newton step of the fine model from it (newton; one fine tangent solve per check, "
+             "sees every error; the extrapolation where the fine tangent there is not positive definite)")
+      .one_of({"extrapolation", "newton"});
   std::string reference;
-  app.cli().add_option("--reference", reference,
-                       "a fine msfab.result of the same scene to compare with instead of solving it again");
+  app.option("--reference", reference,
+             "a fine msfab.result of the same scene to compare with instead of solving it again");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t0 = std::chrono::steady_clock::now();
@@ -158,7 +157,7 @@ int main(int argc, char** argv) {
     check_grid_memory(ctx);
     const Scene scene = read_scene(ctx.config);
     ctx.finish_config();
-    const bool adaptive = target_option->count() > 0;
+    const bool adaptive = target_option.given();
     if (posterior_check && !adaptive) throw InputError("--posterior-check: applies to --target-error only");
     const bool newton_estimate = posterior_estimator == "newton";
     if (newton_estimate && !adaptive) throw InputError("--posterior-estimate: applies to --target-error only");

@@ -233,20 +233,15 @@ int main(int argc, char** argv) {
   app.add_common_options();
   app.set_default_config(kDefaults);
   std::string design_path, mapped_path, structures_path, scene_path, solver_option;
-  app.cli().add_option("--design", design_path, "msfab.design artifact (3D)")->type_name("FILE")->required();
-  app.cli().add_option("--mapped", mapped_path, "msfab.mapped artifact of that design")->type_name("FILE")->required();
-  app.cli()
-      .add_option("--structures", structures_path, "the msfab.microstructures artifact the mapping used")
-      ->type_name("FILE")
-      ->required();
-  app.cli()
-      .add_option("--scene", scene_path,
-                  "topopt scene YAML with the supports and loads (default: the design's own config)")
-      ->type_name("FILE");
-  app.cli()
-      .add_option("--solver", solver_option,
-                  "linear solver of the full-resolution model (same as --set linear_solver=NAME)")
-      ->type_name("NAME");
+  app.option("--design", design_path, "msfab.design artifact (3D)").type_name("FILE").required();
+  app.option("--mapped", mapped_path, "msfab.mapped artifact of that design").type_name("FILE").required();
+  app.option("--structures", structures_path, "the msfab.microstructures artifact the mapping used")
+      .type_name("FILE")
+      .required();
+  app.option("--scene", scene_path, "topopt scene YAML with the supports and loads (default: the design's own config)")
+      .type_name("FILE");
+  app.option("--solver", solver_option, "linear solver of the full-resolution model (same as --set linear_solver=NAME)")
+      .type_name("NAME");
   return app.run(argc, argv, [&](StageContext& ctx) {
     const auto start = std::chrono::steady_clock::now();
     const Settings settings = read_settings(ctx.config, solver_option);
