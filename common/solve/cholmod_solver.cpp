@@ -154,6 +154,13 @@ struct CholmodSolver::Cholmod {
 CholmodSolver::CholmodSolver(const LinearSolverOptions& options)
     : cholmod_(std::make_unique<Cholmod>()), options_(options) {
   validate_linear_solver_options(options);
+  if (options.indefinite) {
+    // CHOLMOD's LDL^T is simplicial only; it runs to the end on negative
+    // pivots and stops at a zero one.
+    cholmod_->common.supernodal = CHOLMOD_SIMPLICIAL;
+    cholmod_->common.final_ll = 0;
+    cholmod_->common.quick_return_if_not_posdef = 0;
+  }
 }
 
 CholmodSolver::~CholmodSolver() = default;
@@ -314,6 +321,7 @@ bool CholmodSolver::factorize(const SpMat& A, double shift) {
   c.factor_ready = false;
   factorized_ = nullptr;
   stats_.positive_definite = false;
+  negative_pivots_ = 0;
 
   if (c.n > 0) {
     cholmod_sparse view = lower_triangle_view(A);
@@ -324,15 +332,20 @@ bool CholmodSolver::factorize(const SpMat& A, double shift) {
     if (status < CHOLMOD_OK || (!ok && status != CHOLMOD_NOT_POSDEF)) {
       throw NumericalError("CHOLMOD numeric factorization failed: " + status_text(status));
     }
-    if (status == CHOLMOD_NOT_POSDEF || c.factor->minor < c.factor->n) {
+    if (c.factor->minor < c.factor->n || (status == CHOLMOD_NOT_POSDEF && !options_.indefinite)) {
       stats_.factorize_seconds = seconds_since(start);
       return false;
+    }
+    if (!c.factor->is_ll) {  // D sits on the diagonal of the simplicial factor
+      const int* p = static_cast<const int*>(c.factor->p);
+      const double* x = static_cast<const double*>(c.factor->x);
+      for (std::size_t j = 0; j < c.factor->n; ++j) negative_pivots_ += x[p[j]] < 0;
     }
   }
   c.factor_ready = true;
   factorized_ = &A;
   shift_ = shift;
-  stats_.positive_definite = true;
+  stats_.positive_definite = negative_pivots_ == 0;
   stats_.factorize_seconds = seconds_since(start);
   return true;
 }

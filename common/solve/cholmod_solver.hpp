@@ -1,6 +1,7 @@
 #pragma once
 // Sparse direct solver: CHOLMOD supernodal LL^T with a METIS nested-dissection
-// ordering (AMD if METIS fails). The symbolic analysis is reused by every
+// ordering (AMD if METIS fails), or simplicial LDL^T for symmetric indefinite
+// matrices (LinearSolverOptions::indefinite). The symbolic analysis is reused by every
 // factorize() on the same pattern.
 #include <memory>
 #include <vector>
@@ -46,6 +47,10 @@ class CholmodSolver final : public LinearSolver {
   const std::string& ordering() const { return ordering_; }
   // Nonzeros of the factor L (0 before the first analyze()).
   double factor_nonzeros() const;
+  // With LinearSolverOptions::indefinite: the negative pivots of the last
+  // successful factorize(), i.e. the negative eigenvalues of A + shift I
+  // (0 otherwise).
+  int negative_pivots() const { return negative_pivots_; }
 
  private:
   void reset_analysis();  // frees the factor and forgets the analysis
@@ -57,6 +62,7 @@ class CholmodSolver final : public LinearSolver {
   std::vector<int> last_;
   const SpMat* factorized_ = nullptr;  // the matrix of the last successful factorize()
   double shift_ = 0.0;
+  int negative_pivots_ = 0;
 };
 
 }  // namespace msfab

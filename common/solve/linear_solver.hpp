@@ -35,6 +35,13 @@ struct LinearSolverOptions {
   // pcg-mg: degree of the Chebyshev smoother, applied before and after each
   // coarse correction (matrix products per smoothing).
   int mg_smoother_degree = 2;
+  // cholmod: factor symmetric indefinite matrices as L D L^T (simplicial,
+  // without pivoting: about the fill of L L^T, with slower kernels).
+  // factorize() then fails only on a zero pivot, and the factor's negative
+  // pivots count the matrix's negative eigenvalues (Sylvester's law of
+  // inertia). Where no negative pivot is expected the L L^T default is
+  // faster.
+  bool indefinite = false;
 };
 
 struct LinearSolveStats {

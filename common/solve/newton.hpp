@@ -85,15 +85,20 @@ NewtonResult solve_static(const ElasticAssembler& assembler, const DirichletCond
 // this model's solution u* the step is u* - x up to terms of second order in
 // |u* - x|, so its size estimates how far an approximate solution (e.g. one
 // of a coarser model) lies from this model's own, errors of every origin
-// included. Where the tangent at x is not positive definite the step is
-// regularized as solve_static's are (a shift of the diagonal, growing until
-// the step descends) and `shift` says by how much. Where there is no step at
-// all, `failure` says why (an inverted element at x, a system that no shift
-// made solvable) and `step` is empty.
+// included. The step is the exact one whether or not it descends: where
+// the tangent at x is not positive definite (`indefinite`), it is solved by
+// MINRES preconditioned with a shifted CHOLMOD factor (L D L^T where MINRES
+// stalls), up to 200 000 unknowns. On larger meshes such a tangent is
+// regularized as solve_static's steps are (a shift of the diagonal, growing
+// until the step descends) and `shift` says by how much.
+// Where there is no step at all, `failure` says why (an inverted element at
+// x, a singular tangent, a system that no shift made solvable) and `step`
+// is empty.
 struct NewtonStepFrom {
   VecX step;
   std::string failure;
-  double shift = 0;  // the regularization the step needed (0: the tangent was positive definite)
+  double shift = 0;         // the regularization the step needed (0: none)
+  bool indefinite = false;  // the tangent at x is not positive definite (and the step is still exact)
 };
 NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
                                 const VecX& force, const NewtonOptions& options, const VecX& x);

@@ -255,6 +255,49 @@ TEST(LinearSolverCholmod, IndefiniteRejectedThenShiftSucceeds) {
   EXPECT_LT(relative_error(x, shifted.ldlt().solve(b)), 1e-8);
 }
 
+// With `indefinite`, CHOLMOD factors L D L^T: the solve matches a pivoted
+// dense one and the negative pivots are the negative eigenvalues (Sylvester);
+// a zero pivot still fails.
+TEST(LinearSolverCholmod, IndefiniteLdltSolvesAndCountsNegativeEigenvalues) {
+  const SpMat spd = random_spd(300, 9);
+  const Eigen::SelfAdjointEigenSolver<MatX> spectrum(MatX(spd), Eigen::EigenvaluesOnly);
+  // Between the 100th and 101st eigenvalues: exactly 100 negative ones.
+  const double cut = 0.5 * (spectrum.eigenvalues()(99) + spectrum.eigenvalues()(100));
+  SpMat identity(spd.rows(), spd.cols());
+  identity.setIdentity();
+  const SpMat A = spd - cut * identity;
+  const VecX b = random_vector(A.rows(), 10);
+
+  LinearSolverOptions options;
+  options.indefinite = true;
+  CholmodSolver solver(options);
+  solver.analyze(A);
+  ASSERT_TRUE(solver.factorize(A));
+  EXPECT_EQ(solver.negative_pivots(), 100);
+  EXPECT_FALSE(solver.stats().positive_definite);
+  const VecX x = solver.solve(b);
+  EXPECT_LT(relative_error(x, MatX(A).fullPivLu().solve(b)), 1e-8);
+  EXPECT_LT(solver.stats().relative_residual, 1e-10);
+
+  // Positive definite: no negative pivot, the L L^T solution.
+  ASSERT_TRUE(solver.factorize(spd));
+  EXPECT_EQ(solver.negative_pivots(), 0);
+  EXPECT_TRUE(solver.stats().positive_definite);
+  CholmodSolver ll;
+  ll.analyze(spd);
+  ASSERT_TRUE(ll.factorize(spd));
+  EXPECT_LT(relative_error(solver.solve(b), ll.solve(b)), 1e-10);
+
+  // A zero pivot: the second unknown decoupled with a zero diagonal.
+  std::vector<Eigen::Triplet<double, int>> entries{{0, 0, 2.0}, {1, 1, 0.0}, {2, 2, -3.0}, {2, 0, 1.0}, {0, 2, 1.0}};
+  SpMat singular(3, 3);
+  singular.setFromTriplets(entries.begin(), entries.end());
+  CholmodSolver zero(options);
+  zero.analyze(singular);
+  EXPECT_FALSE(zero.factorize(singular));
+  EXPECT_THROW(zero.solve(VecX::Ones(3)), NumericalError);
+}
+
 TEST(LinearSolverPcg, NegativeDiagonalRejectedThenShiftSucceeds) {
   const SpMat spd = grid_stiffness(4);
   SpMat identity(spd.rows(), spd.cols());

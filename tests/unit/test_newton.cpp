@@ -393,3 +393,55 @@ TEST(Newton, StepFromAnApproximateSolutionIsItsErrorToSecondOrder) {
     }
   }
 }
+
+// Far from the solution, where the Neo-Hookean tangent is indefinite, the
+// step is still the exact Newton step (no regularization): it solves the
+// linearized equations on the free DOFs and moves the fixed ones onto their
+// values, for either linear solver.
+TEST(Newton, StepFromAnIndefinitePointIsTheExactNewtonStep) {
+  VoxelGrid grid(8, 2, 2, 0.5, 1);
+  const VoxelMesh vm = build_voxel_mesh(grid, {nullptr, std::make_shared<NeoHookean>(1000, 0.3)});
+  ElasticAssembler asmb(vm.mesh);
+  const auto [DC, f, sel] = clamped_with_tip_load(grid, vm, 0.5);
+  const int n = asmb.num_dofs();
+  VecX p(n);
+  for (int i = 0; i < n; ++i) p[i] = std::sin(0.37 * i);
+  bool indefinite_seen = false;
+  for (const double amplitude : {0.05, 0.1, 0.15, 0.2}) {
+    const VecX x = asmb.rest_positions() + amplitude * p;
+    SpMat K = asmb.pattern();
+    VecX g(n);
+    if (!std::isfinite(asmb.evaluate(x, &g, &K))) continue;
+    g -= f;
+    std::vector<int> free;
+    for (int i = 0; i < n; ++i)
+      if (!DC.fixed[i]) free.push_back(i);
+    const MatX dense = MatX(K);
+    MatX Kff(free.size(), free.size());
+    for (size_t a = 0; a < free.size(); ++a)
+      for (size_t b = 0; b < free.size(); ++b) Kff(a, b) = dense(free[a], free[b]);
+    const Eigen::SelfAdjointEigenSolver<MatX> spectrum(Kff, Eigen::EigenvaluesOnly);
+    const int negative = static_cast<int>((spectrum.eigenvalues().array() < 0).count());
+    if (negative == 0) continue;
+    indefinite_seen = true;
+    for (const std::string solver : {"cholmod", "pcg-mg"}) {
+      NewtonOptions options;
+      options.linear_solver = solver;
+      const NewtonStepFrom step = newton_step_from(asmb, DC, f, options, x);
+      ASSERT_TRUE(step.failure.empty()) << step.failure;
+      EXPECT_EQ(step.shift, 0.0) << solver;
+      EXPECT_TRUE(step.indefinite) << solver << " at amplitude " << amplitude;
+      const VecX linearized = dense * step.step + g;
+      double residual = 0, scale = 0;
+      for (int i : free) residual += linearized[i] * linearized[i], scale += g[i] * g[i];
+      EXPECT_LT(std::sqrt(residual / scale), 1e-8) << solver;
+      const VecX target = asmb.rest_positions() + DC.displacement;
+      for (int i = 0; i < n; ++i) {
+        if (DC.fixed[i]) {
+          EXPECT_NEAR(x[i] + step.step[i], target[i], 1e-12);
+        }
+      }
+    }
+  }
+  EXPECT_TRUE(indefinite_seen) << "no perturbation made the tangent indefinite";
+}
