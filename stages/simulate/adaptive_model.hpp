@@ -104,7 +104,8 @@ PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel&
 // (MINRES) and a second step from where it lands is added: one step
 // amplifies the soft directions (1.2-1.3x the true error), two are within
 // 16% on bridge_arch, holes3 and twisting. Not `measured` where the steps
-// do not lower the potential one after the other (they then head for
+// do not lower the potential one after the other, or the second is not
+// shorter than the first (they then head for
 // another equilibrium: skeleton at 0.02 measured 19x its true error), where
 // an element is inverted, or on meshes too large for a direct
 // factorization, whose regularized step measured less than half the true

@@ -125,9 +125,10 @@ check "refinement bound meets the target and lies above the true error" -- \
 # mixed solution is its remaining error up to second order, so the estimate
 # agrees with the true error against fine (within 10%) at every target
 # where the fine tangent there is positive definite, whatever the levels
-# share; where it is indefinite, two exact steps (within 25%); where neither
-# can be taken the log says the extrapolation stood in. With the check the
-# target is met either way.
+# share; where it is indefinite, two exact steps (within 25%); where they
+# are not taken (they do not converge: at 0.01 here the second is longer
+# than the first) the log says the extrapolation stood in. With the check
+# the target is met either way.
 newton_measured=0
 for target in 0.01 0.004 0.002; do
   "$SIM" --config "$BAR" --target-error $target --posterior-estimate newton --posterior-check --database "$WORK/db2.h5" \
