@@ -155,8 +155,9 @@ VecX indefinite_direct_solve(const SpMat& K, const VecX& b, double scale, const 
     const double residual = (K * x - b).norm() / b.norm();
     spdlog::debug(
         "newton_step_from: MINRES on the indefinite tangent, shift {:.2e}, {} iterations, residual "
-        "{:.1e}, {:.3f} s",
-        shift / schedule.growth, iterations, residual, seconds_since(t0));
+        "{:.1e}, {:.3f} s (analysis {:.3f} s, last factorization {:.3f} s)",
+        shift / schedule.growth, iterations, residual, seconds_since(t0), shifted.stats().analyze_seconds,
+        shifted.stats().factorize_seconds);
     if (x.allFinite() && residual <= 1e-8) return x;
   }
   LinearSolverOptions ldlt_options = linear;
