@@ -90,15 +90,21 @@ LinearSolverOptions static_linear_options(const ElasticAssembler& assembler, con
 // after constrain_matrix with `diag`; Kgap is the tangent times gap before
 // that (not read where gap_norm is 0). One rule for solve_static's
 // iterations and newton_step_from.
+// Its right-hand side for the tangent shifted by `shift`: -g_f - K_fc gap_c
+// on the free DOFs, (diag + shift) gap_c on the fixed ones.
+void constrained_newton_rhs(const std::vector<char>& fixed, const VecX& g, const VecX& gap, double gap_norm,
+                            const VecX& Kgap, double diag, double shift, VecX& b) {
+  for (Eigen::Index i = 0; i < g.size(); ++i)
+    b[i] = fixed[std::size_t(i)] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
+}
+
 RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, double diag,
                                         const std::vector<char>& fixed, const VecX& g, const VecX& gap, double gap_norm,
                                         const VecX& Kgap, VecX& rhs, VecX& dx, const char* context) {
   const int n = static_cast<int>(g.size());
   return solve_regularized_step(
       solver, K, diag,
-      [&](double shift, VecX& b) {
-        for (int i = 0; i < n; ++i) b[i] = fixed[i] ? (diag + shift) * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
-      },
+      [&](double shift, VecX& b) { constrained_newton_rhs(fixed, g, gap, gap_norm, Kgap, diag, shift, b); },
       [&](VecX& candidate) {
         double slope = 0;
         for (int i = 0; i < n; ++i)
@@ -108,14 +114,10 @@ RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, do
       rhs, dx, context);
 }
 
-}  // namespace
-
 // The most unknowns newton_step_from factors directly where the tangent is
 // indefinite: on a 3D mesh about 70 k elements, a factor of about 3 GB
 // (static_solve_peak_bytes' CHOLMOD fill).
 constexpr int kLargestIndefiniteDirectStep = 200000;
-
-namespace {
 
 // The preconditioner interface Eigen's MINRES calls.
 struct FactorPreconditioner {
@@ -193,11 +195,11 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   const double diag = mean_free_diagonal(K, dirichlet.fixed);
   constrain_matrix(K, dirichlet.fixed, diag);
   VecX step(n), rhs(n);
-  for (int i = 0; i < n; ++i) rhs[i] = dirichlet.fixed[i] ? diag * gap[i] : -g[i] - (gap_norm > 0 ? Kgap[i] : 0.0);
+  constrained_newton_rhs(dirichlet.fixed, g, gap, gap_norm, Kgap, diag, 0.0, rhs);
   // An estimate needs the step itself, not a descent direction. First the
   // solver solve_static would use, which takes a positive definite tangent.
   const std::string solver_name = static_linear_solver(n, options);
-  auto t0 = Clock::now();
+  const auto t0 = Clock::now();
   const auto solver = make_linear_solver(solver_name, static_linear_options(assembler, solver_name, options));
   solver->analyze(K);
   if (solver->factorize(K)) {
@@ -209,7 +211,6 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
     }
   }
   spdlog::debug("newton_step_from: {} found the tangent indefinite in {:.3f} s", solver_name, seconds_since(t0));
-  t0 = Clock::now();
   // Not positive definite: the exact step where a direct factorization fits.
   if (n <= kLargestIndefiniteDirectStep) {
     step = indefinite_direct_solve(K, rhs, diag, static_linear_options(assembler, "cholmod", options));

@@ -144,7 +144,8 @@ int main(int argc, char** argv) {
              "adaptive coarsening: the a-posteriori estimate of a mixed solve: its distance from the "
              "extrapolated fine solution (extrapolation; free, blind to error the two levels share) or the "
              "size of one Newton step of the fine model from it (newton; one fine tangent solve per check, "
-             "sees every error; the extrapolation where the fine tangent there is not positive definite)")
+             "sees every error; two exact steps where the fine tangent there is indefinite, the extrapolation where "
+             "those do not converge)")
       .one_of({"extrapolation", "newton"});
   std::string reference;
   app.option("--reference", reference,
