@@ -8,6 +8,7 @@
 #include <IpTNLP.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
@@ -20,6 +21,15 @@ namespace {
 
 using Ipopt::Index;
 using Ipopt::Number;
+
+// MUMPS orders some of these KKT systems with SCOTCH (its automatic choice
+// for the 2D grippers), and SCOTCH 7 on several threads orders the same
+// matrix differently from run to run: one run in 20 to 60 then took
+// another first step and ended at another design (docs/topopt.md,
+// "Determinism"). On one thread its ordering is the same every time, and
+// it was faster on two cores. SCOTCH reads this variable whenever MUMPS
+// asks it for an ordering.
+void single_threaded_scotch() { setenv("SCOTCH_PTHREAD_NUMBER", "1", 1); }
 
 // Problem 3.5 for Ipopt. Variables x[r d + k] = q(r, k); constraints: per
 // design cell (when the space has a constraint) Phi and the Voigt bound's
@@ -212,6 +222,7 @@ OptimizationResult optimize_in_gamut(TopologyObjective& objective, const MatX& q
   // The mass constraint below is linear in q (the filter's column sums).
   if (objective.model().derives_density())
     throw InputError("ipopt: a space whose rho is derived from its other parameters is optimized by cell-mma only");
+  single_threaded_scotch();
   OptimizationResult result;
   const auto t0 = std::chrono::steady_clock::now();
   Ipopt::SmartPtr<Ipopt::TNLP> problem = new GamutProblem(objective, q0, settings, result);

@@ -111,6 +111,14 @@ for scene in s_beam gripper gripper_pull gripper_push gripper_stretch; do
   check "configs/topopt/$scene.yaml runs" -- "$T" --config "$SRC/configs/topopt/$scene.yaml" \
     --set gamut="$WORK/set.gamut.h5" --set optimizer.max_iterations=3 --out "$WORK/$scene.design.h5" --quiet
 done
+# The same design on one thread and on two, to the last bit (the pull
+# gripper is the scene whose KKT systems MUMPS once ordered with SCOTCH).
+for threads in 1 2; do
+  check "gripper_pull runs on $threads thread(s)" -- "$T" --config "$SRC/configs/topopt/gripper_pull.yaml" \
+    --set gamut="$WORK/set.gamut.h5" --set optimizer.max_iterations=3 --threads $threads \
+    --out "$WORK/pull_t$threads.design.h5" --quiet
+done
+check "a design does not depend on the thread count" -- h5diff -q "$WORK/pull_t1.design.h5" "$WORK/pull_t2.design.h5" /cells/raw
 
 # Plane strain: the same as the plane-stress plate of E / (1 - nu^2), nu / (1 - nu).
 simp=(--set 'grid.size=[24,12]' --set 'supports=[{box: {min: [0, 0], max: [0, 12]}}]'
