@@ -1,8 +1,16 @@
 # Helpers for stage tests: source from a test_*.sh script.
 # Usage in a test: BIN=$1 SRC=$2; source "$SRC/tests/stage/lib.sh"
 set -u
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
+# MSFAB_TEST_WORK=DIR keeps a test's files in DIR (made if missing) instead
+# of a temporary folder removed at the end, e.g. to compare the artifacts
+# of two runs.
+if [ -n "${MSFAB_TEST_WORK:-}" ]; then
+  WORK=$MSFAB_TEST_WORK
+  mkdir -p "$WORK"
+else
+  WORK=$(mktemp -d)
+  trap 'rm -rf "$WORK"' EXIT
+fi
 FAILURES=0
 PASSES=0
 
