@@ -81,7 +81,7 @@ class Recorder {
       for (size_t b = 0; b < mass.size(); ++b) s.body_center_of_mass[b] /= mass[b];
     }
     s.contacts = step.contacts;
-    s.active_contacts = step.active_contacts;
+    s.active_contacts = step.peak_active_contacts;
     s.newton_iterations = step.newton_iterations;
     s.max_penetration = step.max_penetration;
     s.seconds = step.seconds;
@@ -273,6 +273,7 @@ StepReport elastic_step(NewmarkIntegrator& sim, double h, int levels, bool activ
     second.seconds += r->seconds;
   }
   second.max_penetration = std::max(second.max_penetration, first.max_penetration);
+  second.peak_active_contacts = std::max(second.peak_active_contacts, first.peak_active_contacts);
   return second;
 }
 
@@ -346,8 +347,10 @@ Trajectory run_dynamics_scene(const DynamicsScene& scene, const RunCallbacks& ca
     rec.sample(SimulationPhase::kElastic, sim.positions(), sim.velocities(), r, time);
     // Contact and lift-off events: a resting body's contacts flicker between
     // carrying force and touching without force, so lift-off needs a gap.
-    if (r.active_contacts > 0 && !touching) {
-      rec.event(time, "contact", std::to_string(r.active_contacts) + " nodes");
+    // A touch inside the event substeps of one step counts even where the
+    // body has left again by the step's end.
+    if (r.peak_active_contacts > 0 && !touching) {
+      rec.event(time, "contact", std::to_string(r.peak_active_contacts) + " nodes");
       touching = true;
     } else if (r.active_contacts == 0 && touching &&
                clearance(scene.model, sim.boundary_nodes(), sim.positions(), sim.velocities(), 0.0) > margin) {

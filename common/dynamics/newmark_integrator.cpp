@@ -420,6 +420,7 @@ StepReport NewmarkIntegrator::take_step() {
       report.max_penetration = std::max(
           report.max_penetration, -(contacts[k].gap0 + contacts[k].frame.col(0).dot(contacts[k].relative(delta))));
   }
+  report.peak_active_contacts = report.active_contacts;
   q_ += delta;
   v_ = v_new;
   time_ += h;

@@ -76,6 +76,10 @@ struct StepReport {
   int contact_rounds = 0;
   int contacts = 0;         // in the contact set
   int active_contacts = 0;  // carrying a normal impulse at the end
+  // The most active contacts at the end of any part of the step: where a
+  // step is retaken as event substeps (dynamics_run.cpp), a touch that
+  // starts and ends inside it still counts.
+  int peak_active_contacts = 0;
   int gauss_seidel_sweeps = 0;
   double residual = 0;         // final relative residual
   double max_penetration = 0;  // deepest node below an obstacle surface at the end (m, >= 0)

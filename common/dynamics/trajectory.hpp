@@ -30,6 +30,8 @@ struct TrajectorySample {
   Vec3 rotation = Vec3::Zero();  // best-fit rotation from rest as a rotation vector (axis * angle, rad)
   // With several bodies: each body's centre of mass (Trajectory::body_names order).
   std::vector<Vec3> body_center_of_mass;
+  // Contact candidates at the step's end; contacts carrying a normal
+  // impulse at the end of the step or of any of its event substeps.
   int contacts = 0, active_contacts = 0;
   int newton_iterations = 0;
   double max_penetration = 0;  // m
