@@ -245,7 +245,8 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
 // The impulses and the friction of the event then act over the short steps
 // in which it happens instead of over a whole step. With levels = 0 it is
 // sim.step(). Returns the last (sub)step's report with the Newton
-// iterations, sweeps and seconds of every try; `steps` counts the steps
+// iterations, sweeps and seconds of every try, and the deepest penetration
+// and most active contacts of the steps kept; `steps` counts the steps
 // kept.
 StepReport elastic_step(NewmarkIntegrator& sim, double h, int levels, bool active_before, std::int64_t& steps) {
   if (levels == 0) {  // no retake possible: no state to keep
