@@ -107,6 +107,24 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
   f.write_vector("/evaluations/feasible", feasible);
   f.write_vector("/evaluations/seconds", seconds);
   f.write_attribute("/evaluations/seconds", "units", "s (wall time; the only field that varies between runs)");
+  if (p.confirm_time_step > 0) {
+    // The run at the confirmation step; /evaluations/objective and
+    // constraints are the worse of the two steps.
+    std::vector<double> confirm_objective(n), confirm_outcome;
+    for (std::size_t i = 0; i < n; ++i) {
+      Evaluation confirm = run.evaluations[i];
+      confirm.outcome = confirm.confirm_outcome;
+      confirm.crossed_wall = confirm.confirm_crossed_wall;
+      confirm.z_over_wall = confirm.confirm_z_over_wall;
+      confirm_objective[i] = confirm.confirm_objective;
+      const std::vector<double> row = outcome_row(confirm);
+      confirm_outcome.insert(confirm_outcome.end(), row.begin(), row.end());
+    }
+    f.write_attribute("/evaluations", "confirm_time_step", p.confirm_time_step);
+    f.write_vector("/evaluations/confirm_objective", confirm_objective);
+    f.write_dataset("/evaluations/confirm_outcome", confirm_outcome, {hsize_t(n), hsize_t(outcome_columns().size())});
+    f.write_attribute("/evaluations/confirm_outcome", "columns", format_name_list(outcome_columns()));
+  }
   if (nc > 0) {
     f.write_dataset("/evaluations/constraints", constraints, {hsize_t(n), hsize_t(nc)});
     f.write_attribute("/evaluations/constraints", "units", "m (feasible when <= 0)");

@@ -34,12 +34,15 @@ DesignTask parse_task(const Config& c) {
   return DesignTask::kJumpOver;
 }
 
-void read_measure(const Config& c, JumpMeasureOptions& m, double& settle, std::string& body) {
+void read_measure(const Config& c, DesignProblem& p) {
   if (!c.has("measure")) return;
   const Config s = c.child("measure");
-  body = s.get_or("body", "");
-  settle = s.get_or<double>("settle", settle);
-  if (!(settle >= 0)) s.fail("settle", "must be >= 0 (s)");
+  JumpMeasureOptions& m = p.measure;
+  p.body = s.get_or("body", "");
+  p.settle = s.get_or<double>("settle", p.settle);
+  if (!(p.settle >= 0)) s.fail("settle", "must be >= 0 (s)");
+  if (s.has("confirm_time_step"))
+    p.confirm_time_step = s.require_positive<double>("confirm_time_step", "time step (s)");
   const std::string axis = s.get_or("flip_axis", "y");
   if (axis != "x" && axis != "y" && axis != "z") s.fail("flip_axis", "must be x, y or z");
   m.flip_axis = axis[0] - 'x';
@@ -130,7 +133,7 @@ DesignProblem read_design_problem(const Config& c) {
     p.obstacle = c.get<std::string>("obstacle");
     p.clearance = c.get_or<double>("clearance", 0.0);
   }
-  read_measure(c, p.measure, p.settle, p.body);
+  read_measure(c, p);
   read_optimizer(c, p);
   read_robustness(c, p.robustness);
   return p;

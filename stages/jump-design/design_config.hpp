@@ -53,6 +53,11 @@ struct DesignProblem {
   double clearance = 0;    // m: extra height over the obstacle top the constraints ask for
   JumpMeasureOptions measure;
   double settle = 0.01;  // s: simulated after the landing before the run is stopped
+  // s: every evaluation runs again at this time step and scores the worse
+  // of the two (measure.confirm_time_step; 0: once, at the scene's step).
+  // An outcome decided by a graze or an edge strike changes with the step,
+  // so a design whose score holds at both does not rest on one.
+  double confirm_time_step = 0;
   // Optimizer.
   int max_evaluations = 20;  // per start
   int starts = 1;            // the initial design and starts - 1 more (see start_point)

@@ -28,11 +28,13 @@ double Evaluation::violation() const {
 }
 
 // Row layout: start, index, ok, objective, seconds, elements, crossed_wall,
-// z_over_wall, then the parameters, the constraints and the jump outcome
-// (kOutcomeSize numbers, in the order of pack_outcome).
+// z_over_wall, confirmed, confirm_objective, confirm_crossed_wall,
+// confirm_z_over_wall, then the parameters, the
+// constraints, the jump outcome and the confirmation's outcome
+// (kOutcomeSize numbers each, in the order of pack_outcome).
 namespace {
 
-constexpr int kHeader = 8;
+constexpr int kHeader = 12;
 constexpr int kOutcomeSize = 17;
 
 void pack_outcome(const JumpOutcome& o, double* r) {
@@ -63,7 +65,7 @@ JumpOutcome unpack_outcome(const double* r) {
 }  // namespace
 
 int evaluation_record_size(const DesignProblem& p) {
-  return kHeader + static_cast<int>(p.parameters.size() + constraint_names(p.task).size()) + kOutcomeSize;
+  return kHeader + static_cast<int>(p.parameters.size() + constraint_names(p.task).size()) + 2 * kOutcomeSize;
 }
 
 void pack_evaluation(const Evaluation& e, double* r) {
@@ -75,10 +77,15 @@ void pack_evaluation(const Evaluation& e, double* r) {
   r[5] = e.elements;
   r[6] = e.crossed_wall ? 1 : 0;
   r[7] = e.z_over_wall;
+  r[8] = e.confirmed ? 1 : 0;
+  r[9] = e.confirm_objective;
+  r[10] = e.confirm_crossed_wall ? 1 : 0;
+  r[11] = e.confirm_z_over_wall;
   double* p = r + kHeader;
   for (double x : e.parameters) *p++ = x;
   for (double g : e.constraints) *p++ = g;
   pack_outcome(e.outcome, p);
+  pack_outcome(e.confirm_outcome, p + kOutcomeSize);
 }
 
 Evaluation unpack_evaluation(const DesignProblem& problem, const double* r) {
@@ -91,12 +98,17 @@ Evaluation unpack_evaluation(const DesignProblem& problem, const double* r) {
   e.elements = static_cast<int>(r[5]);
   e.crossed_wall = r[6] != 0;
   e.z_over_wall = r[7];
+  e.confirmed = r[8] != 0;
+  e.confirm_objective = r[9];
+  e.confirm_crossed_wall = r[10] != 0;
+  e.confirm_z_over_wall = r[11];
   const double* p = r + kHeader;
   e.parameters.assign(p, p + problem.parameters.size());
   p += problem.parameters.size();
   const std::size_t nc = constraint_names(problem.task).size();
   e.constraints.assign(p, p + nc);
   e.outcome = unpack_outcome(p + nc);
+  e.confirm_outcome = unpack_outcome(p + nc + kOutcomeSize);
   return e;
 }
 
@@ -109,11 +121,14 @@ std::string number_text(double x) {
 }
 
 // The scene at `values`, meshed at the reference values (the scene's
-// reference_parameters, else the initial design),
-// with every modulus times `modulus_scale` (on top of the scene's own).
-DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double>& values, double modulus_scale = 1.0) {
+// reference_parameters, else the initial design), with every modulus
+// times `modulus_scale` (on top of the scene's own) and run at `time_step`
+// (0: the scene's).
+DynamicsScene build_scene(const DesignProblem& problem, const std::vector<double>& values, double modulus_scale = 1.0,
+                          double time_step = 0) {
   Config scene = Config::load_file(problem.scene_path);
   scene.apply_overrides(problem.scene_set);
+  if (time_step > 0) scene.apply_override("simulation.time_step=" + number_text(time_step));
   if (modulus_scale != 1.0) {
     const double own = scene.has("modulus_scale") ? scene.get<double>("modulus_scale") : 1.0;
     scene.apply_override("modulus_scale=" + number_text(own * modulus_scale));
@@ -157,6 +172,17 @@ DesignEvaluator::DesignEvaluator(const DesignProblem& problem) : problem_(proble
                          ") the scene is invalid: " + e.what());
       }
     }
+  if (problem.confirm_time_step > 0) {
+    if (problem.confirm_time_step == scene.newmark.time_step)
+      throw InputError(problem.config_source + ": measure.confirm_time_step = " +
+                       number_text(problem.confirm_time_step) + " s is the scene's own time step: nothing to confirm");
+    try {
+      build_scene(problem, initial, 1.0, problem.confirm_time_step);
+    } catch (const InputError& e) {
+      throw InputError(problem.config_source +
+                       ": measure.confirm_time_step: the scene at that step is invalid: " + e.what());
+    }
+  }
   if (scene.preload == Preload::kNone)
     spdlog::warn("scene {} has no preload (press or pluck); the design loop runs it as it is", problem.scene_path);
   if (!problem.body.empty() &&
@@ -178,17 +204,13 @@ Trajectory DesignEvaluator::run_trajectory(const std::vector<double>& values, do
   return run_dynamics_scene(scene);
 }
 
-Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index,
-                                     double modulus_scale) const {
-  const auto t0 = std::chrono::steady_clock::now();
+Evaluation DesignEvaluator::simulate(const std::vector<double>& values, double modulus_scale, double time_step) const {
   Evaluation e;
-  e.start = start;
-  e.index = index;
   e.parameters = values;
   e.elements = elements_;
   const std::size_t nc = constraint_names(problem_.task).size();
   try {
-    const DynamicsScene scene = build_scene(problem_, values, modulus_scale);
+    const DynamicsScene scene = build_scene(problem_, values, modulus_scale, time_step);
     // The observer stops the run shortly after the landing (jump_observer.hpp).
     JumpObserver observer(scene, {problem_.measure.min_flight, problem_.settle, 0.01, problem_.body});
     RunCallbacks callbacks;
@@ -208,9 +230,8 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
       if (!e.crossed_wall) e.z_over_wall = obstacle_.lo.z();
     }
   } catch (const std::exception& ex) {
-    spdlog::warn("start {} evaluation {}: simulation failed ({}); penalty values", start, index, ex.what());
+    spdlog::warn("simulation of ({}) failed ({}); penalty values", fmt::join(values, ", "), ex.what());
   }
-  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!e.ok) {
     e.objective = kFailedObjective;
     e.constraints.assign(nc, kFailedConstraint);
@@ -234,6 +255,30 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
       e.constraints = {obstacle_.hi.x() - o.com_at_landing.x(), z_top - e.z_over_wall};
       break;
   }
+  return e;
+}
+
+Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index,
+                                     double modulus_scale) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  Evaluation e = simulate(values, modulus_scale, 0);
+  if (e.ok && problem_.confirm_time_step > 0) {
+    // The worse of the two steps counts: objective, each constraint, and a
+    // failure at either step fails the evaluation.
+    const Evaluation c = simulate(values, modulus_scale, problem_.confirm_time_step);
+    e.confirmed = true;
+    e.confirm_objective = c.objective;
+    e.confirm_outcome = c.outcome;
+    e.confirm_crossed_wall = c.crossed_wall;
+    e.confirm_z_over_wall = c.z_over_wall;
+    e.ok = c.ok;
+    e.objective = std::max(e.objective, c.objective);
+    for (std::size_t i = 0; i < e.constraints.size(); ++i)
+      e.constraints[i] = std::max(e.constraints[i], c.constraints[i]);
+  }
+  e.start = start;
+  e.index = index;
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return e;
 }
 

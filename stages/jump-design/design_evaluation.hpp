@@ -20,9 +20,16 @@ struct Evaluation {
   double objective = 0;             // rad^2 (flip, upright) or m (target)
   std::vector<double> constraints;  // m, feasible when <= 0
   double seconds = 0;               // wall time of the simulation
-  JumpOutcome outcome;
+  JumpOutcome outcome;              // at the scene's time step
+  // With measure.confirm_time_step: the run at that step, whose objective
+  // and constraints are folded into the ones above (the worse of the two).
+  bool confirmed = false;
+  double confirm_objective = 0;
+  JumpOutcome confirm_outcome;
   bool crossed_wall = false;  // jump-over: the centre of mass crossed the obstacle's middle
   double z_over_wall = 0;     // its height there (m); the wall's foot if it never crossed
+  bool confirm_crossed_wall = false;
+  double confirm_z_over_wall = 0;
   int elements = 0;
 
   // Constraints met to within `tolerance` (m) and the simulation succeeded.
@@ -58,6 +65,9 @@ class DesignEvaluator {
   const Obstacle* obstacle() const { return has_obstacle_ ? &obstacle_ : nullptr; }
 
  private:
+  // One simulation at `time_step` (0: the scene's), measured and scored.
+  Evaluation simulate(const std::vector<double>& parameters, double modulus_scale, double time_step) const;
+
   const DesignProblem& problem_;
   Obstacle obstacle_;
   bool has_obstacle_ = false;

@@ -36,6 +36,9 @@ void print_design_summary(const DesignProblem& p, const DesignRun& run, const st
     row((p.parameters[i].name + " (m)").c_str(), num(a.parameters[i]), num(b.parameters[i]));
   row(p.task == DesignTask::kTarget ? "objective (m)" : "objective (rad^2)", num(a.objective, "%.5g"),
       num(b.objective, "%.5g"));
+  if (p.confirm_time_step > 0)
+    row(("objective at h = " + num(p.confirm_time_step, "%.3g") + " s").c_str(), num(a.confirm_objective, "%.5g"),
+        num(b.confirm_objective, "%.5g"));
   const std::vector<std::string> names = constraint_names(p.task);
   for (std::size_t i = 0; i < names.size(); ++i)
     row((names[i] + " (m)").c_str(), num(a.constraints[i], "%+.4f"), num(b.constraints[i], "%+.4f"));
@@ -49,6 +52,8 @@ void print_design_summary(const DesignProblem& p, const DesignRun& run, const st
   row("flip at end (deg)", num(a.outcome.flip_at_end * 180 / M_PI, "%.1f"),
       num(b.outcome.flip_at_end * 180 / M_PI, "%.1f"));
   row("COM x, z at landing (m)", xz(a.outcome.com_at_landing), xz(b.outcome.com_at_landing));
+  if (p.confirm_time_step > 0)
+    row("... at the confirm step", xz(a.confirm_outcome.com_at_landing), xz(b.confirm_outcome.com_at_landing));
   row("COM x, z at end (m)", xz(a.outcome.com_at_end), xz(b.outcome.com_at_end));
   row("highest COM z (m)", num(a.outcome.com_highest.z(), "%.4f"), num(b.outcome.com_highest.z(), "%.4f"));
   if (p.task == DesignTask::kJumpOver)

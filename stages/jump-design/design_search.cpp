@@ -78,8 +78,12 @@ void log_evaluation(const DesignProblem& p, const Evaluation& e) {
   const std::vector<std::string> names = constraint_names(p.task);
   for (std::size_t i = 0; i < e.constraints.size(); ++i)
     constraints += fmt::format(", {} = {:+.4f} m", names[i], e.constraints[i]);
-  spdlog::info("start {} evaluation {}: {}: objective {:.5g}{}, flip at landing {:.1f} deg{}, {:.1f} s", e.start,
-               e.index, params, e.objective, constraints, e.outcome.flip_at_landing * 180 / M_PI,
+  const std::string confirm = e.confirmed
+                                  ? fmt::format(" (at the confirm step {:.5g}, flip {:.1f} deg)", e.confirm_objective,
+                                                e.confirm_outcome.flip_at_landing * 180 / M_PI)
+                                  : "";
+  spdlog::info("start {} evaluation {}: {}: objective {:.5g}{}{}, flip at landing {:.1f} deg{}, {:.1f} s", e.start,
+               e.index, params, e.objective, confirm, constraints, e.outcome.flip_at_landing * 180 / M_PI,
                e.ok ? "" : " (simulation failed)", e.seconds);
 }
 

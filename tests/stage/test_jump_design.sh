@@ -85,6 +85,31 @@ check "starts at the Halton points" -- bash -c "h5dump -d /evaluations/parameter
   END { exit ok != 3 }'"
 expect_exit 2 "start_points" -- "$DESIGN" --config "$WORK/design.yaml" --set optimizer.start_points=random --out "$WORK/bad.h5"
 
+# A confirmation step: every evaluation runs again at another time step
+# and scores the worse of the two, exactly the runs at each step alone.
+# Aimed at x = 2 cm, the throw at 2.5e-3 s lands 0.3 mm further from it
+# than at the scene's 1e-3 s, so the confirmation decides the score.
+one_evaluation=(--set target_x=0.02 --set optimizer.max_evaluations=1 --set optimizer.starts=1 --quiet)
+check "run at the scene's step" -- "$DESIGN" --config "$WORK/design.yaml" "${one_evaluation[@]}" --out "$WORK/at_h.h5"
+check "run at 2.5e-3 s" -- "$DESIGN" --config "$WORK/design.yaml" \
+  --set 'scene_set=["simulation.time_step=2.5e-3"]' "${one_evaluation[@]}" --out "$WORK/coarse.h5"
+check "run at the scene's step, confirmed at 2.5e-3 s" -- "$DESIGN" --config "$WORK/design.yaml" \
+  --set measure.confirm_time_step=2.5e-3 "${one_evaluation[@]}" --out "$WORK/confirm.h5"
+full_objective() { h5dump -m %.17g -a "/$2/objective" "$1" | awk '/\(0\)/ { print $2 }'; }
+at_h=$(full_objective "$WORK/at_h.h5" initial) at_coarse=$(full_objective "$WORK/coarse.h5" initial)
+confirmed=$(full_objective "$WORK/confirm.h5" initial)
+echo "distance to x = 2 cm: $at_h m at 1e-3 s, $at_coarse m at 2.5e-3 s, confirmed $confirmed m"
+check "the confirmed objective is the worse of the two steps" -- \
+  awk -v a="$at_h" -v b="$at_coarse" -v c="$confirmed" 'BEGIN { exit !(c == (a > b ? a : b) && b - a > 1e-4) }'
+same_data() { [ "$(h5dump -d "$2" -A 0 "$1" | tail -n +3)" = "$(h5dump -d "$4" -A 0 "$3" | tail -n +3)" ]; }
+check "the artifact keeps both runs" -- bash -c "$(declare -f same_data); \
+  same_data '$WORK/coarse.h5' /evaluations/outcome '$WORK/confirm.h5' /evaluations/confirm_outcome && \
+  same_data '$WORK/at_h.h5' /evaluations/outcome '$WORK/confirm.h5' /evaluations/outcome"
+expect_exit 2 "measure.confirm_time_step = 0.001 s is the scene's own time step" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set measure.confirm_time_step=1e-3 --out "$WORK/bad.h5"
+expect_exit 2 "measure.confirm_time_step.*positive" -- \
+  "$DESIGN" --config "$WORK/design.yaml" --set measure.confirm_time_step=-1e-3 --out "$WORK/bad.h5"
+
 # Print variation of the final design: the samples are recorded, do not
 # depend on the rank count, and a throw that hits within 2 mm still hits
 # within 1 cm with E +-20% and the length +-0.2 mm.
