@@ -1,5 +1,6 @@
 #include "design_artifact.hpp"
 
+#include <cmath>
 #include <cstdint>
 
 #include "io/artifact.hpp"
@@ -116,7 +117,8 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
       confirm.outcome = confirm.confirm_outcome;
       confirm.crossed_wall = confirm.confirm_crossed_wall;
       confirm.z_over_wall = confirm.confirm_z_over_wall;
-      confirm_objective[i] = confirm.confirm_objective;
+      // NaN where the run at the scene's step failed and was not repeated.
+      confirm_objective[i] = confirm.confirmed ? confirm.confirm_objective : std::nan("");
       const std::vector<double> row = outcome_row(confirm);
       confirm_outcome.insert(confirm_outcome.end(), row.begin(), row.end());
     }
