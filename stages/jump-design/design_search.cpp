@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "design_checkpoint.hpp"
 #include "parallel/fan_out.hpp"
 
 namespace msfab {
@@ -55,9 +56,13 @@ namespace {
 struct StartState {
   const DesignProblem* problem;
   const DesignEvaluator* evaluator;
+  const SearchControl* control;
   int start = 0;
   std::vector<Evaluation> evaluations;
-  std::vector<double> last_x;  // normalized point of evaluations.back()
+  std::vector<double> last_x;      // normalized point of evaluations.back()
+  std::vector<Evaluation> replay;  // from the checkpoint, not yet asked for again
+  int simulated = 0;               // evaluations simulated in this run
+  bool stopped = false;            // stopped at control->max_new_evaluations
 };
 
 std::vector<double> physical(const DesignProblem& p, const double* u) {
@@ -88,14 +93,34 @@ void log_evaluation(const DesignProblem& p, const Evaluation& e) {
 }
 
 // The evaluation at normalized point u, reusing the last one when COBYLA
-// asks for the constraints at the point whose objective it just had.
+// asks for the constraints at the point whose objective it just had, and
+// the checkpoint's when COBYLA asks for the point it recorded.
 const Evaluation& evaluation_at(StartState& s, const double* u) {
   const std::size_t n = s.problem->parameters.size();
   if (!s.evaluations.empty() && std::equal(u, u + n, s.last_x.begin())) return s.evaluations.back();
-  s.evaluations.push_back(
-      s.evaluator->evaluate(physical(*s.problem, u), s.start, static_cast<int>(s.evaluations.size())));
+  const std::vector<double> x = physical(*s.problem, u);
+  const std::size_t k = s.evaluations.size();
+  if (k < s.replay.size()) {
+    if (s.replay[k].parameters == x) {
+      s.evaluations.push_back(s.replay[k]);
+      s.last_x.assign(u, u + n);
+      return s.evaluations.back();
+    }
+    // Only another binary (other round-off) leads COBYLA elsewhere.
+    spdlog::warn("start {}: evaluation {} is not at the checkpoint's point; simulating from here on", s.start, k);
+    s.replay.resize(k);
+  }
+  const SearchControl& c = *s.control;
+  if (c.max_new_evaluations > 0 && s.simulated == c.max_new_evaluations) {
+    s.stopped = true;
+    throw nlopt::forced_stop();
+  }
+  s.evaluations.push_back(s.evaluator->evaluate(x, s.start, static_cast<int>(k)));
+  ++s.simulated;
   s.last_x.assign(u, u + n);
   log_evaluation(*s.problem, s.evaluations.back());
+  if (!c.checkpoint_out.empty())
+    write_start_checkpoint(start_checkpoint_path(c.checkpoint_out, s.start), c.run_text, *s.problem, s.evaluations);
   return s.evaluations.back();
 }
 
@@ -112,9 +137,15 @@ void constraints(unsigned m, double* result, unsigned, const double* u, double*,
 
 }  // namespace
 
-std::vector<Evaluation> run_start(const DesignProblem& p, const DesignEvaluator& evaluator, int start) {
+StartResult run_start(const DesignProblem& p, const DesignEvaluator& evaluator, int start,
+                      const SearchControl& control) {
   const unsigned n = static_cast<unsigned>(p.parameters.size());
-  StartState state{&p, &evaluator, start, {}, {}};
+  StartState state{&p, &evaluator, &control, start, {}, {}, {}, 0, false};
+  if (control.resume && !control.checkpoint_out.empty()) {
+    state.replay = read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
+    if (!state.replay.empty())
+      spdlog::info("start {}: resuming with {} recorded evaluations", start, state.replay.size());
+  }
   nlopt::opt opt(nlopt::LN_COBYLA, n);
   std::vector<double> u(n), step(n);
   const std::vector<double> x0 = start_point(p, start);
@@ -141,6 +172,10 @@ std::vector<Evaluation> run_start(const DesignProblem& p, const DesignEvaluator&
                  : r == nlopt::XTOL_REACHED    ? "step below xtol"
                                                : "converged",
                  state.evaluations.size());
+  } catch (const nlopt::forced_stop&) {
+    if (!state.stopped) throw;
+    spdlog::info("start {}: stopped after {} new evaluations ({} in all); the checkpoint is kept", start,
+                 state.simulated, state.evaluations.size());
   } catch (const nlopt::roundoff_limited&) {
     spdlog::info("start {}: COBYLA stopped on round-off after {} evaluations", start, state.evaluations.size());
   } catch (const InputError&) {
@@ -149,24 +184,34 @@ std::vector<Evaluation> run_start(const DesignProblem& p, const DesignEvaluator&
     // An NLopt failure keeps what was evaluated; the best of it still counts.
     spdlog::warn("start {}: COBYLA failed: {}", start, e.what());
   }
-  return state.evaluations;
+  return {state.evaluations, state.stopped};
 }
 
-std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvaluator& evaluator) {
+std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvaluator& evaluator,
+                                       const SearchControl& control, bool* stopped) {
   const int per = evaluation_record_size(p);
-  const int row = 1 + p.max_evaluations * per;
+  const int row = 2 + p.max_evaluations * per;  // count, stopped, the evaluations
+  // Checkpoints of another run are bad input: refused here, before the
+  // fan-out (which reports failures inside it as numerical ones).
+  if (control.resume && !control.checkpoint_out.empty())
+    for (int start = 0; start < p.starts; ++start)
+      read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
   const std::vector<double> records = fan_out(p.starts, row, [&](int start, double* r) {
-    const std::vector<Evaluation> evaluations = run_start(p, evaluator, start);
-    const std::size_t count = std::min<std::size_t>(evaluations.size(), static_cast<std::size_t>(p.max_evaluations));
+    const StartResult result = run_start(p, evaluator, start, control);
+    const std::size_t count =
+        std::min<std::size_t>(result.evaluations.size(), static_cast<std::size_t>(p.max_evaluations));
     r[0] = static_cast<double>(count);
-    for (std::size_t k = 0; k < count; ++k) pack_evaluation(evaluations[k], r + 1 + k * per);
+    r[1] = result.stopped ? 1 : 0;
+    for (std::size_t k = 0; k < count; ++k) pack_evaluation(result.evaluations[k], r + 2 + k * per);
   });
   std::vector<Evaluation> all;
+  if (stopped) *stopped = false;
   for (int start = 0; start < p.starts; ++start) {
     const double* r = records.data() + static_cast<std::size_t>(start) * row;
+    if (stopped && r[1] != 0) *stopped = true;
     const int count = static_cast<int>(r[0]);
     if (count == 0) spdlog::warn("start {}: no evaluation came back", start);
-    for (int k = 0; k < count; ++k) all.push_back(unpack_evaluation(p, r + 1 + k * per));
+    for (int k = 0; k < count; ++k) all.push_back(unpack_evaluation(p, r + 2 + k * per));
   }
   if (all.empty()) throw NumericalError("design loop: no start produced an evaluation");
   return all;

@@ -6,6 +6,7 @@
 // independent, so they fan out over MPI ranks (start i on rank i mod size)
 // and the threads of a rank; every result is the same for any rank or
 // thread count.
+#include <string>
 #include <vector>
 
 #include "design_config.hpp"
@@ -20,13 +21,29 @@ namespace msfab {
 // box (bases 2, 3, 5, ... per parameter).
 std::vector<double> start_point(const DesignProblem& problem, int start);
 
+// Checkpoints and batch-job limits of a search (design_checkpoint.hpp).
+struct SearchControl {
+  std::string checkpoint_out;   // the artifact's path; empty: no checkpoints
+  std::string run_text;         // config and seed the checkpoints are tagged with
+  bool resume = false;          // replay each start's checkpoint first
+  int max_new_evaluations = 0;  // per start in this run (0: no limit); then stop, keeping the checkpoints
+};
+
+struct StartResult {
+  std::vector<Evaluation> evaluations;  // in order, replayed ones included
+  bool stopped = false;                 // stopped by max_new_evaluations, not by COBYLA
+};
+
 // One COBYLA run of at most max_evaluations simulations; every evaluation
-// in order. `log` prints each one as it finishes.
-std::vector<Evaluation> run_start(const DesignProblem& problem, const DesignEvaluator& evaluator, int start);
+// is logged as it finishes and, with checkpoints, recorded.
+StartResult run_start(const DesignProblem& problem, const DesignEvaluator& evaluator, int start,
+                      const SearchControl& control = {});
 
 // Every start on every rank; the evaluations of all starts, ordered by start
-// and index, identical on every rank.
-std::vector<Evaluation> run_all_starts(const DesignProblem& problem, const DesignEvaluator& evaluator);
+// and index, identical on every rank. `stopped`: some start stopped at the
+// batch limit (the caller writes no artifact then).
+std::vector<Evaluation> run_all_starts(const DesignProblem& problem, const DesignEvaluator& evaluator,
+                                       const SearchControl& control = {}, bool* stopped = nullptr);
 
 // The final design: the feasible evaluation of least objective (ties: the
 // earlier start, then the earlier evaluation); with none feasible, the one

@@ -8,7 +8,8 @@
 //   2. COBYLA starts (the initial design and perturbations of it) fan out
 //      over MPI ranks and threads; each evaluation presses the mechanism
 //      quasistatically, releases it into Newmark dynamics with BBI impact
-//      and rigid flight, and measures the jump
+//      and rigid flight, and measures the jump; each start keeps a
+//      checkpoint of its evaluations (--resume replays it)
 //   3. the final design is the best feasible evaluation of all starts
 //   4. with robustness.samples > 0, the final design again under print
 //      variation (modulus and geometry), fanned out like the starts: the
@@ -23,11 +24,14 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include "cli/progress.hpp"
 #include "cli/stage_app.hpp"
 #include "core/errors.hpp"
 #include "design_artifact.hpp"
+#include "design_checkpoint.hpp"
 #include "design_config.hpp"
 #include "design_evaluation.hpp"
 #include "design_report.hpp"
@@ -50,6 +54,12 @@ int main(int argc, char** argv) {
   std::string trajectory_path;
   app.option("--trajectory", trajectory_path,
              "the final design's run (default: <out without .jump_design.h5>.final.trajectory.h5)");
+  bool resume = false;
+  int max_new_evaluations = 0;
+  app.flag("--resume", resume, "continue every start from <out>.start<k>.checkpoint.h5 (same config and seed)");
+  app.option("--max-new-evaluations", max_new_evaluations,
+             "stop each start after this many simulations in this run, keeping the checkpoints (batch jobs); "
+             "0 = no limit");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
@@ -76,9 +86,25 @@ int main(int argc, char** argv) {
           design_task_name(problem.task), problem.scene_path, problem.parameters.size(), evaluator.elements(),
           problem.starts, problem.max_evaluations, size, omp_get_max_threads());
 
-    // 2-3. Starts and the final design.
+    // 2-3. Starts (checkpointed after every evaluation) and the final design.
+    if (max_new_evaluations < 0)
+      throw InputError("--max-new-evaluations = " + std::to_string(max_new_evaluations) + ": must be >= 0");
+    SearchControl control;
+    control.checkpoint_out = out;
+    control.run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
+    control.resume = resume;
+    control.max_new_evaluations = max_new_evaluations;
     DesignRun run;
-    run.evaluations = run_all_starts(problem, evaluator);
+    bool stopped = false;
+    run.evaluations = run_all_starts(problem, evaluator, control, &stopped);
+    if (stopped) {
+      if (rank == 0)
+        std::printf(
+            "msfab-jump-design: stopped after %d new evaluations per start (%zu recorded); continue with "
+            "--resume\n",
+            max_new_evaluations, run.evaluations.size());
+      return;
+    }
     run.final = best_evaluation(run.evaluations);
     run.initial = 0;  // start 0 begins at the initial design (checked below)
     run.ranks = size;
@@ -99,6 +125,7 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       write_jump_design_artifact(out, problem, run, ctx.config.resolved_text(), ctx.options.seed);
       print_design_summary(problem, run, out);
+      for (int start = 0; start < problem.starts; ++start) std::filesystem::remove(start_checkpoint_path(out, start));
     }
 
     // 6. The final design's whole run.

@@ -74,6 +74,22 @@ same() {
 }
 check "1 and 2 ranks give identical evaluations and designs" -- same "$WORK/one.h5" "$WORK/two.h5"
 
+# Stopped after three evaluations per start (a batch job's time limit) and
+# resumed on two ranks: the recorded evaluations are replayed, not
+# simulated, and the run ends where the uninterrupted one did.
+expect_exit 0 "stopped after 3 new evaluations per start" -- "$DESIGN" --config "$WORK/design.yaml" --threads 2 \
+  --max-new-evaluations 3 --out "$WORK/part.h5"
+check "each start's checkpoint kept, no artifact yet" -- bash -c "[ -s '$WORK/part.h5.start0.checkpoint.h5' ] && \
+  [ -s '$WORK/part.h5.start1.checkpoint.h5' ] && [ ! -e '$WORK/part.h5' ]"
+expect_exit 2 "different configuration or seed" -- "$DESIGN" --config "$WORK/design.yaml" --seed 9 --resume \
+  --out "$WORK/part.h5"
+expect_exit 0 "start 0: resuming with 3 recorded evaluations" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 \
+  "$DESIGN" --config "$WORK/design.yaml" --resume --out "$WORK/part.h5"
+check "the resumed run is the uninterrupted one" -- same "$WORK/one.h5" "$WORK/part.h5"
+check "no checkpoint left" -- bash -c "! ls '$WORK'/part.h5.start*.checkpoint.h5 2> /dev/null"
+expect_exit 2 "--max-new-evaluations = -1: must be >= 0" -- "$DESIGN" --config "$WORK/design.yaml" \
+  --max-new-evaluations -1 --out "$WORK/bad.h5"
+
 # Space-filling starts (the global stage): start k > 0 begins at the k-th
 # Halton point of the box, bases 2 and 3: (1/2, 1/3), then (1/4, 2/3).
 check "space-filling starts" -- "$DESIGN" --config "$WORK/design.yaml" --set optimizer.start_points=space_filling \
