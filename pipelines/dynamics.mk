@@ -12,7 +12,8 @@
 #   make -f Makefile.pipeline design-flipper     design loops of §4.5.1 (msfab-jump-design, COBYLA starts over
 #   make -f Makefile.pipeline design-jump-onto   MPI ranks; docs/design_loop.md): flip to land upright, jump onto
 #   make -f Makefile.pipeline design-jump-over   a platform, over a wall, throw the catapult's cube at a target
-#   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores)
+#   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores; a killed loop
+#                                                resumes from its checkpoints when run again)
 #   make -f Makefile.pipeline design-strips      a side-view strip of each final jump of the design loops run so
 #                                                far (out/design/*.strip.png, python3 -m msfab strip)
 #   make -f Makefile.pipeline bench-dac-plant    DAC against accurate and convergent meshes on the plant-like
@@ -53,7 +54,7 @@ $(DYN)/catapult.trajectory.h5: configs/dynamics/catapult.yaml $(STAGE_ID)/msfab-
 
 $(OUT)/design/%.jump_design.h5: configs/design/%.yaml $(STAGE_ID)/msfab-jump-design.id
 	@mkdir -p $(@D)
-	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-jump-design --config $< --out $@
+	OMP_NUM_THREADS=$(THREADS) $(MPIRUN) $(BIN)/msfab-jump-design --config $< --out $@ --resume
 
 # The final run is written with the design artifact.
 $(OUT)/design/%.strip.png: $(OUT)/design/%.jump_design.h5
