@@ -119,8 +119,16 @@ const Evaluation& evaluation_at(StartState& s, const double* u) {
   ++s.simulated;
   s.last_x.assign(u, u + n);
   log_evaluation(*s.problem, s.evaluations.back());
-  if (!c.checkpoint_out.empty())
-    write_start_checkpoint(start_checkpoint_path(c.checkpoint_out, s.start), c.run_text, *s.problem, s.evaluations);
+  if (!c.checkpoint_out.empty()) {
+    // NLopt would swallow an exception here and stop the start; a
+    // checkpoint that cannot be written (a full disk) must not end a search.
+    const std::string path = start_checkpoint_path(c.checkpoint_out, s.start);
+    try {
+      write_start_checkpoint(path, c.run_text, *s.problem, s.evaluations);
+    } catch (const std::exception& e) {
+      spdlog::warn("start {}: checkpoint {} not written ({}); the search goes on", s.start, path, e.what());
+    }
+  }
   return s.evaluations.back();
 }
 
