@@ -7,6 +7,10 @@ namespace msfab {
 
 std::string checkpoint_path(const std::string& out) { return out + ".checkpoint.h5"; }
 
+std::string checkpoint_run_text(const std::string& resolved_config, std::uint64_t seed) {
+  return resolved_config + "# seed " + std::to_string(seed) + "\n";
+}
+
 void write_checkpoint_file(const std::string& path, const std::string& schema, const std::string& run_text,
                            const std::function<void(H5File&)>& write_state) {
   AtomicFile tmp(path);

@@ -7,6 +7,7 @@
 //     seed where results depend on it);
 //   - read back only when both match, so a resume never mixes two runs.
 // The stage writes and reads its own state inside the file.
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -15,6 +16,10 @@
 namespace msfab {
 
 std::string checkpoint_path(const std::string& out);
+
+// The text a checkpoint is tagged with when the run depends on its seed as
+// well as on its config.
+std::string checkpoint_run_text(const std::string& resolved_config, std::uint64_t seed);
 
 void write_checkpoint_file(const std::string& path, const std::string& schema, const std::string& run_text,
                            const std::function<void(H5File&)>& write_state);

@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     } catch (const InputError& e) {
       throw InputError(std::string("--structures ") + e.what());
     }
-    const std::string run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
+    const std::string run_text = checkpoint_run_text(ctx.config.resolved_text(), ctx.options.seed);
     const GamutSampler sampler(options, ctx.options.seed);
     if (rank == 0)
       spdlog::info("{} gamut, {}^{} voxel cells, population {}, {} cycles; {} rank(s) x {} thread(s)", options.space,

@@ -11,13 +11,13 @@ namespace {
 constexpr const char* kSchema = "msfab.jump_design";
 constexpr int kVersion = 1;
 
-std::vector<double> outcome_row(const Evaluation& e) {
-  const JumpOutcome& o = e.outcome;
-  return {double(o.lifted_off), double(o.landed),  double(o.upright),      o.lift_off_time,      o.landing_time,
-          o.end_time,           o.flip_at_landing, o.flip_at_end,          o.com_at_landing.x(), o.com_at_landing.y(),
-          o.com_at_landing.z(), o.com_at_end.x(),  o.com_at_end.y(),       o.com_at_end.z(),     o.com_highest.x(),
-          o.com_highest.y(),    o.com_highest.z(), double(e.crossed_wall), e.z_over_wall};
+std::vector<double> outcome_row(const JumpOutcome& o, bool crossed_wall, double z_over_wall) {
+  return {double(o.lifted_off), double(o.landed),  double(o.upright),    o.lift_off_time,      o.landing_time,
+          o.end_time,           o.flip_at_landing, o.flip_at_end,        o.com_at_landing.x(), o.com_at_landing.y(),
+          o.com_at_landing.z(), o.com_at_end.x(),  o.com_at_end.y(),     o.com_at_end.z(),     o.com_highest.x(),
+          o.com_highest.y(),    o.com_highest.z(), double(crossed_wall), z_over_wall};
 }
+std::vector<double> outcome_row(const Evaluation& e) { return outcome_row(e.outcome, e.crossed_wall, e.z_over_wall); }
 
 void write_design(H5File& f, const std::string& group, const Evaluation& e) {
   f.create_group(group);
@@ -113,13 +113,10 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
     // constraints are the worse of the two steps.
     std::vector<double> confirm_objective(n), confirm_outcome;
     for (std::size_t i = 0; i < n; ++i) {
-      Evaluation confirm = run.evaluations[i];
-      confirm.outcome = confirm.confirm_outcome;
-      confirm.crossed_wall = confirm.confirm_crossed_wall;
-      confirm.z_over_wall = confirm.confirm_z_over_wall;
+      const Evaluation& e = run.evaluations[i];
       // NaN where the run at the scene's step failed and was not repeated.
-      confirm_objective[i] = confirm.confirmed ? confirm.confirm_objective : std::nan("");
-      const std::vector<double> row = outcome_row(confirm);
+      confirm_objective[i] = e.confirmed ? e.confirm_objective : std::nan("");
+      const std::vector<double> row = outcome_row(e.confirm_outcome, e.confirm_crossed_wall, e.confirm_z_over_wall);
       confirm_outcome.insert(confirm_outcome.end(), row.begin(), row.end());
     }
     f.write_attribute("/evaluations", "confirm_time_step", p.confirm_time_step);

@@ -11,7 +11,7 @@ namespace msfab {
 namespace {
 constexpr const char* kSchema = "msfab.jump_design.checkpoint";
 // HDF5 (Debian's build) is not thread-safe; starts on the threads of one
-// rank take turns. A mutex, not an OpenMP critical section: a failed write
+// rank take turns writing. A mutex, not an OpenMP critical section: a failed write
 // throws, and must release it.
 std::mutex hdf5_mutex;
 }  // namespace
@@ -34,7 +34,6 @@ void write_start_checkpoint(const std::string& path, const std::string& run_text
 std::vector<Evaluation> read_start_checkpoint(const std::string& path, const std::string& run_text,
                                               const DesignProblem& problem) {
   std::vector<Evaluation> evaluations;
-  const std::lock_guard<std::mutex> lock(hdf5_mutex);
   if (!std::filesystem::exists(path)) return evaluations;
   const H5File f = open_checkpoint_file(path, kSchema, "jump-design", run_text);
   const NdArray<double> rows = f.read_dataset<double>("/evaluations", Finite::nan_means_missing);

@@ -17,11 +17,12 @@ namespace msfab {
 
 std::string start_checkpoint_path(const std::string& out, int start);
 
-// Thread-safe: HDF5 calls of concurrent starts are serialized.
+// Thread-safe: writes of concurrent starts are serialized.
 void write_start_checkpoint(const std::string& path, const std::string& run_text, const DesignProblem& problem,
                             const std::vector<Evaluation>& evaluations);
 
-// The recorded evaluations; an empty list when there is no file. InputError
+// The recorded evaluations; an empty list when there is no file. Read
+// before the starts fan out (not thread-safe). InputError
 // naming the file when it is not such a checkpoint or was written by
 // another run (config or seed).
 std::vector<Evaluation> read_start_checkpoint(const std::string& path, const std::string& run_text,

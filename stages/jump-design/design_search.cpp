@@ -7,6 +7,7 @@
 #include <iterator>
 #include <nlopt.hpp>
 #include <string>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "design_checkpoint.hpp"
@@ -145,15 +146,12 @@ void constraints(unsigned m, double* result, unsigned, const double* u, double*,
 
 }  // namespace
 
-StartResult run_start(const DesignProblem& p, const DesignEvaluator& evaluator, int start,
-                      const SearchControl& control) {
+StartResult run_start(const DesignProblem& p, const DesignEvaluator& evaluator, int start, const SearchControl& control,
+                      std::vector<Evaluation> replay) {
   const unsigned n = static_cast<unsigned>(p.parameters.size());
-  StartState state{&p, &evaluator, &control, start, {}, {}, {}, 0, false};
-  if (control.resume && !control.checkpoint_out.empty()) {
-    state.replay = read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
-    if (!state.replay.empty())
-      spdlog::info("start {}: resuming with {} recorded evaluations", start, state.replay.size());
-  }
+  StartState state{&p, &evaluator, &control, start, {}, {}, std::move(replay), 0, false};
+  if (!state.replay.empty())
+    spdlog::info("start {}: resuming with {} recorded evaluations", start, state.replay.size());
   nlopt::opt opt(nlopt::LN_COBYLA, n);
   std::vector<double> u(n), step(n);
   const std::vector<double> x0 = start_point(p, start);
@@ -199,13 +197,14 @@ std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvalu
                                        const SearchControl& control, bool* stopped) {
   const int per = evaluation_record_size(p);
   const int row = 2 + p.max_evaluations * per;  // count, stopped, the evaluations
-  // Checkpoints of another run are bad input: refused here, before the
-  // fan-out (which reports failures inside it as numerical ones).
+  // Read before the fan-out, which would report a checkpoint of another run
+  // (bad input) as a numerical failure.
+  std::vector<std::vector<Evaluation>> replays(p.starts);
   if (control.resume && !control.checkpoint_out.empty())
     for (int start = 0; start < p.starts; ++start)
-      read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
+      replays[start] = read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
   const std::vector<double> records = fan_out(p.starts, row, [&](int start, double* r) {
-    const StartResult result = run_start(p, evaluator, start, control);
+    const StartResult result = run_start(p, evaluator, start, control, std::move(replays[start]));
     const std::size_t count =
         std::min<std::size_t>(result.evaluations.size(), static_cast<std::size_t>(p.max_evaluations));
     r[0] = static_cast<double>(count);

@@ -25,7 +25,7 @@ std::vector<double> start_point(const DesignProblem& problem, int start);
 struct SearchControl {
   std::string checkpoint_out;   // the artifact's path; empty: no checkpoints
   std::string run_text;         // config and seed the checkpoints are tagged with
-  bool resume = false;          // replay each start's checkpoint first
+  bool resume = false;          // run_all_starts replays each start's checkpoint first
   int max_new_evaluations = 0;  // per start in this run (0: no limit); then stop, keeping the checkpoints
 };
 
@@ -35,9 +35,11 @@ struct StartResult {
 };
 
 // One COBYLA run of at most max_evaluations simulations; every evaluation
-// is logged as it finishes and, with checkpoints, recorded.
+// is logged as it finishes and, with checkpoints, recorded. `replay`: the
+// start's recorded evaluations, handed back instead of simulated while
+// COBYLA asks for their points.
 StartResult run_start(const DesignProblem& problem, const DesignEvaluator& evaluator, int start,
-                      const SearchControl& control = {});
+                      const SearchControl& control = {}, std::vector<Evaluation> replay = {});
 
 // Every start on every rank; the evaluations of all starts, ordered by start
 // and index, identical on every rank. `stopped`: some start stopped at the

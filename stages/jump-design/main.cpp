@@ -39,6 +39,7 @@
 #include "design_search.hpp"
 #include "dynamics/trajectory.hpp"
 #include "io/atomic_file.hpp"
+#include "io/checkpoint_file.hpp"
 #include "io/path_names.hpp"
 #include "parallel/fan_out.hpp"
 #include "parallel/mpi_session.hpp"
@@ -91,7 +92,7 @@ int main(int argc, char** argv) {
       throw InputError("--max-new-evaluations = " + std::to_string(max_new_evaluations) + ": must be >= 0");
     SearchControl control;
     control.checkpoint_out = out;
-    control.run_text = ctx.config.resolved_text() + "# seed " + std::to_string(ctx.options.seed) + "\n";
+    control.run_text = checkpoint_run_text(ctx.config.resolved_text(), ctx.options.seed);
     control.resume = resume;
     control.max_new_evaluations = max_new_evaluations;
     DesignRun run;
