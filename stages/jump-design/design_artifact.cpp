@@ -124,6 +124,24 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
     f.write_dataset("/evaluations/confirm_outcome", confirm_outcome, {hsize_t(n), hsize_t(outcome_columns().size())});
     f.write_attribute("/evaluations/confirm_outcome", "columns", format_name_list(outcome_columns()));
   }
+  if (!p.modulus_scales.empty()) {
+    // The runs at each modulus factor; /evaluations/objective and
+    // constraints are the worst of all runs. NaN where the run at the
+    // scene's modulus failed and the factors were not run.
+    const std::size_t ns = p.modulus_scales.size(), nk = outcome_columns().size();
+    std::vector<double> scaled_objective(n * ns, std::nan("")), scaled_outcome(n * ns * nk, std::nan(""));
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < run.evaluations[i].scaled.size(); ++k) {
+        const ScaledRun& r = run.evaluations[i].scaled[k];
+        scaled_objective[i * ns + k] = r.objective;
+        const std::vector<double> row = outcome_row(r.outcome, r.crossed_wall, r.z_over_wall);
+        std::copy(row.begin(), row.end(), scaled_outcome.begin() + (i * ns + k) * nk);
+      }
+    f.write_attribute("/evaluations", "modulus_scales", p.modulus_scales);
+    f.write_dataset("/evaluations/modulus_scale_objective", scaled_objective, {hsize_t(n), hsize_t(ns)});
+    f.write_dataset("/evaluations/modulus_scale_outcome", scaled_outcome, {hsize_t(n), hsize_t(ns), hsize_t(nk)});
+    f.write_attribute("/evaluations/modulus_scale_outcome", "columns", format_name_list(outcome_columns()));
+  }
   if (nc > 0) {
     f.write_dataset("/evaluations/constraints", constraints, {hsize_t(n), hsize_t(nc)});
     f.write_attribute("/evaluations/constraints", "units", "m (feasible when <= 0)");

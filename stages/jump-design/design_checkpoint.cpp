@@ -24,7 +24,7 @@ void write_start_checkpoint(const std::string& path, const std::string& run_text
                             const std::vector<Evaluation>& evaluations) {
   const std::size_t per = static_cast<std::size_t>(evaluation_record_size(problem));
   std::vector<double> rows(evaluations.size() * per);
-  for (std::size_t i = 0; i < evaluations.size(); ++i) pack_evaluation(evaluations[i], rows.data() + i * per);
+  for (std::size_t i = 0; i < evaluations.size(); ++i) pack_evaluation(problem, evaluations[i], rows.data() + i * per);
   const std::lock_guard<std::mutex> lock(hdf5_mutex);
   write_checkpoint_file(path, kSchema, run_text, [&](H5File& f) {
     f.write_dataset("/evaluations", rows, {hsize_t(evaluations.size()), hsize_t(per)});

@@ -43,6 +43,18 @@ void read_measure(const Config& c, DesignProblem& p) {
   if (!(p.settle >= 0)) s.fail("settle", "must be >= 0 (s)");
   if (s.has("confirm_time_step"))
     p.confirm_time_step = s.require_positive<double>("confirm_time_step", "time step (s)");
+  if (s.has("modulus_scales")) {
+    p.modulus_scales = s.get<std::vector<double>>("modulus_scales");
+    if (p.modulus_scales.empty() || p.modulus_scales.size() > 8)
+      s.fail("modulus_scales", "needs 1 to 8 factors of the modulus");
+    for (std::size_t i = 0; i < p.modulus_scales.size(); ++i) {
+      const double f = p.modulus_scales[i];
+      if (!(f > 0) || !(f <= 10)) s.fail("modulus_scales", "factor " + std::to_string(f) + " is not in (0, 10]");
+      if (f == 1) s.fail("modulus_scales", "factor 1 is the scene's own modulus, which every evaluation runs anyway");
+      for (std::size_t j = 0; j < i; ++j)
+        if (p.modulus_scales[j] == f) s.fail("modulus_scales", "factor " + std::to_string(f) + " is listed twice");
+    }
+  }
   const std::string axis = s.get_or("flip_axis", "y");
   if (axis != "x" && axis != "y" && axis != "z") s.fail("flip_axis", "must be x, y or z");
   m.flip_axis = axis[0] - 'x';

@@ -58,6 +58,13 @@ struct DesignProblem {
   // An outcome decided by a graze or an edge strike changes with the step,
   // so a design whose score holds at both does not rest on one.
   double confirm_time_step = 0;
+  // Every evaluation also runs with every material's modulus times each of
+  // these factors (at the scene's time step) and scores the worst of all
+  // its runs (measure.modulus_scales; empty: the scene's modulus only). A
+  // print's modulus varies by tens of percent and the turn in the air
+  // follows it (docs/design_loop.md), so a design scored this way does not
+  // rest on one modulus.
+  std::vector<double> modulus_scales;
   // Optimizer.
   int max_evaluations = 20;  // per start
   int starts = 1;            // the initial design and starts - 1 more (see start_point)

@@ -27,15 +27,29 @@ double Evaluation::violation() const {
   return v;
 }
 
+bool Evaluation::landed_in_every_run() const {
+  if (!ok || !outcome.landed || (confirmed && !confirm_outcome.landed)) return false;
+  for (const ScaledRun& r : scaled)
+    if (!r.outcome.landed) return false;
+  return true;
+}
+
 // Row layout: start, index, ok, objective, seconds, elements, crossed_wall,
 // z_over_wall, confirmed, confirm_objective, confirm_crossed_wall,
-// confirm_z_over_wall, then the parameters, the
-// constraints, the jump outcome and the confirmation's outcome
-// (kOutcomeSize numbers each, in the order of pack_outcome).
+// confirm_z_over_wall, then the parameters, the constraints, the jump
+// outcome and the confirmation's outcome (kOutcomeSize numbers each, in the
+// order of pack_outcome), then one block per modulus factor: ran, ok,
+// objective, crossed_wall, z_over_wall, constraints, outcome (zeros where
+// it did not run).
 namespace {
 
 constexpr int kHeader = 12;
 constexpr int kOutcomeSize = 17;
+constexpr int kScaledHeader = 5;
+
+int scaled_block_size(const DesignProblem& p) {
+  return kScaledHeader + static_cast<int>(constraint_names(p.task).size()) + kOutcomeSize;
+}
 
 void pack_outcome(const JumpOutcome& o, double* r) {
   const double v[kOutcomeSize] = {double(o.lifted_off), double(o.landed),     double(o.upright),    o.lift_off_time,
@@ -65,10 +79,13 @@ JumpOutcome unpack_outcome(const double* r) {
 }  // namespace
 
 int evaluation_record_size(const DesignProblem& p) {
-  return kHeader + static_cast<int>(p.parameters.size() + constraint_names(p.task).size()) + 2 * kOutcomeSize;
+  return kHeader + static_cast<int>(p.parameters.size() + constraint_names(p.task).size()) + 2 * kOutcomeSize +
+         static_cast<int>(p.modulus_scales.size()) * scaled_block_size(p);
 }
 
-void pack_evaluation(const Evaluation& e, double* r) {
+void pack_evaluation(const DesignProblem& problem, const Evaluation& e, double* r) {
+  if (e.scaled.size() > problem.modulus_scales.size())
+    throw NumericalError("pack_evaluation: more modulus-scaled runs than measure.modulus_scales lists");
   r[0] = e.start;
   r[1] = e.index;
   r[2] = e.ok ? 1 : 0;
@@ -86,6 +103,19 @@ void pack_evaluation(const Evaluation& e, double* r) {
   for (double g : e.constraints) *p++ = g;
   pack_outcome(e.outcome, p);
   pack_outcome(e.confirm_outcome, p + kOutcomeSize);
+  p += 2 * kOutcomeSize;
+  const int block = scaled_block_size(problem);
+  std::fill(p, p + problem.modulus_scales.size() * block, 0.0);
+  for (const ScaledRun& s : e.scaled) {
+    p[0] = 1;
+    p[1] = s.ok ? 1 : 0;
+    p[2] = s.objective;
+    p[3] = s.crossed_wall ? 1 : 0;
+    p[4] = s.z_over_wall;
+    std::copy(s.constraints.begin(), s.constraints.end(), p + kScaledHeader);
+    pack_outcome(s.outcome, p + kScaledHeader + s.constraints.size());
+    p += block;
+  }
 }
 
 Evaluation unpack_evaluation(const DesignProblem& problem, const double* r) {
@@ -109,6 +139,20 @@ Evaluation unpack_evaluation(const DesignProblem& problem, const double* r) {
   e.constraints.assign(p, p + nc);
   e.outcome = unpack_outcome(p + nc);
   e.confirm_outcome = unpack_outcome(p + nc + kOutcomeSize);
+  p += nc + 2 * kOutcomeSize;
+  for (double factor : problem.modulus_scales) {
+    if (p[0] == 0) break;
+    ScaledRun s;
+    s.modulus_scale = factor;
+    s.ok = p[1] != 0;
+    s.objective = p[2];
+    s.crossed_wall = p[3] != 0;
+    s.z_over_wall = p[4];
+    s.constraints.assign(p + kScaledHeader, p + kScaledHeader + nc);
+    s.outcome = unpack_outcome(p + kScaledHeader + nc);
+    e.scaled.push_back(std::move(s));
+    p += scaled_block_size(problem);
+  }
   return e;
 }
 
@@ -258,24 +302,34 @@ Evaluation DesignEvaluator::simulate(const std::vector<double>& values, double m
   return e;
 }
 
-Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index,
-                                     double modulus_scale) const {
+Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int start, int index, double modulus_scale,
+                                     bool with_modulus_scales) const {
   const auto t0 = std::chrono::steady_clock::now();
   Evaluation e = simulate(values, modulus_scale, 0);
-  if (e.ok && problem_.confirm_time_step > 0) {
-    // The worse of the two steps counts: objective, each constraint, and a
-    // failure at either step fails the evaluation.
+  // The worst of all runs counts: the objective, each constraint, and a
+  // failure of any run fails the evaluation.
+  const auto fold = [&e](const Evaluation& other) {
+    e.ok = e.ok && other.ok;
+    e.objective = std::max(e.objective, other.objective);
+    for (std::size_t i = 0; i < e.constraints.size(); ++i)
+      e.constraints[i] = std::max(e.constraints[i], other.constraints[i]);
+  };
+  const bool first_ok = e.ok;
+  if (first_ok && problem_.confirm_time_step > 0) {
     const Evaluation c = simulate(values, modulus_scale, problem_.confirm_time_step);
     e.confirmed = true;
     e.confirm_objective = c.objective;
     e.confirm_outcome = c.outcome;
     e.confirm_crossed_wall = c.crossed_wall;
     e.confirm_z_over_wall = c.z_over_wall;
-    e.ok = c.ok;
-    e.objective = std::max(e.objective, c.objective);
-    for (std::size_t i = 0; i < e.constraints.size(); ++i)
-      e.constraints[i] = std::max(e.constraints[i], c.constraints[i]);
+    fold(c);
   }
+  if (first_ok && with_modulus_scales)
+    for (double factor : problem_.modulus_scales) {
+      const Evaluation c = simulate(values, modulus_scale * factor, 0);
+      e.scaled.push_back({factor, c.ok, c.objective, c.constraints, c.outcome, c.crossed_wall, c.z_over_wall});
+      fold(c);
+    }
   e.start = start;
   e.index = index;
   e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

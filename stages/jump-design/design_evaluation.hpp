@@ -13,6 +13,17 @@
 
 namespace msfab {
 
+// One run of a design at a factor of the modulus (measure.modulus_scales).
+struct ScaledRun {
+  double modulus_scale = 1;         // relative to the evaluation's own modulus
+  bool ok = false;                  // the simulation succeeded
+  double objective = 0;             // this run alone
+  std::vector<double> constraints;  // this run alone
+  JumpOutcome outcome;
+  bool crossed_wall = false;
+  double z_over_wall = 0;
+};
+
 struct Evaluation {
   int start = 0, index = 0;         // which optimizer start, which of its evaluations
   std::vector<double> parameters;   // physical values, in DesignProblem order
@@ -30,16 +41,24 @@ struct Evaluation {
   double z_over_wall = 0;     // its height there (m); the wall's foot if it never crossed
   bool confirm_crossed_wall = false;
   double confirm_z_over_wall = 0;
+  // With measure.modulus_scales: the run at each factor, folded into the
+  // objective and constraints above in the same way (the worst counts).
+  // Empty where the run at the scene's modulus failed, and for print
+  // variation samples, which are a variation of the modulus themselves.
+  std::vector<ScaledRun> scaled;
   int elements = 0;
 
   // Constraints met to within `tolerance` (m) and the simulation succeeded.
   bool feasible(double tolerance = 1e-6) const;
   double violation() const;  // sum of positive constraint values (m)
+  // Every run it was scored by (scene's step, confirmation, each modulus
+  // factor) landed.
+  bool landed_in_every_run() const;
 };
 
 // Fixed-size rows of doubles for the MPI fan-out (layout in the .cpp).
 int evaluation_record_size(const DesignProblem& problem);
-void pack_evaluation(const Evaluation& e, double* row);
+void pack_evaluation(const DesignProblem& problem, const Evaluation& e, double* row);
 Evaluation unpack_evaluation(const DesignProblem& problem, const double* row);
 
 class DesignEvaluator {
@@ -51,8 +70,10 @@ class DesignEvaluator {
   // Safe to call from several threads at once (each call reads its own
   // copy of the scene). A simulation that fails gives ok = false and
   // penalty values; bad input still throws. `modulus_scale` multiplies
-  // every material's modulus (print variation).
-  Evaluation evaluate(const std::vector<double>& parameters, int start, int index, double modulus_scale = 1.0) const;
+  // every material's modulus (print variation); `with_modulus_scales`
+  // false skips the runs at measure.modulus_scales.
+  Evaluation evaluate(const std::vector<double>& parameters, int start, int index, double modulus_scale = 1.0,
+                      bool with_modulus_scales = true) const;
 
   // The whole run of a design, with the scene's output frames, up to
   // `until` seconds (or the scene's duration if that is shorter): the

@@ -39,6 +39,14 @@ void print_design_summary(const DesignProblem& p, const DesignRun& run, const st
   if (p.confirm_time_step > 0)
     row(("objective at h = " + num(p.confirm_time_step, "%.3g") + " s").c_str(), num(a.confirm_objective, "%.5g"),
         num(b.confirm_objective, "%.5g"));
+  for (std::size_t k = 0; k < p.modulus_scales.size(); ++k) {
+    const auto scaled = [k](const Evaluation& e) {
+      return k < e.scaled.size() ? num(e.scaled[k].objective, "%.5g") + ", " +
+                                       num(e.scaled[k].outcome.flip_at_landing * 180 / M_PI, "%.1f") + " deg"
+                                 : std::string("not run");
+    };
+    row(("objective, flip at E x " + num(p.modulus_scales[k], "%g")).c_str(), scaled(a), scaled(b));
+  }
   const std::vector<std::string> names = constraint_names(p.task);
   for (std::size_t i = 0; i < names.size(); ++i)
     row((names[i] + " (m)").c_str(), num(a.constraints[i], "%+.4f"), num(b.constraints[i], "%+.4f"));
@@ -54,6 +62,12 @@ void print_design_summary(const DesignProblem& p, const DesignRun& run, const st
   row("COM x, z at landing (m)", xz(a.outcome.com_at_landing), xz(b.outcome.com_at_landing));
   if (p.confirm_time_step > 0)
     row("... at the confirm step", xz(a.confirm_outcome.com_at_landing), xz(b.confirm_outcome.com_at_landing));
+  for (std::size_t k = 0; k < p.modulus_scales.size(); ++k) {
+    const auto at = [k](const Evaluation& e) {
+      return k < e.scaled.size() ? xz(e.scaled[k].outcome.com_at_landing) : std::string("not run");
+    };
+    row(("... at E x " + num(p.modulus_scales[k], "%g")).c_str(), at(a), at(b));
+  }
   row("COM x, z at end (m)", xz(a.outcome.com_at_end), xz(b.outcome.com_at_end));
   row("highest COM z (m)", num(a.outcome.com_highest.z(), "%.4f"), num(b.outcome.com_highest.z(), "%.4f"));
   if (p.task == DesignTask::kJumpOver)

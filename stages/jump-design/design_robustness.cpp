@@ -10,7 +10,7 @@
 namespace msfab {
 
 bool design_succeeded(const DesignProblem& p, const Evaluation& e) {
-  if (!e.ok || !e.outcome.landed || (e.confirmed && !e.confirm_outcome.landed)) return false;
+  if (!e.landed_in_every_run()) return false;
   // The objective is the worse of the two time steps when confirmed
   // (design_evaluation.hpp): miss^2 of the turn, or the target distance.
   const double tolerance = p.measure.upright_tolerance;
@@ -38,10 +38,10 @@ RobustnessResult check_robustness(const DesignProblem& p, const DesignEvaluator&
   }
   const int per = evaluation_record_size(p);
   const std::vector<double> records = fan_out(r.samples, per, [&](int i, double* row) {
-    const Evaluation e = evaluator.evaluate(parameters[i], -1, i, modulus[i]);
+    const Evaluation e = evaluator.evaluate(parameters[i], -1, i, modulus[i], false);
     spdlog::info("print variation {}: E x {:.3f}, {} : {} ({:.1f} s)", i, modulus[i], fmt::join(parameters[i], ", "),
                  design_succeeded(p, e) ? "succeeds" : "fails", e.seconds);
-    pack_evaluation(e, row);
+    pack_evaluation(p, e, row);
   });
   RobustnessResult result;
   for (int i = 0; i < r.samples; ++i) {

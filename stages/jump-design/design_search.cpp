@@ -88,8 +88,14 @@ void log_evaluation(const DesignProblem& p, const Evaluation& e) {
                                   ? fmt::format(" (at the confirm step {:.5g}, flip {:.1f} deg)", e.confirm_objective,
                                                 e.confirm_outcome.flip_at_landing * 180 / M_PI)
                                   : "";
-  spdlog::info("start {} evaluation {}: {}: objective {:.5g}{}{}, flip at landing {:.1f} deg{}, {:.1f} s", e.start,
-               e.index, params, e.objective, confirm, constraints, e.outcome.flip_at_landing * 180 / M_PI,
+  std::string scaled;
+  for (const ScaledRun& r : e.scaled)
+    scaled +=
+        fmt::format("{}E x {:g}: {:.5g}, flip {:.1f} deg, x {:.4f} m", scaled.empty() ? " (" : "; ", r.modulus_scale,
+                    r.objective, r.outcome.flip_at_landing * 180 / M_PI, r.outcome.com_at_landing.x());
+  if (!scaled.empty()) scaled += ")";
+  spdlog::info("start {} evaluation {}: {}: objective {:.5g}{}{}{}, flip at landing {:.1f} deg{}, {:.1f} s", e.start,
+               e.index, params, e.objective, confirm, scaled, constraints, e.outcome.flip_at_landing * 180 / M_PI,
                e.ok ? "" : " (simulation failed)", e.seconds);
 }
 
@@ -209,7 +215,7 @@ std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvalu
         std::min<std::size_t>(result.evaluations.size(), static_cast<std::size_t>(p.max_evaluations));
     r[0] = static_cast<double>(count);
     r[1] = result.stopped ? 1 : 0;
-    for (std::size_t k = 0; k < count; ++k) pack_evaluation(result.evaluations[k], r + 2 + k * per);
+    for (std::size_t k = 0; k < count; ++k) pack_evaluation(p, result.evaluations[k], r + 2 + k * per);
   });
   std::vector<Evaluation> all;
   if (stopped) *stopped = false;

@@ -126,6 +126,71 @@ expect_exit 2 "measure.confirm_time_step = 0.001 s is the scene's own time step"
 expect_exit 2 "measure.confirm_time_step.*positive" -- \
   "$DESIGN" --config "$WORK/design.yaml" --set measure.confirm_time_step=-1e-3 --out "$WORK/bad.h5"
 
+# Modulus factors: every evaluation also runs with the modulus times each
+# factor and scores the worst of its runs, exactly the runs at each modulus
+# alone. A tiny jumper (two plates and a flexure, pressed and released),
+# whose turn in the air grows with its modulus: 18, 31 and 101 degrees at
+# E x 0.8, 1 and 1.2.
+cat > "$WORK/jumper.yaml" <<'YAML'
+name: tiny-jumper
+parameters: {length: 0.020, hinge_height: 0.010}
+materials: [{name: m, E: 2.0e5, nu: 0.3, density: 1000, damping_a: 0, damping_b: 1.0e-3}]
+geometry:
+  voxel_size: 0.005
+  boxes:
+    - {material: m, min: [0, 0, 0], max: [length, 0.005, 0.005]}
+    - {material: m, min: ["length - 0.005", 0, 0.005], max: [length, 0.005, "0.005 + hinge_height"]}
+    - {material: m, min: [0, 0, "0.005 + hinge_height"], max: [length, 0.005, "0.010 + hinge_height"]}
+obstacles: [{type: ground, z: 0}]
+press:
+  region: {min: [0, 0, "0.010 + hinge_height"], max: [0.005, 0.005, "0.010 + hinge_height"]}
+  force: [0, 0, -0.05]
+  steps: 4
+  stop_at_touch: true
+simulation: {time_step: 5.0e-4, duration: 0.4, impact: bbi, rigid_flight: {enabled: true}}
+YAML
+cat > "$WORK/flip.yaml" <<YAML
+scene: $WORK/jumper.yaml
+parameters:
+  - {name: length, lower: 0.015, upper: 0.025, step: 0.005}
+  - {name: hinge_height, lower: 0.005, upper: 0.015, step: 0.005}
+task: flip
+target_flip_deg: 0
+measure: {settle: 0.002}
+optimizer: {max_evaluations: 1, starts: 1}
+YAML
+for m in 0.8 1 1.2; do
+  check "the tiny jumper at E x $m" -- "$DESIGN" --config "$WORK/flip.yaml" --set "scene_set=[\"modulus_scale=$m\"]" \
+    --quiet --out "$WORK/modulus$m.h5"
+done
+check "the tiny jumper scored over E x 0.8 and 1.2, with print variation" -- "$DESIGN" --config "$WORK/flip.yaml" \
+  --set 'measure.modulus_scales=[0.8, 1.2]' --set robustness.samples=3 --quiet --out "$WORK/scaled.h5"
+check "... and without the factors" -- "$DESIGN" --config "$WORK/flip.yaml" --set robustness.samples=3 --quiet \
+  --out "$WORK/unscaled.h5"
+check "the objective is the worst of the three moduli, each run kept as it ran alone" -- env \
+  PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -c "
+import sys, h5py, numpy as np
+run = {m: h5py.File('$WORK/modulus%s.h5' % m) for m in ('0.8', '1', '1.2')}
+s = h5py.File('$WORK/scaled.h5')
+objective = {m: f['/evaluations/objective'][0] for m, f in run.items()}
+print('turn at landing (deg):', {m: round(float(np.degrees(np.sqrt(o))), 1) for m, o in objective.items()})
+ok = s['/evaluations/objective'][0] == max(objective.values()) and len(set(objective.values())) == 3
+ok = ok and list(s['/evaluations'].attrs['modulus_scales']) == [0.8, 1.2]
+for k, m in enumerate(('0.8', '1.2')):
+    ok = ok and s['/evaluations/modulus_scale_objective'][0, k] == objective[m]
+    ok = ok and np.array_equal(s['/evaluations/modulus_scale_outcome'][0, k], run[m]['/evaluations/outcome'][0])
+ok = ok and np.array_equal(s['/evaluations/outcome'][0], run['1']['/evaluations/outcome'][0])
+# Print-variation samples vary the modulus themselves: scored alone.
+u = h5py.File('$WORK/unscaled.h5')
+ok = ok and np.array_equal(s['/robustness/objective'][()], u['/robustness/objective'][()])
+sys.exit(0 if ok else 1)"
+expect_exit 2 "measure.modulus_scales.*factor 1 is the scene's own modulus" -- "$DESIGN" --config "$WORK/flip.yaml" \
+  --set 'measure.modulus_scales=[0.8, 1]' --out "$WORK/bad.h5"
+expect_exit 2 "measure.modulus_scales.*not in \(0, 10\]" -- "$DESIGN" --config "$WORK/flip.yaml" \
+  --set 'measure.modulus_scales=[-0.5]' --out "$WORK/bad.h5"
+expect_exit 2 "measure.modulus_scales.*listed twice" -- "$DESIGN" --config "$WORK/flip.yaml" \
+  --set 'measure.modulus_scales=[0.8, 0.8]' --out "$WORK/bad.h5"
+
 # Print variation of the final design: the samples are recorded, do not
 # depend on the rank count, and a throw that hits within 2 mm still hits
 # within 1 cm with E +-20% and the length +-0.2 mm.
