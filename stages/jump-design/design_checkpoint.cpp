@@ -20,8 +20,12 @@ std::string start_checkpoint_path(const std::string& out, int start) {
   return out + ".start" + std::to_string(start) + ".checkpoint.h5";
 }
 
-void write_start_checkpoint(const std::string& path, const std::string& run_text, const DesignProblem& problem,
-                            const std::vector<Evaluation>& evaluations) {
+std::string sample_checkpoint_path(const std::string& out, int sample) {
+  return out + ".sample" + std::to_string(sample) + ".checkpoint.h5";
+}
+
+void write_evaluations_checkpoint(const std::string& path, const std::string& run_text, const DesignProblem& problem,
+                                  const std::vector<Evaluation>& evaluations) {
   const std::size_t per = static_cast<std::size_t>(evaluation_record_size(problem));
   std::vector<double> rows(evaluations.size() * per);
   for (std::size_t i = 0; i < evaluations.size(); ++i) pack_evaluation(problem, evaluations[i], rows.data() + i * per);
@@ -31,8 +35,8 @@ void write_start_checkpoint(const std::string& path, const std::string& run_text
   });
 }
 
-std::vector<Evaluation> read_start_checkpoint(const std::string& path, const std::string& run_text,
-                                              const DesignProblem& problem) {
+std::vector<Evaluation> read_evaluations_checkpoint(const std::string& path, const std::string& run_text,
+                                                    const DesignProblem& problem) {
   std::vector<Evaluation> evaluations;
   if (!std::filesystem::exists(path)) return evaluations;
   const H5File f = open_checkpoint_file(path, kSchema, "jump-design", run_text);

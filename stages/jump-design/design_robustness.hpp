@@ -4,12 +4,17 @@
 // material's modulus by 1 + modulus (2 u - 1) and moves every design
 // parameter by geometry (2 u - 1), u uniform in [0, 1) from the run's seed,
 // drawn alike on every rank; the samples fan out over ranks and threads like
-// the starts, so the result does not depend on either count.
+// the starts, so the result does not depend on either count. With
+// checkpoints (control.checkpoint_out) each sample is recorded once
+// simulated, and with control.resume a recorded sample is read back instead
+// of simulated again; control.max_new_evaluations > 0 simulates at most that
+// many new samples (the first ones not recorded) and stops.
 #include <cstdint>
 #include <vector>
 
 #include "design_config.hpp"
 #include "design_evaluation.hpp"
+#include "design_search.hpp"
 
 namespace msfab {
 
@@ -22,6 +27,9 @@ struct RobustnessSample {
 struct RobustnessResult {
   std::vector<RobustnessSample> samples;
   int successes = 0;
+  // Stopped by control.max_new_evaluations before every sample was
+  // simulated: the samples are in their checkpoints, not here.
+  bool stopped = false;
   double fraction() const { return samples.empty() ? 0.0 : double(successes) / double(samples.size()); }
 };
 
@@ -32,6 +40,7 @@ struct RobustnessResult {
 bool design_succeeded(const DesignProblem& problem, const Evaluation& e);
 
 RobustnessResult check_robustness(const DesignProblem& problem, const DesignEvaluator& evaluator,
-                                  const std::vector<double>& design, std::uint64_t seed);
+                                  const std::vector<double>& design, std::uint64_t seed,
+                                  const SearchControl& control = {});
 
 }  // namespace msfab

@@ -131,7 +131,7 @@ const Evaluation& evaluation_at(StartState& s, const double* u) {
     // checkpoint that cannot be written (a full disk) must not end a search.
     const std::string path = start_checkpoint_path(c.checkpoint_out, s.start);
     try {
-      write_start_checkpoint(path, c.run_text, *s.problem, s.evaluations);
+      write_evaluations_checkpoint(path, c.run_text, *s.problem, s.evaluations);
     } catch (const std::exception& e) {
       spdlog::warn("start {}: checkpoint {} not written ({}); the search goes on", s.start, path, e.what());
     }
@@ -208,7 +208,8 @@ std::vector<Evaluation> run_all_starts(const DesignProblem& p, const DesignEvalu
   std::vector<std::vector<Evaluation>> replays(p.starts);
   if (control.resume && !control.checkpoint_out.empty())
     for (int start = 0; start < p.starts; ++start)
-      replays[start] = read_start_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
+      replays[start] =
+          read_evaluations_checkpoint(start_checkpoint_path(control.checkpoint_out, start), control.run_text, p);
   const std::vector<double> records = fan_out(p.starts, row, [&](int start, double* r) {
     const StartResult result = run_start(p, evaluator, start, control, std::move(replays[start]));
     const std::size_t count =

@@ -13,7 +13,8 @@
 //   3. the final design is the best feasible evaluation of all starts
 //   4. with robustness.samples > 0, the final design again under print
 //      variation (modulus and geometry), fanned out like the starts: the
-//      fraction of samples that still meet the goal
+//      fraction of samples that still meet the goal; each sample is
+//      checkpointed, and --resume does not simulate a recorded one again
 //   5. write `msfab.jump_design` (every evaluation, initial and final
 //      designs, the variation samples) and print initial against final
 //   6. run the final design once more, whole, to its landing and `settle`
@@ -59,8 +60,8 @@ int main(int argc, char** argv) {
   int max_new_evaluations = 0;
   app.flag("--resume", resume, "continue every start from <out>.start<k>.checkpoint.h5 (same config and seed)");
   app.option("--max-new-evaluations", max_new_evaluations,
-             "stop each start after this many simulations in this run, keeping the checkpoints (batch jobs); "
-             "0 = no limit");
+             "stop each start, and then the print variation, after this many simulations in this run, keeping "
+             "the checkpoints (batch jobs); 0 = no limit");
   const int code = app.run(argc, argv, [&](StageContext& ctx) {
     const std::string& out = ctx.require_out();
     const auto t_start = std::chrono::steady_clock::now();
@@ -118,8 +119,16 @@ int main(int argc, char** argv) {
     if (!at_initial) throw NumericalError("design loop: start 0 did not begin with the initial design");
 
     // 4. Print variation.
-    if (problem.robustness.samples > 0)
-      run.robustness = check_robustness(problem, evaluator, run.evaluations[run.final].parameters, ctx.options.seed);
+    if (problem.robustness.samples > 0) {
+      run.robustness =
+          check_robustness(problem, evaluator, run.evaluations[run.final].parameters, ctx.options.seed, control);
+      if (run.robustness.stopped) {
+        if (rank == 0)
+          std::printf("msfab-jump-design: print variation stopped after %d new samples; continue with --resume\n",
+                      max_new_evaluations);
+        return;
+      }
+    }
     run.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
 
     // 5. Artifact and summary.
@@ -127,6 +136,7 @@ int main(int argc, char** argv) {
       write_jump_design_artifact(out, problem, run, ctx.config.resolved_text(), ctx.options.seed);
       print_design_summary(problem, run, out);
       for (int start = 0; start < problem.starts; ++start) std::filesystem::remove(start_checkpoint_path(out, start));
+      for (int i = 0; i < problem.robustness.samples; ++i) std::filesystem::remove(sample_checkpoint_path(out, i));
     }
 
     // 6. The final design's whole run.

@@ -191,6 +191,21 @@ expect_exit 2 "measure.modulus_scales.*not in \(0, 10\]" -- "$DESIGN" --config "
 expect_exit 2 "measure.modulus_scales.*listed twice" -- "$DESIGN" --config "$WORK/flip.yaml" \
   --set 'measure.modulus_scales=[0.8, 0.8]' --out "$WORK/bad.h5"
 
+# The print variation in batches: stopped after two new samples (the search,
+# one evaluation, finishes first), resumed on two ranks with the recorded
+# samples read back, not simulated: the artifact of the uninterrupted run.
+expect_exit 0 "print variation stopped after 2 new samples" -- "$DESIGN" --config "$WORK/flip.yaml" \
+  --set robustness.samples=3 --max-new-evaluations 2 --out "$WORK/batch.h5"
+check "samples 0 and 1 recorded, sample 2 not, no artifact yet" -- bash -c "[ -s '$WORK/batch.h5.sample0.checkpoint.h5' ] \
+  && [ -s '$WORK/batch.h5.sample1.checkpoint.h5' ] && [ ! -e '$WORK/batch.h5.sample2.checkpoint.h5' ] && \
+  [ ! -e '$WORK/batch.h5' ]"
+expect_exit 0 "print variation: 2 of 3 samples recorded" -- mpirun -np 2 --oversubscribe -x OMP_NUM_THREADS=1 \
+  "$DESIGN" --config "$WORK/flip.yaml" --set robustness.samples=3 --resume --out "$WORK/batch.h5"
+check "the resumed samples are the uninterrupted run's" -- bash -c "$(declare -f same_data); for d in \
+  /robustness/modulus_scale /robustness/parameters /robustness/objective /robustness/outcome /robustness/success \
+  /evaluations/outcome; do same_data '$WORK/unscaled.h5' \$d '$WORK/batch.h5' \$d || exit 1; done"
+check "no sample checkpoint left" -- bash -c "! ls '$WORK'/batch.h5.*checkpoint.h5 2> /dev/null"
+
 # Print variation of the final design: the samples are recorded, do not
 # depend on the rank count, and a throw that hits within 2 mm still hits
 # within 1 cm with E +-20% and the length +-0.2 mm.
