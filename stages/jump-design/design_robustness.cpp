@@ -13,8 +13,9 @@ namespace msfab {
 
 bool design_succeeded(const DesignProblem& p, const Evaluation& e) {
   if (!e.landed_in_every_run()) return false;
-  // The objective is the worse of the two time steps when confirmed
-  // (design_evaluation.hpp): miss^2 of the turn, or the target distance.
+  // The objective is the worst of the evaluation's runs (confirmation
+  // step, modulus factors; design_evaluation.hpp): miss^2 of the turn, or
+  // the target distance.
   const double tolerance = p.measure.upright_tolerance;
   switch (p.task) {
     case DesignTask::kFlip: return e.objective <= tolerance * tolerance;
