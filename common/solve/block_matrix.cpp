@@ -87,14 +87,54 @@ void block_multiply(const BlockMatrix& M, const VecX& x, VecX& y, int threads) {
   });
 }
 
-std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads) {
+std::size_t upper_block_count(const BlockMatrix& M) {
+  std::size_t count = 0;
+  for (int i = 0; i < M.rows; ++i) count += std::size_t(M.row_start[std::size_t(i) + 1] - M.diagonal[std::size_t(i)]);
+  return count;
+}
+
+std::vector<int> upper_block_numbering(const BlockMatrix& M, int threads) {
+  std::vector<int> first_upper(std::size_t(M.rows) + 1, 0);
+  for (int i = 0; i < M.rows; ++i)
+    first_upper[std::size_t(i) + 1] = first_upper[std::size_t(i)] + (M.row_start[i + 1] - M.diagonal[std::size_t(i)]);
+  std::vector<int> block_of_slot(std::size_t(M.num_blocks()));
+  const long long unmatched = chunked_reduce(M.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
+    long long missing = 0;
+    for (Eigen::Index i = begin; i < end; ++i) {
+      for (int slot = M.row_start[i]; slot < M.row_start[i + 1]; ++slot) {
+        const int j = M.column[std::size_t(slot)];
+        if (j >= i) {
+          block_of_slot[std::size_t(slot)] = first_upper[std::size_t(i)] + (slot - M.diagonal[std::size_t(i)]);
+          continue;
+        }
+        // Block (j, i) sits in row j, above its diagonal.
+        const auto begin_j = M.column.begin() + M.diagonal[std::size_t(j)];
+        const auto end_j = M.column.begin() + M.row_start[std::size_t(j) + 1];
+        const auto it = std::lower_bound(begin_j, end_j, static_cast<int>(i));
+        if (it == end_j || *it != i) {
+          ++missing;
+          continue;
+        }
+        block_of_slot[std::size_t(slot)] =
+            first_upper[std::size_t(j)] + static_cast<int>(it - M.column.begin()) - M.diagonal[std::size_t(j)];
+      }
+    }
+    return missing;
+  });
+  if (unmatched != 0) throw std::logic_error("upper_block_numbering: the block pattern is not symmetric");
+  return block_of_slot;
+}
+
+std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads, const std::vector<int>* upper) {
   std::vector<char> decoupled(static_cast<std::size_t>(M.unknowns()), 0);
   parallel_row_ranges(M.rows, resolve_thread_count(threads), [&](int begin, int end) {
+    double block[9];
     for (int i = begin; i < end; ++i) {
       for (int a = 0; a < 3; ++a) {
         bool coupled = false;
         for (int slot = M.row_start[i]; slot < M.row_start[i + 1] && !coupled; ++slot) {
-          const double* m = M.values.data() + 9 * std::size_t(slot) + 3 * a;
+          read_block(M, upper, i, slot, block);
+          const double* m = block + 3 * a;
           const bool diagonal = slot == M.diagonal[i];
           for (int b = 0; b < 3; ++b) {
             if (m[b] != 0.0 && !(diagonal && b == a)) coupled = true;

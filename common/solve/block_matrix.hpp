@@ -85,9 +85,39 @@ void copy_block_values(const SpMat& A, double shift, BlockMatrix& M, int threads
 // y = M x.
 void block_multiply(const BlockMatrix& M, const VecX& x, VecX& y, int threads);
 
+// A symmetric block matrix held by its blocks on and above the diagonal
+// only: half the bytes of the values, for operators too large to hold
+// twice (level 1 of a voxel model's multigrid). The upper blocks are
+// numbered row by row; `upper` gives, per slot of the pattern, the block it
+// reads, the mirror's for a slot below the diagonal (read transposed). The
+// values then hold 9 per upper block, row-major. std::logic_error if the
+// pattern is not symmetric.
+std::vector<int> upper_block_numbering(const BlockMatrix& M, int threads);
+// The number of upper blocks of M's pattern (diagonal included).
+std::size_t upper_block_count(const BlockMatrix& M);
+
+// Block `slot` (in row i) of M into out, row-major: read from M.values as
+// stored, or with `upper` (upper_block_numbering) from its upper block,
+// transposed below the diagonal.
+inline void read_block(const BlockMatrix& M, const std::vector<int>* upper, int i, int slot, double out[9]) {
+  if (!upper) {
+    const double* m = M.values.data() + 9 * std::size_t(slot);
+    for (int e = 0; e < 9; ++e) out[e] = m[e];
+    return;
+  }
+  const double* m = M.values.data() + 9 * std::size_t((*upper)[std::size_t(slot)]);
+  if (M.column[std::size_t(slot)] >= i) {
+    for (int e = 0; e < 9; ++e) out[e] = m[e];
+  } else {
+    for (int r = 0; r < 3; ++r)
+      for (int q = 0; q < 3; ++q) out[3 * r + q] = m[3 * q + r];
+  }
+}
+
 // Per unknown: 1 if its row holds no non-zero but the diagonal (a Dirichlet
-// unknown whose row and column were cleared), else 0.
-std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads);
+// unknown whose row and column were cleared), else 0. `upper`: M's values
+// are held by its upper blocks (upper_block_numbering).
+std::vector<char> decoupled_unknowns(const BlockMatrix& M, int threads, const std::vector<int>* upper = nullptr);
 
 // M as compressed column storage with both triangles, every block stored in
 // full (the pattern; values are filled by copy_to_sparse()).

@@ -24,7 +24,11 @@ void ChebyshevSmoother::upper_row_product(int i, const double* x, double out[3])
   out[2] = y2;
 }
 
-bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, SmootherValues values) {
+bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, SmootherValues values,
+                              const std::vector<int>* upper) {
+  if (upper && values != SmootherValues::single_upper)
+    throw std::logic_error(
+        "ChebyshevSmoother: an operator held by its upper blocks needs SmootherValues::single_upper");
   pattern_ = &A;
   degree_ = degree;
   threads_ = threads;
@@ -38,44 +42,24 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
         values_[k] = static_cast<float>(A.values[k]);
     });
   } else if (values == SmootherValues::single_upper) {
-    // Number the upper blocks row by row, then point every slot at its block.
-    std::vector<int> first_upper(std::size_t(A.rows) + 1, 0);
-    for (int i = 0; i < A.rows; ++i)
-      first_upper[std::size_t(i) + 1] = first_upper[std::size_t(i)] + (A.row_start[i + 1] - A.diagonal[std::size_t(i)]);
-    values_.resize(9 * std::size_t(first_upper.back()));
-    block_of_slot_.resize(std::size_t(A.num_blocks()));
-    const long long unmatched = chunked_reduce(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
-      long long missing = 0;
-      for (Eigen::Index i = begin; i < end; ++i) {
-        for (int slot = A.row_start[i]; slot < A.row_start[i + 1]; ++slot) {
-          const int j = A.column[std::size_t(slot)];
-          if (j >= i) {
-            const int block = first_upper[std::size_t(i)] + (slot - A.diagonal[std::size_t(i)]);
-            block_of_slot_[std::size_t(slot)] = block;
-            for (int e = 0; e < 9; ++e)
-              values_[9 * std::size_t(block) + e] = static_cast<float>(A.values[9 * std::size_t(slot) + e]);
-            continue;
-          }
-          // Block (j, i) sits in row j, above its diagonal.
-          const auto begin_j = A.column.begin() + A.diagonal[std::size_t(j)];
-          const auto end_j = A.column.begin() + A.row_start[std::size_t(j) + 1];
-          const auto it = std::lower_bound(begin_j, end_j, static_cast<int>(i));
-          if (it == end_j || *it != i) {
-            ++missing;
-            continue;
-          }
-          block_of_slot_[std::size_t(slot)] =
-              first_upper[std::size_t(j)] + static_cast<int>(it - A.column.begin()) - A.diagonal[std::size_t(j)];
+    block_of_slot_ = upper ? *upper : upper_block_numbering(A, threads);
+    values_.resize(9 * upper_block_count(A));
+    chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index i = begin; i < end; ++i)
+        for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
+          const std::size_t block = std::size_t(block_of_slot_[std::size_t(slot)]);
+          const double* source = A.values.data() + 9 * (upper ? block : std::size_t(slot));
+          for (int e = 0; e < 9; ++e) values_[9 * block + e] = static_cast<float>(source[e]);
         }
-      }
-      return missing;
     });
-    if (unmatched != 0) throw std::logic_error("ChebyshevSmoother: the block pattern is not symmetric");
   }
+  const auto diagonal_block = [&](Eigen::Index i) {
+    const std::size_t slot = std::size_t(A.diagonal[std::size_t(i)]);
+    return A.values.data() + 9 * (upper ? std::size_t(block_of_slot_[slot]) : slot);
+  };
   diagonal_.resize(9 * std::size_t(A.rows));
   chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
-    for (Eigen::Index i = begin; i < end; ++i)
-      std::copy_n(A.values.data() + 9 * std::size_t(A.diagonal[i]), 9, diagonal_.data() + 9 * i);
+    for (Eigen::Index i = begin; i < end; ++i) std::copy_n(diagonal_block(i), 9, diagonal_.data() + 9 * i);
   });
   if (chebyshev::invert_diagonal_blocks(A.rows, diagonal_.data(), inverse_, threads) != 0) return false;
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(

@@ -15,6 +15,13 @@
 
 namespace msfab {
 
+// Multigrid levels with more blocks than this (level 1 and 2 of a voxel
+// model of millions of voxels) are held by their upper blocks: the
+// smoother's copy in single precision once set up (single_upper below),
+// and level 1 of the voxel multigrid in double from its assembly on
+// (ComponentMultigrid). Memory over speed on the largest matrices.
+constexpr int kUpperLevelBlocks = 1 << 20;
+
 // How a smoother holds its operator's values.
 enum class SmootherValues {
   // Every block in single precision: a product moves half the bytes of A's
@@ -39,9 +46,12 @@ class ChebyshevSmoother {
   // Takes A's values as `values` says, inverts the diagonal blocks and
   // estimates the largest eigenvalue of D^-1 A. A's pattern must stay alive
   // until the next setup() (and A's values too with double_values); for
-  // single_upper it must be symmetric (std::logic_error if not). Returns
-  // false if a diagonal block is not positive definite.
-  bool setup(const BlockMatrix& A, int degree, int threads, SmootherValues values = SmootherValues::single);
+  // single_upper it must be symmetric (std::logic_error if not). With
+  // `upper` (upper_block_numbering(A)), A's values are held by its upper
+  // blocks, and `values` must be single_upper. Returns false if a diagonal
+  // block is not positive definite.
+  bool setup(const BlockMatrix& A, int degree, int threads, SmootherValues values = SmootherValues::single,
+             const std::vector<int>* upper = nullptr);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).

@@ -14,12 +14,6 @@ namespace {
 using namespace hex_lattice;
 
 using namespace multigrid_cycle;
-// Level 1 of a large grid is the biggest matrix held (about 27 blocks per
-// copy), level 2 the next. After set-up only their single-precision copies
-// in the smoothers are used, so above this many blocks the double values of
-// every level but the coarsest are released (set-up refills them), and the
-// smoothers keep only the upper blocks (memory over speed).
-constexpr int kKeepLevelBlocks = 1 << 20;
 
 // Rows [begin, end) of a block matrix built range by range: per row its
 // sorted columns and 9 values per block.
@@ -131,7 +125,8 @@ BlockMatrix level1_element_pattern(const MaterialComponents& components, int thr
 }
 
 void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
-                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads) {
+                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads,
+                                const std::vector<int>* fine_upper) {
   const int rows = transfer.coarse_copies();
   if (transfer.fine_rows() != fine.rows)
     throw std::invalid_argument("component_galerkin_product: transfer and matrix sizes differ");
@@ -149,9 +144,10 @@ void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>
           const int j = fine.column[std::size_t(slot)];
           const char* dj = fine_decoupled.data() + 3 * std::size_t(j);
           double block[9];
-          const double* m = fine.values.data() + 9 * std::size_t(slot);
+          read_block(fine, fine_upper, i, slot, block);
           for (int r = 0; r < 3; ++r)
-            for (int q = 0; q < 3; ++q) block[3 * r + q] = (di[r] || dj[q]) ? 0.0 : m[3 * r + q];
+            for (int q = 0; q < 3; ++q)
+              if (di[r] || dj[q]) block[3 * r + q] = 0.0;
           for (int u = transfer.parent_start[std::size_t(j)]; u < transfer.parent_start[std::size_t(j) + 1]; ++u) {
             const int D = transfer.parent[std::size_t(u)];
             const double w = wi * transfer.parent_weight[std::size_t(u)];
@@ -179,30 +175,38 @@ void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>
   fill_empty_diagonal(coarse);
 }
 
-void fill_empty_diagonal(BlockMatrix& M) {
+void fill_empty_diagonal(BlockMatrix& M, const std::vector<int>* upper) {
+  const auto diagonal = [&](int i) {
+    const std::size_t slot = std::size_t(M.diagonal[std::size_t(i)]);
+    return M.values.data() + 9 * (upper ? std::size_t((*upper)[slot]) : slot);
+  };
   double sum = 0.0;
   std::int64_t count = 0;
   for (int i = 0; i < M.rows; ++i)
     for (int d = 0; d < 3; ++d)
-      if (const double v = M.values[9 * std::size_t(M.diagonal[std::size_t(i)]) + 4 * d]; v > 0) sum += v, ++count;
+      if (const double v = diagonal(i)[4 * d]; v > 0) sum += v, ++count;
   const double scale = count > 0 ? sum / double(count) : 1.0;
   for (int i = 0; i < M.rows; ++i)
     for (int d = 0; d < 3; ++d) {
-      double& v = M.values[9 * std::size_t(M.diagonal[std::size_t(i)]) + 4 * d];
+      double& v = diagonal(i)[4 * d];
       if (v == 0.0) v = scale;
     }
 }
 
 struct ComponentMultigrid::Level {
   BlockMatrix matrix;
+  std::vector<int> upper;  // level 1 of a large grid: matrix.values holds its upper blocks (upper_block_numbering)
   std::vector<char> decoupled;
   ChebyshevSmoother smoother;
   VecX rhs, solution, residual;
 };
 
 ComponentMultigrid::ComponentMultigrid(std::shared_ptr<const MaterialComponents> components, int smoother_degree,
-                                       int threads)
-    : components_(std::move(components)), smoother_degree_(smoother_degree), threads_(threads) {
+                                       int threads, int upper_level_blocks)
+    : components_(std::move(components)),
+      smoother_degree_(smoother_degree),
+      threads_(threads),
+      upper_level_blocks_(upper_level_blocks) {
   const int count = static_cast<int>(components_->levels().size()) - 1;
   if (count < 1) throw std::invalid_argument("ComponentMultigrid: the components have no level 1");
   for (int l = 0; l < count; ++l) levels_.push_back(std::make_unique<Level>());
@@ -212,28 +216,46 @@ ComponentMultigrid::ComponentMultigrid(std::shared_ptr<const MaterialComponents>
 ComponentMultigrid::~ComponentMultigrid() = default;
 
 BlockMatrix& ComponentMultigrid::level1() {
-  BlockMatrix& M = levels_.front()->matrix;
-  if (M.values.empty()) M.values.assign(9 * std::size_t(M.num_blocks()), 0.0);
+  Level& first = *levels_.front();
+  BlockMatrix& M = first.matrix;
+  // Level 1 of a large grid is the biggest matrix of set-up: assembled by
+  // its upper blocks, it never exists in full. (Not where it is also the
+  // coarsest level, which is factored from full storage; that level is
+  // small.)
+  const bool upper = M.num_blocks() > upper_level_blocks_ && levels_.size() > 1;
+  if (upper && first.upper.empty()) first.upper = upper_block_numbering(M, threads_);
+  if (M.values.empty()) M.values.assign(9 * (upper ? upper_block_count(M) : std::size_t(M.num_blocks())), 0.0);
   return M;
+}
+
+const std::vector<int>* ComponentMultigrid::level1_upper() const {
+  const Level& first = *levels_.front();
+  return first.upper.empty() ? nullptr : &first.upper;
 }
 
 const BlockMatrix& ComponentMultigrid::level_matrix(int level) const { return levels_.at(std::size_t(level))->matrix; }
 
 bool ComponentMultigrid::factorize() {
-  fill_empty_diagonal(levels_.front()->matrix);
+  const auto upper_of = [](const Level& level) { return level.upper.empty() ? nullptr : &level.upper; };
+  fill_empty_diagonal(levels_.front()->matrix, upper_of(*levels_.front()));
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& level = *levels_[l];
-    level.decoupled = decoupled_unknowns(level.matrix, threads_);
+    const std::vector<int>* upper = upper_of(level);
+    level.decoupled = decoupled_unknowns(level.matrix, threads_, upper);
     if (l + 1 == levels_.size()) break;
     component_galerkin_product(level.matrix, level.decoupled, components_->transfers()[l + 1], levels_[l + 1]->matrix,
-                               threads_);
+                               threads_, upper);
     const int degree = (l == 0 ? 1 : kCoarseDegreeFactor) * smoother_degree_;
-    // A level too large to keep in double is stored by its upper blocks.
-    const bool large = level.matrix.num_blocks() > kKeepLevelBlocks;
+    // A level too large to keep in double is held by the smoother's upper
+    // blocks in single precision; set-up refills the double values.
+    const bool large = level.matrix.num_blocks() > upper_level_blocks_;
     if (!level.smoother.setup(level.matrix, degree, threads_,
-                              large ? SmootherValues::single_upper : SmootherValues::single))
+                              large ? SmootherValues::single_upper : SmootherValues::single, upper))
       return false;
-    if (large) std::vector<double>().swap(level.matrix.values);
+    if (large) {
+      std::vector<double>().swap(level.matrix.values);
+      std::vector<int>().swap(level.upper);  // the smoother holds its own numbering
+    }
   }
   const BlockMatrix& last = levels_.back()->matrix;
   if (!coarse_analyzed_ || coarsest_.rows() != last.unknowns() ||

@@ -29,8 +29,12 @@ BlockMatrix level1_element_pattern(const MaterialComponents& components, int thr
 // rebuilt); rows and columns of the fine unknowns flagged in
 // fine_decoupled are left out (their rows of P are zero). Unknowns that P
 // reaches with no stiffness get the mean diagonal of the others.
+// `fine_upper`: fine's values are held by its upper blocks
+// (upper_block_numbering); the blocks are read in the same order, so an
+// exactly symmetric fine gives the same bits either way.
 void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
-                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads);
+                                const ComponentTransfer& transfer, BlockMatrix& coarse, int threads,
+                                const std::vector<int>* fine_upper = nullptr);
 
 // coarse = P^T fine and fine += P coarse over a transfer, leaving out the
 // fine unknowns for which is_free(row, component) is false (their rows of
@@ -71,22 +75,30 @@ void component_add_prolongation(const ComponentTransfer& t, const VecX& coarse, 
 }
 
 // Gives every unknown of M with a zero diagonal entry the mean diagonal of
-// the others (coarse copies that no free fine unknown reaches).
-void fill_empty_diagonal(BlockMatrix& M);
+// the others (coarse copies that no free fine unknown reaches). `upper`:
+// M's values are held by its upper blocks.
+void fill_empty_diagonal(BlockMatrix& M, const std::vector<int>* upper = nullptr);
 
 class ComponentMultigrid {
  public:
   // Level 1 is levels()[1] of `components`; its operator is set with
   // level1() and factorize(). smoother_degree: Chebyshev degree on level 1
-  // (twice that below).
-  ComponentMultigrid(std::shared_ptr<const MaterialComponents> components, int smoother_degree, int threads);
+  // (twice that below). Levels with more than upper_level_blocks blocks
+  // are held by their upper blocks (kUpperLevelBlocks; tests lower it to
+  // take the large levels' path on small grids).
+  ComponentMultigrid(std::shared_ptr<const MaterialComponents> components, int smoother_degree, int threads,
+                     int upper_level_blocks = kUpperLevelBlocks);
   ~ComponentMultigrid();
   ComponentMultigrid(const ComponentMultigrid&) = delete;
   ComponentMultigrid& operator=(const ComponentMultigrid&) = delete;
 
   // Level 1's operator: the pattern of level1_element_pattern(); the caller
-  // writes the values, then calls factorize().
+  // writes the values, then calls factorize(). Where level1_upper() is not
+  // null the values hold only the blocks on and above the diagonal, block
+  // (i, j) with j >= i at 9 * (*level1_upper())[slot of (i, j)]; the
+  // blocks below are their mirrors' transposes (the operator is symmetric).
   BlockMatrix& level1();
+  const std::vector<int>* level1_upper() const;
   // Galerkin operators, smoothers and the coarsest factorization. Returns
   // false if a level is not positive definite.
   bool factorize();
@@ -106,6 +118,7 @@ class ComponentMultigrid {
   std::shared_ptr<const MaterialComponents> components_;
   int smoother_degree_;
   int threads_;
+  int upper_level_blocks_;
   std::vector<std::unique_ptr<Level>> levels_;
   SpMat coarsest_;
   Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> coarse_solver_;

@@ -389,7 +389,8 @@ void DirichletGridMultigrid::build_material_components() {
     components_ = std::make_shared<MaterialComponents>(fine_.n[0], fine_.n[1], fine_.n[2], solid,
                                                        std::max(1, options_.coarse_unknowns / 3), options_.threads);
     components_solid_ = std::move(solid);
-    component_solver_ = std::make_unique<ComponentMultigrid>(components_, options_.smoother_degree, options_.threads);
+    component_solver_ = std::make_unique<ComponentMultigrid>(components_, options_.smoother_degree, options_.threads,
+                                                             options_.upper_level_blocks);
     std::string copies;
     for (const ComponentLevel& level : components_->levels())
       copies += (copies.empty() ? "" : ", ") + std::to_string(level.copies());
@@ -402,6 +403,7 @@ void DirichletGridMultigrid::assemble_material_coarse() {
   std::vector<Mat24> P, galerkin;
   galerkin_tables(P, galerkin);
   BlockMatrix& M = component_solver_->level1();
+  const std::vector<int>* upper = component_solver_->level1_upper();
   std::fill(M.values.begin(), M.values.end(), 0.0);
   const auto slot = [&M](int row, int column) {
     const auto begin = M.column.begin() + M.row_start[std::size_t(row)];
@@ -433,7 +435,11 @@ void DirichletGridMultigrid::assemble_material_coarse() {
     for (int g = 0; g < groups; ++g)
       for (int a = 0; a < 8; ++a)
         for (int b = 0; b < 8; ++b) {
-          double* block = M.values.data() + 9 * slot(copies[g][std::size_t(a)], copies[g][std::size_t(b)]);
+          const int row = copies[g][std::size_t(a)], column = copies[g][std::size_t(b)];
+          // Held by its upper blocks, a block below the diagonal is its mirror's transpose.
+          if (upper && column < row) continue;
+          const std::size_t s = slot(row, column);
+          double* block = M.values.data() + 9 * (upper ? std::size_t((*upper)[s]) : s);
           for (int r = 0; r < 3; ++r)
             for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
         }

@@ -35,6 +35,7 @@
 
 #include "fem/voxel_stiffness_field.hpp"
 #include "solve/block_matrix.hpp"
+#include "solve/chebyshev_smoother.hpp"
 #include "solve/linear_solver.hpp"
 
 namespace msfab {
@@ -56,6 +57,9 @@ struct DirichletMultigridOptions {
   // (void without stiffness, gaps and thin members); the hierarchy is
   // rebuilt when set_field() changes which voxels have stiffness.
   bool material_coarse_space = false;
+  // With material_coarse_space: levels with more blocks than this are held
+  // by their upper blocks (kUpperLevelBlocks; tests lower it).
+  int upper_level_blocks = kUpperLevelBlocks;
 };
 
 // The CG limits, smoother, coarse size and threads of a pcg-mg configuration.
