@@ -6,7 +6,7 @@
 #   make -f Makefile.pipeline topopt-bar-check       the 8x2x2 bar of Table 3.1 (128x32x32 voxels)
 #   make -f Makefile.pipeline topopt-gripper-check   the gripper as a 32x16x2 plate (512x256x32 voxels)
 #   make -f Makefile.pipeline topopt-gripper-thesis-check   the gripper at the thesis's 64x32x8 cells
-#                                                    (1024x512x128 voxels, about 40 minutes)
+#                                                    (1024x512x128 voxels, about 45 minutes, 20 GB)
 #   make -f Makefile.pipeline topopt-bridge-check    a 24x6x4 bridge (384x96x64 voxels)
 #   make -f Makefile.pipeline topopt-cantilever-check a 16x4x8 cantilever (256x64x128 voxels)
 #   make -f Makefile.pipeline topopt-checks          all four
@@ -252,7 +252,8 @@ topopt-cantilever-check: stages $(TOPOPT_DIR)/cantilever_cubic.verify.h5 $(TOPOP
 topopt-checks: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check
 # The gripper at the thesis's 64x32x8 cells (configs/topopt/gripper3d_thesis.yaml),
 # checked against its homogenized model with 4^3 hexahedra per cell: about
-# 10 minutes of cell MMA and half an hour for the 67 M-voxel check on 2 cores.
+# 10 minutes of cell MMA and 34 minutes for the 67 M-voxel check on 2 cores
+# (peak 20 GB; docs/BENCHMARKS.md, "The gripper at the thesis's resolution").
 topopt-gripper-thesis-check: stages $(TOPOPT_DIR)/gripper3d_thesis.h4.verify.h5
 topopt-bridge-large: stages $(OUT)/topopt/bridge_cubic_large.design.h5
 topopt-bridge-huge: stages $(HUGE_DIR)/bridge320.mapped.h5
