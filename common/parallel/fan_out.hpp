@@ -13,5 +13,7 @@ std::vector<double> fan_out(int count, int record_size, const std::function<void
 
 int mpi_rank();
 int mpi_size();
+// Returns once every rank has called it.
+void mpi_barrier();
 
 }  // namespace msfab

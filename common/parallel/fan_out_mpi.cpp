@@ -19,6 +19,8 @@ int mpi_size() {
   return s;
 }
 
+void mpi_barrier() { MPI_Barrier(MPI_COMM_WORLD); }
+
 std::vector<double> fan_out(int count, int record_size, const std::function<void(int, double*)>& work) {
   const int rank = mpi_rank(), size = mpi_size();
   std::vector<double> mine(static_cast<std::size_t>(count) * record_size, 0.0);

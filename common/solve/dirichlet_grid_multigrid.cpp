@@ -663,8 +663,10 @@ SpMat DirichletGridMultigrid::fine_operator() const {
 
 SpMat DirichletGridMultigrid::coarse_operator() const {
   if (!component_solver_) return coarse_matrix_;
-  if (component_solver_->level_matrix(0).values.empty())
-    throw std::logic_error("DirichletGridMultigrid::coarse_operator: level 1 was released after set-up (large grid)");
+  if (component_solver_->level_matrix(0).values.empty() || component_solver_->level1_upper())
+    throw std::logic_error(
+        "DirichletGridMultigrid::coarse_operator: level 1 is held by its upper blocks or was released after set-up "
+        "(large grid)");
   SpMat S = sparse_pattern(component_solver_->level_matrix(0));
   copy_to_sparse(component_solver_->level_matrix(0), S);
   return S;

@@ -54,6 +54,9 @@ RobustnessResult check_robustness(const DesignProblem& p, const DesignEvaluator&
       found += static_cast<int>(recorded[i].size());
     }
     if (found > 0) spdlog::info("print variation: {} of {} samples recorded, not simulated again", found, r.samples);
+    // No rank writes a sample's checkpoint before every rank has read them
+    // all: the ranks must agree on which samples are recorded.
+    mpi_barrier();
   }
   // A batch limit (control.max_new_evaluations) simulates the first samples
   // not yet recorded, by index, so the split does not depend on the ranks.

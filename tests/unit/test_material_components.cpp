@@ -239,24 +239,38 @@ TEST(MaterialComponents, CombSolvesLikeADirectSolverInFewerIterations) {
   EXPECT_EQ((x1 - x3).cwiseAbs().maxCoeff(), 0.0);
 }
 
-// An operator on level 1's pattern held by its upper blocks (`upper`):
-// random blocks, symmetric diagonal blocks made dominant, and every
-// seventh copy's diagonal block empty (a copy no free unknown reaches).
-BlockMatrix upper_held_level1(const MaterialComponents& components, std::vector<int>& upper) {
+// An exactly symmetric operator on level 1's pattern in full storage:
+// random blocks, each block below the diagonal written as its mirror's
+// transpose, dominant diagonal blocks, every seventh copy's diagonal block
+// empty (a copy no free unknown reaches) and component 1 of every fifth
+// copy decoupled (its row and column cleared but for the diagonal).
+BlockMatrix symmetric_level1(const MaterialComponents& components) {
   BlockMatrix M = level1_element_pattern(components, 1);
-  upper = upper_block_numbering(M, 2);
-  M.values.assign(9 * upper_block_count(M), 0.0);
+  M.values.assign(9 * std::size_t(M.num_blocks()), 0.0);
+  const auto slot_of = [&M](int i, int j) {
+    const auto begin = M.column.begin() + M.row_start[std::size_t(i)];
+    const auto end = M.column.begin() + M.row_start[std::size_t(i) + 1];
+    return static_cast<std::size_t>(std::lower_bound(begin, end, j) - M.column.begin());
+  };
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> value(-1.0, 1.0);
   for (int i = 0; i < M.rows; ++i)
     for (int slot = M.diagonal[std::size_t(i)]; slot < M.row_start[std::size_t(i) + 1]; ++slot) {
-      double* block = M.values.data() + 9 * std::size_t(upper[std::size_t(slot)]);
+      const int j = M.column[std::size_t(slot)];
+      double* block = M.values.data() + 9 * std::size_t(slot);
       for (int e = 0; e < 9; ++e) block[e] = value(rng);
-      if (slot != M.diagonal[std::size_t(i)]) continue;
+      if (j == i) {
+        for (int r = 0; r < 3; ++r)
+          for (int q = 0; q < r; ++q) block[3 * r + q] = block[3 * q + r];
+        for (int d = 0; d < 3; ++d) block[4 * d] += 60.0;
+        if (i % 7 == 3) std::fill(block, block + 9, 0.0);
+      }
       for (int r = 0; r < 3; ++r)
-        for (int q = 0; q < r; ++q) block[3 * r + q] = block[3 * q + r];
-      for (int d = 0; d < 3; ++d) block[4 * d] += 60.0;
-      if (i % 7 == 3) std::fill(block, block + 9, 0.0);
+        for (int q = 0; q < 3; ++q) {
+          if ((i % 5 == 0 && r == 1 && !(j == i && q == 1)) || (j % 5 == 0 && q == 1 && !(j == i && r == 1)))
+            block[3 * r + q] = 0.0;
+          M.values[9 * slot_of(j, i) + 3 * std::size_t(q) + std::size_t(r)] = block[3 * r + q];
+        }
     }
   return M;
 }
@@ -265,19 +279,27 @@ TEST(MaterialComponents, UpperHeldLevelOneGivesTheSameBitsAsFullStorage) {
   const int nx = 12, ny = 8, nz = 4;
   const MaterialComponents components(nx, ny, nz, comb(nx, ny, nz), 10, 1);
   ASSERT_GE(components.levels().size(), 3u);
-  std::vector<int> upper;
-  BlockMatrix held = upper_held_level1(components, upper);
-  // The same operator in full storage: the blocks below read from their mirrors.
-  BlockMatrix full = held;
-  full.values.assign(9 * std::size_t(full.num_blocks()), 0.0);
+  BlockMatrix full = symmetric_level1(components);
+  // The same operator by its upper blocks.
+  const std::vector<int> upper = upper_block_numbering(full, 2);
+  BlockMatrix held = full;
+  held.values.assign(9 * upper_block_count(full), 0.0);
   for (int i = 0; i < full.rows; ++i)
-    for (int slot = full.row_start[std::size_t(i)]; slot < full.row_start[std::size_t(i) + 1]; ++slot)
-      read_block(held, &upper, i, slot, full.values.data() + 9 * std::size_t(slot));
+    for (int slot = full.diagonal[std::size_t(i)]; slot < full.row_start[std::size_t(i) + 1]; ++slot)
+      std::copy_n(full.values.data() + 9 * std::size_t(slot), 9,
+                  held.values.data() + 9 * std::size_t(upper[std::size_t(slot)]));
   EXPECT_LT(held.values.size(), full.values.size() * 6 / 10);
+  double block[9];  // a block below the diagonal reads as its stored self
+  for (int i = 0; i < full.rows; ++i)
+    for (int slot = full.row_start[std::size_t(i)]; slot < full.row_start[std::size_t(i) + 1]; ++slot) {
+      read_block(held, &upper, i, slot, block);
+      ASSERT_TRUE(std::equal(block, block + 9, full.values.data() + 9 * std::size_t(slot)));
+    }
 
   fill_empty_diagonal(full);
   fill_empty_diagonal(held, &upper);
   const std::vector<char> decoupled = decoupled_unknowns(full, 2);
+  EXPECT_GT(std::count(decoupled.begin(), decoupled.end(), char(1)), 0);
   EXPECT_EQ(decoupled_unknowns(held, 2, &upper), decoupled);
   BlockMatrix coarse_full, coarse_held;
   component_galerkin_product(full, decoupled, components.transfers()[1], coarse_full, 2);
@@ -319,6 +341,10 @@ TEST(MaterialComponents, UpperHeldLevelsSolveLikeFullOnes) {
     mg.set_field(field_of(nx, ny, nz, solid));
     const VecX first = mg.solve(b);
     if (iterations) *iterations = mg.stats().iterations;
+    EXPECT_GE(mg.num_levels(), 4);
+    if (upper_level_blocks == 0) {  // level 1 held by its upper blocks, then released
+      EXPECT_THROW(mg.coarse_operator(), std::logic_error);
+    }
     // A new field on the same material rebuilds level 1 from its released values.
     mg.set_field(field_of(nx, ny, nz, solid));
     const VecX again = mg.solve(b);
