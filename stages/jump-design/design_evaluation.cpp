@@ -324,7 +324,8 @@ Evaluation DesignEvaluator::evaluate(const std::vector<double>& values, int star
     e.confirm_z_over_wall = c.z_over_wall;
     fold(c);
   }
-  if (first_ok && with_modulus_scales)
+  // A failed run already fails the evaluation: no factor can change that.
+  if (e.ok && with_modulus_scales)
     for (double factor : problem_.modulus_scales) {
       const Evaluation c = simulate(values, modulus_scale * factor, 0);
       e.scaled.push_back({factor, c.ok, c.objective, c.constraints, c.outcome, c.crossed_wall, c.z_over_wall});
