@@ -42,9 +42,8 @@ DynamicsModel corner_over_ridge_model(const Eigen::Matrix3d& turn, double taper,
   std::vector<std::array<int, 8>> elements(2);
   for (int i = 0; i < 8; ++i) {
     const Vec3 s((i >> 2) - 0.5, ((i >> 1) & 1) - 0.5, (i & 1) - 0.5);
-    nodes.row(i) = (turn_bar * Vec3(s.x() * kBarLength, s.y() * kWidth, s.z() * kWidth) -
-                    Vec3(0, 0, kHalfDiagonal))
-                       .transpose();
+    nodes.row(i) =
+        (turn_bar * Vec3(s.x() * kBarLength, s.y() * kWidth, s.z() * kWidth) - Vec3(0, 0, kHalfDiagonal)).transpose();
     nodes.row(8 + i) = (block_point(i) - lowest + Vec3(0.003, 0, 1e-3)).transpose();
     elements[0][i] = i;
     elements[1][i] = 8 + i;
