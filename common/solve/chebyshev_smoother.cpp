@@ -29,6 +29,17 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
   if (upper && values != SmootherValues::single_upper)
     throw std::logic_error(
         "ChebyshevSmoother: an operator held by its upper blocks needs SmootherValues::single_upper");
+  return setup_with(A, degree, threads, values, upper != nullptr, upper ? *upper : std::vector<int>());
+}
+
+bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper) {
+  std::vector<int> numbering;
+  numbering.swap(upper);
+  return setup_with(A, degree, threads, SmootherValues::single_upper, true, std::move(numbering));
+}
+
+bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values,
+                                   bool held_by_upper, std::vector<int> numbering) {
   pattern_ = &A;
   degree_ = degree;
   threads_ = threads;
@@ -42,20 +53,20 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
         values_[k] = static_cast<float>(A.values[k]);
     });
   } else if (values == SmootherValues::single_upper) {
-    block_of_slot_ = upper ? *upper : upper_block_numbering(A, threads);
+    block_of_slot_ = numbering.empty() ? upper_block_numbering(A, threads) : std::move(numbering);
     values_.resize(9 * upper_block_count(A));
     chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
       for (Eigen::Index i = begin; i < end; ++i)
         for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
           const std::size_t block = std::size_t(block_of_slot_[std::size_t(slot)]);
-          const double* source = A.values.data() + 9 * (upper ? block : std::size_t(slot));
+          const double* source = A.values.data() + 9 * (held_by_upper ? block : std::size_t(slot));
           for (int e = 0; e < 9; ++e) values_[9 * block + e] = static_cast<float>(source[e]);
         }
     });
   }
   const auto diagonal_block = [&](Eigen::Index i) {
     const std::size_t slot = std::size_t(A.diagonal[std::size_t(i)]);
-    return A.values.data() + 9 * (upper ? std::size_t(block_of_slot_[slot]) : slot);
+    return A.values.data() + 9 * (held_by_upper ? std::size_t(block_of_slot_[slot]) : slot);
   };
   diagonal_.resize(9 * std::size_t(A.rows));
   chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {

@@ -52,6 +52,11 @@ class ChebyshevSmoother {
   // block is not positive definite.
   bool setup(const BlockMatrix& A, int degree, int threads, SmootherValues values = SmootherValues::single,
              const std::vector<int>* upper = nullptr);
+  // The same for A held by its upper blocks (single_upper), taking over the
+  // numbering `upper` instead of copying it: on a large level the numbering
+  // is a fifth of the single values, and the copy would meet them at
+  // set-up's peak. `upper` is left empty.
+  bool setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).
@@ -71,6 +76,11 @@ class ChebyshevSmoother {
     }
   }
   void upper_row_product(int i, const double* x, double out[3]) const;
+  // setup() with the numbering in hand (empty: computed here where
+  // single_upper needs it); `held_by_upper`: A's values are A's upper
+  // blocks in that numbering.
+  bool setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values, bool held_by_upper,
+                  std::vector<int> numbering);
   const BlockMatrix* pattern_ = nullptr;
   SmootherValues values_kind_ = SmootherValues::single;
   // single: A's values in single precision, laid out like A.values.

@@ -249,13 +249,12 @@ bool ComponentMultigrid::factorize() {
     // A level too large to keep in double is held by the smoother's upper
     // blocks in single precision; set-up refills the double values.
     const bool large = level.matrix.num_blocks() > upper_level_blocks_;
-    if (!level.smoother.setup(level.matrix, degree, threads_,
-                              large ? SmootherValues::single_upper : SmootherValues::single, upper))
-      return false;
-    if (large) {
-      std::vector<double>().swap(level.matrix.values);
-      std::vector<int>().swap(level.upper);  // the smoother holds its own numbering
-    }
+    // An upper-held level hands its numbering over to the smoother.
+    const bool set = upper ? level.smoother.setup(level.matrix, degree, threads_, std::move(level.upper))
+                           : level.smoother.setup(level.matrix, degree, threads_,
+                                                  large ? SmootherValues::single_upper : SmootherValues::single);
+    if (!set) return false;
+    if (large) std::vector<double>().swap(level.matrix.values);
   }
   const BlockMatrix& last = levels_.back()->matrix;
   if (!coarse_analyzed_ || coarsest_.rows() != last.unknowns() ||

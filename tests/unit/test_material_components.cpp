@@ -317,6 +317,15 @@ TEST(MaterialComponents, UpperHeldLevelOneGivesTheSameBitsAsFullStorage) {
   from_full.residual(b, x, r_full);
   from_held.residual(b, x, r_held);
   EXPECT_EQ((r_full - r_held).cwiseAbs().maxCoeff(), 0.0);
+  // Handed over instead of copied: the same operator, the numbering gone.
+  ChebyshevSmoother from_taken;
+  std::vector<int> taken = upper;
+  ASSERT_TRUE(from_taken.setup(held, 2, 2, std::move(taken)));
+  EXPECT_TRUE(taken.empty());
+  EXPECT_EQ(from_taken.max_eigenvalue(), from_full.max_eigenvalue());
+  VecX r_taken;
+  from_taken.residual(b, x, r_taken);
+  EXPECT_EQ((r_full - r_taken).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_THROW(from_held.setup(held, 2, 2, SmootherValues::single, &upper), std::logic_error);
 }
 
