@@ -35,7 +35,9 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
 bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper) {
   std::vector<int> numbering;
   numbering.swap(upper);
-  return setup_with(A, degree, threads, SmootherValues::single_upper, true, std::move(numbering));
+  if (setup_with(A, degree, threads, SmootherValues::single_upper, true, std::move(numbering))) return true;
+  upper.swap(block_of_slot_);  // a failed set-up leaves the numbering with the caller
+  return false;
 }
 
 bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values,

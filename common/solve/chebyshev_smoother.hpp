@@ -55,7 +55,7 @@ class ChebyshevSmoother {
   // The same for A held by its upper blocks (single_upper), taking over the
   // numbering `upper` instead of copying it: on a large level the numbering
   // is a fifth of the single values, and the copy would meet them at
-  // set-up's peak. `upper` is left empty.
+  // set-up's peak. `upper` is left empty, or as it was where set-up fails.
   bool setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x

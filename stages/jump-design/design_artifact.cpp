@@ -127,7 +127,8 @@ void write_jump_design_artifact(const std::string& path, const DesignProblem& p,
   if (!p.modulus_scales.empty()) {
     // The runs at each modulus factor; /evaluations/objective and
     // constraints are the worst of all runs. NaN where the run at the
-    // scene's modulus failed and the factors were not run.
+    // scene's modulus or its confirmation failed and the factors were not
+    // run.
     const std::size_t ns = p.modulus_scales.size(), nk = outcome_columns().size();
     std::vector<double> scaled_objective(n * ns, std::nan("")), scaled_outcome(n * ns * nk, std::nan(""));
     for (std::size_t i = 0; i < n; ++i)

@@ -326,6 +326,16 @@ TEST(MaterialComponents, UpperHeldLevelOneGivesTheSameBitsAsFullStorage) {
   VecX r_taken;
   from_taken.residual(b, x, r_taken);
   EXPECT_EQ((r_full - r_taken).cwiseAbs().maxCoeff(), 0.0);
+  // A set-up that fails (a diagonal block not positive definite) leaves the
+  // numbering with the caller.
+  BlockMatrix broken = held;
+  double* diagonal = broken.values.data() + 9 * std::size_t(upper[std::size_t(broken.diagonal[0])]);
+  std::fill(diagonal, diagonal + 9, 0.0);
+  diagonal[0] = diagonal[4] = diagonal[8] = -1.0;
+  std::vector<int> kept = upper;
+  ChebyshevSmoother from_broken;
+  EXPECT_FALSE(from_broken.setup(broken, 2, 2, std::move(kept)));
+  EXPECT_EQ(kept, upper);
   EXPECT_THROW(from_held.setup(held, 2, 2, SmootherValues::single, &upper), std::logic_error);
 }
 
