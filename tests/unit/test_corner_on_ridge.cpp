@@ -13,8 +13,7 @@
 #include <cstdio>
 
 #include "dynamics/newmark_integrator.hpp"
-#include "fem/hex_mesh_bodies.hpp"
-#include "material/neo_hookean.hpp"
+#include "two_body_test_model.hpp"
 
 using namespace msfab;
 
@@ -48,14 +47,7 @@ DynamicsModel corner_over_ridge_model(const Eigen::Matrix3d& turn, double taper,
     elements[0][i] = i;
     elements[1][i] = 8 + i;
   }
-  DynamicsModel model;
-  model.mesh = make_hex_mesh(nodes, elements, std::make_shared<NeoHookean>(1e7, 0.3));
-  model.density.assign(2, 1000);
-  model.damping_a.assign(2, 0.0);
-  model.damping_b.assign(2, 1e-4);
-  model.element_material_name = {"a", "b"};
-  model.contact = true;
-  model.body_contact = true;
+  DynamicsModel model = contact_test::two_body_model(nodes, elements);
   model.fixed.assign(model.mesh.num_dofs(), 0);
   for (int i = 0; i < 24; ++i) model.fixed[i] = 1;
   return model;

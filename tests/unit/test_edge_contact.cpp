@@ -13,6 +13,7 @@
 #include "fem/hex_mesh_bodies.hpp"
 #include "fem/voxel_grid.hpp"
 #include "material/neo_hookean.hpp"
+#include "two_body_test_model.hpp"
 
 using namespace msfab;
 
@@ -36,15 +37,7 @@ DynamicsModel crossing_bars_model(double gap) {
       }
       elements[bar][i] = node;
     }
-  DynamicsModel model;
-  model.mesh = make_hex_mesh(nodes, elements, std::make_shared<NeoHookean>(1e7, 0.3));
-  model.density.assign(2, 1000);
-  model.damping_a.assign(2, 0.0);
-  model.damping_b.assign(2, 1e-4);
-  model.element_material_name = {"a", "b"};
-  model.contact = true;
-  model.body_contact = true;
-  return model;
+  return contact_test::two_body_model(nodes, elements);
 }
 
 VecX rest_of(const HexMesh& mesh) { return Eigen::Map<const VecX>(mesh.nodes.data(), mesh.num_dofs()); }
