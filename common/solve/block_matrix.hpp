@@ -96,17 +96,19 @@ std::vector<int> upper_block_numbering(const BlockMatrix& M, int threads);
 // The number of upper blocks of M's pattern (diagonal included).
 std::size_t upper_block_count(const BlockMatrix& M);
 
+// Where block `slot`'s values are stored in M.values: at the slot itself,
+// or with `upper` (upper_block_numbering) at its upper block (below the
+// diagonal: the mirror, not transposed).
+inline std::size_t stored_block(const std::vector<int>* upper, int slot) {
+  return 9 * (upper ? std::size_t((*upper)[std::size_t(slot)]) : std::size_t(slot));
+}
+
 // Block `slot` (in row i) of M into out, row-major: read from M.values as
 // stored, or with `upper` (upper_block_numbering) from its upper block,
 // transposed below the diagonal.
 inline void read_block(const BlockMatrix& M, const std::vector<int>* upper, int i, int slot, double out[9]) {
-  if (!upper) {
-    const double* m = M.values.data() + 9 * std::size_t(slot);
-    for (int e = 0; e < 9; ++e) out[e] = m[e];
-    return;
-  }
-  const double* m = M.values.data() + 9 * std::size_t((*upper)[std::size_t(slot)]);
-  if (M.column[std::size_t(slot)] >= i) {
+  const double* m = M.values.data() + stored_block(upper, slot);
+  if (!upper || M.column[std::size_t(slot)] >= i) {
     for (int e = 0; e < 9; ++e) out[e] = m[e];
   } else {
     for (int r = 0; r < 3; ++r)

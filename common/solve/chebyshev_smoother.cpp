@@ -61,14 +61,13 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
       for (Eigen::Index i = begin; i < end; ++i)
         for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
           const std::size_t block = std::size_t(block_of_slot_[std::size_t(slot)]);
-          const double* source = A.values.data() + 9 * (held_by_upper ? block : std::size_t(slot));
+          const double* source = A.values.data() + stored_block(held_by_upper ? &block_of_slot_ : nullptr, slot);
           for (int e = 0; e < 9; ++e) values_[9 * block + e] = static_cast<float>(source[e]);
         }
     });
   }
   const auto diagonal_block = [&](Eigen::Index i) {
-    const std::size_t slot = std::size_t(A.diagonal[std::size_t(i)]);
-    return A.values.data() + 9 * (held_by_upper ? std::size_t(block_of_slot_[slot]) : slot);
+    return A.values.data() + stored_block(held_by_upper ? &block_of_slot_ : nullptr, A.diagonal[std::size_t(i)]);
   };
   diagonal_.resize(9 * std::size_t(A.rows));
   chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {

@@ -176,10 +176,7 @@ void component_galerkin_product(const BlockMatrix& fine, const std::vector<char>
 }
 
 void fill_empty_diagonal(BlockMatrix& M, const std::vector<int>* upper) {
-  const auto diagonal = [&](int i) {
-    const std::size_t slot = std::size_t(M.diagonal[std::size_t(i)]);
-    return M.values.data() + 9 * (upper ? std::size_t((*upper)[slot]) : slot);
-  };
+  const auto diagonal = [&](int i) { return M.values.data() + stored_block(upper, M.diagonal[std::size_t(i)]); };
   double sum = 0.0;
   std::int64_t count = 0;
   for (int i = 0; i < M.rows; ++i)

@@ -438,8 +438,7 @@ void DirichletGridMultigrid::assemble_material_coarse() {
           const int row = copies[g][std::size_t(a)], column = copies[g][std::size_t(b)];
           // Held by its upper blocks, a block below the diagonal is its mirror's transpose.
           if (upper && column < row) continue;
-          const std::size_t s = slot(row, column);
-          double* block = M.values.data() + 9 * (upper ? std::size_t((*upper)[s]) : s);
+          double* block = M.values.data() + stored_block(upper, static_cast<int>(slot(row, column)));
           for (int r = 0; r < 3; ++r)
             for (int q = 0; q < 3; ++q) block[3 * r + q] += KE[g](3 * a + r, 3 * b + q);
         }
