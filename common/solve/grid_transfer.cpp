@@ -1,5 +1,6 @@
 #include "solve/grid_transfer.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <string>
@@ -87,12 +88,39 @@ const std::array<EntryList, 27>& box_entry_offsets() {
 
 }  // namespace
 
+int lattice_reach(const NodeLattice& lattice, const BlockMatrix& matrix) {
+  int reach = 0;
+  for (int f = 0; f < matrix.rows; ++f) {
+    const std::array<int, 3>& c = lattice.coords[f];
+    for (int slot = matrix.row_start[f]; slot < matrix.row_start[f + 1]; ++slot) {
+      const int g = matrix.column[slot];
+      const std::array<int, 3>& d = lattice.coords[g];
+      const int steps = std::max({std::abs(d[0] - c[0]), std::abs(d[1] - c[1]), std::abs(d[2] - c[2])});
+      if (steps > GridTransfer::kMaxCouplingSteps) {
+        throw InputError("pcg-mg needs a voxel mesh: the matrix couples nodes " + std::to_string(f) + " and " +
+                         std::to_string(g) + ", which are not neighbours on the node lattice (" +
+                         std::to_string(steps) + " lattice steps apart, more than the " +
+                         std::to_string(GridTransfer::kMaxCouplingSteps) +
+                         " elements of mixed sizes reach; is node_positions the rest configuration of this mesh?)");
+      }
+      reach = std::max(reach, steps);
+    }
+  }
+  return reach;
+}
+
 GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator) {
   const int fine_count = fine.num_nodes();
   const int coarse_count = coarse.num_nodes();
   if (fine_operator.rows != fine_count) {
     throw std::invalid_argument("GridTransfer: the fine operator has " + std::to_string(fine_operator.rows) +
                                 " block rows for " + std::to_string(fine_count) + " lattice nodes");
+  }
+
+  neighbour_coupled_ = lattice_reach(fine, fine_operator) <= 1;
+  if (!neighbour_coupled_) {
+    build_wide_transfer(fine, coarse, fine_operator);
+    return;
   }
 
   // Parents and coordinate parities of the fine nodes; offsets of the fine blocks.
@@ -115,15 +143,8 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, c
   for (int f = 0; f < fine_count; ++f) {
     const std::array<int, 3>& c = fine.coords[f];
     for (int slot = fine_operator.row_start[f]; slot < fine_operator.row_start[f + 1]; ++slot) {
-      const int g = fine_operator.column[slot];
-      const std::array<int, 3>& d = fine.coords[g];
+      const std::array<int, 3>& d = fine.coords[fine_operator.column[slot]];
       const int dx = d[0] - c[0], dy = d[1] - c[1], dz = d[2] - c[2];
-      if (std::abs(dx) > 1 || std::abs(dy) > 1 || std::abs(dz) > 1) {
-        throw InputError("pcg-mg needs a voxel mesh: the matrix couples nodes " + std::to_string(f) + " and " +
-                         std::to_string(g) +
-                         ", which are not neighbours on the node lattice (is node_positions "
-                         "the rest configuration of this mesh?)");
-      }
       fine_block_offset_[slot] = static_cast<std::uint8_t>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1));
     }
   }
@@ -197,6 +218,10 @@ BlockMatrix GridTransfer::coarse_pattern() const {
 
 void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
                                     BlockMatrix& coarse, int threads) {
+  if (!neighbour_coupled_) {
+    wide_galerkin_product(fine, fine_decoupled, coarse, threads);
+    return;
+  }
   const int team = resolve_thread_count(threads);
   const auto& parents = parent_box_entries();
   const auto& box_offsets = box_entry_offsets();
@@ -274,6 +299,166 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<c
     for (int p = begin; p < end; ++p) {
       for (int slot = coarse.row_start[p]; slot < coarse.row_start[p + 1]; ++slot) {
         if (coarse_block_offset_[slot] >= kCenter) continue;
+        const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[slot]);
+        double* target = coarse.values.data() + 9 * std::size_t(slot);
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) target[3 * a + b] = source[3 * b + a];
+        }
+      }
+    }
+  });
+}
+
+void GridTransfer::build_wide_transfer(const NodeLattice& fine, const NodeLattice& coarse,
+                                       const BlockMatrix& fine_operator) {
+  // Parents by the rule of coarsen_lattice_by_injection: the corners of the
+  // enclosing coarse cell whose fine point holds a node, all with the same
+  // weight; a node with none of them takes the corner at floor(c / 2) alone.
+  // Each coarse column then has a row of its own with weight 1 (its
+  // injected node, or a node for which it is the only parent), so P has
+  // full column rank and P^T A P is definite where A is.
+  const int fine_count = fine.num_nodes();
+  const int coarse_count = coarse.num_nodes();
+  parent_start_.assign(static_cast<std::size_t>(fine_count) + 1, 0);
+  for (int f = 0; f < fine_count; ++f) {
+    const std::array<int, 3>& c = fine.coords[f];
+    for (int k = c[2] / 2; k <= (c[2] + 1) / 2; ++k) {
+      for (int j = c[1] / 2; j <= (c[1] + 1) / 2; ++j) {
+        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i) {
+          if (fine.node(2 * i, 2 * j, 2 * k) < 0) continue;
+          const int p = coarse.node(i, j, k);
+          if (p < 0) throw std::logic_error("GridTransfer: a coarse point over a fine node has no node");
+          parent_node_.push_back(p);
+        }
+      }
+    }
+    if (static_cast<int>(parent_node_.size()) == parent_start_[f]) {
+      const int p = coarse.node(c[0] / 2, c[1] / 2, c[2] / 2);
+      if (p < 0) throw std::logic_error("GridTransfer: a fine node without parents has no floor corner");
+      parent_node_.push_back(p);
+    }
+    parent_start_[f + 1] = static_cast<int>(parent_node_.size());
+  }
+  // Children: the parents' lists inverted, in fine node order.
+  child_start_.assign(static_cast<std::size_t>(coarse_count) + 1, 0);
+  for (const int p : parent_node_) ++child_start_[static_cast<std::size_t>(p) + 1];
+  for (int p = 0; p < coarse_count; ++p) child_start_[p + 1] += child_start_[p];
+  child_node_.resize(parent_node_.size());
+  child_weight_.resize(parent_node_.size());
+  std::vector<int> next(child_start_.begin(), child_start_.end() - 1);
+  for (int f = 0; f < fine_count; ++f) {
+    const double weight = 1.0 / (parent_start_[f + 1] - parent_start_[f]);
+    for (int e = parent_start_[f]; e < parent_start_[f + 1]; ++e) {
+      const int slot = next[static_cast<std::size_t>(parent_node_[e])]++;
+      child_node_[slot] = f;
+      child_weight_[slot] = weight;
+    }
+  }
+  build_wide_pattern(fine_operator);
+}
+
+void GridTransfer::build_wide_pattern(const BlockMatrix& fine_operator) {
+  // Block (p, q) is stored if a child of p couples to a fine node that q
+  // interpolates to: the same rule as the neighbour tables, found directly.
+  const int coarse_count = coarse_nodes();
+  coarse_.rows = coarse_count;
+  coarse_.row_start.assign(static_cast<std::size_t>(coarse_count) + 1, 0);
+  coarse_.diagonal.assign(static_cast<std::size_t>(coarse_count), -1);
+  std::vector<char> seen(static_cast<std::size_t>(coarse_count), 0);
+  std::vector<int> columns;
+  for (int p = 0; p < coarse_count; ++p) {
+    columns.assign(1, p);
+    seen[p] = 1;
+    for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
+      const int f = child_node_[k];
+      for (int slot = fine_operator.row_start[f]; slot < fine_operator.row_start[f + 1]; ++slot) {
+        const int g = fine_operator.column[slot];
+        for (int e = parent_start_[g]; e < parent_start_[g + 1]; ++e) {
+          const int q = parent_node_[e];
+          if (seen[q]) continue;
+          seen[q] = 1;
+          columns.push_back(q);
+        }
+      }
+    }
+    std::sort(columns.begin(), columns.end());
+    for (const int q : columns) {
+      seen[q] = 0;
+      if (q == p) coarse_.diagonal[p] = static_cast<int>(coarse_.column.size());
+      coarse_.column.push_back(q);
+    }
+    coarse_.row_start[p + 1] = static_cast<int>(coarse_.column.size());
+  }
+  mirror_slot_.resize(coarse_.column.size());
+  for (int p = 0; p < coarse_count; ++p) {
+    for (int slot = coarse_.row_start[p]; slot < coarse_.row_start[p + 1]; ++slot) {
+      const int q = coarse_.column[slot];
+      const auto row_begin = coarse_.column.begin() + coarse_.row_start[q];
+      const auto row_end = coarse_.column.begin() + coarse_.row_start[q + 1];
+      const auto found = std::lower_bound(row_begin, row_end, p);
+      if (found == row_end || *found != p) throw std::logic_error("GridTransfer: the coarse pattern is not symmetric");
+      mirror_slot_[slot] = static_cast<int>(found - coarse_.column.begin());
+    }
+  }
+}
+
+void GridTransfer::wide_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled,
+                                         BlockMatrix& coarse, int threads) const {
+  const int team = resolve_thread_count(threads);
+  const int coarse_count = coarse.rows;
+  // Upper block triangle of P^T A P, one coarse row at a time from its
+  // children's fine rows: each fine block, weighted by the child's and the
+  // column's interpolation weights (powers of two: exact), lands on the
+  // column's parents. Rows are independent, so the sums do not depend on the
+  // thread count.
+  parallel_row_ranges(coarse_count, team, [&](int begin, int end) {
+    std::vector<int> slot_of(static_cast<std::size_t>(coarse_count), -1);
+    for (int p = begin; p < end; ++p) {
+      const int upper = coarse.diagonal[p];
+      const int last = coarse.row_start[p + 1];
+      for (int slot = upper; slot < last; ++slot) slot_of[coarse.column[slot]] = slot;
+      std::fill(coarse.values.data() + 9 * std::size_t(upper), coarse.values.data() + 9 * std::size_t(last), 0.0);
+      bool reached[3] = {false, false, false};
+      for (int k = child_start_[p]; k < child_start_[p + 1]; ++k) {
+        const int f = child_node_[k];
+        for (int a = 0; a < 3; ++a) reached[a] = reached[a] || !fine_decoupled[3 * std::size_t(f) + std::size_t(a)];
+        for (int slot = fine.row_start[f]; slot < fine.row_start[f + 1]; ++slot) {
+          const int g = fine.column[slot];
+          const int first_parent = parent_start_[g];
+          const int end_parent = parent_start_[g + 1];
+          const double weight = child_weight_[k] / (end_parent - first_parent);
+          double scaled[9];
+          const double* block = fine.values.data() + 9 * std::size_t(slot);
+          for (int a = 0; a < 9; ++a) scaled[a] = weight * block[a];
+          if (slot == fine.diagonal[f]) {
+            // P has no row for a decoupled unknown: drop its diagonal.
+            for (int a = 0; a < 3; ++a) {
+              if (fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) scaled[4 * a] = 0.0;
+            }
+          }
+          for (int e = first_parent; e < end_parent; ++e) {
+            const int q = parent_node_[e];
+            if (q < p) continue;
+            double* target = coarse.values.data() + 9 * std::size_t(slot_of[q]);
+            for (int a = 0; a < 9; ++a) target[a] += scaled[a];
+          }
+        }
+      }
+      double* diagonal = coarse.values.data() + 9 * std::size_t(upper);
+      for (int a = 0; a < 3; ++a) {
+        for (int b = a + 1; b < 3; ++b) {
+          const double mean = 0.5 * (diagonal[3 * a + b] + diagonal[3 * b + a]);
+          diagonal[3 * a + b] = mean;
+          diagonal[3 * b + a] = mean;
+        }
+        if (!reached[a]) diagonal[4 * a] = 1.0;
+      }
+      for (int slot = upper; slot < last; ++slot) slot_of[coarse.column[slot]] = -1;
+    }
+  });
+  parallel_row_ranges(coarse_count, team, [&](int begin, int end) {
+    for (int p = begin; p < end; ++p) {
+      for (int slot = coarse.row_start[p]; slot < coarse.diagonal[p]; ++slot) {
         const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[slot]);
         double* target = coarse.values.data() + 9 * std::size_t(slot);
         for (int a = 0; a < 3; ++a) {

@@ -9,6 +9,17 @@
 // unknowns, whose matrix row holds only the diagonal) are zero, so coarse
 // corrections leave them alone and their diagonal does not leak into the
 // coarse operator.
+//
+// Two ways to form P^T A P. Where A couples only lattice neighbours (a mesh
+// of equal voxels), fixed 3x3x3 boxes of coarse columns per fine row make it
+// a table-driven product. Where A couples nodes several lattice steps apart
+// (a mesh of mixed element sizes whose hanging nodes are eliminated, as the
+// adaptive DDFEM meshes), the level is coarsened by injection
+// (coarsen_lattice_by_injection): a fine node takes equal weights from those
+// corners of its enclosing coarse cell whose fine point holds a node, or
+// weight 1 from the corner at floor(c / 2) where none does, and the product
+// runs over each coarse node's children, their fine blocks and the columns'
+// parents, with the coarse pattern found the same way.
 #include <cstdint>
 #include <vector>
 
@@ -19,11 +30,17 @@ namespace msfab {
 
 class GridTransfer {
  public:
-  // coarse = coarsen_lattice(fine); fine_operator holds the block pattern of
+  // Widest coupling accepted, in lattice steps per axis: elements four steps
+  // wide whose faces carry eliminated hanging nodes reach five.
+  static constexpr int kMaxCouplingSteps = 8;
+
+  // coarse = coarsen_lattice(fine), or coarsen_lattice_by_injection(fine)
+  // where the fine pattern reaches beyond lattice neighbours (the parents
+  // then follow that rule); fine_operator holds the block pattern of
   // the fine matrix (node order of `fine`). Builds P, the coarse pattern and
   // the index tables of the triple product. Throws InputError if the fine
-  // pattern couples nodes that are not lattice neighbours (the matrix is not
-  // that of a trilinear hex mesh on this lattice).
+  // pattern couples nodes more than kMaxCouplingSteps lattice steps apart on
+  // some axis (the matrix is not that of a hex mesh on this lattice).
   GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator);
 
   // The coarse operator's block pattern (values zero).
@@ -46,8 +63,16 @@ class GridTransfer {
 
   int fine_nodes() const { return static_cast<int>(parent_start_.size()) - 1; }
   int coarse_nodes() const { return static_cast<int>(child_start_.size()) - 1; }
+  // True where the fine matrix couples only lattice neighbours (the table-driven product).
+  bool neighbour_coupled() const { return neighbour_coupled_; }
 
  private:
+  void build_wide_transfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator);
+  void build_wide_pattern(const BlockMatrix& fine_operator);
+  void wide_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled, BlockMatrix& coarse,
+                             int threads) const;
+
+  bool neighbour_coupled_ = true;
   // Fine node -> its coarse parents (interpolation sources), weight 1/count.
   std::vector<int> parent_start_, parent_node_;
   // Coarse node -> fine children with weights; child_offset_ codes the
@@ -70,5 +95,10 @@ class GridTransfer {
   std::vector<std::uint8_t> coarse_block_offset_;
   std::vector<int> mirror_slot_;
 };
+
+// The largest lattice distance (steps on one axis) between two nodes the
+// block pattern couples: 1 for a mesh of equal voxels. Throws InputError
+// ("pcg-mg needs a voxel mesh: ...") above GridTransfer::kMaxCouplingSteps.
+int lattice_reach(const NodeLattice& lattice, const BlockMatrix& matrix);
 
 }  // namespace msfab

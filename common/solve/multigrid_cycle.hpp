@@ -27,7 +27,8 @@ constexpr int kCoarseCorrections = 2;
 //   bool is_coarsest(i);  void solve_coarsest(i, rhs, x);
 //   void smooth(i, rhs, x, bool zero_start);  void residual(i, rhs, x, r);
 //   void restrict_to_coarse(i, r, coarse_rhs);  void add_prolongation(i, coarse_x, x);
-//   VecX& residual_workspace(i), rhs_workspace(i), solution_workspace(i).
+//   VecX& residual_workspace(i), rhs_workspace(i), solution_workspace(i);
+//   int corrections(i).
 // The operations alike on every level that keeps its own smoother and cycle
 // workspace (members smoother, rhs, solution, residual) in a vector of
 // pointers: a Levels type derives from this and adds the rest.
@@ -39,6 +40,9 @@ struct SmoothedLevels {
   VecX& residual_workspace(std::size_t i) { return stored[i]->residual; }
   VecX& rhs_workspace(std::size_t i) { return stored[i]->rhs; }
   VecX& solution_workspace(std::size_t i) { return stored[i]->solution; }
+  // Coarse corrections per visit of level i: one on the finest level, a W
+  // below. A solver whose level i+1 barely shrinks hides this with its own rule.
+  int corrections(std::size_t i) const { return i == 0 ? 1 : kCoarseCorrections; }
 };
 
 template <class Levels>
@@ -48,7 +52,7 @@ void cycle(Levels& levels, std::size_t index, const VecX& rhs, VecX& solution) {
     return;
   }
   levels.smooth(index, rhs, solution, /*zero_start=*/true);
-  const int corrections = index == 0 ? 1 : kCoarseCorrections;
+  const int corrections = levels.corrections(index);
   for (int c = 0; c < corrections; ++c) {
     VecX& residual = levels.residual_workspace(index);
     VecX& coarse_rhs = levels.rhs_workspace(index + 1);

@@ -79,9 +79,18 @@ void MultigridSolver::analyze(const SpMat& A) {
   while (levels_.back()->matrix.unknowns() >= options_.mg_coarse_unknowns &&
          static_cast<int>(levels_.size()) < kMaxLevels) {
     Level& level = *levels_.back();
-    NodeLattice coarse_lattice = coarsen_lattice(level.lattice);
-    // A lattice only one or two points thick in every direction stops shrinking.
-    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes())) break;
+    // Levels whose matrix reaches beyond lattice neighbours (elements of
+    // mixed sizes) coarsen by injection (node_lattice.hpp).
+    NodeLattice coarse_lattice = lattice_reach(level.lattice, level.matrix) > 1
+                                     ? coarsen_lattice_by_injection(level.lattice)
+                                     : coarsen_lattice(level.lattice);
+    // A lattice only one or two points thick in every direction stops
+    // shrinking. On a mesh of mixed element sizes nodes sit several lattice
+    // steps apart where elements are large: there a level keeps its nodes
+    // while the lattice halves, and the level after it shrinks.
+    if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes()) &&
+        coarse_lattice.dims == level.lattice.dims)
+      break;
     level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix);
     auto coarse = std::make_unique<Level>();
     coarse->matrix = level.to_coarse->coarse_pattern();
@@ -140,6 +149,14 @@ void MultigridSolver::cycle(std::size_t index, const VecX& rhs, VecX& solution) 
   struct Levels : multigrid_cycle::SmoothedLevels<decltype(levels_)> {
     MultigridSolver& s;
     bool is_coarsest(std::size_t i) const { return i + 1 == s.levels_.size(); }
+    // A coarser level that keeps most of this one's unknowns (large elements
+    // of a mixed mesh) costs as much as this one: a W there would double the
+    // cycle's cost at every such level, so it is visited once.
+    int corrections(std::size_t i) const {
+      if (i > 0 && 4 * std::int64_t(s.levels_[i + 1]->matrix.rows) > 3 * std::int64_t(s.levels_[i]->matrix.rows))
+        return 1;
+      return SmoothedLevels::corrections(i);
+    }
     void solve_coarsest(std::size_t, const VecX& b, VecX& x) { x = s.coarse_solver_.solve(b); }
     void restrict_to_coarse(std::size_t i, const VecX& r, VecX& coarse_rhs) {
       const Level& level = *s.levels_[i];

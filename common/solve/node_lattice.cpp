@@ -123,4 +123,38 @@ NodeLattice coarsen_lattice(const NodeLattice& fine) {
   return coarse;
 }
 
+NodeLattice coarsen_lattice_by_injection(const NodeLattice& fine) {
+  NodeLattice coarse;
+  for (int axis = 0; axis < 3; ++axis) coarse.dims[axis] = fine.dims[axis] / 2 + 1;
+  coarse.node_at.assign(static_cast<std::size_t>(coarse.dims[0]) * coarse.dims[1] * coarse.dims[2], -1);
+  auto point_index = [&](int i, int j, int k) {
+    return static_cast<std::size_t>(i) +
+           static_cast<std::size_t>(coarse.dims[0]) *
+               (static_cast<std::size_t>(j) + static_cast<std::size_t>(coarse.dims[1]) * k);
+  };
+  auto injected = [&](int i, int j, int k) { return fine.node(2 * i, 2 * j, 2 * k) >= 0; };
+  for (const std::array<int, 3>& c : fine.coords) {
+    bool has_parent = false;
+    for (int k = c[2] / 2; k <= (c[2] + 1) / 2; ++k)
+      for (int j = c[1] / 2; j <= (c[1] + 1) / 2; ++j)
+        for (int i = c[0] / 2; i <= (c[0] + 1) / 2; ++i)
+          if (injected(i, j, k)) {
+            coarse.node_at[point_index(i, j, k)] = 0;
+            has_parent = true;
+          }
+    if (!has_parent) coarse.node_at[point_index(c[0] / 2, c[1] / 2, c[2] / 2)] = 0;
+  }
+  for (int k = 0; k < coarse.dims[2]; ++k) {
+    for (int j = 0; j < coarse.dims[1]; ++j) {
+      for (int i = 0; i < coarse.dims[0]; ++i) {
+        int& slot = coarse.node_at[point_index(i, j, k)];
+        if (slot < 0) continue;
+        slot = coarse.num_nodes();
+        coarse.coords.push_back({i, j, k});
+      }
+    }
+  }
+  return coarse;
+}
+
 }  // namespace msfab

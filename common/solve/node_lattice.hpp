@@ -42,4 +42,14 @@ NodeLattice lattice_from_positions(const NodePositions& positions);
 // Coarse nodes are numbered in lattice order (x fastest).
 NodeLattice coarsen_lattice(const NodeLattice& fine);
 
+// The next coarser level of a mesh of mixed element sizes: the lattice
+// points with even coordinates whose fine point holds a node, plus, for a
+// fine node none of whose enclosing coarse corners is such a point, the
+// corner at floor(c / 2). Where large elements leave nodes at odd
+// coordinates with no node beside them, coarsen_lattice would give each two
+// coarse points that only it reaches, and P^T A P would be singular; here
+// every coarse point has a fine node of its own (GridTransfer's parents
+// follow this rule). Numbered in lattice order (x fastest).
+NodeLattice coarsen_lattice_by_injection(const NodeLattice& fine);
+
 }  // namespace msfab

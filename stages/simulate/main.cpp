@@ -183,10 +183,6 @@ int main(int argc, char** argv) {
         throw InputError(
             "--target-error: --coarse-window is not supported (the mixed mesh takes one material set "
             "per distinct block, a window needs one per cell); drop it");
-      if (scene.newton.linear_solver == "pcg-mg")
-        throw InputError((ctx.options.config_path.empty() ? std::string("built-in scene") : ctx.options.config_path) +
-                         ": solver.linear_solver: pcg-mg needs a mesh of equal elements and --target-error meshes "
-                         "several sizes (use auto, cholmod or pcg)");
       coarsening.level = 2;
     }
     if (coarsening.level == 0 && !coarsening.element.empty())
@@ -227,10 +223,10 @@ int main(int argc, char** argv) {
       uniform_seconds = solve2.timings.total + solve1.timings.total;
       adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, *level1_db,
                                      target_error);
-      // The mixed solve and, with --posterior-check, its a-posteriori check. The lattice multigrid
-      // needs neighbouring nodes one lattice step apart, which elements of
-      // mixed sizes are not: mixed models are factored directly (they are the
-      // smaller ones; docs/ddfem.md). A miss tightens the target of the
+      // The mixed solve and, with --posterior-check, its a-posteriori check.
+      // Its linear solver follows the size rule of every static solve: the
+      // lattice multigrid takes elements of mixed sizes, whose nodes sit on
+      // the fine lattice (docs/solvers.md). A miss tightens the target of the
       // choice by the ratio it missed by and solves again.
       // A refinement that does not bring the estimate down means the
       // extrapolation, not the model, dominates it (where the error falls
@@ -239,8 +235,6 @@ int main(int argc, char** argv) {
       // estimate.
       // After a refinement the estimate is also bounded by how far the solve
       // moved from the previous one (posterior_estimate).
-      NewtonOptions mixed_newton = warm_newton;
-      if (mixed_newton.linear_solver == "auto") mixed_newton.linear_solver = "cholmod";
       std::optional<ElasticAssembler> fine_assembler;
       if (newton_estimate) fine_assembler.emplace(fine.mesh);
       AdaptiveModel best;
@@ -253,7 +247,7 @@ int main(int argc, char** argv) {
         const bool all_level2 = adapted.mixed.elements_per_level[0] == 0 && adapted.mixed.elements_per_level[1] == 0;
         const NodeArray& unknown_rest = adapted.mixed.constraints->unknown_rest;
         const NewtonResult solved = solve_or_throw(
-            mixed_assembler, adapted.conditions, mixed_newton, "adaptive load",
+            mixed_assembler, adapted.conditions, warm_newton, "adaptive load",
             all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
         ++adaptive_solves;
         const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);

@@ -3,6 +3,8 @@
 // constrained, the constrained assembler, and the choice of levels.
 #include <gtest/gtest.h>
 
+#include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -14,6 +16,8 @@
 #include "ddfem_test_blocks.hpp"
 #include "fem/elastic_assembler.hpp"
 #include "material/neo_hookean.hpp"
+#include "solve/cholmod_solver.hpp"
+#include "solve/multigrid_solver.hpp"
 #include "solve/newton.hpp"
 
 namespace msfab {
@@ -21,17 +25,17 @@ namespace {
 
 using Rows3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-// An 8 x 12 x 8 block of two materials in an irregular pattern (so that
-// level-1 and level-2 blocks mix them), with a few void voxels, clamped at
-// y = 0 and pulled and sheared at y = max.
-Scene two_material_block() {
+// An 8 x 12 x 8 block (or another size) of two materials in an irregular
+// pattern (so that level-1 and level-2 blocks mix them), with a few void
+// voxels, clamped at y = 0 and pulled and sheared at y = max.
+Scene two_material_block(int nx = 8, int ny = 12, int nz = 8) {
   Scene s;
   s.name = "mixed-block";
-  s.grid = VoxelGrid(8, 12, 8, 0.001, 0);
+  s.grid = VoxelGrid(nx, ny, nz, 0.001, 0);
   std::mt19937 rng(3);
-  for (int k = 0; k < 8; ++k)
-    for (int j = 0; j < 12; ++j)
-      for (int i = 0; i < 8; ++i) s.grid.at(i, j, k) = rng() % 3 == 0 ? 2 : 1;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) s.grid.at(i, j, k) = rng() % 3 == 0 ? 2 : 1;
   s.grid.at(5, 6, 2) = 0;
   s.grid.at(1, 9, 6) = 0;
   s.material_by_id = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e6, 0.45)};
@@ -248,6 +252,123 @@ TEST(AdaptiveMixedMesh, AllFineLevelsSolveTheFineModel) {
       W * Eigen::Map<const Rows3>(um.data(), m.num_unknown_nodes(), 3);
   const VecX uf = rf.x - af.rest_positions();
   EXPECT_LT(mean_vertex_error(fine.mesh, uf, interpolated), 1e-8 * uf.cwiseAbs().maxCoeff());
+}
+
+// The lattice multigrid on a mesh of three element sizes (docs/solvers.md):
+// with its hanging nodes eliminated the tangent couples nodes several
+// lattice steps apart, and the hierarchy is still P^T A P, symmetric, the
+// same on one thread and two, and solves as CHOLMOD does, alone and in Newton.
+TEST(AdaptiveMixedMesh, LatticeMultigridSolvesMixedMeshesLikeCholmod) {
+  // Over 2048 unknown nodes, so that two threads split the rows. The second
+  // block has void voxels at x = 0 under fine cells, so that its lowest node
+  // (the lattice origin) lies one voxel in and the large elements' corners
+  // sit at odd lattice coordinates: there the coarsening of equal voxels
+  // would make P^T A P singular.
+  struct Case {
+    const char* name;
+    const CoarseVariant& variant;
+    bool offset;
+  };
+  for (const Case& test : {Case{"patchwork", kCoarseVariants[0], false}, Case{"patchwork", kCoarseVariants[2], false},
+                           Case{"odd corners", kCoarseVariants[0], true}}) {
+    const CoarseVariant& v = test.variant;
+    SCOPED_TRACE(std::string(test.name) + ", " + v.name);
+    Scene s = two_material_block(16, 32, 16);
+    if (test.offset)
+      for (int k = 0; k < s.grid.nz; ++k)
+        for (int j = 0; j < s.grid.ny; ++j) s.grid.at(0, j, k) = 0;
+    const Grids g = grids_of(s);
+    std::vector<int> levels = patchwork_levels(g.level2);
+    if (test.offset) {
+      for (int K = 0; K < g.level2.nz; ++K)
+        for (int J = 0; J < g.level2.ny; ++J) levels[g.level2.index(0, J, K)] = 0;
+    }
+    const VoxelMesh fine = build_voxel_mesh(s.grid, s.material_by_id);
+    const StaticConditions fc = build_static_conditions(s, fine);
+    const MixedLevelMesh m = variant_mixed_mesh(s, g, levels, v);
+    ASSERT_GT(m.hanging_nodes, 0);
+    const StaticConditions mc = mixed_static_conditions(s, fine, fc, g.level1, g.level2, m);
+    const ElasticAssembler am(m.mesh, m.constraints);
+    SpMat K = am.pattern();
+    am.evaluate(am.rest_positions(), nullptr, &K);
+    const auto positions = std::make_shared<const NodeArray>(am.unknown_rest_nodes());
+    int reach = 0;
+    for (int c = 0; c < K.outerSize(); ++c)
+      for (SpMat::InnerIterator it(K, c); it; ++it)
+        for (int a = 0; a < 3; ++a)
+          reach = std::max(
+              reach, static_cast<int>(std::lround(std::abs((*positions)(it.row() / 3, a) - (*positions)(c / 3, a)) /
+                                                  s.grid.voxel_size)));
+    EXPECT_GE(reach, 4);
+    // Clamped unknowns as Newton treats them: rows and columns cleared, a
+    // positive diagonal kept.
+    const std::vector<char>& fixed = mc.dirichlet.fixed;
+    const double diagonal = K.diagonal().mean();
+    for (int c = 0; c < K.outerSize(); ++c)
+      for (SpMat::InnerIterator it(K, c); it; ++it)
+        if (fixed[std::size_t(c)] || fixed[std::size_t(it.row())]) it.valueRef() = it.row() == c ? diagonal : 0.0;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> noise(-1.0, 1.0);
+    VecX b(K.rows());
+    for (Eigen::Index i = 0; i < b.size(); ++i) b[i] = fixed[std::size_t(i)] ? 0.0 : noise(rng);
+    CholmodSolver direct;
+    direct.analyze(K);
+    ASSERT_TRUE(direct.factorize(K));
+    const VecX reference = direct.solve(b);
+
+    VecX solutions[2];
+    for (int threads : {1, 2}) {
+      LinearSolverOptions options;
+      options.node_positions = positions;
+      options.pcg_tolerance = 1e-10;
+      options.pcg_max_iterations = 300;
+      options.mg_coarse_unknowns = 100;
+      options.threads = threads;
+      MultigridSolver solver(options);
+      solver.analyze(K);
+      ASSERT_TRUE(solver.factorize(K));
+      ASSERT_GE(solver.num_levels(), 3);
+      solutions[threads - 1] = solver.solve(b);
+      EXPECT_LT(solver.stats().iterations, 100);
+      EXPECT_GT(K.rows(), 3 * 2048);
+      EXPECT_LT((solutions[threads - 1] - reference).norm(), 1e-8 * reference.norm());
+      if (threads == 2) continue;
+      for (int level = 0; level + 1 < solver.num_levels(); ++level) {
+        const SpMat P = solver.prolongation(level);
+        const SpMat expected = SpMat(P.transpose()) * solver.level_operator(level) * P;
+        const SpMat coarse = solver.level_operator(level + 1);
+        SpMat difference = coarse - expected;
+        for (int c = 0; c < P.cols(); ++c)
+          if (P.col(c).nonZeros() == 0) difference.coeffRef(c, c) -= 1.0;
+        EXPECT_LT(difference.norm(), 1e-12 * expected.norm()) << "level " << level;
+        EXPECT_EQ(SpMat(coarse - SpMat(coarse.transpose())).norm(), 0.0) << "level " << level;
+        // P has full column rank, so every level is as definite as A.
+        const Eigen::SimplicialLLT<SpMat> cholesky(coarse);
+        EXPECT_EQ(cholesky.info(), Eigen::Success) << "level " << level + 1;
+      }
+      // The cycle is symmetric positive definite, so CG applies.
+      VecX x(b.size()), y(b.size());
+      for (Eigen::Index i = 0; i < b.size(); ++i) {
+        x[i] = noise(rng);
+        y[i] = noise(rng);
+      }
+      const VecX mx = solver.apply_preconditioner(x), my = solver.apply_preconditioner(y);
+      EXPECT_GT(mx.dot(x), 0.0);
+      EXPECT_LT(std::abs(mx.dot(y) - x.dot(my)), 1e-10 * std::sqrt(mx.dot(x) * my.dot(y)));
+    }
+    EXPECT_TRUE((solutions[0].array() == solutions[1].array()).all());
+    if (v.galerkin || test.offset) continue;  // one case is enough for Newton's use of it
+
+    NewtonOptions opt;
+    opt.relative_tolerance = 1e-10;
+    opt.linear_solver = "cholmod";
+    const NewtonResult by_cholmod = solve_static(am, mc.dirichlet, mc.force, opt);
+    opt.linear_solver = "pcg-mg";
+    const NewtonResult by_multigrid = solve_static(am, mc.dirichlet, mc.force, opt);
+    ASSERT_TRUE(by_cholmod.converged && by_multigrid.converged);
+    const VecX u = by_cholmod.x - am.rest_positions();
+    EXPECT_LT((by_multigrid.x - by_cholmod.x).norm(), 1e-6 * u.norm());
+  }
 }
 
 // Loads restricted to the unknowns keep their total; the interpolation to the
