@@ -12,6 +12,7 @@
 #include "core/timing.hpp"
 #include "solve/cholmod_solver.hpp"
 #include "solve/load_continuation.hpp"
+#include "solve/multigrid_solver.hpp"
 #include "solve/regularized_step.hpp"
 
 namespace msfab {
@@ -114,11 +115,6 @@ RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, do
       rhs, dx, context);
 }
 
-// The most unknowns newton_step_from factors directly where the tangent is
-// indefinite: on a 3D mesh about 70 k elements, a factor of about 3 GB
-// (static_solve_peak_bytes' CHOLMOD fill).
-constexpr int kLargestIndefiniteDirectStep = 200000;
-
 // The preconditioner interface Eigen's MINRES calls.
 struct FactorPreconditioner {
   CholmodSolver* factor;
@@ -175,6 +171,40 @@ VecX indefinite_direct_solve(const SpMat& K, const VecX& b, double scale, const 
   return x;
 }
 
+// Preconditioning by one lattice multigrid cycle (pcg-mg) of K + s I.
+struct CyclePreconditioner {
+  MultigridSolver* cycle;
+  VecX solve(const VecX& v) const { return cycle->apply_preconditioner(v); }
+};
+
+// Above NewtonOptions::largest_indefinite_direct_step on a voxel lattice: MINRES on K x = b
+// preconditioned by the multigrid cycle of K + s I. MINRES needs a
+// positive definite preconditioner, which the cycle is once K + s I is;
+// the multigrid's own checks (definite diagonal blocks and coarsest level)
+// do not prove that, so a shift whose MINRES does not reach the residual
+// is taken as too small, and the next one tried. Empty where none does.
+VecX indefinite_multigrid_solve(const SpMat& K, const VecX& b, double scale, const LinearSolverOptions& linear) {
+  if (b.norm() == 0) return VecX::Zero(b.size());
+  const auto t0 = Clock::now();
+  MultigridSolver shifted(linear);
+  shifted.analyze(K);
+  const RegularizationSchedule schedule;
+  double shift = 1e-4 * scale;  // as indefinite_direct_solve's first shift
+  for (int attempt = 0; attempt < schedule.max_factorizations; ++attempt, shift *= schedule.growth) {
+    if (!shifted.factorize(K, shift)) continue;
+    VecX x = VecX::Zero(b.size());
+    Eigen::Index iterations = 200;
+    double tolerance = 1e-10;
+    Eigen::internal::minres(K, b, x, CyclePreconditioner{&shifted}, iterations, tolerance);
+    const double residual = (K * x - b).norm() / b.norm();
+    spdlog::debug("newton_step_from: MINRES on the indefinite tangent, multigrid of shift {:.2e}, {} iterations, "
+                  "residual {:.1e}, {:.3f} s",
+                  shift, iterations, residual, seconds_since(t0));
+    if (x.allFinite() && residual <= 1e-8) return x;
+  }
+  return VecX();
+}
+
 }  // namespace
 
 NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const DirichletConditions& dirichlet,
@@ -212,7 +242,7 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   }
   spdlog::debug("newton_step_from: {} found the tangent indefinite in {:.3f} s", solver_name, seconds_since(t0));
   // Not positive definite: the exact step where a direct factorization fits.
-  if (n <= kLargestIndefiniteDirectStep) {
+  if (n <= options.largest_indefinite_direct_step) {
     step = indefinite_direct_solve(K, rhs, diag, static_linear_options(assembler, "cholmod", options));
     if (step.size() == 0)
       return {VecX(),
@@ -220,7 +250,17 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
               "accuracy)"};
     return {std::move(step), "", 0.0, true};
   }
-  // Larger: regularized as the solver's own Newton steps are.
+  // Larger, on a voxel lattice: MINRES preconditioned by the multigrid.
+  if (solver_name == "pcg-mg") {
+    step = indefinite_multigrid_solve(K, rhs, diag, static_linear_options(assembler, solver_name, options));
+    if (step.size() > 0) {
+      // Their rows are diag x_i = diag gap_i: exact, not to MINRES's tolerance.
+      for (int i = 0; i < n; ++i)
+        if (dirichlet.fixed[i]) step[i] = gap[i];
+      return {std::move(step), "", 0.0, true};
+    }
+  }
+  // Otherwise regularized as the solver's own Newton steps are.
   const RegularizedStep regularized = constrained_newton_step(*solver, K, diag, dirichlet.fixed, g, gap, gap_norm, Kgap,
                                                               rhs, step, "newton_step_from: ");
   if (!regularized.ok) return {VecX(), "the tangent could not be solved even with regularization", 0.0};

@@ -37,6 +37,10 @@ struct NewtonOptions {
   // multigrid-preconditioned CG (pcg-mg) above; or name a solver.
   std::string linear_solver = "auto";
   int auto_iterative_dofs = 4000;  // measured crossover, docs/solvers.md
+  // newton_step_from at an indefinite tangent: the most unknowns it factors
+  // directly (CHOLMOD; about 70 k elements of a 3D mesh, a factor of about
+  // 3 GB). Above, with pcg-mg, MINRES preconditioned by the multigrid.
+  int largest_indefinite_direct_step = 200000;
   LinearSolverOptions linear;
   // Called after each converged load increment with the load factor reached.
   std::function<void(double load_factor)> on_load_step;

@@ -107,9 +107,9 @@ PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel&
 // do not lower the potential one after the other, or the second is not
 // shorter than the first (they then head for
 // another equilibrium: skeleton at 0.02 measured 19x its true error), where
-// an element is inverted, or on meshes too large for a direct
-// factorization, whose regularized step measured less than half the true
-// error on bridge_arch.
+// an element is inverted, or where the exact step cannot be taken (a mesh
+// too large for a direct factorization without the lattice multigrid: a
+// regularized step measured less than half the true error on bridge_arch).
 PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssembler& fine_assembler,
                                        const StaticConditions& fine_conditions, const NewtonOptions& options,
                                        const AdaptiveModel& model, const VecX& on_fine);

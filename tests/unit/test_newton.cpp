@@ -424,9 +424,15 @@ TEST(Newton, StepFromAnIndefinitePointIsTheExactNewtonStep) {
     const int negative = static_cast<int>((spectrum.eigenvalues().array() < 0).count());
     if (negative == 0) continue;
     indefinite_seen = true;
-    for (const std::string solver : {"cholmod", "pcg-mg"}) {
+    // pcg-mg factored directly, and pcg-mg above the direct limit: MINRES
+    // preconditioned by its multigrid cycle (a hierarchy of three levels).
+    for (const std::string solver : {"cholmod", "pcg-mg", "pcg-mg, MINRES"}) {
       NewtonOptions options;
-      options.linear_solver = solver;
+      options.linear_solver = solver == "cholmod" ? "cholmod" : "pcg-mg";
+      if (solver == "pcg-mg, MINRES") {
+        options.largest_indefinite_direct_step = 0;
+        options.linear.mg_coarse_unknowns = 30;
+      }
       const NewtonStepFrom step = newton_step_from(asmb, DC, f, options, x);
       ASSERT_TRUE(step.failure.empty()) << step.failure;
       EXPECT_EQ(step.shift, 0.0) << solver;
