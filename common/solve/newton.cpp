@@ -197,9 +197,10 @@ VecX indefinite_multigrid_solve(const SpMat& K, const VecX& b, double scale, con
     double tolerance = 1e-10;
     Eigen::internal::minres(K, b, x, CyclePreconditioner{&shifted}, iterations, tolerance);
     const double residual = (K * x - b).norm() / b.norm();
-    spdlog::debug("newton_step_from: MINRES on the indefinite tangent, multigrid of shift {:.2e}, {} iterations, "
-                  "residual {:.1e}, {:.3f} s",
-                  shift, iterations, residual, seconds_since(t0));
+    spdlog::debug(
+        "newton_step_from: MINRES on the indefinite tangent, multigrid of shift {:.2e}, {} iterations, "
+        "residual {:.1e}, {:.3f} s",
+        shift, iterations, residual, seconds_since(t0));
     if (x.allFinite() && residual <= 1e-8) return x;
   }
   return VecX();
