@@ -24,6 +24,19 @@ int offset_component(int code, int axis) { return (axis == 0 ? code : axis == 1 
 int box_extent(int parity_bit) { return parity_bit ? 2 : 3; }
 int box_size(int parity) { return box_extent(parity & 1) * box_extent(parity >> 1 & 1) * box_extent(parity >> 2 & 1); }
 
+// Block `slot` of fine row f times `weight`, into `scaled`. P has no row for
+// a decoupled unknown, so its diagonal entry is dropped (its off-diagonal
+// entries are zero already).
+void scaled_fine_block(const BlockMatrix& fine, const std::vector<char>& fine_decoupled, int f, int slot, double weight,
+                       double scaled[9]) {
+  const double* block = fine.values.data() + 9 * std::size_t(slot);
+  for (int a = 0; a < 9; ++a) scaled[a] = weight * block[a];
+  if (slot != fine.diagonal[f]) return;
+  for (int a = 0; a < 3; ++a) {
+    if (fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) scaled[4 * a] = 0.0;
+  }
+}
+
 struct EntryList {
   int count = 0;
   std::array<std::uint8_t, 27> entry{};
@@ -235,17 +248,8 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<c
       std::fill(box, box + 9 * box_size(parity), 0.0);
       for (int slot = fine.row_start[f]; slot < fine.row_start[f + 1]; ++slot) {
         const EntryList& entries = parents[parity][fine_block_offset_[slot]];
-        const double weight = 1.0 / entries.count;  // a power of two: exact
         double scaled[9];
-        const double* block = fine.values.data() + 9 * std::size_t(slot);
-        for (int a = 0; a < 9; ++a) scaled[a] = weight * block[a];
-        if (slot == fine.diagonal[f]) {
-          // P has no row for a decoupled unknown: drop its diagonal (its
-          // off-diagonal entries are zero already).
-          for (int a = 0; a < 3; ++a) {
-            if (fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) scaled[4 * a] = 0.0;
-          }
-        }
+        scaled_fine_block(fine, fine_decoupled, f, slot, 1.0 / entries.count, scaled);  // a power of two: exact
         for (int e = 0; e < entries.count; ++e) {
           double* target = box + 9 * std::size_t(entries.entry[e]);
           for (int a = 0; a < 9; ++a) target[a] += scaled[a];
@@ -426,16 +430,8 @@ void GridTransfer::wide_galerkin_product(const BlockMatrix& fine, const std::vec
           const int g = fine.column[slot];
           const int first_parent = parent_start_[g];
           const int end_parent = parent_start_[g + 1];
-          const double weight = child_weight_[k] / (end_parent - first_parent);
           double scaled[9];
-          const double* block = fine.values.data() + 9 * std::size_t(slot);
-          for (int a = 0; a < 9; ++a) scaled[a] = weight * block[a];
-          if (slot == fine.diagonal[f]) {
-            // P has no row for a decoupled unknown: drop its diagonal.
-            for (int a = 0; a < 3; ++a) {
-              if (fine_decoupled[3 * std::size_t(f) + std::size_t(a)]) scaled[4 * a] = 0.0;
-            }
-          }
+          scaled_fine_block(fine, fine_decoupled, f, slot, child_weight_[k] / (end_parent - first_parent), scaled);
           for (int e = first_parent; e < end_parent; ++e) {
             const int q = parent_node_[e];
             if (q < p) continue;

@@ -89,6 +89,26 @@ NodeLattice lattice_from_positions(const NodePositions& positions) {
   return lattice;
 }
 
+namespace {
+
+// Numbers the points of `lattice` marked in node_at (>= 0) in lattice
+// order, x fastest, and lists their coordinates.
+void number_marked_points(NodeLattice& lattice) {
+  std::size_t point = 0;
+  for (int k = 0; k < lattice.dims[2]; ++k) {
+    for (int j = 0; j < lattice.dims[1]; ++j) {
+      for (int i = 0; i < lattice.dims[0]; ++i, ++point) {
+        int& slot = lattice.node_at[point];
+        if (slot < 0) continue;
+        slot = lattice.num_nodes();
+        lattice.coords.push_back({i, j, k});
+      }
+    }
+  }
+}
+
+}  // namespace
+
 NodeLattice coarsen_lattice(const NodeLattice& fine) {
   NodeLattice coarse;
   for (int axis = 0; axis < 3; ++axis) {
@@ -110,16 +130,7 @@ NodeLattice coarsen_lattice(const NodeLattice& fine) {
       }
     }
   }
-  for (int k = 0; k < coarse.dims[2]; ++k) {
-    for (int j = 0; j < coarse.dims[1]; ++j) {
-      for (int i = 0; i < coarse.dims[0]; ++i) {
-        int& slot = coarse.node_at[point_index(i, j, k)];
-        if (slot < 0) continue;
-        slot = coarse.num_nodes();
-        coarse.coords.push_back({i, j, k});
-      }
-    }
-  }
+  number_marked_points(coarse);
   return coarse;
 }
 
@@ -144,16 +155,7 @@ NodeLattice coarsen_lattice_by_injection(const NodeLattice& fine) {
           }
     if (!has_parent) coarse.node_at[point_index(c[0] / 2, c[1] / 2, c[2] / 2)] = 0;
   }
-  for (int k = 0; k < coarse.dims[2]; ++k) {
-    for (int j = 0; j < coarse.dims[1]; ++j) {
-      for (int i = 0; i < coarse.dims[0]; ++i) {
-        int& slot = coarse.node_at[point_index(i, j, k)];
-        if (slot < 0) continue;
-        slot = coarse.num_nodes();
-        coarse.coords.push_back({i, j, k});
-      }
-    }
-  }
+  number_marked_points(coarse);
   return coarse;
 }
 
