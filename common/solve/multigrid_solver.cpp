@@ -81,15 +81,15 @@ void MultigridSolver::analyze(const SpMat& A) {
     Level& level = *levels_.back();
     // Levels whose matrix reaches beyond lattice neighbours (elements of
     // mixed sizes) coarsen by injection (node_lattice.hpp).
-    NodeLattice coarse_lattice = lattice_reach(level.lattice, level.matrix) > 1
-                                     ? coarsen_lattice_by_injection(level.lattice)
-                                     : coarsen_lattice(level.lattice);
+    const bool wide = lattice_reach(level.lattice, level.matrix) > 1;
+    NodeLattice coarse_lattice = wide ? coarsen_lattice_by_injection(level.lattice) : coarsen_lattice(level.lattice);
     // A lattice only one or two points thick in every direction stops
     // shrinking. On a mesh of mixed element sizes nodes sit several lattice
     // steps apart where elements are large: there a level keeps its nodes
-    // while the lattice halves, and the level after it shrinks.
+    // while the lattice halves, and the level after it shrinks, so only a
+    // lattice that no longer halves stops it.
     if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes()) &&
-        coarse_lattice.dims == level.lattice.dims)
+        (!wide || coarse_lattice.dims == level.lattice.dims))
       break;
     level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix);
     auto coarse = std::make_unique<Level>();
@@ -149,11 +149,14 @@ void MultigridSolver::cycle(std::size_t index, const VecX& rhs, VecX& solution) 
   struct Levels : multigrid_cycle::SmoothedLevels<decltype(levels_)> {
     MultigridSolver& s;
     bool is_coarsest(std::size_t i) const { return i + 1 == s.levels_.size(); }
-    // A coarser level that keeps most of this one's unknowns (large elements
-    // of a mixed mesh) costs as much as this one: a W there would double the
-    // cycle's cost at every such level, so it is visited once.
+    // On a mesh of mixed element sizes, a coarser level that keeps most of
+    // this one's unknowns (large elements) costs as much as this one: a W
+    // there would double the cycle's cost at every such level, so it is
+    // visited once. Meshes of equal voxels keep the V-over-W cycle.
     int corrections(std::size_t i) const {
-      if (i > 0 && 4 * std::int64_t(s.levels_[i + 1]->matrix.rows) > 3 * std::int64_t(s.levels_[i]->matrix.rows))
+      const Level& level = *s.levels_[i];
+      if (i > 0 && !level.to_coarse->neighbour_coupled() &&
+          4 * std::int64_t(s.levels_[i + 1]->matrix.rows) > 3 * std::int64_t(level.matrix.rows))
         return 1;
       return SmoothedLevels::corrections(i);
     }
