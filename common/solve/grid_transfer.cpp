@@ -122,7 +122,8 @@ int lattice_reach(const NodeLattice& lattice, const BlockMatrix& matrix) {
   return reach;
 }
 
-GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator) {
+GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator,
+                           int reach) {
   const int fine_count = fine.num_nodes();
   const int coarse_count = coarse.num_nodes();
   if (fine_operator.rows != fine_count) {
@@ -130,7 +131,7 @@ GridTransfer::GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, c
                                 " block rows for " + std::to_string(fine_count) + " lattice nodes");
   }
 
-  neighbour_coupled_ = lattice_reach(fine, fine_operator) <= 1;
+  neighbour_coupled_ = reach <= 1;
   if (!neighbour_coupled_) {
     build_wide_transfer(fine, coarse, fine_operator);
     return;
@@ -298,11 +299,15 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<c
     }
   });
 
-  // Lower triangle: transposes of the upper blocks.
+  mirror_lower_blocks(coarse, team);
+}
+
+void GridTransfer::mirror_lower_blocks(BlockMatrix& coarse, int team) const {
+  // Columns ascend within a row (lattice order), so the blocks before the
+  // diagonal are the lower triangle: each the transpose of its mirror.
   parallel_row_ranges(coarse.rows, team, [&](int begin, int end) {
     for (int p = begin; p < end; ++p) {
-      for (int slot = coarse.row_start[p]; slot < coarse.row_start[p + 1]; ++slot) {
-        if (coarse_block_offset_[slot] >= kCenter) continue;
+      for (int slot = coarse.row_start[p]; slot < coarse.diagonal[p]; ++slot) {
         const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[slot]);
         double* target = coarse.values.data() + 9 * std::size_t(slot);
         for (int a = 0; a < 3; ++a) {
@@ -452,17 +457,7 @@ void GridTransfer::wide_galerkin_product(const BlockMatrix& fine, const std::vec
       for (int slot = upper; slot < last; ++slot) slot_of[coarse.column[slot]] = -1;
     }
   });
-  parallel_row_ranges(coarse_count, team, [&](int begin, int end) {
-    for (int p = begin; p < end; ++p) {
-      for (int slot = coarse.row_start[p]; slot < coarse.diagonal[p]; ++slot) {
-        const double* source = coarse.values.data() + 9 * std::size_t(mirror_slot_[slot]);
-        double* target = coarse.values.data() + 9 * std::size_t(slot);
-        for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) target[3 * a + b] = source[3 * b + a];
-        }
-      }
-    }
-  });
+  mirror_lower_blocks(coarse, team);
 }
 
 void GridTransfer::restrict_to_coarse(const VecX& fine, const std::vector<char>& fine_decoupled, VecX& coarse,

@@ -34,14 +34,13 @@ class GridTransfer {
   // wide whose faces carry eliminated hanging nodes reach five.
   static constexpr int kMaxCouplingSteps = 8;
 
-  // coarse = coarsen_lattice(fine), or coarsen_lattice_by_injection(fine)
-  // where the fine pattern reaches beyond lattice neighbours (the parents
-  // then follow that rule); fine_operator holds the block pattern of
-  // the fine matrix (node order of `fine`). Builds P, the coarse pattern and
-  // the index tables of the triple product. Throws InputError if the fine
-  // pattern couples nodes more than kMaxCouplingSteps lattice steps apart on
-  // some axis (the matrix is not that of a hex mesh on this lattice).
-  GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator);
+  // fine_operator holds the block pattern of the fine matrix (node order of
+  // `fine`) and reach = lattice_reach(fine, fine_operator), which throws
+  // where the matrix is not that of a hex mesh on this lattice. coarse =
+  // coarsen_lattice(fine) for reach 1, else coarsen_lattice_by_injection(fine)
+  // (the parents then follow that rule). Builds P, the coarse pattern and
+  // the index tables of the triple product.
+  GridTransfer(const NodeLattice& fine, const NodeLattice& coarse, const BlockMatrix& fine_operator, int reach);
 
   // The coarse operator's block pattern (values zero).
   BlockMatrix coarse_pattern() const;
@@ -71,6 +70,8 @@ class GridTransfer {
   void build_wide_pattern(const BlockMatrix& fine_operator);
   void wide_galerkin_product(const BlockMatrix& fine, const std::vector<char>& fine_decoupled, BlockMatrix& coarse,
                              int threads) const;
+  // The lower block triangle of `coarse` from its upper one.
+  void mirror_lower_blocks(BlockMatrix& coarse, int team) const;
 
   bool neighbour_coupled_ = true;
   // Fine node -> its coarse parents (interpolation sources), weight 1/count.

@@ -81,7 +81,8 @@ void MultigridSolver::analyze(const SpMat& A) {
     Level& level = *levels_.back();
     // Levels whose matrix reaches beyond lattice neighbours (elements of
     // mixed sizes) coarsen by injection (node_lattice.hpp).
-    const bool wide = lattice_reach(level.lattice, level.matrix) > 1;
+    const int reach = lattice_reach(level.lattice, level.matrix);
+    const bool wide = reach > 1;
     NodeLattice coarse_lattice = wide ? coarsen_lattice_by_injection(level.lattice) : coarsen_lattice(level.lattice);
     // A lattice only one or two points thick in every direction stops
     // shrinking. On a mesh of mixed element sizes nodes sit several lattice
@@ -91,7 +92,7 @@ void MultigridSolver::analyze(const SpMat& A) {
     if (10 * std::int64_t(coarse_lattice.num_nodes()) > 9 * std::int64_t(level.lattice.num_nodes()) &&
         (!wide || coarse_lattice.dims == level.lattice.dims))
       break;
-    level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix);
+    level.to_coarse = std::make_unique<GridTransfer>(level.lattice, coarse_lattice, level.matrix, reach);
     auto coarse = std::make_unique<Level>();
     coarse->matrix = level.to_coarse->coarse_pattern();
     coarse->lattice = std::move(coarse_lattice);

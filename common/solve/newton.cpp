@@ -115,11 +115,36 @@ RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, do
       rhs, dx, context);
 }
 
-// The preconditioner interface Eigen's MINRES calls.
-struct FactorPreconditioner {
-  CholmodSolver* factor;
-  VecX solve(const VecX& v) const { return factor->solve(v); }
+// The first shift of the preconditioners of indefinite_direct_solve and
+// indefinite_multigrid_solve, relative to the mean diagonal. A
+// preconditioner needs no smaller one, and the regularization schedule's
+// 1e-8 spent eight failed factorizations before reaching it (bridge_arch:
+// 1.5 s against 0.7 s; 1e-3 and up double the MINRES iterations).
+constexpr double kFirstPreconditionerShift = 1e-4;
+
+// The preconditioner interface Eigen's MINRES calls, for any z = M^-1 r.
+template <class Apply>
+struct AppliedPreconditioner {
+  Apply apply;
+  VecX solve(const VecX& v) const { return apply(v); }
 };
+
+// MINRES on K x = b from x = 0 (to 1e-10, at most `max_iterations`) with
+// the preconditioner `apply`: x where it reached a relative residual of
+// 1e-8, else empty. `what` names the preconditioner in the debug log.
+template <class Apply>
+VecX preconditioned_minres(const SpMat& K, const VecX& b, Apply apply, Eigen::Index max_iterations,
+                           const std::string& what, Clock::time_point t0) {
+  VecX x = VecX::Zero(b.size());
+  Eigen::Index iterations = max_iterations;
+  double tolerance = 1e-10;
+  Eigen::internal::minres(K, b, x, AppliedPreconditioner<Apply>{std::move(apply)}, iterations, tolerance);
+  const double residual = (K * x - b).norm() / b.norm();
+  spdlog::debug("newton_step_from: MINRES on the indefinite tangent, {}, {} iterations, residual {:.1e}, {:.3f} s",
+                what, iterations, residual, seconds_since(t0));
+  if (x.allFinite() && residual <= 1e-8) return x;
+  return VecX();
+}
 
 // Solves K x = b for a symmetric K that is not positive definite: MINRES
 // preconditioned by the L L^T factor of K + s I, s the first of a growing
@@ -134,29 +159,20 @@ VecX indefinite_direct_solve(const SpMat& K, const VecX& b, double scale, const 
   CholmodSolver shifted(linear);
   shifted.analyze(K);
   const RegularizationSchedule schedule;
-  // The first shift: 1e-4 of the mean diagonal. A preconditioner needs no
-  // smaller one, and the schedule's 1e-8 spent eight failed factorizations
-  // before reaching it (bridge_arch: 1.5 s against 0.7 s; 1e-3 and up
-  // double the MINRES iterations).
-  double shift = 1e-4 * scale;
+  double shift = kFirstPreconditionerShift * scale;
   bool factored = false;
   for (int attempt = 0; attempt < schedule.max_factorizations && !factored; ++attempt, shift *= schedule.growth)
     factored = shifted.factorize(K, shift);
   if (factored) {
-    VecX x = VecX::Zero(b.size());
     // 17-25 iterations on the ten scenes' tangents; where the shift had to
     // reach far into the spectrum MINRES stalls, and L D L^T is cheaper
     // than more of it (random3: 200 iterations, 1.2 s, residual 2e-4).
-    Eigen::Index iterations = 60;
-    double tolerance = 1e-10;
-    Eigen::internal::minres(K, b, x, FactorPreconditioner{&shifted}, iterations, tolerance);
-    const double residual = (K * x - b).norm() / b.norm();
-    spdlog::debug(
-        "newton_step_from: MINRES on the indefinite tangent, shift {:.2e}, {} iterations, residual "
-        "{:.1e}, {:.3f} s (analysis {:.3f} s, last factorization {:.3f} s)",
-        shift / schedule.growth, iterations, residual, seconds_since(t0), shifted.stats().analyze_seconds,
-        shifted.stats().factorize_seconds);
-    if (x.allFinite() && residual <= 1e-8) return x;
+    VecX x = preconditioned_minres(
+        K, b, [&shifted](const VecX& v) { return shifted.solve(v); }, 60,
+        fmt::format("factor of shift {:.2e} (analysis {:.3f} s, last factorization {:.3f} s)", shift / schedule.growth,
+                    shifted.stats().analyze_seconds, shifted.stats().factorize_seconds),
+        t0);
+    if (x.size() > 0) return x;
   }
   LinearSolverOptions ldlt_options = linear;
   ldlt_options.indefinite = true;
@@ -171,12 +187,6 @@ VecX indefinite_direct_solve(const SpMat& K, const VecX& b, double scale, const 
   return x;
 }
 
-// Preconditioning by one lattice multigrid cycle (pcg-mg) of K + s I.
-struct CyclePreconditioner {
-  MultigridSolver* cycle;
-  VecX solve(const VecX& v) const { return cycle->apply_preconditioner(v); }
-};
-
 // Above NewtonOptions::largest_indefinite_direct_step on a voxel lattice: MINRES on K x = b
 // preconditioned by the multigrid cycle of K + s I. MINRES needs a
 // positive definite preconditioner, which the cycle is once K + s I is;
@@ -189,19 +199,13 @@ VecX indefinite_multigrid_solve(const SpMat& K, const VecX& b, double scale, con
   MultigridSolver shifted(linear);
   shifted.analyze(K);
   const RegularizationSchedule schedule;
-  double shift = 1e-4 * scale;  // as indefinite_direct_solve's first shift
+  double shift = kFirstPreconditionerShift * scale;
   for (int attempt = 0; attempt < schedule.max_factorizations; ++attempt, shift *= schedule.growth) {
     if (!shifted.factorize(K, shift)) continue;
-    VecX x = VecX::Zero(b.size());
-    Eigen::Index iterations = 200;
-    double tolerance = 1e-10;
-    Eigen::internal::minres(K, b, x, CyclePreconditioner{&shifted}, iterations, tolerance);
-    const double residual = (K * x - b).norm() / b.norm();
-    spdlog::debug(
-        "newton_step_from: MINRES on the indefinite tangent, multigrid of shift {:.2e}, {} iterations, "
-        "residual {:.1e}, {:.3f} s",
-        shift, iterations, residual, seconds_since(t0));
-    if (x.allFinite() && residual <= 1e-8) return x;
+    VecX x = preconditioned_minres(
+        K, b, [&shifted](const VecX& v) { return shifted.apply_preconditioner(v); }, 200,
+        fmt::format("multigrid of shift {:.2e}", shift), t0);
+    if (x.size() > 0) return x;
   }
   return VecX();
 }

@@ -63,13 +63,8 @@ double depth_in_bar(const Vec3& x) {
 // gets inside the bar.
 double deepest_block_vertex(const Eigen::Matrix3d& turn, double taper, double height, bool edge_contact) {
   const DynamicsModel model = corner_over_ridge_model(turn, taper, height);
-  NewmarkOptions opt;
-  opt.time_step = 1e-4;
-  opt.edge_contact = edge_contact;
-  NewmarkIntegrator sim(model, opt);
-  VecX v = VecX::Zero(model.mesh.num_dofs());
-  for (int i = 8; i < 16; ++i) v(3 * i + 2) = -0.5;
-  sim.set_state(sim.assembler().rest_positions(), v);
+  NewmarkIntegrator sim(model, contact_test::drop_options(edge_contact));
+  contact_test::drop_body_b(sim, 0.5);
   double deepest = -INFINITY;
   while (sim.time() < 0.02) {
     sim.step();

@@ -128,13 +128,8 @@ TEST(EdgeContact, ABarDroppedCrosswiseRestsOnAClampedBar) {
     DynamicsModel model = crossing_bars_model(1e-3);
     model.fixed.assign(model.mesh.num_dofs(), 0);
     for (int i = 0; i < 24; ++i) model.fixed[i] = 1;  // bar A
-    NewmarkOptions opt;
-    opt.time_step = 1e-4;
-    opt.edge_contact = edges;
-    NewmarkIntegrator sim(model, opt);
-    VecX v = VecX::Zero(model.mesh.num_dofs());
-    for (int i = 8; i < 16; ++i) v(3 * i + 2) = -0.5;
-    sim.set_state(sim.assembler().rest_positions(), v);
+    NewmarkIntegrator sim(model, contact_test::drop_options(edges));
+    contact_test::drop_body_b(sim, 0.5);
     *lowest = INFINITY;
     int active = 0;
     while (sim.time() < 0.03) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dynamics/dynamics_model.hpp"
+#include "dynamics/newmark_integrator.hpp"
 #include "fem/hex_mesh_bodies.hpp"
 #include "material/neo_hookean.hpp"
 
@@ -22,6 +23,21 @@ inline DynamicsModel two_body_model(const NodeArray& nodes, const std::vector<st
   model.contact = true;
   model.body_contact = true;
   return model;
+}
+
+// Newmark at 0.1 ms steps, with or without edge-edge contact rows.
+inline NewmarkOptions drop_options(bool edge_contact) {
+  NewmarkOptions options;
+  options.time_step = 1e-4;
+  options.edge_contact = edge_contact;
+  return options;
+}
+
+// Body b (nodes 8 to 15) set moving down at `speed`, at rest positions.
+inline void drop_body_b(NewmarkIntegrator& sim, double speed) {
+  VecX v = VecX::Zero(sim.assembler().num_dofs());
+  for (int i = 8; i < 16; ++i) v(3 * i + 2) = -speed;
+  sim.set_state(sim.assembler().rest_positions(), v);
 }
 
 }  // namespace msfab::contact_test
