@@ -55,6 +55,28 @@ double predicted_error(const std::vector<CellErrorModel>& cells, const LevelErro
 // target 0 gives level 0 everywhere (the fine model). Deterministic.
 LevelChoice choose_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors, double target);
 
+// The level errors calibrated by a measured solve. A solve at levels
+// `levels` had its error measured (`measured_error`, by a fine Newton step)
+// together with where it sits (`cell_error_energy`: the fine strain energy
+// of the measured error field in each cell). The squared error is split
+// between the level-1 and level-2 cells by that energy (fine cells' share is
+// induced by the coarse cells around them and left out), and each level's
+// error is the one that gives its part with the cells' energy shares:
+// e_L^2 = measured^2 (field energy in level-L cells / in coarse cells) /
+// (energy share of level-L cells). predicted_error at `levels` is then the
+// measured error. A level with no cells keeps its a-priori ratio to the
+// other; `errors` is returned where no coarse cell carries field energy.
+// Unlike a tightened target, which keeps the a-priori ratio e_2 / e_1, this
+// sees where level 1 itself is not good enough and asks for fine cells.
+LevelErrors calibrated_level_errors(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
+                                    const std::vector<int>& levels, const std::vector<double>& cell_error_energy,
+                                    double measured_error);
+
+// Levels meeting `target` refined from `levels` (no cell coarsened), by the
+// greedy rule of choose_cell_levels.
+LevelChoice refine_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
+                               const std::vector<int>& levels, double target);
+
 // The cells of `level2` (coarsen_grid(level1)) with their energy shares
 // from a solve on the level-1 mesh (`level1_energy` per element of
 // level1_mesh) and their element counts per level. All-void cells have no
@@ -64,5 +86,13 @@ std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const Coars
 
 // Strain energy of every element of `mesh` at positions x (node-major).
 std::vector<double> element_energies(const HexMesh& mesh, const VecX& x);
+
+// The fine strain energy of the displacement field `field` about the state
+// `on_fine` (fine-node displacements), summed over each cell of `level2`:
+// per element the second difference (E(x + f) + E(x - f)) / 2 - E(x), which
+// is f^T K(x) f / 2 to third order (the energy at rest of f where x - f
+// inverts an element).
+std::vector<double> cell_field_energies(const VoxelMesh& fine, const CoarseGrid& level2, const VecX& on_fine,
+                                        const VecX& field);
 
 }  // namespace msfab

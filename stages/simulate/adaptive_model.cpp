@@ -114,6 +114,36 @@ VecX start_from(const CoarseModel& from, const VecX& x_from, const NodeArray& re
   return x;
 }
 
+namespace {
+
+// Meshes `choice` as the levels of `m`. A node the scene fixes must not
+// hang on free corners: the cells around it are meshed fine (face
+// conditions fix whole faces, so this is rare).
+void mesh_chosen_levels(AdaptiveModel& m, const Scene& scene, const VoxelMesh& fine,
+                        const StaticConditions& fine_conditions, const CoarseModel& level2, LevelChoice choice) {
+  m.choice = std::move(choice);
+  m.cells_refined_for_conditions = 0;
+  std::vector<int>& levels = m.choice.cell_level;
+  for (;;) {
+    m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels,
+                                     m.level1_materials, m.level2_materials, level2.element == "enhanced");
+    std::vector<int> unresolved;
+    m.conditions =
+        mixed_static_conditions(scene, fine, fine_conditions, level2.level1, level2.grid, m.mixed, &unresolved);
+    int changed = 0;
+    for (int c : unresolved)
+      if (levels[c] != 0) {
+        levels[c] = 0;
+        ++changed;
+      }
+    if (changed == 0) break;
+    m.cells_refined_for_conditions += changed;
+  }
+  m.choice.predicted_error = predicted_error(m.cells, m.level_errors, levels);
+}
+
+}  // namespace
+
 void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelMesh& fine,
                               const StaticConditions& fine_conditions, const CoarseModel& level2,
                               double choice_target) {
@@ -133,30 +163,27 @@ void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelM
     choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
   }
   m.choice_target = choice_target;
-  m.choice = std::move(choice);
-  m.cells_refined_for_conditions = 0;
-
-  // The mixed mesh, with the same materials as the uniform models. A node
-  // the scene fixes must not hang on free corners: the cells around it are
-  // meshed fine (face conditions fix whole faces, so this is rare).
-  std::vector<int>& levels = m.choice.cell_level;
-  for (;;) {
-    m.mixed = build_mixed_level_mesh(scene.grid, scene.material_by_id, level2.level1, level2.grid, levels,
-                                     m.level1_materials, m.level2_materials, level2.element == "enhanced");
-    std::vector<int> unresolved;
-    m.conditions =
-        mixed_static_conditions(scene, fine, fine_conditions, level2.level1, level2.grid, m.mixed, &unresolved);
-    int changed = 0;
-    for (int c : unresolved)
-      if (levels[c] != 0) {
-        levels[c] = 0;
-        ++changed;
-      }
-    if (changed == 0) break;
-    m.cells_refined_for_conditions += changed;
-  }
-  m.choice.predicted_error = predicted_error(m.cells, m.level_errors, levels);
+  mesh_chosen_levels(m, scene, fine, fine_conditions, level2, std::move(choice));
   m.seconds += seconds_since(t0);
+}
+
+bool rechoose_where_measured(AdaptiveModel& m, const Scene& scene, const VoxelMesh& fine,
+                             const StaticConditions& fine_conditions, const CoarseModel& level2, const VecX& on_fine,
+                             const PosteriorEstimate& measured, double target_error) {
+  if (measured.error_field.size() == 0) return false;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<double> energies = cell_field_energies(fine, level2.grid, on_fine, measured.error_field);
+  const LevelErrors calibrated =
+      calibrated_level_errors(m.cells, m.level_errors, m.choice.cell_level, energies, measured.value);
+  LevelChoice choice = refine_cell_levels(m.cells, calibrated, m.choice.cell_level, target_error);
+  if (choice.cell_level == m.choice.cell_level) return false;
+  // The model keeps its a-priori errors (the artifact's, and the ratio of
+  // predictions the refinement bound takes); the a-priori target these
+  // levels meet is what a later tightened re-choice starts from.
+  m.choice_target = predicted_error(m.cells, m.level_errors, choice.cell_level);
+  mesh_chosen_levels(m, scene, fine, fine_conditions, level2, std::move(choice));
+  m.seconds += seconds_since(t0);
+  return true;
 }
 
 AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
@@ -227,7 +254,7 @@ PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssem
             false};
   const VecX zero = VecX::Zero(newton.step.size());
   const double size = mean_vertex_error(fine.mesh, newton.step, zero);
-  if (!newton.indefinite) return {size, "a fine Newton step"};
+  if (!newton.indefinite) return {size, "a fine Newton step", true, newton.step};
   // An indefinite tangent amplifies the step along its soft directions (one
   // step measured up to 1.26x the true error on the ten scenes): a second
   // step from where the first lands corrects the estimate to third order.
@@ -260,9 +287,11 @@ PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssem
             fmt::format("{}, and the second Newton step from it is not shorter than the first ({:.3g}, then {:.3g})",
                         indefinite, size, second_size),
             false};
-  return {mean_vertex_error(fine.mesh, VecX(newton.step + second.step), zero),
+  const VecX both = newton.step + second.step;
+  return {mean_vertex_error(fine.mesh, both, zero),
           fmt::format("two fine Newton steps, {:.3g} then {:.3g}; {}{}", size, second_size, indefinite,
-                      second.indefinite ? ", also after the first step" : "")};
+                      second.indefinite ? ", also after the first step" : ""),
+          true, both};
 }
 
 }  // namespace msfab

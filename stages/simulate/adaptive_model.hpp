@@ -90,9 +90,24 @@ struct PosteriorEstimate {
   double value = 0;
   std::string source;    // what `value` is, for the log; or why there is none
   bool measured = true;  // false: no estimate of this kind here (`source` says why)
+  // The estimated error itself as displacements at the fine nodes, where
+  // the estimate is a field that says where the error sits (fine Newton
+  // steps); empty otherwise.
+  VecX error_field = VecX();
 };
 PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel& model, const VecX& on_fine,
                                      const VecX* previous_on_fine, double previous_predicted, int previous_solve);
+
+// Re-chooses the levels of `model` after its solve (`on_fine`, fine-node
+// displacements) missed `target_error` by the estimate `measured`, whose
+// error field says where the error sits: the level errors are calibrated
+// by it (calibrated_level_errors, with the field's fine strain energy per
+// level-2 cell) and the levels refined to meet the target with them.
+// Returns false, changing nothing, where the estimate has no field or the
+// calibrated errors refine no cell.
+bool rechoose_where_measured(AdaptiveModel& model, const Scene& scene, const VoxelMesh& fine,
+                             const StaticConditions& fine_conditions, const CoarseModel& level2, const VecX& on_fine,
+                             const PosteriorEstimate& measured, double target_error);
 
 // The a-posteriori estimate by the fine model itself (--posterior-estimate
 // newton): the mean-vertex size of one Newton step of the fine model from

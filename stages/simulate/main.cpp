@@ -226,8 +226,9 @@ int main(int argc, char** argv) {
       // The mixed solve and, with --posterior-check, its a-posteriori check.
       // Its linear solver follows the size rule of every static solve: the
       // lattice multigrid takes elements of mixed sizes, whose nodes sit on
-      // the fine lattice (docs/solvers.md). A miss tightens the target of the
-      // choice by the ratio it missed by and solves again.
+      // the fine lattice (docs/solvers.md). A miss refines the cells where
+      // the estimate puts the error, or tightens the target of the choice by
+      // the ratio it missed by, and solves again.
       // A refinement that does not bring the estimate down means the
       // extrapolation, not the model, dominates it (where the error falls
       // much faster than the rate assumed, the extrapolated solution is
@@ -289,8 +290,13 @@ int main(int argc, char** argv) {
               checked_error, target_error, adaptive_solves);
           break;
         }
-        rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
-                                 adapted.choice_target * target_error / estimate);
+        // Where the estimate says where the error sits (fine Newton steps),
+        // the cells that carry it are refined, to fine cells if need be;
+        // else the a-priori choice is made for a target tightened by the
+        // ratio of the miss.
+        if (!rechoose_where_measured(adapted, scene, fine, fine_conditions, coarse, on_fine, posterior, target_error))
+          rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
+                                   adapted.choice_target * target_error / estimate);
       }
       adapted = std::move(best);
       adaptive_seconds = seconds_since(t_adaptive);

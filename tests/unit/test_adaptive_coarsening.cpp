@@ -484,6 +484,100 @@ TEST(AdaptiveLevels, ChoiceMeetsTheTargetAndRefinesHighEnergyCellsFirst) {
   EXPECT_THROW(level_errors_from_difference(INFINITY), InputError);
 }
 
+TEST(AdaptiveLevels, CalibratedErrorsGiveTheMeasuredErrorSplitAsTheFieldSaysAndAskForFineCells) {
+  // Four level-2 cells; the a-priori model thinks level 1 (0.03) meets the
+  // target 0.05. A measured solve says otherwise.
+  std::vector<CellErrorModel> cells(4);
+  const double shares[4] = {0.4, 0.3, 0.2, 0.1};
+  for (int c = 0; c < 4; ++c) {
+    cells[c].energy_share = shares[c];
+    cells[c].elements = {64, 8, 1};
+  }
+  const LevelErrors prior = level_errors_from_difference(0.03);
+  const LevelChoice first = choose_cell_levels(cells, prior, 0.05);
+  const std::vector<int> levels = {1, 1, 2, 0};
+  const std::vector<double> field = {3.0, 1.0, 2.0, 50.0};  // the fine cell's is induced, left out
+  const double measured = 0.08;
+  const LevelErrors e = calibrated_level_errors(cells, prior, levels, field, measured);
+  EXPECT_EQ(e[0], 0.0);
+  // At the measured levels the calibrated model predicts the measured error,
+  // split between the levels as the field's energy is.
+  EXPECT_NEAR(predicted_error(cells, e, levels), measured, 1e-15);
+  EXPECT_NEAR((0.4 + 0.3) * e[1] * e[1] / (0.2 * e[2] * e[2]), (3.0 + 1.0) / 2.0, 1e-12);
+  EXPECT_EQ(calibrated_level_errors(cells, prior, levels, {3.0, 1.0, 2.0, 0.0}, measured), e);
+  // A level without cells keeps its a-priori ratio to the measured one.
+  const LevelErrors only1 = calibrated_level_errors(cells, prior, {1, 1, 1, 1}, {1, 1, 1, 1}, measured);
+  EXPECT_NEAR(only1[1], measured, 1e-15);
+  EXPECT_NEAR(only1[2], 2 * measured, 1e-15);
+  // No field energy in a coarse cell: nothing to calibrate.
+  EXPECT_EQ(calibrated_level_errors(cells, prior, levels, {0, 0, 0, 5}, measured), prior);
+
+  // Re-chosen with the calibrated errors: level 1 (now above the target)
+  // gives way to fine cells, no cell is coarsened, and the target is met.
+  const LevelChoice again = refine_cell_levels(cells, e, levels, 0.05);
+  EXPECT_LE(again.predicted_error, 0.05 * (1 + 1e-12));
+  EXPECT_NEAR(again.predicted_error, predicted_error(cells, e, again.cell_level), 1e-15);
+  int fine_from_level1 = 0;
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_LE(again.cell_level[c], levels[c]);
+    fine_from_level1 += levels[c] == 1 && again.cell_level[c] == 0;
+  }
+  EXPECT_GT(fine_from_level1, 0);
+  for (int l : first.cell_level) EXPECT_GT(l, 0);  // what the a-priori model chose: no fine cell
+  // A met target refines nothing.
+  EXPECT_EQ(refine_cell_levels(cells, e, levels, measured).cell_level, levels);
+  EXPECT_THROW(calibrated_level_errors(cells, prior, levels, field, NAN), InputError);
+  EXPECT_THROW(calibrated_level_errors(cells, prior, {1, 1}, field, measured), InputError);
+  EXPECT_THROW(refine_cell_levels(cells, e, levels, -1), InputError);
+}
+
+TEST(AdaptiveLevels, FieldEnergiesPerCellAreTheQuadraticFormOfTheTangent) {
+  const Scene s = two_material_block();
+  const Grids g = grids_of(s);
+  const VoxelMesh fine = build_voxel_mesh(s.grid, s.material_by_id);
+  const ElasticAssembler a(fine.mesh);
+  const int n = fine.mesh.num_dofs();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  VecX state(n), field(n);
+  for (int i = 0; i < n; ++i) {
+    state[i] = 2e-5 * u(rng);
+    field[i] = 1e-7 * u(rng);
+  }
+  const std::vector<double> cells = cell_field_energies(fine, g.level2, state, field);
+  ASSERT_EQ(cells.size(), size_t(g.level2.num_cells()));
+  SpMat K = a.pattern();
+  a.evaluate(a.rest_positions() + state, nullptr, &K);
+  double total = 0;
+  for (double c : cells) total += c;
+  const double quadratic = 0.5 * field.dot(K * field);
+  EXPECT_NEAR(total, quadratic, 1e-5 * quadratic);
+  // A field on the nodes of one cell's voxels only puts its energy there.
+  VecX local = VecX::Zero(n);
+  const auto first = g.level2.first_voxel(1);
+  for (int e = 0; e < fine.mesh.num_elements(); ++e) {
+    const int v = fine.element_voxel[e];
+    const int i = v % s.grid.nx, j = (v / s.grid.nx) % s.grid.ny, k = v / (s.grid.nx * s.grid.ny);
+    if (i < first[0] || i >= first[0] + 4 || j < first[1] || j >= first[1] + 4 || k < first[2] || k >= first[2] + 4)
+      continue;
+    // Interior voxels' nodes only, so that no neighbouring cell's element moves.
+    if (i == first[0] || i == first[0] + 3 || j == first[1] || j == first[1] + 3 || k == first[2] || k == first[2] + 3)
+      continue;
+    for (int q = 0; q < 8; ++q) {
+      const int node = fine.mesh.elements[e][q];
+      local.segment<3>(3 * node) = field.segment<3>(3 * node);
+    }
+  }
+  ASSERT_GT(local.norm(), 0);
+  const std::vector<double> one = cell_field_energies(fine, g.level2, state, local);
+  for (size_t c = 0; c < one.size(); ++c)
+    if (c == 1)
+      EXPECT_GT(one[c], 0);
+    else
+      EXPECT_EQ(one[c], 0.0) << "cell " << c;
+  EXPECT_THROW(cell_field_energies(fine, g.level2, state, VecX(3)), InputError);
+}
+
 TEST(AdaptiveMixedMesh, BadLevelsAndGridsAreRefused) {
   const Scene s = two_material_block();
   const Grids g = grids_of(s);
