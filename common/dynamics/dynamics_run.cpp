@@ -156,6 +156,7 @@ QuasistaticResult press_at(const DynamicsScene& scene, const NewmarkIntegrator& 
   options.load_steps = scene.preload_steps;
   options.threads = 1;  // as the Newmark factorization: same bits for any --threads
   options.self_contact = scene.press_self_contact;
+  options.edge_contact = scene.newmark.edge_contact;
   QuasistaticResult r = solve_quasistatic_loading(sim.assembler(), sim.model().obstacles,
                                                   scale * load + sim.gravity_force(), scene.initial_positions, options);
   if (!r.converged) throw NumericalError(r.failure + "\n" + format_quasistatic_history(r.history));
@@ -226,7 +227,11 @@ VecX preload(const DynamicsScene& scene, const NewmarkIntegrator& sim, Recorder&
         scene.stop_at_touch ? press_until_touch(scene, sim, fold, load, scale) : press_at(scene, sim, load, 1.0);
     q = r.x;
     detail << "quasistatic press: " << r.iterations << " iterations, " << r.contacts.size() << " contact vertices";
-    if (scene.press_self_contact) detail << ", " << r.self_contacts.size() << " self-contact ties";
+    if (scene.press_self_contact) {
+      const auto edge_ties = std::count_if(r.self_contacts.begin(), r.self_contacts.end(),
+                                           [](const SelfContactTie& t) { return t.is_edge_pair(); });
+      detail << ", " << r.self_contacts.size() << " self-contact ties (" << edge_ties << " between edges)";
+    }
     if (scale < 1.0)
       detail << "; stopped at touch: " << 100 * scale << "% of the load (" << scale * scene.load.force.norm() << " N)";
   }

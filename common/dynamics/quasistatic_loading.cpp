@@ -233,7 +233,7 @@ void Press::start() {
   solver_ = std::make_unique<CholmodSolver>(linear);
   solver_->analyze(K_);
 
-  if (opt_.self_contact) ties_ = std::make_unique<SelfContactTies>(mesh_);
+  if (opt_.self_contact) ties_ = std::make_unique<SelfContactTies>(mesh_, opt_.edge_contact);
   // Nodes touching a face at the start are tied from the start, as
   // vertices touching an obstacle start active.
   if (ties_) {

@@ -44,6 +44,9 @@ struct QuasistaticOptions {
   // that reaches a boundary face is tied to it without slip
   // (self_contact_ties.hpp), as the obstacles hold vertices.
   bool self_contact = false;
+  // With self_contact: boundary edges that cross are tied at their closest
+  // points too (self_contact_ties.hpp).
+  bool edge_contact = true;
   // Threads of the linear solver; 0 uses the OpenMP default. Assembly always
   // follows the OpenMP default (set by the stage).
   int threads = 0;

@@ -154,3 +154,75 @@ TEST(QuasistaticSelfContact, ACShapePressedShutRestsOnItsLowerArm) {
   for (const SelfContactTie& t : shut.self_contacts)
     EXPECT_GE(tie_push(t, shut.x), -1e-7 * load.norm()) << "node " << t.node;
 }
+
+TEST(QuasistaticSelfContact, ABarPressedCrosswiseOntoABarRestsOnItsEdges) {
+  // Bar A (one element along x) on the ground, bar B (one element along y)
+  // laid across it, touching: no vertex of either lies over a face of the
+  // other, so only ties between their crossing edges can hold B up.
+  constexpr double kLength = 0.06, kWidth = 0.01;
+  NodeArray nodes(16, 3);
+  std::vector<std::array<int, 8>> elements(2);
+  for (int bar = 0; bar < 2; ++bar)
+    for (int i = 0; i < 8; ++i) {
+      const double sx = (i >> 2) - 0.5, sy = ((i >> 1) & 1) - 0.5, sz = i & 1;
+      if (bar == 0)
+        nodes.row(i) << sx * kLength, sy * kWidth, sz * kWidth;
+      else
+        nodes.row(8 + i) << sx * kWidth, sy * kLength, kWidth + sz * kWidth;
+      elements[bar][i] = 8 * bar + i;
+    }
+  const HexMesh mesh = make_hex_mesh(nodes, elements, std::make_shared<NeoHookean>(1e6, 0.3));
+  const ElasticAssembler assembler(mesh);
+  VecX force = VecX::Zero(mesh.num_dofs());
+  const double load = 2.0;  // N on B's top, about 400 times its weight
+  for (int i = 0; i < 16; ++i) force[3 * i + 2] = -9.81 * 1000 * kLength * kWidth * kWidth / 8;
+  for (int i = 8; i < 16; ++i)
+    if (i & 1) force[3 * i + 2] -= load / 4;
+  // Mean z of B's lower face minus mean z of A's upper face.
+  auto clearance = [](const VecX& x) {
+    double b_bottom = 0, a_top = 0;
+    for (int i = 0; i < 8; ++i) {
+      if (i & 1) a_top += x[3 * i + 2] / 4;
+      if (!(i & 1)) b_bottom += x[3 * (8 + i) + 2] / 4;
+    }
+    return b_bottom - a_top;
+  };
+  QuasistaticOptions opt;
+  opt.self_contact = true;
+  opt.edge_contact = false;
+  const QuasistaticResult through = solve_quasistatic_loading(assembler, {floor_plane()}, force, VecX(), opt);
+  opt.edge_contact = true;
+  const QuasistaticResult rests = solve_quasistatic_loading(assembler, {floor_plane()}, force, VecX(), opt);
+  ASSERT_TRUE(rests.converged) << rests.failure;
+  int edge_ties = 0;
+  double apart = 0;  // largest distance between the two points a tie holds together
+  for (const SelfContactTie& t : rests.self_contacts) {
+    edge_ties += t.is_edge_pair();
+    Vec3 a = Vec3::Zero(), b = Vec3::Zero();
+    if (t.is_edge_pair()) {
+      a = (1 - t.alpha) * rests.x.segment<3>(3 * t.edge_nodes[0]) + t.alpha * rests.x.segment<3>(3 * t.edge_nodes[1]);
+      b = (1 - t.beta) * rests.x.segment<3>(3 * t.edge_nodes[2]) + t.beta * rests.x.segment<3>(3 * t.edge_nodes[3]);
+    }
+    apart = std::max(apart, (a - b).norm());
+  }
+  Vec3 reactions = Vec3::Zero(), applied = Vec3::Zero();
+  for (const ContactVertex& v : rests.contacts) reactions += v.reaction;
+  for (int i = 0; i < 16; ++i) applied += force.segment<3>(3 * i);
+  const double largest = (rests.x - assembler.rest_positions()).cwiseAbs().maxCoeff();
+  std::printf(
+      "  clearance of the upper bar: %.3e m with edge ties (%d of %zu ties; largest displacement %.3e m), %.3e m "
+      "without; tied points %.1e m apart; ground reactions + load = %.2e N of %.3f N\n",
+      clearance(rests.x), edge_ties, rests.self_contacts.size(), largest, clearance(through.x), apart,
+      (reactions + applied).norm(), applied.norm());
+  EXPECT_GT(largest, 1e-3 * kWidth);               // the load deforms the bars
+  EXPECT_LT(clearance(through.x), -0.5 * kWidth);  // node-face ties alone: B goes through A
+  EXPECT_GT(edge_ties, 0);
+  // B rests on A's edges: its lower face sags between them by its bending
+  // alone, a small fraction of a width.
+  EXPECT_GT(clearance(rests.x), -0.05 * kWidth);
+  EXPECT_LT(apart, 1e-12);
+  // Ties are internal: the ground carries the whole load, and no tie pulls.
+  EXPECT_LT((reactions + applied).norm(), 1e-7 * applied.norm());
+  for (const SelfContactTie& t : rests.self_contacts)
+    EXPECT_GE(t.push_normal(rests.x).dot(t.reaction), -1e-7 * applied.norm()) << "node " << t.node;
+}
