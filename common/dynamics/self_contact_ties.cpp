@@ -106,15 +106,21 @@ bool SelfContactTies::tie(const NodeFaceContact& c, VecX& trial) {
   t.weight = c.weights;
   for (int m : t.face_nodes)
     if (slave_[m]) return false;
-  Vec3 p = Vec3::Zero();
-  for (int i = 0; i < 4; ++i) p += t.weight[i] * at(trial, t.face_nodes[i]);
-  trial.segment<3>(3 * t.node) = p;
   slave_[t.node] = 1;
   for (int m : t.face_nodes) ++master_count_[m];
   ties_.push_back(t);
-  // The node is in no other tie and its face holds no slave: C_S keeps an
-  // identity block, so the rebuild cannot fail.
-  rebuild();
+  // The node is in no other tie and its face holds no slave, so C_S gains
+  // an identity row and column; checked all the same.
+  if (!rebuild()) {
+    ties_.pop_back();
+    slave_[t.node] = 0;
+    for (int m : t.face_nodes) --master_count_[m];
+    rebuild();
+    return false;
+  }
+  Vec3 p = Vec3::Zero();
+  for (int i = 0; i < 4; ++i) p += t.weight[i] * at(trial, t.face_nodes[i]);
+  trial.segment<3>(3 * t.node) = p;
   ++version_;
   return true;
 }
