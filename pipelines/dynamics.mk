@@ -14,6 +14,8 @@
 #   make -f Makefile.pipeline design-jump-over   a platform, over a wall, throw the catapult's cube at a target
 #   make -f Makefile.pipeline design-catapult    (minutes each; RANKS=2 THREADS=1 on two cores; a killed loop
 #                                                resumes from its checkpoints when run again)
+#   make -f Makefile.pipeline design-catapult-rim  the catapult with its basket's wall height as a third
+#                                                parameter (about 25 minutes on two ranks)
 #   make -f Makefile.pipeline design-strips      a side-view strip of each final jump of the design loops run so
 #                                                far (out/design/*.strip.png, python3 -m msfab strip)
 #   make -f Makefile.pipeline bench-dac-plant    DAC against accurate and convergent meshes on the plant-like
@@ -64,8 +66,9 @@ $(OUT)/design/flipper.jump_design.h5: configs/dynamics/flipper_param.yaml
 $(OUT)/design/jump_onto.jump_design.h5: configs/dynamics/jumper_onto.yaml
 $(OUT)/design/jump_over.jump_design.h5: configs/dynamics/jumper_over.yaml
 $(OUT)/design/catapult.jump_design.h5: configs/dynamics/catapult_param.yaml
+$(OUT)/design/catapult_rim.jump_design.h5: configs/dynamics/catapult_param.yaml
 
-.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult dynamics-catapult \
+.PHONY: dynamics-drops dac-cantilever dynamics-flipper design-flipper design-jump-onto design-jump-over design-catapult design-catapult-rim dynamics-catapult \
     bench-dac-plant bench-dac-jumper
 dynamics-drops: stages $(DYN)/drop_face_complementarity.trajectory.h5 $(DYN)/drop_face_dke.trajectory.h5 \
     $(DYN)/drop_face_bbi.trajectory.h5 $(DYN)/drop_oblique.trajectory.h5
@@ -76,6 +79,7 @@ design-flipper: stages $(OUT)/design/flipper.jump_design.h5
 design-jump-onto: stages $(OUT)/design/jump_onto.jump_design.h5
 design-jump-over: stages $(OUT)/design/jump_over.jump_design.h5
 design-catapult: stages $(OUT)/design/catapult.jump_design.h5
+design-catapult-rim: stages $(OUT)/design/catapult_rim.jump_design.h5
 .PHONY: design-strips
 design-strips:
 	@test -n "$(wildcard $(OUT)/design/*.jump_design.h5)" || \
