@@ -97,7 +97,8 @@ LevelErrors calibrated_level_errors(const std::vector<CellErrorModel>& cells, co
   // cells around them and is left out.
   std::array<double, 3> share{}, field{};
   for (size_t c = 0; c < n; ++c) {
-    if (levels[c] <= 0 || levels[c] > 2) continue;
+    if (levels[c] < 0 || levels[c] > 2) throw InputError("calibrated_level_errors: levels are 0, 1 or 2");
+    if (levels[c] == 0) continue;
     share[levels[c]] += cells[c].energy_share;
     field[levels[c]] += std::max(0.0, cell_error_energy[c]);
   }
@@ -122,6 +123,8 @@ LevelErrors calibrated_level_errors(const std::vector<CellErrorModel>& cells, co
 LevelChoice refine_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
                                const std::vector<int>& levels, double target) {
   if (levels.size() != cells.size()) throw InputError("refine_cell_levels: one level per cell expected");
+  for (int l : levels)
+    if (l < 0 || l > 2) throw InputError("refine_cell_levels: levels are 0, 1 or 2");
   if (!(target >= 0) || !std::isfinite(target)) throw InputError("target error must be finite and >= 0");
   check_level_errors(errors);
   LevelChoice out;

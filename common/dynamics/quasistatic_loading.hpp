@@ -80,7 +80,7 @@ struct QuasistaticResult {
   std::string failure;                        // why it stopped, when not converged
   VecX x;                                     // equilibrium positions (3N, node-major)
   std::vector<ContactVertex> contacts;        // active vertices, ascending node order
-  std::vector<SelfContactTie> self_contacts;  // nodes tied to faces, with their reactions
+  std::vector<SelfContactTie> self_contacts;  // nodes tied to faces and crossing edges tied together, with their forces
   int iterations = 0;                         // Newton steps taken, all increments
   int load_steps = 0;                         // increments attempted (including cut ones)
   double elastic_energy = 0;                  // E(x)

@@ -32,7 +32,11 @@ Vec3 SelfContactTie::face_normal(const VecX& x) const {
 
 Vec3 SelfContactTie::push_normal(const VecX& x) const {
   if (!is_edge_pair()) return face_normal(x);
-  Vec3 n = (at(x, edge_nodes[1]) - at(x, edge_nodes[0])).cross(at(x, edge_nodes[3]) - at(x, edge_nodes[2]));
+  const Vec3 ea = at(x, edge_nodes[1]) - at(x, edge_nodes[0]), eb = at(x, edge_nodes[3]) - at(x, edge_nodes[2]);
+  Vec3 n = ea.cross(eb);
+  // Edges turned nearly parallel have no common normal: the one they were
+  // tied with stands in.
+  if (!(n.norm() > 1e-3 * ea.norm() * eb.norm())) return edge_normal;
   n.normalize();
   return n.dot(edge_normal) < 0 ? Vec3(-n) : n;
 }
@@ -54,36 +58,48 @@ SelfContactTies::SelfContactTies(const HexMesh& mesh, bool edge_contact)
 bool SelfContactTies::rebuild() {
   const size_t m = ties_.size();
   slave_rows_.assign(m, {});
-  // C_S is the identity unless a tie's slave has a coefficient other than 1
-  // or appears in another tie.
-  coupled_ = false;
+  // A tie whose slave has the coefficient 1, appears in no other tie and
+  // has no slave among its other nodes has a unit row and column in C_S: its
+  // slave follows R = -C_M directly. The others (edge ties, and what they
+  // touch) form the coupled block, solved together.
+  std::vector<int> appearances(slave_.size(), 0);
   for (const SelfContactTie& t : ties_)
+    for (const auto& term : t.constraint()) ++appearances[term.first];
+  coupled_.assign(m, 0);
+  std::vector<int> block;  // coupled ties
+  for (size_t k = 0; k < m; ++k) {
+    const SelfContactTie& t = ties_[k];
     for (const auto& [node, c] : t.constraint())
-      if ((node == t.node && c != 1.0) || (node != t.node && slave_[node])) coupled_ = true;
-  if (!coupled_) {
-    for (size_t k = 0; k < m; ++k)
-      for (const auto& [node, c] : ties_[k].constraint())
-        if (node != ties_[k].node) slave_rows_[k].emplace_back(node, -c);
-    return true;
+      if (node == t.node ? (c != 1.0 || appearances[node] != 1) : slave_[node] != 0) coupled_[k] = 1;
+    if (coupled_[k]) {
+      block.push_back(static_cast<int>(k));
+    } else {
+      for (const auto& [node, c] : t.constraint())
+        if (node != t.node) slave_rows_[k].emplace_back(node, -c);
+    }
   }
+  if (block.empty()) return true;
+  // The coupled ties' slaves appear only in coupled ties (a slave in another
+  // tie makes both coupled), so the block is closed.
+  const int b = static_cast<int>(block.size());
   std::vector<int> slave_index(slave_.size(), -1), master_column(slave_.size(), -1);
   std::vector<int> masters;
-  for (size_t k = 0; k < m; ++k) slave_index[ties_[k].node] = static_cast<int>(k);
+  for (int r = 0; r < b; ++r) slave_index[ties_[block[r]].node] = r;
   std::vector<Eigen::Triplet<double>> cs;
-  for (size_t k = 0; k < m; ++k)
-    for (const auto& [node, c] : ties_[k].constraint())
+  for (int r = 0; r < b; ++r)
+    for (const auto& [node, c] : ties_[block[r]].constraint())
       if (slave_index[node] >= 0) {
-        cs.emplace_back(static_cast<int>(k), slave_index[node], c);
+        cs.emplace_back(r, slave_index[node], c);
       } else if (master_column[node] < 0) {
         master_column[node] = static_cast<int>(masters.size());
         masters.push_back(node);
       }
-  SpMat CS(m, m);
+  SpMat CS(b, b);
   CS.setFromTriplets(cs.begin(), cs.end());
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m, masters.size());
-  for (size_t k = 0; k < m; ++k)
-    for (const auto& [node, c] : ties_[k].constraint())
-      if (slave_index[node] < 0) rhs(k, master_column[node]) -= c;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(b, masters.size());
+  for (int r = 0; r < b; ++r)
+    for (const auto& [node, c] : ties_[block[r]].constraint())
+      if (slave_index[node] < 0) rhs(r, master_column[node]) -= c;
   Eigen::SparseLU<SpMat> lu(CS);
   if (lu.info() != Eigen::Success) return false;
   const Eigen::MatrixXd R = lu.solve(rhs);
@@ -91,9 +107,9 @@ bool SelfContactTies::rebuild() {
   // Weights that only round-off made nonzero are dropped: they would widen
   // the reduced pattern for nothing.
   const double drop = 1e-14 * std::max(1.0, R.cwiseAbs().maxCoeff());
-  for (size_t k = 0; k < m; ++k)
+  for (int r = 0; r < b; ++r)
     for (size_t j = 0; j < masters.size(); ++j)
-      if (std::abs(R(k, j)) > drop) slave_rows_[k].emplace_back(masters[j], R(k, j));
+      if (std::abs(R(r, j)) > drop) slave_rows_[block[r]].emplace_back(masters[j], R(r, j));
   return true;
 }
 
@@ -106,7 +122,7 @@ bool SelfContactTies::tie(const NodeFaceContact& c, VecX& trial) {
   t.weight = c.weights;
   for (int m : t.face_nodes)
     if (slave_[m]) return false;
-  slave_[t.node] = 1;
+  slave_[t.node] = kFaceSlave;
   for (int m : t.face_nodes) ++master_count_[m];
   ties_.push_back(t);
   // The node is in no other tie and its face holds no slave, so C_S gains
@@ -150,7 +166,7 @@ std::vector<int> SelfContactTies::edge_slave_candidates(const SelfContactTie& t)
 bool SelfContactTies::add_edge_tie(SelfContactTie t, int slave, VecX& trial) {
   t.node = slave;
   ties_.push_back(t);
-  slave_[slave] = 1;
+  slave_[slave] = kEdgeSlave;
   for (int n : t.edge_nodes)
     if (n != slave) ++master_count_[n];
   if (!rebuild()) {
@@ -214,24 +230,28 @@ void SelfContactTies::expand(VecX& step) const {
 std::vector<Vec3> SelfContactTies::forces(const VecX& g) const {
   const size_t m = ties_.size();
   std::vector<Vec3> lambda(m);
-  if (!coupled_) {
-    for (size_t k = 0; k < m; ++k) lambda[k] = at(g, ties_[k].node);
-    return lambda;
+  std::vector<int> block;
+  for (size_t k = 0; k < m; ++k) {
+    lambda[k] = at(g, ties_[k].node);  // a unit row and column of C_S
+    if (coupled_[k]) block.push_back(static_cast<int>(k));
   }
-  // g_S = C_S^T lambda: the slaves' equilibrium with the ties' forces.
+  if (block.empty()) return lambda;
+  // g_S = C_S^T lambda over the coupled block: the slaves' equilibrium with
+  // the ties' forces.
+  const int b = static_cast<int>(block.size());
   std::vector<int> slave_index(slave_.size(), -1);
-  for (size_t k = 0; k < m; ++k) slave_index[ties_[k].node] = static_cast<int>(k);
+  for (int r = 0; r < b; ++r) slave_index[ties_[block[r]].node] = r;
   std::vector<Eigen::Triplet<double>> cst;
-  for (size_t k = 0; k < m; ++k)
-    for (const auto& [node, c] : ties_[k].constraint())
-      if (slave_index[node] >= 0) cst.emplace_back(slave_index[node], static_cast<int>(k), c);
-  SpMat CST(m, m);
+  for (int r = 0; r < b; ++r)
+    for (const auto& [node, c] : ties_[block[r]].constraint())
+      if (slave_index[node] >= 0) cst.emplace_back(slave_index[node], r, c);
+  SpMat CST(b, b);
   CST.setFromTriplets(cst.begin(), cst.end());
-  Eigen::MatrixXd gs(m, 3);
-  for (size_t k = 0; k < m; ++k) gs.row(k) = at(g, ties_[k].node).transpose();
+  Eigen::MatrixXd gs(b, 3);
+  for (int r = 0; r < b; ++r) gs.row(r) = at(g, ties_[block[r]].node).transpose();
   Eigen::SparseLU<SpMat> lu(CST);
   const Eigen::MatrixXd l = lu.solve(gs);
-  for (size_t k = 0; k < m; ++k) lambda[k] = l.row(k).transpose();
+  for (int r = 0; r < b; ++r) lambda[block[r]] = l.row(r).transpose();
   return lambda;
 }
 
@@ -252,8 +272,15 @@ int SelfContactTies::release(const VecX& q, const VecX& g, double threshold) {
   }
   if (kept.size() == before) return 0;
   ties_ = std::move(kept);
-  if (!rebuild())
-    throw NumericalError("self-contact: the ties left after a release make the slaves' coefficients singular");
+  if (!rebuild()) {
+    // What is left of a coupled set can be singular although the whole was
+    // not: its edge ties go too (node-face ties alone always rebuild), and
+    // are made again where the edges still cross.
+    std::vector<SelfContactTie> face_ties;
+    for (const SelfContactTie& t : ties_)
+      if (!t.is_edge_pair()) face_ties.push_back(t);
+    assign(face_ties);
+  }
   ++version_;
   return static_cast<int>(before - ties_.size());
 }
@@ -269,7 +296,7 @@ void SelfContactTies::assign(const std::vector<SelfContactTie>& ties) {
   std::fill(master_count_.begin(), master_count_.end(), 0);
   tied_edges_.clear();
   for (const SelfContactTie& t : ties_) {
-    slave_[t.node] = 1;
+    slave_[t.node] = t.is_edge_pair() ? kEdgeSlave : kFaceSlave;
     for (const auto& term : t.constraint())
       if (term.first != t.node) ++master_count_[term.first];
     if (t.is_edge_pair()) tied_edges_.insert({t.edges[0], t.edges[1]});
@@ -279,8 +306,10 @@ void SelfContactTies::assign(const std::vector<SelfContactTie>& ties) {
 }
 
 bool SelfContactTies::penetrates(const VecX& q, const VecX& trial, double depth, double depth_limit) const {
+  // A node tied to a face follows it; a slave of an edge tie is held only
+  // at its edge's crossing and must not go through a face either.
   for (const NodeFaceContact& c : surface_.find(q, trial, -depth, depth_limit))
-    if (!slave_[c.node]) return true;
+    if (slave_[c.node] != kFaceSlave) return true;
   if (edge_contact_)
     for (const EdgeEdgeContact& c : surface_.find_edges(q, trial, -depth, depth_limit))
       if (!tied_edges_.count({c.edge_a, c.edge_b})) return true;

@@ -23,11 +23,17 @@
 // on edge a. A tie is released when it would pull: n . lambda < 0 with n
 // the face's outward normal, or the edges' common normal from b towards a.
 //
-// A node-face tie's node is never a master of another tie, and a face with a
-// slave holds no other node, so node-face ties alone give C_S = I (R is the
-// face weights). An edge tie's slave is the node of larger weight on one of
-// its edges (|c| >= 1/2, so R stays bounded) that is no slave yet; a tie
-// that would make C_S singular or R larger than kMaxTieWeight is not made.
+// A node-face tie is made only for a node that is in no other tie, on a face
+// with no slave, so node-face ties alone give C_S = I (R is the face
+// weights). An edge tie's slave is the node of larger weight on one of its
+// edges (|c| >= 1/2, so R stays bounded) that is no slave yet; it may be
+// another tie's master, and its other nodes may be slaves. The ties that
+// do not have a unit row and column in C_S form a block solved together; a
+// tie that would make it singular or R larger than kMaxTieWeight is not
+// made. A release that leaves the block singular releases its edge ties
+// too. A slave of an edge tie is held only where its edges cross: it may
+// neither go through a face nor be tied to one, and an obstacle does not
+// hold it (the press then halves its steps rather than let it through).
 #include <array>
 #include <set>
 #include <utility>
@@ -144,13 +150,14 @@ class SelfContactTies {
   BoundarySurface surface_;
   bool edge_contact_ = true;
   std::vector<SelfContactTie> ties_;
-  std::vector<char> slave_;
+  static constexpr char kFaceSlave = 1, kEdgeSlave = 2;
+  std::vector<char> slave_;        // per node: 0, or the kind of tie it is the slave of
   std::vector<int> master_count_;  // ties each node is a master of
   std::set<std::pair<int, int>> tied_edges_;
   // R: per tie, its slave's masters and weights.
   std::vector<std::vector<std::pair<int, double>>> slave_rows_;
-  bool coupled_ = false;  // C_S is not the identity
-  int version_ = 0;       // only grows, so no two sets share a version
+  std::vector<char> coupled_;  // per tie: in the coupled block of C_S (not a unit row and column)
+  int version_ = 0;            // only grows, so no two sets share a version
 };
 
 }  // namespace msfab

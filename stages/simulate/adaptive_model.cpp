@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -162,6 +163,10 @@ void rechoose_adaptive_levels(AdaptiveModel& m, const Scene& scene, const VoxelM
     choice_target *= 0.5;
     choice = choose_cell_levels(m.cells, m.level_errors, choice_target);
   }
+  // Cells an earlier re-choice refined further (with calibrated level
+  // errors) stay so.
+  if (!previous.empty())
+    for (size_t c = 0; c < previous.size(); ++c) choice.cell_level[c] = std::min(choice.cell_level[c], previous[c]);
   m.choice_target = choice_target;
   mesh_chosen_levels(m, scene, fine, fine_conditions, level2, std::move(choice));
   m.seconds += seconds_since(t0);

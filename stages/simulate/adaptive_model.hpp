@@ -56,7 +56,7 @@ AdaptiveModel build_adaptive_model(const Scene& scene, const VoxelMesh& fine, co
 
 // Re-chooses the levels of `model` for `choice_target` (below the target the
 // previous choice was made for, after its a-posteriori check missed) and
-// meshes them again.
+// meshes them again; no cell ends coarser than in the previous choice.
 void rechoose_adaptive_levels(AdaptiveModel& model, const Scene& scene, const VoxelMesh& fine,
                               const StaticConditions& fine_conditions, const CoarseModel& level2, double choice_target);
 
@@ -100,9 +100,11 @@ PosteriorEstimate posterior_estimate(const VoxelMesh& fine, const AdaptiveModel&
 
 // Re-chooses the levels of `model` after its solve (`on_fine`, fine-node
 // displacements) missed `target_error` by the estimate `measured`, whose
-// error field says where the error sits: the level errors are calibrated
-// by it (calibrated_level_errors, with the field's fine strain energy per
-// level-2 cell) and the levels refined to meet the target with them.
+// error field says how the error splits between the level-1 and level-2
+// cells: the two level errors are calibrated by it
+// (calibrated_level_errors, with the field's fine strain energy per
+// level-2 cell; the spread over the cells stays the a-priori one) and the
+// levels refined from the current ones to meet the target itself.
 // Returns false, changing nothing, where the estimate has no field or the
 // calibrated errors refine no cell.
 bool rechoose_where_measured(AdaptiveModel& model, const Scene& scene, const VoxelMesh& fine,

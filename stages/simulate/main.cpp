@@ -290,10 +290,11 @@ int main(int argc, char** argv) {
               checked_error, target_error, adaptive_solves);
           break;
         }
-        // Where the estimate says where the error sits (fine Newton steps),
-        // the cells that carry it are refined, to fine cells if need be;
-        // else the a-priori choice is made for a target tightened by the
-        // ratio of the miss.
+        // Where the estimate is a field (fine Newton steps), it calibrates
+        // the level-1 and level-2 errors and the levels are refined for the
+        // target with them, to fine cells where level 1 falls short; else
+        // the a-priori choice is made for a target tightened by the ratio
+        // of the miss.
         if (!rechoose_where_measured(adapted, scene, fine, fine_conditions, coarse, on_fine, posterior, target_error))
           rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
                                    adapted.choice_target * target_error / estimate);

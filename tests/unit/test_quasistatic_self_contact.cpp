@@ -68,9 +68,9 @@ Obstacle floor_plane() {
   return o;
 }
 
-// The push of a tie's face on its node along the face's outward normal at
-// `x` (positive: pushing the node off).
-double tie_push(const SelfContactTie& t, const VecX& x) { return t.face_normal(x).dot(t.reaction); }
+// The push of a tie along its normal at `x`: a face's on its node, or edge
+// b's on edge a (positive: pushing them apart).
+double tie_push(const SelfContactTie& t, const VecX& x) { return t.push_normal(x).dot(t.reaction); }
 
 }  // namespace
 
