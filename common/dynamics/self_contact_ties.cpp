@@ -65,19 +65,21 @@ bool SelfContactTies::rebuild() {
   std::vector<int> appearances(slave_.size(), 0);
   for (const SelfContactTie& t : ties_)
     for (const auto& term : t.constraint()) ++appearances[term.first];
-  coupled_.assign(m, 0);
-  std::vector<int> block;  // coupled ties
+  block_.clear();
+  block_matrix_ = SpMat();
   for (size_t k = 0; k < m; ++k) {
     const SelfContactTie& t = ties_[k];
+    bool coupled = false;
     for (const auto& [node, c] : t.constraint())
-      if (node == t.node ? (c != 1.0 || appearances[node] != 1) : slave_[node] != 0) coupled_[k] = 1;
-    if (coupled_[k]) {
-      block.push_back(static_cast<int>(k));
+      if (node == t.node ? (c != 1.0 || appearances[node] != 1) : slave_[node] != 0) coupled = true;
+    if (coupled) {
+      block_.push_back(static_cast<int>(k));
     } else {
       for (const auto& [node, c] : t.constraint())
         if (node != t.node) slave_rows_[k].emplace_back(node, -c);
     }
   }
+  const std::vector<int>& block = block_;
   if (block.empty()) return true;
   // The coupled ties' slaves appear only in coupled ties (a slave in another
   // tie makes both coupled), so the block is closed.
@@ -94,8 +96,9 @@ bool SelfContactTies::rebuild() {
         master_column[node] = static_cast<int>(masters.size());
         masters.push_back(node);
       }
-  SpMat CS(b, b);
-  CS.setFromTriplets(cs.begin(), cs.end());
+  block_matrix_.resize(b, b);
+  block_matrix_.setFromTriplets(cs.begin(), cs.end());
+  const SpMat& CS = block_matrix_;
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(b, masters.size());
   for (int r = 0; r < b; ++r)
     for (const auto& [node, c] : ties_[block[r]].constraint())
@@ -122,23 +125,9 @@ bool SelfContactTies::tie(const NodeFaceContact& c, VecX& trial) {
   t.weight = c.weights;
   for (int m : t.face_nodes)
     if (slave_[m]) return false;
-  slave_[t.node] = kFaceSlave;
-  for (int m : t.face_nodes) ++master_count_[m];
-  ties_.push_back(t);
   // The node is in no other tie and its face holds no slave, so C_S gains
-  // an identity row and column; checked all the same.
-  if (!rebuild()) {
-    ties_.pop_back();
-    slave_[t.node] = 0;
-    for (int m : t.face_nodes) --master_count_[m];
-    rebuild();
-    return false;
-  }
-  Vec3 p = Vec3::Zero();
-  for (int i = 0; i < 4; ++i) p += t.weight[i] * at(trial, t.face_nodes[i]);
-  trial.segment<3>(3 * t.node) = p;
-  ++version_;
-  return true;
+  // a unit row and column; add_tie checks all the same.
+  return add_tie(t, trial);
 }
 
 SelfContactTie SelfContactTies::edge_tie(const EdgeEdgeContact& c) const {
@@ -163,30 +152,38 @@ std::vector<int> SelfContactTies::edge_slave_candidates(const SelfContactTie& t)
   return out;
 }
 
-bool SelfContactTies::add_edge_tie(SelfContactTie t, int slave, VecX& trial) {
-  t.node = slave;
-  ties_.push_back(t);
-  slave_[slave] = kEdgeSlave;
-  for (int n : t.edge_nodes)
-    if (n != slave) ++master_count_[n];
-  if (!rebuild()) {
-    ties_.pop_back();
-    slave_[slave] = 0;
-    for (int n : t.edge_nodes)
-      if (n != slave) --master_count_[n];
-    rebuild();  // the set before, which was valid
+bool SelfContactTies::add_tie(const SelfContactTie& t, VecX& trial) {
+  std::vector<SelfContactTie> more = ties_;
+  more.push_back(t);
+  if (!set_ties(std::move(more))) {
+    more = ties_;
+    more.pop_back();
+    set_ties(std::move(more));  // the set before, which was valid
     return false;
   }
-  tied_edges_.insert({t.edges[0], t.edges[1]});
-  // A new slave may have been a master: every slave is put where its
-  // masters put it.
-  for (size_t k = 0; k < ties_.size(); ++k) {
+  // A new edge tie's slave may have been a master: every slave is put where
+  // its masters put it. A node-face tie changes no other slave's row.
+  for (size_t k = t.is_edge_pair() ? 0 : ties_.size() - 1; k < ties_.size(); ++k) {
     Vec3 p = Vec3::Zero();
     for (const auto& [node, w] : slave_rows_[k]) p += w * at(trial, node);
     trial.segment<3>(3 * ties_[k].node) = p;
   }
   ++version_;
   return true;
+}
+
+bool SelfContactTies::set_ties(std::vector<SelfContactTie> ties) {
+  ties_ = std::move(ties);
+  std::fill(slave_.begin(), slave_.end(), 0);
+  std::fill(master_count_.begin(), master_count_.end(), 0);
+  tied_edges_.clear();
+  for (const SelfContactTie& t : ties_) {
+    slave_[t.node] = t.is_edge_pair() ? kEdgeSlave : kFaceSlave;
+    for (const auto& term : t.constraint())
+      if (term.first != t.node) ++master_count_[term.first];
+    if (t.is_edge_pair()) tied_edges_.insert({t.edges[0], t.edges[1]});
+  }
+  return rebuild();
 }
 
 VecX SelfContactTies::reduce(const VecX& g) const {
@@ -228,30 +225,18 @@ void SelfContactTies::expand(VecX& step) const {
 }
 
 std::vector<Vec3> SelfContactTies::forces(const VecX& g) const {
-  const size_t m = ties_.size();
-  std::vector<Vec3> lambda(m);
-  std::vector<int> block;
-  for (size_t k = 0; k < m; ++k) {
-    lambda[k] = at(g, ties_[k].node);  // a unit row and column of C_S
-    if (coupled_[k]) block.push_back(static_cast<int>(k));
-  }
-  if (block.empty()) return lambda;
+  std::vector<Vec3> lambda(ties_.size());
+  for (size_t k = 0; k < ties_.size(); ++k) lambda[k] = at(g, ties_[k].node);  // a unit row and column of C_S
+  if (block_.empty()) return lambda;
   // g_S = C_S^T lambda over the coupled block: the slaves' equilibrium with
   // the ties' forces.
-  const int b = static_cast<int>(block.size());
-  std::vector<int> slave_index(slave_.size(), -1);
-  for (int r = 0; r < b; ++r) slave_index[ties_[block[r]].node] = r;
-  std::vector<Eigen::Triplet<double>> cst;
-  for (int r = 0; r < b; ++r)
-    for (const auto& [node, c] : ties_[block[r]].constraint())
-      if (slave_index[node] >= 0) cst.emplace_back(slave_index[node], r, c);
-  SpMat CST(b, b);
-  CST.setFromTriplets(cst.begin(), cst.end());
+  const int b = static_cast<int>(block_.size());
   Eigen::MatrixXd gs(b, 3);
-  for (int r = 0; r < b; ++r) gs.row(r) = at(g, ties_[block[r]].node).transpose();
-  Eigen::SparseLU<SpMat> lu(CST);
+  for (int r = 0; r < b; ++r) gs.row(r) = lambda[block_[r]].transpose();
+  const SpMat transposed = block_matrix_.transpose();
+  Eigen::SparseLU<SpMat> lu(transposed);
   const Eigen::MatrixXd l = lu.solve(gs);
-  for (int r = 0; r < b; ++r) lambda[block[r]] = l.row(r).transpose();
+  for (int r = 0; r < b; ++r) lambda[block_[r]] = l.row(r).transpose();
   return lambda;
 }
 
@@ -259,27 +244,17 @@ int SelfContactTies::release(const VecX& q, const VecX& g, double threshold) {
   const size_t before = ties_.size();
   const std::vector<Vec3> lambda = forces(g);
   std::vector<SelfContactTie> kept;
-  for (size_t k = 0; k < before; ++k) {
-    const SelfContactTie& t = ties_[k];
-    if (t.push_normal(q).dot(lambda[k]) < -threshold) {
-      slave_[t.node] = 0;
-      for (const auto& term : t.constraint())
-        if (term.first != t.node) --master_count_[term.first];
-      if (t.is_edge_pair()) tied_edges_.erase({t.edges[0], t.edges[1]});
-    } else {
-      kept.push_back(t);
-    }
-  }
+  for (size_t k = 0; k < before; ++k)
+    if (!(ties_[k].push_normal(q).dot(lambda[k]) < -threshold)) kept.push_back(ties_[k]);
   if (kept.size() == before) return 0;
-  ties_ = std::move(kept);
-  if (!rebuild()) {
+  if (!set_ties(kept)) {
     // What is left of a coupled set can be singular although the whole was
     // not: its edge ties go too (node-face ties alone always rebuild), and
     // are made again where the edges still cross.
     std::vector<SelfContactTie> face_ties;
-    for (const SelfContactTie& t : ties_)
+    for (const SelfContactTie& t : kept)
       if (!t.is_edge_pair()) face_ties.push_back(t);
-    assign(face_ties);
+    set_ties(std::move(face_ties));
   }
   ++version_;
   return static_cast<int>(before - ties_.size());
@@ -291,17 +266,7 @@ void SelfContactTies::record_reactions(const VecX& g) {
 }
 
 void SelfContactTies::assign(const std::vector<SelfContactTie>& ties) {
-  ties_ = ties;
-  std::fill(slave_.begin(), slave_.end(), 0);
-  std::fill(master_count_.begin(), master_count_.end(), 0);
-  tied_edges_.clear();
-  for (const SelfContactTie& t : ties_) {
-    slave_[t.node] = t.is_edge_pair() ? kEdgeSlave : kFaceSlave;
-    for (const auto& term : t.constraint())
-      if (term.first != t.node) ++master_count_[term.first];
-    if (t.is_edge_pair()) tied_edges_.insert({t.edges[0], t.edges[1]});
-  }
-  if (!rebuild()) throw NumericalError("self-contact: a restored tie set makes the slaves' coefficients singular");
+  if (!set_ties(ties)) throw NumericalError("self-contact: a restored tie set makes the slaves' coefficients singular");
   ++version_;
 }
 

@@ -131,17 +131,21 @@ class SelfContactTies {
   bool tie_edges(const EdgeEdgeContact& c, VecX& trial, Held held) {
     if (tied_edges_.count({c.edge_a, c.edge_b})) return false;
     SelfContactTie t = edge_tie(c);
-    for (int slave : edge_slave_candidates(t))
-      if (!held(slave) && add_edge_tie(t, slave, trial)) return true;
+    for (int slave : edge_slave_candidates(t)) {
+      t.node = slave;
+      if (!held(slave) && add_tie(t, trial)) return true;
+    }
     return false;
   }
   SelfContactTie edge_tie(const EdgeEdgeContact& c) const;
   // The nodes of larger weight on each edge, the larger first.
   std::vector<int> edge_slave_candidates(const SelfContactTie& t) const;
-  // Adds `t` with `slave`, rebuilding R; false (nothing changed) where C_S
-  // becomes singular or R too large. Puts every slave of `trial` where its
-  // masters put it.
-  bool add_edge_tie(SelfContactTie t, int slave, VecX& trial);
+  // Adds `t`; false (nothing changed) where C_S becomes singular or R too
+  // large. Puts every slave of `trial` where its masters put it.
+  bool add_tie(const SelfContactTie& t, VecX& trial);
+  // Replaces the ties, deriving the slaves, master counts and tied edges,
+  // and rebuilds R; false where that fails (the set is kept all the same).
+  bool set_ties(std::vector<SelfContactTie> ties);
   // R from the ties; false where C_S is singular or R too large.
   bool rebuild();
   // Each tie's force lambda = C_S^-T g_S.
@@ -156,8 +160,11 @@ class SelfContactTies {
   std::set<std::pair<int, int>> tied_edges_;
   // R: per tie, its slave's masters and weights.
   std::vector<std::vector<std::pair<int, double>>> slave_rows_;
-  std::vector<char> coupled_;  // per tie: in the coupled block of C_S (not a unit row and column)
-  int version_ = 0;            // only grows, so no two sets share a version
+  // The ties of the coupled block of C_S (those without a unit row and
+  // column), and that block's matrix.
+  std::vector<int> block_;
+  SpMat block_matrix_;
+  int version_ = 0;  // only grows, so no two sets share a version
 };
 
 }  // namespace msfab

@@ -12,6 +12,21 @@ namespace msfab {
 
 namespace {
 
+// A coarse diagonal 3x3 block after the Galerkin sum: made exactly
+// symmetric (the sums round differently above and below the diagonal),
+// with a decoupled unit row for each unknown nothing interpolates to, which
+// keeps the coarse matrix definite.
+void finish_diagonal_block(double* block, const bool reached[3]) {
+  for (int a = 0; a < 3; ++a) {
+    for (int b = a + 1; b < 3; ++b) {
+      const double mean = 0.5 * (block[3 * a + b] + block[3 * b + a]);
+      block[3 * a + b] = mean;
+      block[3 * b + a] = mean;
+    }
+    if (!reached[a]) block[4 * a] = 1.0;
+  }
+}
+
 // Lattice offsets (each component in {-1, 0, 1}) are coded as
 // (dx+1) + 3 (dy+1) + 9 (dz+1); 13 is (0, 0, 0). With nodes numbered in
 // lattice order (x fastest), a code >= 13 means a column node >= the row node.
@@ -284,17 +299,7 @@ void GridTransfer::galerkin_product(const BlockMatrix& fine, const std::vector<c
         if (code < kCenter) continue;
         double* target = coarse.values.data() + 9 * std::size_t(slot);
         std::copy(sum[code], sum[code] + 9, target);
-        if (code != kCenter) continue;
-        for (int a = 0; a < 3; ++a) {
-          for (int b = a + 1; b < 3; ++b) {
-            const double mean = 0.5 * (target[3 * a + b] + target[3 * b + a]);
-            target[3 * a + b] = mean;
-            target[3 * b + a] = mean;
-          }
-          // Nothing interpolates to this unknown: keep the coarse matrix
-          // definite with a decoupled unit row.
-          if (!reached[a]) target[4 * a] = 1.0;
-        }
+        if (code == kCenter) finish_diagonal_block(target, reached);
       }
     }
   });
@@ -445,15 +450,7 @@ void GridTransfer::wide_galerkin_product(const BlockMatrix& fine, const std::vec
           }
         }
       }
-      double* diagonal = coarse.values.data() + 9 * std::size_t(upper);
-      for (int a = 0; a < 3; ++a) {
-        for (int b = a + 1; b < 3; ++b) {
-          const double mean = 0.5 * (diagonal[3 * a + b] + diagonal[3 * b + a]);
-          diagonal[3 * a + b] = mean;
-          diagonal[3 * b + a] = mean;
-        }
-        if (!reached[a]) diagonal[4 * a] = 1.0;
-      }
+      finish_diagonal_block(coarse.values.data() + 9 * std::size_t(upper), reached);
       for (int slot = upper; slot < last; ++slot) slot_of[coarse.column[slot]] = -1;
     }
   });
