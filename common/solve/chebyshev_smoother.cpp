@@ -8,20 +8,37 @@
 
 namespace msfab {
 
-void ChebyshevSmoother::upper_row_product(int i, const double* x, double out[3]) const {
-  double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-  const int* column = pattern_->column.data();
-  for (int slot = pattern_->row_start[i]; slot < pattern_->row_start[i + 1]; ++slot) {
-    const float* m = values_.data() + 9 * std::size_t(block_of_slot_[std::size_t(slot)]);
-    const double* xj = x + 3 * std::size_t(column[slot]);
-    if (column[slot] >= i)
-      add_block_product(m, xj, y0, y1, y2);
-    else
-      add_transposed_block_product(m, xj, y0, y1, y2);
+void ChebyshevSmoother::upper_product(const VecX& x) const {
+  const BlockMatrix& A = *pattern_;
+  product_.resize(A.unknowns());
+  const int chunks = static_cast<int>(chunk_start_.size()) - 1;
+  const int team = resolve_thread_count(threads_);
+  const int* column = A.column.data();
+#pragma omp parallel num_threads(team) if (A.rows > 4096)
+  {
+#pragma omp for schedule(static)
+    for (Eigen::Index k = 0; k < product_.size(); ++k) product_[k] = 0.0;
+    for (int parity = 0; parity < 2; ++parity) {
+#pragma omp for schedule(static)
+      for (int c = parity; c < chunks; c += 2) {
+        for (int i = chunk_start_[std::size_t(c)]; i < chunk_start_[std::size_t(c) + 1]; ++i) {
+          const double* xi = x.data() + 3 * std::size_t(i);
+          const float* m = values_.data() + 9 * std::size_t(first_upper_[std::size_t(i)]);
+          double y0 = 0.0, y1 = 0.0, y2 = 0.0;
+          add_block_product(m, xi, y0, y1, y2);  // the diagonal block
+          for (int slot = A.diagonal[std::size_t(i)] + 1; slot < A.row_start[i + 1]; ++slot) {
+            m += 9;
+            const std::size_t j = std::size_t(column[slot]);
+            add_block_product(m, x.data() + 3 * j, y0, y1, y2);
+            double* yj = product_.data() + 3 * j;
+            add_transposed_block_product(m, xi, yj[0], yj[1], yj[2]);
+          }
+          double* yi = product_.data() + 3 * std::size_t(i);
+          yi[0] += y0, yi[1] += y1, yi[2] += y2;
+        }
+      }
+    }
   }
-  out[0] = y0;
-  out[1] = y1;
-  out[2] = y2;
 }
 
 bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, SmootherValues values,
@@ -57,6 +74,17 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
   } else if (values == SmootherValues::single_upper) {
     block_of_slot_ = numbering.empty() ? upper_block_numbering(A, threads) : std::move(numbering);
     values_.resize(9 * upper_block_count(A));
+    first_upper_.assign(std::size_t(A.rows) + 1, 0);
+    int reach = 1;
+    for (int i = 0; i < A.rows; ++i) {
+      first_upper_[std::size_t(i) + 1] =
+          first_upper_[std::size_t(i)] + (A.row_start[i + 1] - A.diagonal[std::size_t(i)]);
+      if (A.row_start[i + 1] > A.row_start[i])
+        reach = std::max(reach, A.column[std::size_t(A.row_start[i + 1]) - 1] - i);
+    }
+    chunk_start_.clear();
+    for (int begin = 0; begin < A.rows; begin += reach) chunk_start_.push_back(begin);
+    chunk_start_.push_back(A.rows);
     chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
       for (Eigen::Index i = begin; i < end; ++i)
         for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
@@ -76,12 +104,15 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
   if (chebyshev::invert_diagonal_blocks(A.rows, diagonal_.data(), inverse_, threads) != 0) return false;
   max_eigenvalue_ = chebyshev::estimate_max_eigenvalue(
       A.rows, diagonal_.data(), inverse_.data(), [&](int i, const double* x, double out[3]) { row_product(i, x, out); },
-      [](const VecX&) {}, threads);
+      [&](const VecX& x) { before_pass(x); }, threads);
   std::vector<double>().swap(diagonal_);  // the smoothing uses the inverses only
-  return std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0;
+  if (!(std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0)) return false;
+  std::vector<int>().swap(block_of_slot_);  // the products read the upper blocks row by row
+  return true;
 }
 
 void ChebyshevSmoother::residual(const VecX& b, const VecX& x, VecX& r) const {
+  before_pass(x);
   chebyshev::residual(
       pattern_->rows, [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, b, x, r, threads_);
 }
@@ -89,8 +120,8 @@ void ChebyshevSmoother::residual(const VecX& b, const VecX& x, VecX& r) const {
 void ChebyshevSmoother::smooth(const VecX& b, VecX& x, bool zero_start) {
   chebyshev::smooth(
       pattern_->rows, inverse_.data(), max_eigenvalue_, degree_,
-      [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, [](const VecX&) {}, b, x, zero_start,
-      step_, next_, threads_);
+      [&](int i, const double* y, double out[3]) { row_product(i, y, out); }, [&](const VecX& y) { before_pass(y); }, b,
+      x, zero_start, step_, next_, threads_);
 }
 
 }  // namespace msfab

@@ -9,6 +9,7 @@
 // damping factor tuned to the Poisson ratio or the stiffness contrast. The
 // same polynomial is used before and after the coarse correction, so the
 // V-cycle is symmetric.
+#include <cstdint>
 #include <vector>
 
 #include "solve/block_matrix.hpp"
@@ -27,11 +28,11 @@ enum class SmootherValues {
   // Every block in single precision: a product moves half the bytes of A's
   // (the smoother is only a preconditioner).
   single,
-  // Only the blocks on and above the diagonal, in single precision; a block
-  // below is read as its mirror transposed. About 40% fewer bytes than
-  // `single` and an exactly symmetric operator, but a product takes about
-  // twice as long (the mirrors lie a lattice plane away in memory): for
-  // levels too large to hold otherwise.
+  // Only the blocks on and above the diagonal, in single precision. A
+  // product reads each of them once and applies it twice, B x_j to row i
+  // and B^T x_i to row j, by chunks of rows (upper_product()). About 40%
+  // fewer bytes than `single` and an exactly symmetric operator: for levels
+  // too large to hold otherwise.
   single_upper,
   // A's own double values: where the stiffness contrast exceeds what
   // single precision resolves (about 1e7), rounding the stiff entries
@@ -68,14 +69,29 @@ class ChebyshevSmoother {
   int degree() const { return degree_; }
 
  private:
+  // Row i of A x. With single_upper, A x is formed whole by
+  // before_pass(x) and read back here.
   void row_product(int i, const double* x, double out[3]) const {
     switch (values_kind_) {
       case SmootherValues::single: block_row_product(*pattern_, values_.data(), i, x, out); break;
-      case SmootherValues::single_upper: upper_row_product(i, x, out); break;
+      case SmootherValues::single_upper: {
+        const double* y = product_.data() + 3 * std::size_t(i);
+        out[0] = y[0], out[1] = y[1], out[2] = y[2];
+        break;
+      }
       case SmootherValues::double_values: block_row_product(*pattern_, pattern_->values.data(), i, x, out); break;
     }
   }
-  void upper_row_product(int i, const double* x, double out[3]) const;
+  // What a pass over the rows needs first: A x into product_ (single_upper).
+  void before_pass(const VecX& x) const {
+    if (values_kind_ == SmootherValues::single_upper) upper_product(x);
+  }
+  // product_ = A x from the upper blocks. Rows go in chunks of at least the
+  // pattern's reach (the largest j - i of a block), so a chunk's
+  // transposed blocks land in it or the next one: the even chunks run in
+  // parallel, then the odd ones, and every entry sums its terms in an
+  // order fixed by the pattern, whatever the thread count.
+  void upper_product(const VecX& x) const;
   // setup() with the numbering in hand (empty: computed here where
   // single_upper needs it); `held_by_upper`: A's values are A's upper
   // blocks in that numbering.
@@ -84,10 +100,15 @@ class ChebyshevSmoother {
   const BlockMatrix* pattern_ = nullptr;
   SmootherValues values_kind_ = SmootherValues::single;
   // single: A's values in single precision, laid out like A.values.
-  // single_upper: A's blocks on and above the diagonal (9 each, row-major),
-  // and per slot of A the block it reads (below the diagonal: its mirror's).
+  // single_upper: A's blocks on and above the diagonal (9 each, row-major,
+  // row by row), the first of each row, the chunks' first rows, and the
+  // product's workspace. (The numbering of every slot is needed only while
+  // the values are copied, and released after.)
   std::vector<float> values_;
   std::vector<int> block_of_slot_;
+  std::vector<std::int64_t> first_upper_;
+  std::vector<int> chunk_start_;
+  mutable VecX product_;
   std::vector<double> diagonal_;  // diagonal blocks, 9 per node, row-major (released after setup)
   std::vector<double> inverse_;   // their inverses
   double max_eigenvalue_ = 0.0;

@@ -96,6 +96,8 @@ DirichletGridMultigrid::DirichletGridMultigrid(int nx, int ny, int nz, std::vect
   if (options_.max_iterations < 1) throw InputError("matrix-free multigrid: max_iterations must be >= 1");
   if (options_.smoother_degree < 1 || options_.smoother_degree > 10)
     throw InputError("matrix-free multigrid: smoother_degree must lie in 1..10");
+  if (options_.grid_smoother_degree < 1 || options_.grid_smoother_degree > 10)
+    throw InputError("matrix-free multigrid: grid_smoother_degree must lie in 1..10");
   const std::int64_t nodes = fine_.nodes();
   if (nodes > (std::int64_t(1) << 31) / 3) throw InputError("matrix-free multigrid: more than 2^31 unknowns");
   if (std::int64_t(fixed_.size()) != 3 * nodes)
@@ -589,8 +591,8 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
     out[0] = y[0], out[1] = y[1], out[2] = y[2];
   };
   const auto apply = [this](const VecX& x) { multiply_rows(x, product_); };
-  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z, true,
-                    step_, next_, threads);
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.grid_smoother_degree, row_product, apply, r, z,
+                    true, step_, next_, threads);
   apply(z);
   // r - A z into product_ itself (each row is read before it is written).
   chebyshev::residual(rows, row_product, r, z, product_, threads);
@@ -600,8 +602,8 @@ void DirichletGridMultigrid::cycle(const VecX& r, VecX& z) {
   else
     coarse_solution_ = coarse_solver_->apply_preconditioner(coarse_rhs_);
   add_prolongation(coarse_solution_, z);
-  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.smoother_degree, row_product, apply, r, z, false,
-                    step_, next_, threads);
+  chebyshev::smooth(rows, inverse_.data(), max_eigenvalue_, options_.grid_smoother_degree, row_product, apply, r, z,
+                    false, step_, next_, threads);
 }
 
 VecX DirichletGridMultigrid::apply_preconditioner(const VecX& r) {

@@ -48,9 +48,16 @@ struct DirichletMultigridOptions {
   double tolerance = 1e-8;  // stop when ||b - A x|| <= tolerance ||b||
   int max_iterations = 2000;
   std::string max_iterations_key;  // the config key that sets max_iterations, for messages (empty: none)
-  int smoother_degree = 2;         // Chebyshev degree on the grid (matrix products per smoothing)
-  int coarse_unknowns = 3000;      // the assembled hierarchy factors its first level with fewer unknowns
-  int threads = 0;                 // 0: the OpenMP default
+  int smoother_degree = 2;         // Chebyshev degree on the assembled levels (matrix products per smoothing)
+  // Chebyshev degree on the grid itself, whose products (element by
+  // element) cost most of a cycle. One step is as good a smoother there:
+  // on printed structures degree 2 saved no CG iteration (99 against 100
+  // on the gripper plate) and cost 40% more time; on SIMP fields it saved
+  // at most a third of the iterations for the same time
+  // (docs/BENCHMARKS.md, "The matrix-free product on wide vectors").
+  int grid_smoother_degree = 1;
+  int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
+  int threads = 0;             // 0: the OpenMP default
   // Coarse spaces that follow the material (solve/material_components.hpp):
   // one copy of a coarse node per connected piece of material in its
   // support, from level 1 down. For voxel models of printed structures

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -18,8 +19,9 @@ namespace {
 
 // A symmetric positive definite matrix of n nodes with random 3x3 blocks
 // between random node pairs (an irregular pattern, several blocks per row),
-// made definite by a dominant diagonal.
-SpMat random_spd_block_matrix(int nodes, unsigned seed) {
+// made definite by a dominant diagonal; with `band`, pairs at most that
+// many nodes apart.
+SpMat random_spd_block_matrix(int nodes, unsigned seed, int band = 0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> value(-1.0, 1.0);
   std::uniform_int_distribution<int> node(0, nodes - 1);
@@ -27,7 +29,7 @@ SpMat random_spd_block_matrix(int nodes, unsigned seed) {
   std::vector<double> row_sum(3 * std::size_t(nodes), 0.0);
   for (int pair = 0; pair < 4 * nodes; ++pair) {
     const int i = node(rng), j = node(rng);
-    if (i == j) continue;
+    if (i == j || (band > 0 && std::abs(i - j) > band)) continue;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
         const double v = value(rng);
@@ -76,6 +78,28 @@ TEST(ChebyshevSmootherOperator, UpperBlocksInFloatReproduceTheRoundedProduct) {
   EXPECT_NEAR(y.dot(minus_ax), x.dot(minus_ay), 1e-12 * std::abs(y.dot(minus_ax)));
   // And the rounding is a small change of A.
   EXPECT_LE((minus_ax + A * x).norm(), 1e-6 * (A * x).norm());
+}
+
+// A banded pattern (the lattice levels' shape) splits into many chunks of
+// rows that run in parallel, two parities apart: the product is the
+// rounded one and has the same bits on one and on three threads.
+TEST(ChebyshevSmootherOperator, UpperProductByChunksIsTheSameOnAnyThreadCount) {
+  const int nodes = 6000;
+  const SpMat A = random_spd_block_matrix(nodes, 5, 37);
+  BlockMatrix M = block_pattern(A);
+  copy_block_values(A, 0.0, M, 1);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  VecX x(A.rows()), zero = VecX::Zero(A.rows());
+  for (Eigen::Index k = 0; k < x.size(); ++k) x[k] = value(rng);
+  VecX minus_ax[2];
+  for (int run = 0; run < 2; ++run) {
+    ChebyshevSmoother smoother;
+    ASSERT_TRUE(smoother.setup(M, 2, run == 0 ? 1 : 3, SmootherValues::single_upper));
+    smoother.residual(zero, x, minus_ax[run]);
+  }
+  EXPECT_EQ(0, std::memcmp(minus_ax[0].data(), minus_ax[1].data(), sizeof(double) * std::size_t(x.size())));
+  EXPECT_LE((minus_ax[0] + A * x).norm(), 1e-6 * (A * x).norm());
 }
 
 TEST(ChebyshevSmootherOperator, RefusesAPatternThatIsNotSymmetric) {
