@@ -6,7 +6,7 @@
 #   make -f Makefile.pipeline topopt-bar-check       the 8x2x2 bar of Table 3.1 (128x32x32 voxels)
 #   make -f Makefile.pipeline topopt-gripper-check   the gripper as a 32x16x2 plate (512x256x32 voxels)
 #   make -f Makefile.pipeline topopt-gripper-thesis-check   the gripper at the thesis's 64x32x8 cells
-#                                                    (1024x512x128 voxels, about 45 minutes, 20 GB)
+#                                                    (1024x512x128 voxels, design about 10 minutes, each check about 8, 19 GB)
 #   make -f Makefile.pipeline topopt-bridge-check    a 24x6x4 bridge (384x96x64 voxels)
 #   make -f Makefile.pipeline topopt-cantilever-check a 16x4x8 cantilever (256x64x128 voxels)
 #   make -f Makefile.pipeline topopt-checks          all four
@@ -81,7 +81,7 @@ endif
 CUBES_GAMUT := $(OUT)/gamut/cubic3d_bar_dense
 TWO_SCALE_SCENES := bar gripper3d bridge_cubic cantilever_cubic
 # Scenes built by the same rules but not part of topopt-checks (each check
-# of the thesis-resolution gripper solves 67 M voxels: about half an hour).
+# of the thesis-resolution gripper solves 67 M voxels: about 8 minutes on 2 cores).
 TWO_SCALE_LARGE_SCENES := gripper3d_thesis
 TWO_SCALE_ALL := $(TWO_SCALE_SCENES) $(TWO_SCALE_LARGE_SCENES)
 

@@ -256,7 +256,7 @@ Mat24 PeriodicGridMultigrid::coarse_element(std::size_t l, std::int64_t element,
 void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
   const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
   const Eigen::Index n = 3 * Eigen::Index(nx) * ny * nz;
-  const int hx = nx / 2, hy = ny / 2, half = hx * hy * (nz / 2);
+  const int hy = ny / 2, rows = hy * (nz / 2);
   const int B = field_.basis_size();
   y.resize(n);
   const int team = resolve_thread_count(options_.threads);
@@ -265,21 +265,30 @@ void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
   {
 #pragma omp for schedule(static)
     for (Eigen::Index k = 0; k < n; ++k) y[k] = 0.0;
-    for (int colour = 0; colour < 8; ++colour) {
+    // Voxels in natural order (x fastest), a row of the grid at a time:
+    // rows whose j or k parity differ share no node (the dimensions are
+    // even, so also across the periodic wrap), so each of the four colours
+    // runs its rows in parallel, and every entry sums its voxels in the
+    // same order for any thread count. (Single voxels coloured by parity
+    // swept the grid eight times; docs/solvers.md.)
+    for (int colour = 0; colour < 4; ++colour) {
+      const int cj = colour & 1, ck = colour >> 1;
 #pragma omp for schedule(static)
-      for (int t = 0; t < half; ++t) {
-        const int i = 2 * (t % hx) + corner_x(colour), j = 2 * ((t / hx) % hy) + corner_y(colour),
-                  k = 2 * (t / (hx * hy)) + corner_z(colour);
-        const int xs[2] = {i, i + 1 == nx ? 0 : i + 1}, ys[2] = {j, j + 1 == ny ? 0 : j + 1},
-                  zs[2] = {k, k + 1 == nz ? 0 : k + 1};
-        int corner[8];
-        for (int a = 0; a < 8; ++a) corner[a] = xs[corner_x(a)] + nx * (ys[corner_y(a)] + ny * zs[corner_z(a)]);
-        Eigen::Matrix<double, 24, 1> xe, ye = Eigen::Matrix<double, 24, 1>::Zero();
-        for (int a = 0; a < 8; ++a) xe.segment<3>(3 * a) = x.segment<3>(3 * Eigen::Index(corner[a]));
-        const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
-        for (int b = 0; b < B; ++b)
-          if (const double w = field_.weight(e, b); w != 0.0) product(field_.basis[b].data(), w, xe.data(), ye.data());
-        for (int a = 0; a < 8; ++a) y.segment<3>(3 * Eigen::Index(corner[a])) += ye.segment<3>(3 * a);
+      for (int t = 0; t < rows; ++t) {
+        const int j = 2 * (t % hy) + cj, k = 2 * (t / hy) + ck;
+        const int j1 = j + 1 == ny ? 0 : j + 1, k1 = k + 1 == nz ? 0 : k + 1;
+        for (int i = 0; i < nx; ++i) {
+          const int xs[2] = {i, i + 1 == nx ? 0 : i + 1}, ys[2] = {j, j1}, zs[2] = {k, k1};
+          int corner[8];
+          for (int a = 0; a < 8; ++a) corner[a] = xs[corner_x(a)] + nx * (ys[corner_y(a)] + ny * zs[corner_z(a)]);
+          Eigen::Matrix<double, 24, 1> xe, ye = Eigen::Matrix<double, 24, 1>::Zero();
+          for (int a = 0; a < 8; ++a) xe.segment<3>(3 * a) = x.segment<3>(3 * Eigen::Index(corner[a]));
+          const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
+          for (int b = 0; b < B; ++b)
+            if (const double w = field_.weight(e, b); w != 0.0)
+              product(field_.basis[b].data(), w, xe.data(), ye.data());
+          for (int a = 0; a < 8; ++a) y.segment<3>(3 * Eigen::Index(corner[a])) += ye.segment<3>(3 * a);
+        }
       }
     }
   }
