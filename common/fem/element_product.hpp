@@ -9,7 +9,8 @@
 // AVX2 and AVX-512 and picked at run time by what the CPU supports. Every
 // variant performs the same operations in the same order, a product then
 // a sum per entry and column (no fused multiply-add), so all of them give
-// the same bits, the same as Eigen's `ye += (w * xe[c]) * K.col(c)`.
+// the same bits, the same as Eigen's `ye += (w * xe[c]) * K.col(c)` in the
+// default build (a build for a CPU with FMA lets the compiler fuse Eigen's).
 #include <string>
 
 namespace msfab {

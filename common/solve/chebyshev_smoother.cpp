@@ -65,6 +65,9 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
   values_kind_ = values;
   std::vector<float>().swap(values_);
   std::vector<int>().swap(block_of_slot_);
+  std::vector<std::int64_t>().swap(first_upper_);
+  std::vector<int>().swap(chunk_start_);
+  VecX().swap(product_);
   if (values == SmootherValues::single) {
     values_.resize(A.values.size());
     chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
@@ -88,7 +91,9 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
     chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
       for (Eigen::Index i = begin; i < end; ++i)
         for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
-          const std::size_t block = std::size_t(block_of_slot_[std::size_t(slot)]);
+          // Row by row, as upper_product() reads them; the numbering only
+          // locates the source where A itself is held by its upper blocks.
+          const std::size_t block = std::size_t(first_upper_[std::size_t(i)] + (slot - A.diagonal[std::size_t(i)]));
           const double* source = A.values.data() + stored_block(held_by_upper ? &block_of_slot_ : nullptr, slot);
           for (int e = 0; e < 9; ++e) values_[9 * block + e] = static_cast<float>(source[e]);
         }

@@ -62,7 +62,9 @@ class ChebyshevSmoother {
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
   // (or from zero if zero_start, without reading x).
   void smooth(const VecX& b, VecX& x, bool zero_start);
-  // r = b - A x with the smoother's operator.
+  // r = b - A x with the smoother's operator. Not to be called on one
+  // smoother from two threads at once: with single_upper it forms A x in
+  // the smoother's workspace.
   void residual(const VecX& b, const VecX& x, VecX& r) const;
 
   double max_eigenvalue() const { return max_eigenvalue_; }

@@ -25,8 +25,10 @@ namespace {
 
 using namespace hex_lattice;
 
-// Element rows per band of the matrix-free product (multiply_rows).
-constexpr int kProductBandRows = 8;
+// Element rows per band of the matrix-free product (multiply_rows): 8, or
+// fewer on a grid of few rows, so that each colour still has several bands
+// (a function of the grid alone, so the order of the sums is too).
+int product_band_rows(int ny) { return std::clamp(ny / 8, 1, 8); }
 
 std::string dims_text(const int n[3]) {
   return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
@@ -495,14 +497,15 @@ void DirichletGridMultigrid::multiply_rows(const VecX& x, VecX& y) const {
     };
     // Elements in natural order (x fastest), so that neighbours share the
     // corners just read and the weights stream: by bands of
-    // kProductBandRows element rows of one layer. Bands that differ in the
+    // up to 8 element rows of one layer. Bands that differ in the
     // band's or the layer's parity share no node, so each of the four
     // colours runs its bands in parallel without conflicting additions,
     // and every entry sums its elements in the same order for any thread
     // count. (Colouring single elements by parity visited the grid eight
     // times, each time every other element: 1.4x slower on a printed
     // gripper, docs/solvers.md.)
-    const int bands = (ny + kProductBandRows - 1) / kProductBandRows;
+    const int band_rows = product_band_rows(ny);
+    const int bands = (ny + band_rows - 1) / band_rows;
     for (int colour = 0; colour < 4; ++colour) {
       const int cb = colour & 1, ck = colour >> 1;
       const int hb = (bands - cb + 1) / 2, hz = (nz - ck + 1) / 2;
@@ -510,8 +513,8 @@ void DirichletGridMultigrid::multiply_rows(const VecX& x, VecX& y) const {
 #pragma omp for schedule(static)
       for (int t = 0; t < count; ++t) {
         const int band = cb + 2 * (t % hb), k = ck + 2 * (t / hb);
-        const int j_end = std::min(ny, (band + 1) * kProductBandRows);
-        for (int j = band * kProductBandRows; j < j_end; ++j)
+        const int j_end = std::min(ny, (band + 1) * band_rows);
+        for (int j = band * band_rows; j < j_end; ++j)
           for (int i = 0; i < nx; ++i) add_element(i, j, k);
       }
     }

@@ -55,6 +55,7 @@ struct DirichletMultigridOptions {
   // on the gripper plate) and cost 40% more time; on SIMP fields it saved
   // at most a third of the iterations for the same time
   // (docs/BENCHMARKS.md, "The matrix-free product on wide vectors").
+  // Set here only: solver.mg_smoother_degree sets smoother_degree.
   int grid_smoother_degree = 1;
   int coarse_unknowns = 3000;  // the assembled hierarchy factors its first level with fewer unknowns
   int threads = 0;             // 0: the OpenMP default

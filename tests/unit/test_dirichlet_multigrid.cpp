@@ -85,7 +85,7 @@ TEST(DirichletMultigrid, ProductMatchesAssembledMatrix) {
 // several bands, the last one partial, with void, against the assembled
 // matrix, and the same bits on one and on three threads.
 TEST(DirichletMultigrid, ProductAcrossBandsMatchesAssembledMatrixOnAnyThreadCount) {
-  const int nx = 4, ny = 22, nz = 6;
+  const int nx = 20, ny = 22, nz = 14;  // above the rows where the product goes parallel
   const VoxelStiffnessField field = dirichlet_random_field(nx, ny, nz, 7, 0.3);
   VecX y[2];
   for (int run = 0; run < 2; ++run) {
@@ -93,6 +93,7 @@ TEST(DirichletMultigrid, ProductAcrossBandsMatchesAssembledMatrixOnAnyThreadCoun
     options.threads = run == 0 ? 1 : 3;
     DirichletGridMultigrid mg(nx, ny, nz, cantilever_mask(nx, ny, nz), options);
     mg.set_field(field);
+    ASSERT_GT(3 * mg.rows(), 3 * 4096);
     const SpMat A = mg.fine_operator();
     const VecX x = dirichlet_random_vector(A.rows(), 11);
     mg.multiply(x, y[run]);
