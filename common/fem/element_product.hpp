@@ -11,7 +11,10 @@
 // a sum per entry and column (no fused multiply-add), so all of them give
 // the same bits, the same as Eigen's `ye += (w * xe[c]) * K.col(c)` in the
 // default build (a build for a CPU with FMA lets the compiler fuse Eigen's).
+#include <cstdint>
 #include <string>
+
+#include "fem/voxel_stiffness_field.hpp"
 
 namespace msfab {
 
@@ -24,5 +27,13 @@ const char* element_product_kernel_name();
 // A named variant, for tests and benchmarks; nullptr where the CPU lacks it
 // or the name is unknown.
 ElementProductKernel element_product_kernel(const std::string& name);
+
+// y_e += K_v x_e for voxel v of `field`: its basis matrices with non-zero
+// weight, in basis order, by `kernel` (element_product_kernel()).
+inline void add_voxel_product(const VoxelStiffnessField& field, std::int64_t v, ElementProductKernel kernel,
+                              const double* x, double* y) {
+  for (int b = 0; b < field.basis_size(); ++b)
+    if (const double w = field.weight(v, b); w != 0.0) kernel(field.basis[std::size_t(b)].data(), w, x, y);
+}
 
 }  // namespace msfab

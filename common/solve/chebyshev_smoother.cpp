@@ -46,25 +46,22 @@ bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, Smo
   if (upper && values != SmootherValues::single_upper)
     throw std::logic_error(
         "ChebyshevSmoother: an operator held by its upper blocks needs SmootherValues::single_upper");
-  return setup_with(A, degree, threads, values, upper != nullptr, upper ? *upper : std::vector<int>());
+  return setup_with(A, degree, threads, values, upper);
 }
 
 bool ChebyshevSmoother::setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper) {
-  std::vector<int> numbering;
-  numbering.swap(upper);
-  if (setup_with(A, degree, threads, SmootherValues::single_upper, true, std::move(numbering))) return true;
-  upper.swap(block_of_slot_);  // a failed set-up leaves the numbering with the caller
-  return false;
+  if (!setup_with(A, degree, threads, SmootherValues::single_upper, &upper)) return false;
+  std::vector<int>().swap(upper);  // the products read the upper blocks row by row
+  return true;
 }
 
 bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values,
-                                   bool held_by_upper, std::vector<int> numbering) {
+                                   const std::vector<int>* held_by_upper) {
   pattern_ = &A;
   degree_ = degree;
   threads_ = threads;
   values_kind_ = values;
   std::vector<float>().swap(values_);
-  std::vector<int>().swap(block_of_slot_);
   std::vector<std::int64_t>().swap(first_upper_);
   std::vector<int>().swap(chunk_start_);
   VecX().swap(product_);
@@ -75,7 +72,9 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
         values_[k] = static_cast<float>(A.values[k]);
     });
   } else if (values == SmootherValues::single_upper) {
-    block_of_slot_ = numbering.empty() ? upper_block_numbering(A, threads) : std::move(numbering);
+    // The upper product needs every block's mirror; the numbering refuses
+    // a pattern that is not symmetric (std::logic_error).
+    if (!held_by_upper) upper_block_numbering(A, threads);
     values_.resize(9 * upper_block_count(A));
     first_upper_.assign(std::size_t(A.rows) + 1, 0);
     int reach = 1;
@@ -91,16 +90,16 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
     chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
       for (Eigen::Index i = begin; i < end; ++i)
         for (int slot = A.diagonal[std::size_t(i)]; slot < A.row_start[i + 1]; ++slot) {
-          // Row by row, as upper_product() reads them; the numbering only
+          // Row by row, as upper_product() reads them; a numbering only
           // locates the source where A itself is held by its upper blocks.
           const std::size_t block = std::size_t(first_upper_[std::size_t(i)] + (slot - A.diagonal[std::size_t(i)]));
-          const double* source = A.values.data() + stored_block(held_by_upper ? &block_of_slot_ : nullptr, slot);
+          const double* source = A.values.data() + stored_block(held_by_upper, slot);
           for (int e = 0; e < 9; ++e) values_[9 * block + e] = static_cast<float>(source[e]);
         }
     });
   }
   const auto diagonal_block = [&](Eigen::Index i) {
-    return A.values.data() + stored_block(held_by_upper ? &block_of_slot_ : nullptr, A.diagonal[std::size_t(i)]);
+    return A.values.data() + stored_block(held_by_upper, A.diagonal[std::size_t(i)]);
   };
   diagonal_.resize(9 * std::size_t(A.rows));
   chunked_for(A.rows, threads, [&](Eigen::Index begin, Eigen::Index end) {
@@ -111,9 +110,7 @@ bool ChebyshevSmoother::setup_with(const BlockMatrix& A, int degree, int threads
       A.rows, diagonal_.data(), inverse_.data(), [&](int i, const double* x, double out[3]) { row_product(i, x, out); },
       [&](const VecX& x) { before_pass(x); }, threads);
   std::vector<double>().swap(diagonal_);  // the smoothing uses the inverses only
-  if (!(std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0)) return false;
-  std::vector<int>().swap(block_of_slot_);  // the products read the upper blocks row by row
-  return true;
+  return std::isfinite(max_eigenvalue_) && max_eigenvalue_ > 0.0;
 }
 
 void ChebyshevSmoother::residual(const VecX& b, const VecX& x, VecX& r) const {

@@ -53,10 +53,10 @@ class ChebyshevSmoother {
   // block is not positive definite.
   bool setup(const BlockMatrix& A, int degree, int threads, SmootherValues values = SmootherValues::single,
              const std::vector<int>* upper = nullptr);
-  // The same for A held by its upper blocks (single_upper), taking over the
-  // numbering `upper` instead of copying it: on a large level the numbering
-  // is a fifth of the single values, and the copy would meet them at
-  // set-up's peak. `upper` is left empty, or as it was where set-up fails.
+  // The same for A held by its upper blocks (single_upper), releasing the
+  // numbering `upper` once set up (the products do not need it): on a large
+  // level it is a fifth of the single values. `upper` is left empty, or as
+  // it was where set-up fails.
   bool setup(const BlockMatrix& A, int degree, int threads, std::vector<int>&& upper);
 
   // `degree` steps of the Chebyshev iteration for A x = b, starting from x
@@ -94,20 +94,17 @@ class ChebyshevSmoother {
   // parallel, then the odd ones, and every entry sums its terms in an
   // order fixed by the pattern, whatever the thread count.
   void upper_product(const VecX& x) const;
-  // setup() with the numbering in hand (empty: computed here where
-  // single_upper needs it); `held_by_upper`: A's values are A's upper
-  // blocks in that numbering.
-  bool setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values, bool held_by_upper,
-                  std::vector<int> numbering);
+  // setup(); `held_by_upper` (or null): A's values are A's upper blocks in
+  // that numbering.
+  bool setup_with(const BlockMatrix& A, int degree, int threads, SmootherValues values,
+                  const std::vector<int>* held_by_upper);
   const BlockMatrix* pattern_ = nullptr;
   SmootherValues values_kind_ = SmootherValues::single;
   // single: A's values in single precision, laid out like A.values.
   // single_upper: A's blocks on and above the diagonal (9 each, row-major,
   // row by row), the first of each row, the chunks' first rows, and the
-  // product's workspace. (The numbering of every slot is needed only while
-  // the values are copied, and released after.)
+  // product's workspace.
   std::vector<float> values_;
-  std::vector<int> block_of_slot_;
   std::vector<std::int64_t> first_upper_;
   std::vector<int> chunk_start_;
   mutable VecX product_;

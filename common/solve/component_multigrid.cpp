@@ -246,7 +246,7 @@ bool ComponentMultigrid::factorize() {
     // A level too large to keep in double is held by the smoother's upper
     // blocks in single precision; set-up refills the double values.
     const bool large = level.matrix.num_blocks() > upper_level_blocks_;
-    // An upper-held level hands its numbering over to the smoother.
+    // An upper-held level's numbering is released once its smoother is set up.
     const bool set = upper ? level.smoother.setup(level.matrix, degree, threads_, std::move(level.upper))
                            : level.smoother.setup(level.matrix, degree, threads_,
                                                   large ? SmootherValues::single_upper : SmootherValues::single);

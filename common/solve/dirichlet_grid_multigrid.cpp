@@ -491,8 +491,7 @@ void DirichletGridMultigrid::multiply_rows(const VecX& x, VecX& y) const {
           for (int d = 0; d < 3; ++d)
             if (m >> d & 1) xe[3 * a + d] = 0.0;
       }
-      for (int b = 0; b < B; ++b)
-        if (const double w = field_.weight(e, b); w != 0.0) product(field_.basis[b].data(), w, xe.data(), ye.data());
+      add_voxel_product(field_, e, product, xe.data(), ye.data());
       for (int a = 0; a < 8; ++a) y.segment<3>(3 * corner[a]) += ye.segment<3>(3 * a);
     };
     // Elements in natural order (x fastest), so that neighbours share the

@@ -257,7 +257,6 @@ void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
   const int nx = field_.nx, ny = field_.ny, nz = field_.nz;
   const Eigen::Index n = 3 * Eigen::Index(nx) * ny * nz;
   const int hy = ny / 2, rows = hy * (nz / 2);
-  const int B = field_.basis_size();
   y.resize(n);
   const int team = resolve_thread_count(options_.threads);
   const ElementProductKernel product = element_product_kernel();
@@ -284,9 +283,7 @@ void PeriodicGridMultigrid::multiply(const VecX& x, VecX& y) const {
           Eigen::Matrix<double, 24, 1> xe, ye = Eigen::Matrix<double, 24, 1>::Zero();
           for (int a = 0; a < 8; ++a) xe.segment<3>(3 * a) = x.segment<3>(3 * Eigen::Index(corner[a]));
           const std::int64_t e = i + std::int64_t(nx) * (j + std::int64_t(ny) * k);
-          for (int b = 0; b < B; ++b)
-            if (const double w = field_.weight(e, b); w != 0.0)
-              product(field_.basis[b].data(), w, xe.data(), ye.data());
+          add_voxel_product(field_, e, product, xe.data(), ye.data());
           for (int a = 0; a < 8; ++a) y.segment<3>(3 * Eigen::Index(corner[a])) += ye.segment<3>(3 * a);
         }
       }
