@@ -24,37 +24,80 @@ const CoarseMaterialFit* database_fit(const CoarseDatabase& db, const std::vecto
   return level == 2 ? find_level2_fit(db, combinations, ids) : db.find(ids);
 }
 
+// What deciding one cell's (or block's) materials found. Per cell, so that
+// cells can be decided in parallel and counted afterwards.
+struct CellOutcome {
+  bool unresolved = false;  // the window gave no stiffness: the cell's own C^H was used
+  bool checked = false;     // a solid mixed cell whose fit was checked
+  bool replaced = false;    // ... and coarsened by the matched model instead
+};
+
 // The database's lookup, except where a solid mixed block's fit has a
 // response to uniform strains farther than `tolerance` from the block's own
 // C^H: there the matched model, which has that C^H by construction. The fit
 // comes from a representative (compression, the level-2 pairing stages), so
 // its stiffness can sit elsewhere in the block than the block's own; C^H is
 // computed from the block itself.
+QuadratureMaterials checked_block(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
+                                  const std::vector<ChildIds>& combos, int level, double tolerance, bool enhanced,
+                                  const CoarseMaterialLookup& database, const ChildIds& ids, CellOutcome& outcome) {
+  const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
+  if (!fit) return database(ids);
+  const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
+  if (!solid_mixed_block(voxels)) return database(ids);
+  outcome.checked = true;
+  const int n = level == 2 ? 4 : 2;
+  const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
+  if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
+  outcome.replaced = true;
+  return matched_block_materials(palette, voxels, n, enhanced, &CH);
+}
+
 CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
                                     const CoarseGrid& level1, int level, double tolerance, bool enhanced,
                                     CoarseMaterialLookup database, CoarsenedVoxels* counts) {
   return
       [&db, palette, combos = level1.combinations, level, tolerance, enhanced, database, counts](const ChildIds& ids) {
-        const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
-        if (!fit) return database(ids);
-        const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
-        if (!solid_mixed_block(voxels)) return database(ids);
-        if (counts) ++counts->checked_blocks;
-        const int n = level == 2 ? 4 : 2;
-        const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
-        if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
-        if (counts) ++counts->replaced_blocks;
-        return matched_block_materials(palette, voxels, n, enhanced, &CH);
+        CellOutcome outcome;
+        QuadratureMaterials m = checked_block(db, palette, combos, level, tolerance, enhanced, database, ids, outcome);
+        if (counts) {
+          counts->checked_blocks += outcome.checked;
+          counts->replaced_blocks += outcome.replaced;
+        }
+        return m;
       };
 }
 
-// What deciding one cell's materials found. Per cell, so that cells can be
-// decided in parallel and counted afterwards.
-struct CellOutcome {
-  bool unresolved = false;  // the window gave no stiffness: the cell's own C^H was used
-  bool checked = false;     // a solid mixed cell whose fit was checked
-  bool replaced = false;    // ... and coarsened by the matched model instead
-};
+// The checked lookup's materials for every distinct block of `grid`, in
+// parallel: each block's materials depend on the block alone (its periodic
+// homogenization and matched model are most of a checked coarsening's
+// time). `database` must be safe to call from several threads (the plain
+// database lookup and its fallbacks are). Counts are summed per block.
+std::vector<QuadratureMaterials> checked_blocks_in_parallel(
+    const CoarseDatabase& db, const std::vector<MaterialPtr>& palette, const CoarseGrid& level1, const CoarseGrid& grid,
+    int level, double tolerance, bool enhanced, const CoarseMaterialLookup& database, CoarsenedVoxels& counts) {
+  const int count = static_cast<int>(grid.combinations.size());
+  std::vector<CellOutcome> outcome(count);
+  std::vector<QuadratureMaterials> materials(count);
+  std::vector<std::exception_ptr> failure(count);
+#pragma omp parallel for schedule(dynamic)
+  for (int c = 0; c < count; ++c) {
+    try {
+      materials[c] = checked_block(db, palette, level1.combinations, level, tolerance, enhanced, database,
+                                   grid.combinations[c], outcome[c]);
+    } catch (...) {
+      failure[c] = std::current_exception();
+    }
+  }
+  for (int c = 0; c < count; ++c) {
+    // The first block's failure in block order, whatever the threads.
+    if (failure[c]) std::rethrow_exception(failure[c]);
+    counts.checked_blocks += outcome[c].checked;
+    counts.replaced_blocks += outcome[c].replaced;
+  }
+  return materials;
+}
+
 using CellMaterials = std::function<QuadratureMaterials(int cell, CellOutcome& outcome)>;
 
 // The coarse mesh of `cells` (one combination per solid cell, as
@@ -245,6 +288,19 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
         },
         enhanced, &m.stats, &m);
     m.grid = cells;
+  } else if (request.material == "ddfem" && request.check_tolerance > 0) {
+    m.fallback = request.fallback;
+    m.check_tolerance = request.check_tolerance;
+    for (const ChildIds& c : m.grid.combinations)
+      m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
+    CoarsenedVoxels unchecked = m;
+    unchecked.check_tolerance = 0;
+    const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
+    const std::vector<QuadratureMaterials> materials =
+        checked_blocks_in_parallel(*m.database, palette, m.level1, m.grid, request.level, request.check_tolerance,
+                                   m.element == "enhanced", lookup, m);
+    m.mesh = build_coarse_mesh(m.grid, IndexedMaterialLookup([&](int c) { return materials[c]; }), 0, &m.stats,
+                               m.element == "enhanced");
   } else {
     CoarseMaterialLookup lookup;
     if (request.material != "ddfem") {

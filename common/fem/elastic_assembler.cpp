@@ -8,7 +8,7 @@ namespace msfab {
 
 ElasticAssembler::ElasticAssembler(const HexMesh& mesh) : mesh_(mesh) {
   for (const auto& geo : mesh.geometries)
-    if (geo.has_enhanced_modes()) bubbles_.assign(mesh.num_elements(), Mat3::Zero());
+    if (geo.has_enhanced_modes()) bubbles_.assign(mesh.num_elements(), BubbleState{});
   const int n = mesh.num_nodes();
   std::vector<std::vector<int>> adjacent(n);
   for (const auto& el : mesh.elements)
@@ -156,7 +156,11 @@ double ElasticAssembler::evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hes
     {
       Vec24 ge;
       Mat24 Ke;
-#pragma omp for schedule(static)
+      // Dynamic: elements with bubble modes differ in cost (their
+      // condensations take 0 to several Newton steps), and a colour of a
+      // coarse mesh holds few of them. Each element writes only its own
+      // entries, so the schedule changes no result.
+#pragma omp for schedule(dynamic, 16)
       for (int c = 0; c < nc; ++c) {
         const int e = color[c];
         const auto& geo = mesh_.geometries[mesh_.element_geometry[e]];

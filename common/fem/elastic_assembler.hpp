@@ -78,10 +78,10 @@ class ElasticAssembler {
   SpMat dof_map_, dof_map_t_, reduced_pattern_;
   std::vector<int> reduce_from_, reduce_to_;
   std::vector<double> reduce_weight_;
-  // Per element: the bubble amplitudes of its last evaluation (empty when
-  // no element has bubble modes). A cache: it changes no result beyond
-  // round-off, only the cost.
-  mutable std::vector<Mat3> bubbles_;
+  // Per element: its bubble state (hex_element.hpp; empty when no element
+  // has bubble modes). A cache: it changes no result beyond the
+  // condensation's tolerance, only the cost.
+  mutable std::vector<BubbleState> bubbles_;
 };
 
 }  // namespace msfab

@@ -115,44 +115,73 @@ Eigen::LDLT<Mat9> definite_factor(const Mat9& K) {
   return f;
 }
 
+// Below this Newton step (relative to the element's size) the bubbles'
+// problem is in Newton's quadratic regime and the energy decrease a step
+// brings, ~(step / h)^2 of the energy scale, is below the energy's own
+// round-off: full steps are taken without a line search.
+constexpr double kRoundOffStep = 1e-7;
+// Amplitudes are converged when the step is this small against the
+// element's size: ~1e3 above the round-off of the amplitudes themselves
+// (eps times h), and their energy error ~1e-26 of the energy scale.
+constexpr double kConvergedStep = 1e-13;
+
 // The bubble amplitudes that minimize the element energy at nodal
-// positions x: Newton with backtracking from the amplitudes A passed in
-// (from A = 0 if the element is inverted there). Stops when the residual
-// has fallen 1e-12 of its start or the Newton decrement (the decrease a
-// full step predicts) is below 1e-14 of the energy. The second test is the
-// one that usually ends it: below it the line search compares energies
-// that differ by their round-off and backtracked 40 times before giving up
-// (measured: 7 iterations per condensation on the sole scene, 4.5 with the
-// test, 2.8 with warm starts); it also means the same from a warm start
-// that begins near the minimum. The gradient error it leaves is of the
-// order of the decrement (the condensed gradient is corrected to first
-// order in r_A), the energy's below 1e-14 of itself. Returns false if the
-// element is inverted at A = 0.
+// positions x: Newton from the amplitudes A passed in (from A = 0 if the
+// element is inverted there). It stops when the residual has fallen 1e-12
+// of its start, the Newton decrement (the decrease a full step predicts) is
+// below 1e-14 of the energy, or the step is below kConvergedStep of the
+// element's size. Steps above kRoundOffStep are backtracked on the energy;
+// smaller ones are taken whole, since there the energies compared differ by
+// their round-off (the line search then halved 30-40 times before giving
+// up: on the fibre bar at level 1, 28% of the condensations did, and the
+// energy evaluations of those stalls were 90% of the element's work). Each
+// accepted trial's terms are those of the next iteration. The gradient error
+// left is second order in the last step (the condensed gradient is corrected
+// to first order in r_A). Returns false if the element is inverted at A = 0.
 bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
-                      Mat3& A, double& energy) {
+                      Mat3& A, double& energy, int* evaluations = nullptr) {
+  int count = 1;
+  struct Count {
+    int& count;
+    int* out;
+    ~Count() {
+      if (out) *out = count;
+    }
+  } report{count, evaluations};
   EnhancedTerms t;
   t.coupling = false;
   energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
   if (!std::isfinite(energy) && !A.isZero(0.0)) {
     A.setZero();
     energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+    ++count;
   }
   if (!std::isfinite(energy)) return false;
+  double volume = 0;
+  for (double w : geo.weight) volume += w;
+  const double size = std::cbrt(volume);
   const double r0 = t.r_A.norm();
+  EnhancedTerms trial_terms;
+  trial_terms.coupling = false;
   for (int it = 0; it < 30 && t.r_A.norm() > 1e-12 * r0; ++it) {
     const Vec9 step = -definite_factor(t.K_AA).solve(t.r_A);
     const double slope = t.r_A.dot(step);
     if (-slope <= 1e-14 * std::abs(energy)) break;
+    const double step_size = step.cwiseAbs().maxCoeff();
+    if (step_size <= kConvergedStep * size) break;
+    const bool whole = step_size <= kRoundOffStep * size;
     double s = 1.0, trial = kInfiniteEnergy;
     Mat3 B;
     for (int k = 0; k < 40; ++k, s *= 0.5) {
       B = A + s * Eigen::Map<const Mat3>(step.data());
-      trial = evaluate_with(geo, mat, x, B, nullptr, nullptr, nullptr);
-      if (std::isfinite(trial) && trial <= energy + 1e-4 * s * slope) break;
+      trial = evaluate_with(geo, mat, x, B, nullptr, nullptr, &trial_terms);
+      ++count;
+      if (std::isfinite(trial) && (whole || trial <= energy + 1e-4 * s * slope)) break;
     }
-    if (!(std::isfinite(trial) && trial <= energy)) break;  // round-off: no decrease left
+    if (!(std::isfinite(trial) && (whole || trial <= energy))) break;  // round-off: no decrease left
     A = B;
-    energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+    energy = trial;
+    std::swap(t, trial_terms);
   }
   return true;
 }
@@ -174,12 +203,32 @@ double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& m
 }
 
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
-                    Vec24* gradient, Mat24* hessian, Mat3* bubbles) {
+                    Vec24* gradient, Mat24* hessian, BubbleState* bubbles) {
   if (!geo.has_enhanced_modes()) return evaluate_with(geo, mat, x, Mat3::Zero(), gradient, hessian, nullptr);
-  Mat3 A = bubbles ? *bubbles : Mat3::Zero();
-  double energy;
-  if (!condense_bubbles(geo, mat, x, A, energy)) return kInfiniteEnergy;
-  if (bubbles) *bubbles = A;
+  Mat3 A = Mat3::Zero();
+  double energy = 0;
+  // Where the amplitudes were condensed at these very positions (a Newton
+  // iteration's assembly after its line search accepted them) they are
+  // reused; elsewhere the condensation starts from their first-order
+  // prediction, which Newton finishes in about one step.
+  const bool reuse = bubbles && bubbles->condensed && bubbles->at == x;
+  if (reuse) {
+    A = bubbles->A;
+    energy = bubbles->energy;
+    bubbles->evaluations = 0;
+  } else {
+    if (bubbles) A = bubbles->has_model ? bubbles->predicted(x) : bubbles->A;
+    if (!condense_bubbles(geo, mat, x, A, energy, bubbles ? &bubbles->evaluations : nullptr)) {
+      if (bubbles) bubbles->condensed = false;
+      return kInfiniteEnergy;
+    }
+    if (bubbles) {
+      bubbles->A = A;
+      bubbles->at = x;
+      bubbles->energy = energy;
+      bubbles->condensed = true;
+    }
+  }
   if (!gradient && !hessian) return energy;
   EnhancedTerms t;
   energy = evaluate_with(geo, mat, x, A, gradient, hessian, &t);
@@ -187,9 +236,24 @@ double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials&
   // (r_A ~ 0 at the minimum) and d2E/dx2 = K_xx - K_xA K_AA^-1 K_Ax.
   const Eigen::LDLT<Mat9> K_AA = definite_factor(t.K_AA);
   const Mat24x9 coupling = t.K_Au.transpose();
+  const Mat9x24 sensitivity = K_AA.solve(t.K_Au);  // -dA/dx at the minimum
   if (gradient) gradient->noalias() -= coupling * K_AA.solve(t.r_A);
-  if (hessian) hessian->noalias() -= coupling * K_AA.solve(t.K_Au);
+  if (hessian) hessian->noalias() -= coupling * sensitivity;
+  if (bubbles) {
+    bubbles->sensitivity = sensitivity;
+    bubbles->model_A = A;
+    bubbles->model_at = x;
+    bubbles->has_model = true;
+  }
   return energy;
+}
+
+Mat3 BubbleState::predicted(const hex8::NodeMatrix& x) const {
+  Vec24 dx;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a) dx[3 * i + a] = x(i, a) - model_at(i, a);
+  const Vec9 dA = -sensitivity * dx;
+  return model_A + Eigen::Map<const Mat3>(dA.data());
 }
 
 bool hex_condensed_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,

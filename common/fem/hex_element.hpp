@@ -29,18 +29,41 @@ struct QuadratureMaterials {
 // as soon as one quadrature point is inverted.
 double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x);
 
+// What an element with bubble modes keeps between evaluations (one per
+// element of a mesh; ElasticAssembler holds them). Its state changes only
+// the cost of an evaluation, not its result beyond the condensation's
+// tolerance (below 1e-14 of the energy; hex_element.cpp).
+struct BubbleState {
+  // The minimizing amplitudes at the positions of the last condensation,
+  // and the energy there.
+  Mat3 A = Mat3::Zero();
+  hex8::NodeMatrix at;
+  double energy = 0;
+  bool condensed = false;
+  int evaluations = 0;  // of the element's terms in the last condensation (0: reused)
+  // From the last evaluation with a gradient: the amplitudes there and their
+  // derivative in the positions (dA/dx = -sensitivity, node-major columns),
+  // so that a later condensation nearby starts from
+  // model_A - sensitivity (x - model_at), second-order close to its minimum.
+  Eigen::Matrix<double, 9, 24> sensitivity;
+  Mat3 model_A;
+  hex8::NodeMatrix model_at;
+  bool has_model = false;
+  Mat3 predicted(const hex8::NodeMatrix& x) const;
+};
+
 // Energy, gradient (24, node-major: 3*i + a) and Hessian (24x24) in one pass;
 // pass nullptr for what is not needed. Returns the energy (+inf if inverted,
 // in which case gradient and Hessian are not meaningful).
 //
-// For an element with bubble modes, `bubbles` (optional) is a warm start:
-// the condensation begins at *bubbles (at 0 if the element is inverted
-// there) and leaves the minimizing amplitudes in it. Between nearby
-// evaluations this saves about 40% of the bubbles' Newton iterations; the
-// energy differs from a cold start by less than 1e-14 of itself
-// (hex_element.cpp).
+// For an element with bubble modes, `bubbles` (optional) is the element's
+// state: the condensation at positions it last condensed at is reused, and
+// elsewhere starts from the state's prediction (at 0 if the element is
+// inverted there); the state is then updated. A Newton iteration (one
+// gradient evaluation and a line search along its step) then condenses in
+// about one bubble Newton step per evaluation instead of three to six.
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
-                    Vec24* gradient, Mat24* hessian, Mat3* bubbles = nullptr);
+                    Vec24* gradient, Mat24* hessian, BubbleState* bubbles = nullptr);
 
 // For an element with bubble modes (geo.has_enhanced_modes()): the 3 x 3
 // amplitudes A (row i: displacement component i, column k: bubble

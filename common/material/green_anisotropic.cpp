@@ -56,9 +56,16 @@ void GreenAnisotropic::evaluate(const Mat3& F, double* psi, Mat3* P, Mat9* dPdF)
   if (P) *P = F * S;
   if (dPdF) {
     // dP = dF S + F dS, dS = voigt_to_stress(C de), de = strain_to_voigt(F^T dF).
+    // Coefficient-based (lazy) products: a chain of these sizes would go
+    // through Eigen's general matrix product, whose packing cost 70% of this
+    // Hessian (the matched DDFEM materials evaluate it at every point).
     static const Eigen::Matrix<double, 9, 6> T = stress_unflattening();
     static const Eigen::Matrix<double, 6, 9> B = voigt_strain_operator();
-    *dPdF = right_product(S) + left_product(F) * T * C_ * B * left_product(F.transpose());
+    const Eigen::Matrix<double, 6, 9> strain_of_dF = B.lazyProduct(left_product(F.transpose()));
+    const Eigen::Matrix<double, 9, 6> stress_to_dP = left_product(F).lazyProduct(T);
+    const Eigen::Matrix<double, 6, 9> dS = C_.lazyProduct(strain_of_dF);
+    *dPdF = right_product(S);
+    dPdF->noalias() += stress_to_dP.lazyProduct(dS);
   }
 }
 

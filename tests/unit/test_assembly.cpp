@@ -272,3 +272,101 @@ TEST(VoxelMesh, OnlySolidVoxelsBecomeElementsWithSharedNodes) {
   g.at(0, 0, 0) = 5;  // not in the palette
   EXPECT_ANY_THROW(build_voxel_mesh(g, two_material_palette()));
 }
+
+namespace {
+
+// A non-parallelepiped element with a different material at each of its
+// 4 x 4 x 4 points (as a level-2 DDFEM element) and a random deformation.
+struct EnhancedCase {
+  hex8::NodeMatrix X, x;
+  hex8::ElementGeometry geo;
+  QuadratureMaterials mat;
+};
+EnhancedCase enhanced_case(double amplitude) {
+  EnhancedCase c;
+  for (int i = 0; i < 8; ++i) c.X.row(i) = 0.5 * (hex8::natural_node(i).transpose() + Eigen::RowVector3d::Ones());
+  c.X(7, 0) += 0.1;
+  c.geo = hex8::enhanced_element_geometry(c.X, hex8::gauss_rule(4));
+  for (int q = 0; q < c.geo.size(); ++q)
+    c.mat.at_point.push_back(std::make_shared<NeoHookean>(1e3 * (1 + q % 5), 0.45));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  c.x = c.X;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a) c.x(i, a) += u(rng);
+  return c;
+}
+
+}  // namespace
+
+TEST(EnhancedElement, KeptStateGivesTheColdResultsAndPredictsTheBubblesToSecondOrder) {
+  const EnhancedCase c = enhanced_case(0.06);
+  Vec24 g_cold, g;
+  Mat24 K_cold, K;
+  const double e_cold = hex_evaluate(c.geo, c.mat, c.x, &g_cold, &K_cold);
+  BubbleState state;
+  const double e = hex_evaluate(c.geo, c.mat, c.x, &g, &K, &state);
+  EXPECT_NEAR(e, e_cold, 1e-13 * e_cold);
+  EXPECT_LT((g - g_cold).norm(), 1e-10 * g_cold.norm());
+  EXPECT_LT((K - K_cold).norm(), 1e-10 * K_cold.norm());
+  ASSERT_TRUE(state.has_model);
+
+  // Along a direction, the prediction's error falls with the square of the
+  // distance (the held amplitudes' with the distance itself).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  hex8::NodeMatrix d;
+  for (int i = 0; i < 8; ++i)
+    for (int a = 0; a < 3; ++a) d(i, a) = u(rng);
+  double previous_error = 0;
+  for (double s : {1e-2, 1e-3}) {
+    const hex8::NodeMatrix xs = c.x + s * d;
+    Mat3 exact;
+    ASSERT_TRUE(hex_condensed_bubbles(c.geo, c.mat, xs, exact));
+    const double predicted_error = (state.predicted(xs) - exact).norm();
+    const double held_error = (state.model_A - exact).norm();
+    EXPECT_LT(predicted_error, 0.05 * held_error) << "step " << s;
+    if (previous_error > 0) {
+      EXPECT_LT(predicted_error, 0.03 * previous_error);
+    }
+    previous_error = predicted_error;
+  }
+  // An energy evaluation nearby starts from the prediction and needs at
+  // most two Newton steps; it equals the cold one.
+  const hex8::NodeMatrix near = c.x + 1e-3 * d;
+  BubbleState kept = state;
+  const double e_near = hex_evaluate(c.geo, c.mat, near, nullptr, nullptr, &kept);
+  EXPECT_NEAR(e_near, hex_energy(c.geo, c.mat, near), 1e-13 * e_near);
+  EXPECT_LE(kept.evaluations, 3);
+  // At the positions it last condensed at, the state is reused as it is.
+  Vec24 g_near, g_near_cold;
+  hex_evaluate(c.geo, c.mat, near, &g_near, nullptr, &kept);
+  EXPECT_EQ(kept.evaluations, 0);
+  hex_evaluate(c.geo, c.mat, near, &g_near_cold, nullptr);
+  EXPECT_LT((g_near - g_near_cold).norm(), 1e-10 * g_near_cold.norm());
+}
+
+TEST(EnhancedElement, CondensationAtSmallStrainsEndsInsteadOfBacktrackingInRoundOff) {
+  // At strains of 1e-6 to 1e-10 the bubbles' last Newton steps change F by
+  // less than its round-off, so the energies a line search compares are
+  // equal or noise; it halved such steps 40 times per iteration (360-380
+  // evaluations for one condensation before the round-off rule).
+  for (double amplitude : {1e-6, 1e-8, 1e-10}) {
+    const EnhancedCase c = enhanced_case(amplitude);
+    BubbleState state;
+    EXPECT_TRUE(std::isfinite(hex_evaluate(c.geo, c.mat, c.x, nullptr, nullptr, &state)));
+    EXPECT_LE(state.evaluations, 4) << "cold, strain " << amplitude;
+    hex8::NodeMatrix moved = c.x;
+    moved(3, 1) += 1e-3 * amplitude;
+    hex_evaluate(c.geo, c.mat, moved, nullptr, nullptr, &state);
+    EXPECT_LE(state.evaluations, 4) << "warm, strain " << amplitude;
+    // The amplitudes are the linear problem's: a deformation twice as large
+    // gives twice the amplitudes.
+    const hex8::NodeMatrix doubled = c.X + 2 * (c.x - c.X);
+    Mat3 A1, A2;
+    ASSERT_TRUE(hex_condensed_bubbles(c.geo, c.mat, c.x, A1));
+    ASSERT_TRUE(hex_condensed_bubbles(c.geo, c.mat, doubled, A2));
+    EXPECT_GT(A1.norm(), 0);
+    EXPECT_LT((A2 - 2 * A1).norm(), 1e-4 * A2.norm()) << "strain " << amplitude;
+  }
+}
