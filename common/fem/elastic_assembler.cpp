@@ -156,11 +156,10 @@ double ElasticAssembler::evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hes
     {
       Vec24 ge;
       Mat24 Ke;
-      // Dynamic: elements with bubble modes differ in cost (their
-      // condensations take 0 to several Newton steps), and a colour of a
-      // coarse mesh holds few of them. Each element writes only its own
-      // entries, so the schedule changes no result.
-#pragma omp for schedule(dynamic, 16)
+      // Static: a dynamic or guided schedule was measured slower on every
+      // mesh tried, coarse meshes with bubbles included (neighbouring
+      // elements' entries then change threads and their cache lines bounce).
+#pragma omp for schedule(static)
       for (int c = 0; c < nc; ++c) {
         const int e = color[c];
         const auto& geo = mesh_.geometries[mesh_.element_geometry[e]];
