@@ -246,16 +246,11 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
     }
   }
   spdlog::debug("newton_step_from: {} found the tangent indefinite in {:.3f} s", solver_name, seconds_since(t0));
-  // Not positive definite: the exact step where a direct factorization fits.
-  if (n <= options.largest_indefinite_direct_step) {
-    step = indefinite_direct_solve(K, rhs, diag, static_linear_options(assembler, "cholmod", options));
-    if (step.size() == 0)
-      return {VecX(),
-              "the indefinite tangent could not be solved (MINRES stalled, L D L^T met a zero pivot or lost "
-              "accuracy)"};
-    return {std::move(step), "", 0.0, true};
-  }
-  // Larger, on a voxel lattice: MINRES preconditioned by the multigrid.
+  // Not positive definite: the exact step. On a voxel lattice first MINRES
+  // preconditioned by the multigrid (the ten adaptive scenes' fine
+  // tangents: 0.09 s against 0.35 s for the shifted factorization on
+  // bridge_arch's 24 k unknowns, the same step); where it stalls, or the
+  // static solver is CHOLMOD, the direct solve where a factorization fits.
   if (solver_name == "pcg-mg") {
     step = indefinite_multigrid_solve(K, rhs, diag, static_linear_options(assembler, solver_name, options));
     if (step.size() > 0) {
@@ -264,6 +259,14 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
         if (dirichlet.fixed[i]) step[i] = gap[i];
       return {std::move(step), "", 0.0, true};
     }
+  }
+  if (n <= options.largest_indefinite_direct_step) {
+    step = indefinite_direct_solve(K, rhs, diag, static_linear_options(assembler, "cholmod", options));
+    if (step.size() == 0)
+      return {VecX(),
+              "the indefinite tangent could not be solved (MINRES stalled, L D L^T met a zero pivot or lost "
+              "accuracy)"};
+    return {std::move(step), "", 0.0, true};
   }
   // Otherwise regularized as the solver's own Newton steps are.
   const RegularizedStep regularized = constrained_newton_step(*solver, K, diag, dirichlet.fixed, g, gap, gap_norm, Kgap,

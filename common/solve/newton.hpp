@@ -39,7 +39,8 @@ struct NewtonOptions {
   int auto_iterative_dofs = 4000;  // measured crossover, docs/solvers.md
   // newton_step_from at an indefinite tangent: the most unknowns it factors
   // directly (CHOLMOD; about 70 k elements of a 3D mesh, a factor of about
-  // 3 GB). Above, with pcg-mg, MINRES preconditioned by the multigrid.
+  // 3 GB). With pcg-mg it first runs MINRES preconditioned by the multigrid
+  // and factors only where that fails.
   int largest_indefinite_direct_step = 200000;
   LinearSolverOptions linear;
   // Called after each converged load increment with the load factor reached.
