@@ -9,7 +9,9 @@
 # DATABASE: a level-1 coarse_db of the scenes' palette (E = 1e5, 1e6, 1e7,
 # nu = 0.45), e.g. from `make -f Makefile.pipeline ddfem-db-level1`;
 # DATABASE2 (environment, optional): a level-2 coarse_db of the same palette
-# (`ddfem-db-level2`), without it level 2 has only the baselines. BENCH_SECTION
+# (`ddfem-db-level2`), without it level 2 has only the baselines. DDFEM_ARGS
+# (environment, optional): more msfab-simulate arguments of the DDFEM runs
+# (e.g. "--coarse-fallback galerkin --coarse-check 0.1"). BENCH_SECTION
 # (environment, default ddfem) names the section of BENCHMARKS.md written. A run that
 # does not converge within BENCH_RUN_LIMIT seconds (default 900) is "failed".
 set -euo pipefail
@@ -17,6 +19,7 @@ BIN=$1 OUTDIR=$2 DOC=$3 DB=$4
 shift 4
 SCENES=("$@")
 DB2=${DATABASE2:-}
+read -r -a DDFEM_ARG_LIST <<< "${DDFEM_ARGS:-}"
 [ ${#SCENES[@]} -gt 0 ] || SCENES=(pushing bending bending_uniform twisting buckling fibers bridge bridge_arch layers1 checker random3 skeleton sole holes3)
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$OUTDIR"
@@ -50,7 +53,10 @@ for scene in "${SCENES[@]}"; do
       if [ "$m" = ddfem ] && [ -z "$db" ]; then continue; fi
       out="$OUTDIR/$scene-L$level-$m.h5"
       echo "bench: $scene level $level $m ..." >&2
-      if ! run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" ${db:+--database "$db"} --reference "$fine"; then
+      extra=()
+      [ "$m" = ddfem ] && extra=("${DDFEM_ARG_LIST[@]}")
+      if ! run "$out" --config "$cfg" --coarsen "$level" --coarse-material "$m" ${db:+--database "$db"} "${extra[@]}" \
+        --reference "$fine"; then
         # A baseline that does not converge is a result too (the naive
         # model is pathologically stiff); the row says so.
         err[$m]=nan tot[$m]=nan its[$m]=0 asm[$m]=nan sol[$m]=nan crs[$m]=nan dofs[$level]=0
@@ -82,7 +88,8 @@ for scene in "${SCENES[@]}"; do
   if [ "$scene" != fibers ] && [ "$scene" != buckling ]; then
     echo "bench: $scene with CHOLMOD at both levels ..." >&2
     run "$OUTDIR/$scene-direct-L0.h5" --config "$cfg" --set solver.linear_solver=cholmod
-    run "$OUTDIR/$scene-direct-L1.h5" --config "$cfg" --set solver.linear_solver=cholmod --coarsen 1 --database "$DB"
+    run "$OUTDIR/$scene-direct-L1.h5" --config "$cfg" --set solver.linear_solver=cholmod --coarsen 1 --database "$DB" \
+      "${DDFEM_ARG_LIST[@]}"
     d0=$(attr "$OUTDIR/$scene-direct-L0.h5" /timings newton_total) d1=$(attr "$OUTDIR/$scene-direct-L1.h5" /timings newton_total)
     i0=$(attr "$OUTDIR/$scene-direct-L0.h5" /newton iterations) i1=$(attr "$OUTDIR/$scene-direct-L1.h5" /newton iterations)
     direct_rows+=$(awk -v s="$scene" -v a="$d0" -v b="$d1" -v i="$i0" -v j="$i1" \
@@ -93,7 +100,8 @@ for scene in "${SCENES[@]}"; do
   if [ "$scene" != fibers ] && [ "$scene" != buckling ]; then
     echo "bench: $scene CG iterations ..." >&2
     run "$OUTDIR/$scene-cg-L0.h5" --config "$cfg" --set solver.linear_solver=pcg
-    run "$OUTDIR/$scene-cg-L1.h5" --config "$cfg" --set solver.linear_solver=pcg --coarsen 1 --database "$DB"
+    run "$OUTDIR/$scene-cg-L1.h5" --config "$cfg" --set solver.linear_solver=pcg --coarsen 1 --database "$DB" \
+      "${DDFEM_ARG_LIST[@]}"
     cg_rows+="| $scene | $(mean_linear_its "$OUTDIR/$scene-cg-L0.h5") | $(mean_linear_its "$OUTDIR/$scene-cg-L1.h5") |"$'\n'
   fi
 done
@@ -101,7 +109,7 @@ done
 star_note=""
 [ -n "$DB2" ] || star_note="\* level 2 without a level-2 database: speed columns are naive coarsening's."
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -n1), $(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB"
-table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB")${DB2:+ (level 1) and $(basename "$DB2") (level 2)}.
+table="Measured $(date -u +%Y-%m-%d) on $machine, OMP_NUM_THREADS=${OMP_NUM_THREADS:-all}, revision $(git -C "$SRC" rev-parse --short HEAD 2>/dev/null || echo unknown), databases $(basename "$DB")${DB2:+ (level 1) and $(basename "$DB2") (level 2)}${DDFEM_ARGS:+, DDFEM runs with $DDFEM_ARGS}.
 
 | scene | level | grid | DOFs | speedup | s/it | its | assembly s/it | solve s/it | DDFEM error | naive error | averaged error | coarsening ms |
 |---|---|---|---|---|---|---|---|---|---|---|---|---|

@@ -7,8 +7,17 @@
 namespace msfab {
 
 ElasticAssembler::ElasticAssembler(const HexMesh& mesh) : mesh_(mesh) {
-  for (const auto& geo : mesh.geometries)
-    if (geo.has_enhanced_modes()) bubbles_.assign(mesh.num_elements(), BubbleState{});
+  // A state only for the elements with bubble modes (about 2.3 kB each): a
+  // mixed mesh's fine elements have none.
+  int with_bubbles = 0;
+  for (int e = 0; e < mesh.num_elements(); ++e)
+    if (mesh.geometries[mesh.element_geometry[e]].has_enhanced_modes()) ++with_bubbles;
+  if (with_bubbles > 0) {
+    bubble_slot_.assign(mesh.num_elements(), -1);
+    for (int e = 0, slot = 0; e < mesh.num_elements(); ++e)
+      if (mesh.geometries[mesh.element_geometry[e]].has_enhanced_modes()) bubble_slot_[e] = slot++;
+    bubbles_.assign(with_bubbles, BubbleState{});
+  }
   const int n = mesh.num_nodes();
   std::vector<std::vector<int>> adjacent(n);
   for (const auto& el : mesh.elements)
@@ -164,8 +173,9 @@ double ElasticAssembler::evaluate_mesh(const VecX& x, VecX* gradient, SpMat* hes
         const int e = color[c];
         const auto& geo = mesh_.geometries[mesh_.element_geometry[e]];
         const auto& mat = mesh_.materials[mesh_.element_material[e]];
+        const int slot = bubble_slot_.empty() ? -1 : bubble_slot_[e];
         const double E = hex_evaluate(geo, mat, gather(x, e), gradient ? &ge : nullptr, hessian ? &Ke : nullptr,
-                                      bubbles_.empty() ? nullptr : &bubbles_[e]);
+                                      slot < 0 ? nullptr : &bubbles_[slot]);
         element_energy[e] = E;
         if (!std::isfinite(E)) continue;
         const auto& el = mesh_.elements[e];

@@ -78,9 +78,11 @@ class ElasticAssembler {
   SpMat dof_map_, dof_map_t_, reduced_pattern_;
   std::vector<int> reduce_from_, reduce_to_;
   std::vector<double> reduce_weight_;
-  // Per element: its bubble state (hex_element.hpp; empty when no element
-  // has bubble modes). A cache: it changes no result beyond the
+  // The bubble states (hex_element.hpp) of the elements with bubble modes,
+  // and each element's slot among them (-1 without; both empty when no
+  // element has bubble modes). A cache: it changes no result beyond the
   // condensation's tolerance, only the cost.
+  std::vector<int> bubble_slot_;
   mutable std::vector<BubbleState> bubbles_;
 };
 

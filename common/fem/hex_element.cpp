@@ -117,8 +117,8 @@ Eigen::LDLT<Mat9> definite_factor(const Mat9& K) {
 
 // Below this Newton step (relative to the element's size) the bubbles'
 // problem is in Newton's quadratic regime and the energy decrease a step
-// brings, ~(step / h)^2 of the energy scale, is below the energy's own
-// round-off: full steps are taken without a line search.
+// brings, ~(step / h)^2 of the energy scale (1e-14 here), is at the
+// energy's own round-off: full steps are taken without a line search.
 constexpr double kRoundOffStep = 1e-7;
 // Amplitudes are converged when the step is this small against the
 // element's size: ~1e3 above the round-off of the amplitudes themselves
@@ -126,8 +126,8 @@ constexpr double kRoundOffStep = 1e-7;
 constexpr double kConvergedStep = 1e-13;
 
 // The bubble amplitudes that minimize the element energy at nodal
-// positions x: Newton from the amplitudes A passed in (from A = 0 if the
-// element is inverted there). It stops when the residual has fallen 1e-12
+// positions x: Newton from the amplitudes A passed in (from `second_start`,
+// then from A = 0, where the element is inverted there). It stops when the residual has fallen 1e-12
 // of its start, the Newton decrement (the decrease a full step predicts) is
 // below 1e-14 of the energy, or the step is below kConvergedStep of the
 // element's size. Steps above kRoundOffStep are backtracked on the energy;
@@ -139,7 +139,7 @@ constexpr double kConvergedStep = 1e-13;
 // left is second order in the last step (the condensed gradient is corrected
 // to first order in r_A). Returns false if the element is inverted at A = 0.
 bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
-                      Mat3& A, double& energy, int* evaluations = nullptr) {
+                      Mat3& A, double& energy, int* evaluations = nullptr, const Mat3* second_start = nullptr) {
   int count = 1;
   struct Count {
     int& count;
@@ -151,6 +151,11 @@ bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterial
   EnhancedTerms t;
   t.coupling = false;
   energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+  if (!std::isfinite(energy) && second_start && *second_start != A) {
+    A = *second_start;
+    energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
+    ++count;
+  }
   if (!std::isfinite(energy) && !A.isZero(0.0)) {
     A.setZero();
     energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
@@ -218,7 +223,8 @@ double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials&
     bubbles->evaluations = 0;
   } else {
     if (bubbles) A = bubbles->has_model ? bubbles->predicted(x) : bubbles->A;
-    if (!condense_bubbles(geo, mat, x, A, energy, bubbles ? &bubbles->evaluations : nullptr)) {
+    if (!condense_bubbles(geo, mat, x, A, energy, bubbles ? &bubbles->evaluations : nullptr,
+                          bubbles && bubbles->has_model ? &bubbles->A : nullptr)) {
       if (bubbles) bubbles->condensed = false;
       return kInfiniteEnergy;
     }

@@ -30,14 +30,16 @@ struct QuadratureMaterials {
 double hex_energy(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x);
 
 // What an element with bubble modes keeps between evaluations (one per
-// element of a mesh; ElasticAssembler holds them). Its state changes only
-// the cost of an evaluation, not its result beyond the condensation's
-// tolerance (below 1e-14 of the energy; hex_element.cpp).
+// such element of a mesh; ElasticAssembler holds them). Its state changes
+// only the cost of an evaluation, not its result beyond the condensation's
+// tolerance (hex_element.cpp: a decrement below 1e-14 of the energy, or a
+// step below 1e-13 of the element's size, whose energy error is ~1e-26 of
+// the element's energy scale).
 struct BubbleState {
   // The minimizing amplitudes at the positions of the last condensation,
   // and the energy there.
   Mat3 A = Mat3::Zero();
-  hex8::NodeMatrix at;
+  hex8::NodeMatrix at = hex8::NodeMatrix::Zero();
   double energy = 0;
   bool condensed = false;
   int evaluations = 0;  // of the element's terms in the last condensation (0: reused)
@@ -45,9 +47,9 @@ struct BubbleState {
   // derivative in the positions (dA/dx = -sensitivity, node-major columns),
   // so that a later condensation nearby starts from
   // model_A - sensitivity (x - model_at), second-order close to its minimum.
-  Eigen::Matrix<double, 9, 24> sensitivity;
-  Mat3 model_A;
-  hex8::NodeMatrix model_at;
+  Eigen::Matrix<double, 9, 24> sensitivity = Eigen::Matrix<double, 9, 24>::Zero();
+  Mat3 model_A = Mat3::Zero();
+  hex8::NodeMatrix model_at = hex8::NodeMatrix::Zero();
   bool has_model = false;
   Mat3 predicted(const hex8::NodeMatrix& x) const;
 };
@@ -58,8 +60,9 @@ struct BubbleState {
 //
 // For an element with bubble modes, `bubbles` (optional) is the element's
 // state: the condensation at positions it last condensed at is reused, and
-// elsewhere starts from the state's prediction (at 0 if the element is
-// inverted there); the state is then updated. A Newton iteration (one
+// elsewhere starts from the state's prediction (from its last amplitudes,
+// then from 0, if the element is inverted there); the state is then
+// updated. A Newton iteration (one
 // gradient evaluation and a line search along its step) then condenses in
 // about one bubble Newton step per evaluation instead of three to six.
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,

@@ -16,9 +16,6 @@ class SingleThreadedBlas {
   ~SingleThreadedBlas();
   SingleThreadedBlas(const SingleThreadedBlas&) = delete;
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
-
- private:
-  int saved_;
 };
 
 // OpenMP's thread count for a scope (the calling thread's setting), e.g.

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <unsupported/Eigen/IterativeSolvers>
@@ -187,25 +188,31 @@ VecX indefinite_direct_solve(const SpMat& K, const VecX& b, double scale, const 
   return x;
 }
 
-// Above NewtonOptions::largest_indefinite_direct_step on a voxel lattice: MINRES on K x = b
-// preconditioned by the multigrid cycle of K + s I. MINRES needs a
-// positive definite preconditioner, which the cycle is once K + s I is;
-// the multigrid's own checks (definite diagonal blocks and coarsest level)
-// do not prove that, so a shift whose MINRES does not reach the residual
-// is taken as too small, and the next one tried. Empty where none does.
-VecX indefinite_multigrid_solve(const SpMat& K, const VecX& b, double scale, const LinearSolverOptions& linear) {
+// On a voxel lattice: MINRES on K x = b preconditioned by the multigrid
+// cycle of K + s I. MINRES needs a positive definite preconditioner, which
+// the cycle is once K + s I is; the multigrid's own checks (definite
+// diagonal blocks and coarsest level) do not prove that, so a shift whose
+// MINRES does not reach the residual is taken as too small, and the next
+// one tried, up to `max_stalled` such shifts (a caller with a direct
+// fallback gives up early: each costs up to 200 cycles). Empty where none
+// does.
+VecX indefinite_multigrid_solve(const SpMat& K, const VecX& b, double scale, const LinearSolverOptions& linear,
+                                int max_stalled) {
   if (b.norm() == 0) return VecX::Zero(b.size());
   const auto t0 = Clock::now();
   MultigridSolver shifted(linear);
   shifted.analyze(K);
   const RegularizationSchedule schedule;
   double shift = kFirstPreconditionerShift * scale;
-  for (int attempt = 0; attempt < schedule.max_factorizations; ++attempt, shift *= schedule.growth) {
+  int stalled = 0;
+  for (int attempt = 0; attempt < schedule.max_factorizations && stalled < max_stalled;
+       ++attempt, shift *= schedule.growth) {
     if (!shifted.factorize(K, shift)) continue;
     VecX x = preconditioned_minres(
         K, b, [&shifted](const VecX& v) { return shifted.apply_preconditioner(v); }, 200,
         fmt::format("multigrid of shift {:.2e}", shift), t0);
     if (x.size() > 0) return x;
+    ++stalled;
   }
   return VecX();
 }
@@ -251,8 +258,10 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   // tangents: 0.09 s against 0.35 s for the shifted factorization on
   // bridge_arch's 24 k unknowns, the same step); where it stalls, or the
   // static solver is CHOLMOD, the direct solve where a factorization fits.
+  const bool direct_fits = n <= options.largest_indefinite_direct_step;
   if (solver_name == "pcg-mg") {
-    step = indefinite_multigrid_solve(K, rhs, diag, static_linear_options(assembler, solver_name, options));
+    step = indefinite_multigrid_solve(K, rhs, diag, static_linear_options(assembler, solver_name, options),
+                                      direct_fits ? 2 : std::numeric_limits<int>::max());
     if (step.size() > 0) {
       // Their rows are diag x_i = diag gap_i: exact, not to MINRES's tolerance.
       for (int i = 0; i < n; ++i)
@@ -260,12 +269,12 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
       return {std::move(step), "", 0.0, true};
     }
   }
-  if (n <= options.largest_indefinite_direct_step) {
+  if (direct_fits) {
     step = indefinite_direct_solve(K, rhs, diag, static_linear_options(assembler, "cholmod", options));
     if (step.size() == 0)
-      return {VecX(),
-              "the indefinite tangent could not be solved (MINRES stalled, L D L^T met a zero pivot or lost "
-              "accuracy)"};
+      return {VecX(), fmt::format("the indefinite tangent could not be solved ({}MINRES on the shifted factor "
+                                  "stalled, L D L^T met a zero pivot or lost accuracy)",
+                                  solver_name == "pcg-mg" ? "MINRES on the multigrid stalled, " : "")};
     return {std::move(step), "", 0.0, true};
   }
   // Otherwise regularized as the solver's own Newton steps are.

@@ -304,7 +304,15 @@ TEST(EnhancedElement, KeptStateGivesTheColdResultsAndPredictsTheBubblesToSecondO
   Vec24 g_cold, g;
   Mat24 K_cold, K;
   const double e_cold = hex_evaluate(c.geo, c.mat, c.x, &g_cold, &K_cold);
+  // A state that has been elsewhere (a gradient at other positions, then
+  // an energy at third ones) gives the cold results at x.
   BubbleState state;
+  hex8::NodeMatrix elsewhere = c.x;
+  elsewhere.col(2) *= 1.02;
+  Vec24 g_elsewhere;
+  hex_evaluate(c.geo, c.mat, elsewhere, &g_elsewhere, nullptr, &state);
+  elsewhere.col(0) *= 0.99;
+  hex_evaluate(c.geo, c.mat, elsewhere, nullptr, nullptr, &state);
   const double e = hex_evaluate(c.geo, c.mat, c.x, &g, &K, &state);
   EXPECT_NEAR(e, e_cold, 1e-13 * e_cold);
   EXPECT_LT((g - g_cold).norm(), 1e-10 * g_cold.norm());

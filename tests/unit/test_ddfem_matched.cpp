@@ -1,6 +1,7 @@
 // Matched coarsening (ddfem/matched_coarsening.hpp): naive per-point
 // materials carried by one congruence onto the block's homogenized C^H.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Geometry>
 #include <filesystem>
@@ -222,6 +223,41 @@ TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffnes
   request.check_tolerance = 0.1;
   request.material = "naive";
   EXPECT_THROW(coarsen_voxels(grid, palette, request), InputError);
+}
+
+TEST(MatchedCoarsening, CheckedBlocksAreTheSameOnAnyThreadCount) {
+  // A random two-material field: most blocks are mixed and distinct, so the
+  // checked lookup homogenizes and matches many of them in parallel.
+  const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
+                                            std::make_shared<NeoHookean>(1e7, 0.45)};
+  BlockMaterials checker;
+  for (int c = 0; c < 8; ++c) checker[c] = 1 + ((c >> 2) + (c >> 1) + c) % 2;
+  VoxelGrid grid(8, 6, 4, 1e-3, 1);
+  std::mt19937_64 rng(7);
+  for (int& id : grid.ids) id = 1 + static_cast<int>(rng() % 2);
+  for (int c = 0; c < 8; ++c) grid.at(c >> 2 & 1, c >> 1 & 1, c & 1) = checker[c];  // one replaced for sure
+  CoarseningRequest request;
+  request.level = 1;
+  request.database = write_naive_database_with_wrong_checker(palette, checker);
+  request.check_tolerance = 0.1;
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const CoarsenedVoxels one = coarsen_voxels(grid, palette, request);
+  omp_set_num_threads(3);
+  const CoarsenedVoxels three = coarsen_voxels(grid, palette, request);
+  omp_set_num_threads(saved);
+  EXPECT_GE(one.checked_blocks, 10);
+  EXPECT_GE(one.replaced_blocks, 1);
+  EXPECT_EQ(one.checked_blocks, three.checked_blocks);
+  EXPECT_EQ(one.replaced_blocks, three.replaced_blocks);
+  EXPECT_EQ(one.fallback_blocks, three.fallback_blocks);
+  ASSERT_EQ(one.mesh.mesh.materials.size(), three.mesh.mesh.materials.size());
+  for (size_t m = 0; m < one.mesh.mesh.materials.size(); ++m) {
+    const auto& a = one.mesh.mesh.materials[m].at_point;
+    const auto& b = three.mesh.mesh.materials[m].at_point;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t q = 0; q < a.size(); ++q) EXPECT_EQ(rest_voigt_stiffness(*a[q]), rest_voigt_stiffness(*b[q]));
+  }
 }
 
 TEST(WindowedStiffness, NoMarginIsTheCellsHomogenizedStiffness) {
