@@ -205,6 +205,26 @@ CoarseMaterialLookup ddfem_lookup(const CoarseDatabase& db, const std::vector<Ma
   return checked_lookup(db, palette, level1, level, settings.check_tolerance, enhanced, lookup, counts);
 }
 
+namespace {
+
+// The checked coarsenings' plain database lookup (the check is theirs to
+// make, per block or per cell, in parallel), with the run's fallback and
+// tolerance recorded in `m` and the blocks without a fit counted once per
+// distinct block (the lookup itself counts nothing: it runs on several
+// threads).
+CoarseMaterialLookup unchecked_lookup_for_the_check(CoarsenedVoxels& m, const std::vector<MaterialPtr>& palette,
+                                                    const CoarseningRequest& request) {
+  m.fallback = request.fallback;
+  m.check_tolerance = request.check_tolerance;
+  for (const ChildIds& c : m.grid.combinations)
+    m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
+  CoarsenedVoxels unchecked = m;
+  unchecked.check_tolerance = 0;
+  return ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
+}
+
+}  // namespace
+
 CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<MaterialPtr>& palette,
                                const CoarseningRequest& request) {
   if (request.fallback != "naive" && request.fallback != "galerkin" && request.fallback != "galerkin-full" &&
@@ -270,14 +290,7 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
         enhanced, &m.stats, &m);
     m.grid = cells;
   } else if (request.window > 0) {  // ddfem, checked against each cell's windowed stiffness
-    m.fallback = request.fallback;
-    m.check_tolerance = request.check_tolerance;
-    // Blocks without a fit are counted once per distinct block, as without a window.
-    for (const ChildIds& c : m.grid.combinations)
-      m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
-    CoarsenedVoxels unchecked = m;
-    unchecked.check_tolerance = 0;
-    const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
+    const CoarseMaterialLookup lookup = unchecked_lookup_for_the_check(m, palette, request);
     const CoarseGrid cells = with_one_combination_per_cell(m.grid);
     const bool enhanced = m.element == "enhanced";
     m.mesh = per_cell_mesh(
@@ -289,13 +302,7 @@ CoarsenedVoxels coarsen_voxels(const VoxelGrid& grid, const std::vector<Material
         enhanced, &m.stats, &m);
     m.grid = cells;
   } else if (request.material == "ddfem" && request.check_tolerance > 0) {
-    m.fallback = request.fallback;
-    m.check_tolerance = request.check_tolerance;
-    for (const ChildIds& c : m.grid.combinations)
-      m.fallback_blocks += !database_fit(*m.database, m.level1.combinations, request.level, c);
-    CoarsenedVoxels unchecked = m;
-    unchecked.check_tolerance = 0;
-    const CoarseMaterialLookup lookup = ddfem_lookup(*m.database, palette, m.level1, request.level, unchecked, nullptr);
+    const CoarseMaterialLookup lookup = unchecked_lookup_for_the_check(m, palette, request);
     const std::vector<QuadratureMaterials> materials =
         checked_blocks_in_parallel(*m.database, palette, m.level1, m.grid, request.level, request.check_tolerance,
                                    m.element == "enhanced", lookup, m);
