@@ -1,8 +1,10 @@
 #include "homog/periodic_homogenization.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <sstream>
 
@@ -177,6 +179,45 @@ Eigen::MatrixXd strain_loads(const VoxelStiffnessField& field) {
   return B;
 }
 
+// Cells up to this many voxels keep their symbolic analysis per thread.
+// Small cells (DDFEM blocks, the windows of the checked lookup) are
+// homogenized by the thousand, all of one size, and the pattern of K is
+// that of the size alone (every element's entries are assembled, void ones
+// as zeros); the METIS ordering, which runs one at a time process-wide,
+// was then a third of each homogenization and serialized the threads.
+// The ordering of a pattern does not depend on when it is computed, so
+// the results are the same bits.
+constexpr std::int64_t kCachedAnalysisVoxels = 12 * 12 * 12;
+
+// One BLAS thread for the cells' factorizations: a multithreaded
+// supernodal factorization rounds differently per thread count, and C^H
+// must not depend on it.
+LinearSolverOptions cell_solver_options() {
+  LinearSolverOptions options;
+  options.threads = 1;
+  return options;
+}
+
+// The calling thread's kept solver analyzed for A, the stiffness of a small
+// nx x ny x nz cell (analyzed now if the size is new to the thread), or
+// null for a cell above kCachedAnalysisVoxels, whose factor is not kept.
+CholmodSolver* kept_analyzed_solver(const SpMat& A, int nx, int ny, int nz) {
+  if (std::int64_t(nx) * ny * nz > kCachedAnalysisVoxels) return nullptr;
+  struct Kept {
+    std::array<int, 3> size{-1, -1, -1};
+    std::unique_ptr<CholmodSolver> solver;
+  };
+  thread_local Kept kept;
+  const std::array<int, 3> size{nx, ny, nz};
+  if (!kept.solver || kept.size != size) {
+    kept.solver = std::make_unique<CholmodSolver>(cell_solver_options());
+    kept.size = {-1, -1, -1};
+    kept.solver->analyze(A);
+    kept.size = size;
+  }
+  return kept.solver.get();
+}
+
 // The direct solver: K assembled with node 0 pinned (it removes the
 // translations), factorized once, six solves.
 void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads, HomogenizationResult& out,
@@ -213,12 +254,13 @@ void solve_direct(const VoxelStiffnessField& field, const Eigen::MatrixXd& loads
   SpMat A(out.unknowns, out.unknowns);
   A.setFromTriplets(all.begin(), all.end());
   std::vector<Eigen::Triplet<double>>().swap(all);
-  // One BLAS thread: a multithreaded supernodal factorization rounds
-  // differently per thread count, and C^H must not depend on it.
-  LinearSolverOptions solver_options;
-  solver_options.threads = 1;
-  CholmodSolver solver(solver_options);
-  solver.analyze(A);
+  std::unique_ptr<CholmodSolver> own;
+  CholmodSolver* kept = kept_analyzed_solver(A, nx, ny, nz);
+  if (!kept) {
+    own = std::make_unique<CholmodSolver>(cell_solver_options());
+    own->analyze(A);
+  }
+  CholmodSolver& solver = kept ? *kept : *own;
   if (!solver.factorize(A))
     throw NumericalError("homogenization: the cell's stiffness matrix is not positive definite");
   for (int m : cases) {

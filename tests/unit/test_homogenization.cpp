@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <random>
+#include <thread>
 
 #include "core/errors.hpp"
 #include "gamut/structure_ops.hpp"
@@ -63,6 +64,32 @@ VoxelGrid sphere_inclusion(int n, double radius_fraction) {
         if (x.norm() < radius_fraction) g.at(i, j, k) = 2;
       }
   return g;
+}
+
+TEST(Homogenization, SmallCellsOfOneSizeGiveTheSameBitsWhateverCameBefore) {
+  // Each thread keeps the symbolic analysis of the last small cell size it
+  // solved directly; a cell must come out as from a thread that never
+  // solved one.
+  const auto pal = two_phases(1e6, 0.3, 5e4, 0.4);
+  std::mt19937_64 rng(17);
+  auto random_cell = [&](int nx, int void_every) {
+    VoxelGrid cell(nx, 6, 6, 1e-3, 1);
+    int v = 0;
+    for (int& id : cell.ids) id = (void_every > 0 && ++v % void_every == 0) ? 0 : 1 + int(rng() % 2);
+    return cell;
+  };
+  const VoxelGrid a = random_cell(6, 0), b = random_cell(6, 0), holed = random_cell(6, 7), longer = random_cell(7, 0);
+  HomogenizationOptions direct;
+  direct.solver = "cholmod";
+  Mat6 a_fresh, holed_fresh;
+  std::thread([&] { a_fresh = homogenize(a, pal, direct).C; }).join();
+  std::thread([&] { holed_fresh = homogenize(holed, pal, direct).C; }).join();
+  homogenize(b, pal, direct);
+  homogenize(longer, pal, direct);  // another size: analyzed anew
+  homogenize(b, pal, direct);
+  EXPECT_EQ(homogenize(holed, pal, direct).C, holed_fresh);  // void voxels: the same pattern
+  EXPECT_EQ(homogenize(a, pal, direct).C, a_fresh);
+  EXPECT_GT((a_fresh - homogenize(b, pal, direct).C).norm(), 1e-3 * a_fresh.norm());
 }
 
 TEST(Homogenization, HomogeneousCellReturnsItsMaterial) {
