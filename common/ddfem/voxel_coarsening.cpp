@@ -32,25 +32,53 @@ struct CellOutcome {
   bool replaced = false;    // ... and coarsened by the matched model instead
 };
 
+// The stiffness a solid mixed block's fit is checked against, from the
+// block's voxels (laid out as block_level1 / block_level2 give them).
+using ReferenceStiffness = std::function<Mat6(const std::vector<int>& voxels, CellOutcome& outcome)>;
+
 // The database's lookup, except where a solid mixed block's fit has a
-// response to uniform strains farther than `tolerance` from the block's own
-// C^H: there the matched model, which has that C^H by construction. The fit
-// comes from a representative (compression, the level-2 pairing stages), so
-// its stiffness can sit elsewhere in the block than the block's own; C^H is
-// computed from the block itself.
+// response to uniform strains farther than `tolerance` from the block's
+// reference stiffness: there the matched model, which has that stiffness by
+// construction. The fit comes from a representative (compression, the
+// level-2 pairing stages), so its stiffness can sit elsewhere in the block
+// than the block's own. The reference is the block's own periodic C^H, or
+// (`reference`) the cell's stiffness among its neighbours.
 QuadratureMaterials checked_block(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
                                   const std::vector<ChildIds>& combos, int level, double tolerance, bool enhanced,
-                                  const CoarseMaterialLookup& database, const ChildIds& ids, CellOutcome& outcome) {
+                                  const CoarseMaterialLookup& database, const ChildIds& ids, CellOutcome& outcome,
+                                  const ReferenceStiffness& reference = nullptr) {
   const CoarseMaterialFit* fit = database_fit(db, combos, level, ids);
   if (!fit) return database(ids);
   const std::vector<int> voxels = level == 2 ? block_level2(ids, combos) : block_level1(ids);
   if (!solid_mixed_block(voxels)) return database(ids);
   outcome.checked = true;
   const int n = level == 2 ? 4 : 2;
-  const Mat6 CH = block_homogenized_stiffness(palette, voxels, n);
-  if (stiffness_distance(fit_uniform_response(*fit), CH) <= tolerance) return database(ids);
+  const Mat6 C = reference ? reference(voxels, outcome) : block_homogenized_stiffness(palette, voxels, n);
+  if (stiffness_distance(fit_uniform_response(*fit), C) <= tolerance) return database(ids);
   outcome.replaced = true;
-  return matched_block_materials(palette, voxels, n, enhanced, &CH);
+  return matched_block_materials(palette, voxels, n, enhanced, &C);
+}
+
+// materials[k] = decide(k, outcome[k]) for k < count, in parallel: each
+// result depends on its k alone, not on the threads. A failure is rethrown
+// after the loop, the one of the smallest k whatever the threads.
+std::vector<QuadratureMaterials> decide_in_parallel(
+    int count, std::vector<CellOutcome>& outcome,
+    const std::function<QuadratureMaterials(int k, CellOutcome& outcome)>& decide) {
+  outcome.assign(count, CellOutcome{});
+  std::vector<QuadratureMaterials> materials(count);
+  std::vector<std::exception_ptr> failure(count);
+#pragma omp parallel for schedule(dynamic)
+  for (int k = 0; k < count; ++k) {
+    try {
+      materials[k] = decide(k, outcome[k]);
+    } catch (...) {
+      failure[k] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& f : failure)
+    if (f) std::rethrow_exception(f);
+  return materials;
 }
 
 CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<MaterialPtr>& palette,
@@ -76,24 +104,15 @@ CoarseMaterialLookup checked_lookup(const CoarseDatabase& db, const std::vector<
 std::vector<QuadratureMaterials> checked_blocks_in_parallel(
     const CoarseDatabase& db, const std::vector<MaterialPtr>& palette, const CoarseGrid& level1, const CoarseGrid& grid,
     int level, double tolerance, bool enhanced, const CoarseMaterialLookup& database, CoarsenedVoxels& counts) {
-  const int count = static_cast<int>(grid.combinations.size());
-  std::vector<CellOutcome> outcome(count);
-  std::vector<QuadratureMaterials> materials(count);
-  std::vector<std::exception_ptr> failure(count);
-#pragma omp parallel for schedule(dynamic)
-  for (int c = 0; c < count; ++c) {
-    try {
-      materials[c] = checked_block(db, palette, level1.combinations, level, tolerance, enhanced, database,
-                                   grid.combinations[c], outcome[c]);
-    } catch (...) {
-      failure[c] = std::current_exception();
-    }
-  }
-  for (int c = 0; c < count; ++c) {
-    // The first block's failure in block order, whatever the threads.
-    if (failure[c]) std::rethrow_exception(failure[c]);
-    counts.checked_blocks += outcome[c].checked;
-    counts.replaced_blocks += outcome[c].replaced;
+  std::vector<CellOutcome> outcome;
+  std::vector<QuadratureMaterials> materials =
+      decide_in_parallel(static_cast<int>(grid.combinations.size()), outcome, [&](int c, CellOutcome& o) {
+        return checked_block(db, palette, level1.combinations, level, tolerance, enhanced, database,
+                             grid.combinations[c], o);
+      });
+  for (const CellOutcome& o : outcome) {
+    counts.checked_blocks += o.checked;
+    counts.replaced_blocks += o.replaced;
   }
   return materials;
 }
@@ -126,19 +145,9 @@ VoxelMesh per_cell_mesh(const VoxelGrid& fine, const CoarseGrid& cells, int marg
     }
   }
   const int count = static_cast<int>(first_cell.size());
-  std::vector<CellOutcome> outcome(count);
-  std::vector<QuadratureMaterials> per_window(count);
-  std::exception_ptr failure;
-#pragma omp parallel for schedule(dynamic)
-  for (int k = 0; k < count; ++k) {
-    try {
-      per_window[k] = materials(first_cell[k], outcome[k]);
-    } catch (...) {
-#pragma omp critical(per_cell_failure)
-      if (!failure) failure = std::current_exception();
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  std::vector<CellOutcome> outcome;
+  const std::vector<QuadratureMaterials> per_window =
+      decide_in_parallel(count, outcome, [&](int k, CellOutcome& o) { return materials(first_cell[k], o); });
   for (int w : window_of) {
     counts->unresolved_windows += outcome[w].unresolved;
     counts->checked_blocks += outcome[w].checked;
@@ -158,15 +167,11 @@ QuadratureMaterials windowed_checked_cell(const VoxelGrid& fine, const std::vect
                                           const CoarseDatabase& db, const CoarseGrid& level1, int level,
                                           const CoarseGrid& cells, const CoarseMaterialLookup& lookup, bool enhanced,
                                           int margin, double tolerance, int cell, CellOutcome& outcome) {
-  const ChildIds& child = cells.combinations[cells.cell_combination[cell]];
-  const CoarseMaterialFit* fit = database_fit(db, level1.combinations, level, child);
-  const std::vector<int> voxels = level == 2 ? block_level2(child, level1.combinations) : block_level1(child);
-  if (!fit || !solid_mixed_block(voxels)) return lookup(child);
-  outcome.checked = true;
-  const Mat6 A = cell_windowed_stiffness(fine, palette, cells, voxels, cell, margin, &outcome.unresolved);
-  if (stiffness_distance(fit_uniform_response(*fit), A) <= tolerance) return coarse_quadrature_materials(*fit);
-  outcome.replaced = true;
-  return matched_block_materials(palette, voxels, cells.fine_per_cell(), enhanced, &A);
+  return checked_block(db, palette, level1.combinations, level, tolerance, enhanced, lookup,
+                       cells.combinations[cells.cell_combination[cell]], outcome,
+                       [&](const std::vector<int>& voxels, CellOutcome& o) {
+                         return cell_windowed_stiffness(fine, palette, cells, voxels, cell, margin, &o.unresolved);
+                       });
 }
 
 }  // namespace

@@ -127,27 +127,25 @@ constexpr double kConvergedStep = 1e-13;
 
 // The bubble amplitudes that minimize the element energy at nodal
 // positions x: Newton from the amplitudes A passed in (from `second_start`,
-// then from A = 0, where the element is inverted there). It stops when the residual has fallen 1e-12
-// of its start, the Newton decrement (the decrease a full step predicts) is
-// below 1e-14 of the energy, or the step is below kConvergedStep of the
-// element's size. Steps above kRoundOffStep are backtracked on the energy;
-// smaller ones are taken whole, since there the energies compared differ by
-// their round-off (the line search then halved up to 40 times before
-// giving up: on the fibre bar at level 1 a fifth of the Newton steps did,
-// and those stalls made 85% of the element's evaluations). Each
-// accepted trial's terms are those of the next iteration. The gradient error
-// left is second order in the last step (the condensed gradient is corrected
-// to first order in r_A). Returns false if the element is inverted at A = 0.
+// then from A = 0, where the element is inverted there). It stops when the
+// residual has fallen 1e-12 of its start, the Newton decrement (the
+// decrease a full step predicts) is below 1e-14 of the energy, or the step
+// is below kConvergedStep of the element's size. Steps above kRoundOffStep
+// are backtracked on the energy; smaller ones are taken whole, since there
+// the energies compared differ by their round-off (the line search then
+// halved up to 40 times before giving up: on the fibre bar at level 1 a
+// fifth of the Newton steps did, and those stalls made 85% of the
+// element's evaluations). Each accepted trial's terms are those of the
+// next iteration. The gradient error left is second order in the last step
+// (the condensed gradient is corrected to first order in r_A). Returns
+// false if the element is inverted at A = 0.
 bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
                       Mat3& A, double& energy, int* evaluations = nullptr, const Mat3* second_start = nullptr) {
-  int count = 1;
-  struct Count {
-    int& count;
-    int* out;
-    ~Count() {
-      if (out) *out = count;
-    }
-  } report{count, evaluations};
+  int count = 1;  // evaluations of the element's terms, reported in `evaluations`
+  const auto done = [&](bool finite) {
+    if (evaluations) *evaluations = count;
+    return finite;
+  };
   EnhancedTerms t;
   t.coupling = false;
   energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
@@ -161,7 +159,7 @@ bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterial
     energy = evaluate_with(geo, mat, x, A, nullptr, nullptr, &t);
     ++count;
   }
-  if (!std::isfinite(energy)) return false;
+  if (!std::isfinite(energy)) return done(false);
   double volume = 0;
   for (double w : geo.weight) volume += w;
   const double size = std::cbrt(volume);
@@ -188,7 +186,7 @@ bool condense_bubbles(const hex8::ElementGeometry& geo, const QuadratureMaterial
     energy = trial;
     std::swap(t, trial_terms);
   }
-  return true;
+  return done(true);
 }
 
 }  // namespace

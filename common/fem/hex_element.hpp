@@ -62,9 +62,9 @@ struct BubbleState {
 // state: the condensation at positions it last condensed at is reused, and
 // elsewhere starts from the state's prediction (from its last amplitudes,
 // then from 0, if the element is inverted there); the state is then
-// updated. A Newton iteration (one
-// gradient evaluation and a line search along its step) then condenses in
-// about one bubble Newton step per evaluation instead of three to six.
+// updated. A Newton iteration (one gradient evaluation and a line search
+// along its step) then condenses in about one bubble Newton step per
+// evaluation instead of three to six.
 double hex_evaluate(const hex8::ElementGeometry& geo, const QuadratureMaterials& mat, const hex8::NodeMatrix& x,
                     Vec24* gradient, Mat24* hessian, BubbleState* bubbles = nullptr);
 

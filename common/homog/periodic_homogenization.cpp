@@ -211,7 +211,7 @@ CholmodSolver* kept_analyzed_solver(const SpMat& A, int nx, int ny, int nz) {
   const std::array<int, 3> size{nx, ny, nz};
   if (!kept.solver || kept.size != size) {
     kept.solver = std::make_unique<CholmodSolver>(cell_solver_options());
-    kept.size = {-1, -1, -1};
+    kept.size = {-1, -1, -1};  // an analysis that throws keeps no size
     kept.solver->analyze(A);
     kept.size = size;
   }
