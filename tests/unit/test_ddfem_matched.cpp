@@ -157,6 +157,18 @@ TEST(MatchedCoarsening, LookupMaterialsHaveTheMatchedStiffnessAndStoreNoEnergyIn
 
 namespace {
 
+// The two materials of write_naive_database_with_wrong_checker's palette.
+std::vector<MaterialPtr> soft_and_stiff() {
+  return {nullptr, std::make_shared<NeoHookean>(1e5, 0.45), std::make_shared<NeoHookean>(1e7, 0.45)};
+}
+
+// A 2 x 2 x 2 block of the two materials in a checkerboard.
+BlockMaterials checkerboard_block() {
+  BlockMaterials checker;
+  for (int c = 0; c < 8; ++c) checker[c] = 1 + ((c >> 2) + (c >> 1) + c) % 2;
+  return checker;
+}
+
 // A level-1 database of two materials whose every fit is the block's naive
 // materials (Neo-Hookean per point) on the enhanced element, except the
 // checkerboard block, looked up to an all-stiff fit: a representative with
@@ -187,10 +199,8 @@ std::string write_naive_database_with_wrong_checker(const std::vector<MaterialPt
 }  // namespace
 
 TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffness) {
-  const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
-                                            std::make_shared<NeoHookean>(1e7, 0.45)};
-  BlockMaterials checker;
-  for (int c = 0; c < 8; ++c) checker[c] = 1 + ((c >> 2) + (c >> 1) + c) % 2;
+  const std::vector<MaterialPtr> palette = soft_and_stiff();
+  const BlockMaterials checker = checkerboard_block();
   // Three blocks along x: one material, the checkerboard, layers normal to x.
   VoxelGrid grid(6, 2, 2, 1e-3, 1);
   for (int c = 0; c < 8; ++c) grid.at(2 + (c >> 2 & 1), c >> 1 & 1, c & 1) = checker[c];
@@ -228,10 +238,8 @@ TEST(MatchedCoarsening, CheckedLookupReplacesOnlyFitsFarFromTheBlocksOwnStiffnes
 TEST(MatchedCoarsening, CheckedBlocksAreTheSameOnAnyThreadCount) {
   // A random two-material field: most blocks are mixed and distinct, so the
   // checked lookup homogenizes and matches many of them in parallel.
-  const std::vector<MaterialPtr> palette = {nullptr, std::make_shared<NeoHookean>(1e5, 0.45),
-                                            std::make_shared<NeoHookean>(1e7, 0.45)};
-  BlockMaterials checker;
-  for (int c = 0; c < 8; ++c) checker[c] = 1 + ((c >> 2) + (c >> 1) + c) % 2;
+  const std::vector<MaterialPtr> palette = soft_and_stiff();
+  const BlockMaterials checker = checkerboard_block();
   VoxelGrid grid(8, 6, 4, 1e-3, 1);
   std::mt19937_64 rng(7);
   for (int& id : grid.ids) id = 1 + static_cast<int>(rng() % 2);
