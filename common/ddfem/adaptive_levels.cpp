@@ -1,7 +1,9 @@
 #include "ddfem/adaptive_levels.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <queue>
+#include <stdexcept>
 #include <tuple>
 
 #include "core/errors.hpp"
@@ -133,6 +135,42 @@ LevelChoice refine_cell_levels(const std::vector<CellErrorModel>& cells, const L
   refine_greedily(cells, out.cell_level, term, target * target);
   out.predicted_error = predicted_error(cells, errors, out.cell_level);
   return out;
+}
+
+namespace {
+
+// Every cell of `finer` at the level of `coarser` or below it.
+bool refines(const std::vector<int>& finer, const std::vector<int>& coarser) {
+  if (finer.size() != coarser.size()) return false;
+  for (size_t c = 0; c < finer.size(); ++c)
+    if (finer[c] > coarser[c]) return false;
+  return true;
+}
+
+}  // namespace
+
+double ranked_estimate(const std::vector<CheckedSolve>& solves, std::size_t index) {
+  if (index >= solves.size()) throw std::out_of_range("ranked_estimate: no such solve");
+  const CheckedSolve& s = solves[index];
+  double ranked = s.estimate;
+  if (s.measured) return ranked;
+  for (size_t j = 0; j < solves.size(); ++j)
+    if (j != index && solves[j].measured && refines(solves[j].cell_level, s.cell_level))
+      ranked = std::max(ranked, solves[j].estimate);
+  return ranked;
+}
+
+std::size_t kept_solve(const std::vector<CheckedSolve>& solves) {
+  if (solves.empty()) throw std::invalid_argument("kept_solve: no solves");
+  size_t kept = 0;
+  double kept_ranked = ranked_estimate(solves, 0);
+  for (size_t i = 1; i < solves.size(); ++i) {
+    const double r = ranked_estimate(solves, i);
+    // Later solves win ties; a measured estimate beats an extrapolated one.
+    const bool better = r < kept_ranked || (r == kept_ranked && (solves[i].measured || !solves[kept].measured));
+    if (better) kept = i, kept_ranked = r;
+  }
+  return kept;
 }
 
 std::vector<CellErrorModel> cell_error_models(const VoxelGrid& fine, const CoarseGrid& level1, const CoarseGrid& level2,

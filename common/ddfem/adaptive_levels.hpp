@@ -77,6 +77,25 @@ LevelErrors calibrated_level_errors(const std::vector<CellErrorModel>& cells, co
 LevelChoice refine_cell_levels(const std::vector<CellErrorModel>& cells, const LevelErrors& errors,
                                const std::vector<int>& levels, double target);
 
+// A mixed solve of an adaptive run as its a-posteriori check saw it.
+struct CheckedSolve {
+  std::vector<int> cell_level;  // per level-2 cell
+  double estimate = 0;          // its a-posteriori error estimate
+  bool measured = false;        // a fine Newton estimate; false: the extrapolation
+};
+
+// The estimate a solve is ranked by. A measured estimate is its own. The
+// extrapolation cannot see error that both uniform levels share, so an
+// extrapolated estimate is raised to the measured estimate of any solve
+// whose every cell is at the same level or finer: a refinement is not
+// less accurate than what it refines (the saturation assumption of the
+// refinement bound), so the coarser solve's error is at least about that.
+double ranked_estimate(const std::vector<CheckedSolve>& solves, std::size_t index);
+
+// The solve to keep: the smallest ranked estimate; on a tie a measured
+// estimate, then the later (finer) solve.
+std::size_t kept_solve(const std::vector<CheckedSolve>& solves);
+
 // The cells of `level2` (coarsen_grid(level1)) with their energy shares
 // from a solve on the level-1 mesh (`level1_energy` per element of
 // level1_mesh) and their element counts per level. All-void cells have no

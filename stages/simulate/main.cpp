@@ -229,16 +229,26 @@ int main(int argc, char** argv) {
       // the fine lattice (docs/solvers.md). A miss refines the cells where
       // the estimate puts the error, or tightens the target of the choice by
       // the ratio it missed by, and solves again.
-      // A refinement that does not bring the estimate down means the
-      // extrapolation, not the model, dominates it (where the error falls
-      // much faster than the rate assumed, the extrapolated solution is
-      // itself off): the loop stops and keeps the round with the smallest
-      // estimate.
+      // The solves are ranked by their estimates (kept_solve): an
+      // extrapolated estimate is raised to the fine Newton estimate of a
+      // solve that refines it, since the extrapolation cannot see the error
+      // both uniform levels share. A refinement whose extrapolated estimate
+      // does not come down means the extrapolation, not the model,
+      // dominates it (where the error falls much faster than the rate
+      // assumed, the extrapolated solution is itself off): the loop stops.
+      // A measured estimate that does not come down is a model that needs
+      // more refinement, which the next round gives from those levels.
       // After a refinement the estimate is also bounded by how far the solve
       // moved from the previous one (posterior_estimate).
       std::optional<ElasticAssembler> fine_assembler;
       if (newton_estimate) fine_assembler.emplace(fine.mesh);
-      AdaptiveModel best;
+      struct Round {
+        AdaptiveModel model;
+        NewtonResult result;
+        std::string source;
+      };
+      std::vector<Round> rounds;
+      std::vector<CheckedSolve> checked;
       VecX previous_on_fine;
       double previous_predicted = 0;
       for (;;) {
@@ -257,7 +267,8 @@ int main(int argc, char** argv) {
         PosteriorEstimate posterior{0.0, "", false};
         if (newton_estimate)
           posterior = fine_newton_estimate(fine, *fine_assembler, fine_conditions, scene.newton, adapted, on_fine);
-        if (!posterior.measured) {
+        const bool measured = posterior.measured;
+        if (!measured) {
           const std::string no_newton = posterior.source;
           posterior = posterior_estimate(fine, adapted, on_fine, adaptive_solves > 1 ? &previous_on_fine : nullptr,
                                          previous_predicted, adaptive_solves - 1);
@@ -272,18 +283,20 @@ int main(int argc, char** argv) {
             adaptive_solves, adapted.choice_target, adapted.choice.predicted_error, estimate, posterior.source,
             target_error, adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
             adapted.mixed.elements_per_level[2]);
-        const bool improved = !adaptive_result || estimate < checked_error;
-        if (improved) {
-          if (adaptive_result) rejected_seconds += adaptive_result->timings.total;
-          adaptive_result = solved;
-          checked_error = estimate;
-          checked_source = posterior.source;
-          best = adapted;
-        } else {
-          rejected_seconds += solved.timings.total;
-        }
+        const std::size_t previously_kept = checked.empty() ? 0 : kept_solve(checked);
+        const double previous_ranked = checked.empty() ? 0 : ranked_estimate(checked, previously_kept);
+        checked.push_back({adapted.choice.cell_level, estimate, measured});
+        rounds.push_back({adapted, solved, posterior.source});
+        const std::size_t kept = kept_solve(checked);
+        checked_error = ranked_estimate(checked, kept);
+        if (checked_error > checked[kept].estimate)
+          spdlog::info(
+              "adaptive: solve {}'s extrapolated estimate {:.3g} is raised to {:.3g}, the fine Newton estimate of "
+              "a solve that refines it",
+              kept + 1, checked[kept].estimate, checked_error);
         if (!posterior_check || checked_error <= target_error) break;
-        if (!improved || adaptive_solves == kMaxAdaptiveSolves) {
+        const bool improved = checked.size() == 1 || checked_error < previous_ranked || kept == checked.size() - 1;
+        if ((!improved && !measured) || adaptive_solves == kMaxAdaptiveSolves) {
           spdlog::warn(
               "adaptive: the a-posteriori estimate {:.3g} stays above the target {:.3g} after {} mixed solves; "
               "keeping the solve with the smallest estimate",
@@ -299,7 +312,15 @@ int main(int argc, char** argv) {
           rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
                                    adapted.choice_target * target_error / estimate);
       }
-      adapted = std::move(best);
+      const std::size_t kept = kept_solve(checked);
+      for (std::size_t r = 0; r < rounds.size(); ++r)
+        if (r != kept) rejected_seconds += rounds[r].result.timings.total;
+      adaptive_result = rounds[kept].result;
+      checked_source = rounds[kept].source;
+      if (checked_error > checked[kept].estimate)
+        checked_source +=
+            fmt::format(", raised from {:.3g} to the fine Newton estimate of a refinement", checked[kept].estimate);
+      adapted = std::move(rounds[kept].model);
       adaptive_seconds = seconds_since(t_adaptive);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;

@@ -484,6 +484,51 @@ TEST(AdaptiveLevels, ChoiceMeetsTheTargetAndRefinesHighEnergyCellsFirst) {
   EXPECT_THROW(level_errors_from_difference(INFINITY), InputError);
 }
 
+TEST(AdaptiveLevels, TighterTargetsRefineEveryCellOfTheLooserChoice) {
+  // The a-posteriori check ranks a solve by the estimates of the solves
+  // that refine it; re-choices for tightened targets must be refinements.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.01, 1.0);
+  std::vector<CellErrorModel> cells(40);
+  double total = 0;
+  for (auto& c : cells) total += c.energy_share = u(rng), c.elements = {64, 8, 1};
+  for (auto& c : cells) c.energy_share /= total;
+  const LevelErrors e = level_errors_from_difference(0.02);
+  std::vector<int> looser = choose_cell_levels(cells, e, 0.05).cell_level;
+  for (double target : {0.03, 0.02, 0.012, 0.008, 0.004, 0.001}) {
+    const std::vector<int> tighter = choose_cell_levels(cells, e, target).cell_level;
+    for (size_t c = 0; c < cells.size(); ++c) EXPECT_LE(tighter[c], looser[c]) << "target " << target << " cell " << c;
+    looser = tighter;
+  }
+}
+
+TEST(AdaptiveLevels, ExtrapolatedEstimatesAreRaisedByTheMeasuredEstimatesOfTheirRefinements) {
+  const std::vector<int> coarse = {2, 2, 1}, finer = {1, 2, 0}, elsewhere = {2, 1, 2};
+  // An extrapolated 5e-3 refined by a solve measured at 6e-3: the coarser
+  // solve's error is taken as at least 6e-3, and the measured solve is kept.
+  std::vector<CheckedSolve> solves = {{coarse, 5e-3, false}, {finer, 6e-3, true}};
+  EXPECT_DOUBLE_EQ(ranked_estimate(solves, 0), 6e-3);
+  EXPECT_DOUBLE_EQ(ranked_estimate(solves, 1), 6e-3);
+  EXPECT_EQ(kept_solve(solves), 1u);
+  // A measured estimate below it keeps its own value.
+  solves = {{coarse, 5e-3, false}, {finer, 3e-3, true}};
+  EXPECT_DOUBLE_EQ(ranked_estimate(solves, 0), 5e-3);
+  EXPECT_EQ(kept_solve(solves), 1u);
+  // A measured solve that does not refine it (one cell coarser) says nothing about it.
+  solves = {{coarse, 5e-3, false}, {elsewhere, 6e-3, true}};
+  EXPECT_DOUBLE_EQ(ranked_estimate(solves, 0), 5e-3);
+  EXPECT_EQ(kept_solve(solves), 0u);
+  // Measured estimates are never raised; the smaller one is kept, and on
+  // equal extrapolations the later (finer) solve.
+  solves = {{coarse, 2e-3, true}, {finer, 4e-3, true}};
+  EXPECT_DOUBLE_EQ(ranked_estimate(solves, 0), 2e-3);
+  EXPECT_EQ(kept_solve(solves), 0u);
+  solves = {{coarse, 4e-3, false}, {finer, 4e-3, false}};
+  EXPECT_EQ(kept_solve(solves), 1u);
+  EXPECT_THROW(kept_solve({}), std::invalid_argument);
+  EXPECT_THROW(ranked_estimate(solves, 2), std::out_of_range);
+}
+
 TEST(AdaptiveLevels, CalibratedErrorsGiveTheMeasuredErrorSplitAsTheFieldSaysAndAskForFineCells) {
   // Four level-2 cells; the a-priori model thinks level 1 (0.03) meets the
   // target 0.05. A measured solve says otherwise.
