@@ -23,6 +23,8 @@
 #   make -f Makefile.pipeline topopt-cubes           Table 3.1's cubes and the tiling study (Fig. 3-23) in
 #                                                    configs/gamut/cubic3d_bar_dense.yaml: out/topopt/cubes.md
 #                                                    (tools/bench_cubes.sh, about 15 minutes)
+#   make -f Makefile.pipeline topopt-bar-tiling      the Table 3.1 bar mapped with 1, 2, 3 copies per cell edge, its twist
+#                                                    also as end-face tractions: out/topopt/bar_tiling.md (about 2 minutes)
 #
 # Per scene S (configs/topopt/S.yaml) it writes out/topopt/S.design.h5,
 # S.structures.h5 (the gamut's structures; with FILL_TARGETS=1 plus those
@@ -157,6 +159,14 @@ $(TOPOPT_DIR)/bar.t2.verify.h5: $(TOPOPT_DIR)/bar.t2.mapped.h5 $(TOPOPT_DIR)/bar
 	$(BIN)/msfab-verify-map --design $(TOPOPT_DIR)/bar.design.h5 --mapped $< \
 	  --structures $(TOPOPT_DIR)/bar.structures.h5 --set homogenized_elements=4 --threads $(THREADS) --out $@
 
+# The bar against tiling (t = 1, 2, 3 copies per cell edge) under its loads
+# and the twist as end-face tractions (configs/topopt/bar_check_loads.yaml):
+# docs/BENCHMARKS.md, "The bar's twist against tiling"; about 2 minutes.
+$(OUT)/topopt/bar_tiling.md: $(TOPOPT_DIR)/bar.design.h5 $(TOPOPT_DIR)/bar.structures.h5 tools/bench_bar_tiling.sh \
+    configs/topopt/bar_check_loads.yaml $(STAGE_ID)/msfab-map.id $(STAGE_ID)/msfab-verify-map.id
+	bash tools/bench_bar_tiling.sh $(BIN) $(OUT)/topopt/bar_tiling $(TOPOPT_DIR)/bar.design.h5 \
+	  $(TOPOPT_DIR)/bar.structures.h5 $(SEED) > $@.tmp && mv $@.tmp $@ && cat $@
+
 $(CUBES_GAMUT).microstructures.h5: $(CUBES_GAMUT).gamut.h5
 	@test -s $@ && touch -r $< $@
 
@@ -238,11 +248,12 @@ topopt-fig316: stages $(OUT)/topopt/fig316.md
 .PHONY: topopt-thesis-2d
 topopt-thesis-2d: stages $(THESIS_2D_SCENES:%=$(OUT)/topopt/%.design.h5)
 
-.PHONY: topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check topopt-checks topopt-cubes \
+.PHONY: topopt-bar-tiling topopt-bar-check topopt-gripper-check topopt-bridge-check topopt-cantilever-check topopt-checks topopt-cubes \
     topopt-bridge-large topopt-bridge-huge topopt-gripper-thesis-check
 topopt-bar-check: stages $(TOPOPT_DIR)/bar.verify.h5 $(TOPOPT_DIR)/bar.h4.verify.h5 $(TOPOPT_DIR)/bar.solid.verify.h5 \
     $(TOPOPT_DIR)/bar.t2.verify.h5
 topopt-cubes: stages $(OUT)/topopt/cubes.md
+topopt-bar-tiling: stages $(OUT)/topopt/bar_tiling.md
 topopt-gripper-check: stages $(TOPOPT_DIR)/gripper3d.verify.h5 $(TOPOPT_DIR)/gripper3d.h4.verify.h5 \
     $(TOPOPT_DIR)/gripper3d.solid.verify.h5
 topopt-bridge-check: stages $(TOPOPT_DIR)/bridge_cubic.verify.h5 $(TOPOPT_DIR)/bridge_cubic.h4.verify.h5 \
