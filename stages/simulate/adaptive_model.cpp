@@ -1,6 +1,7 @@
 #include "adaptive_model.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
@@ -8,11 +9,15 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "core/timing.hpp"
 #include "ddfem/baseline_coarsening.hpp"
 #include "ddfem/coarsening_error.hpp"
+#include "static_solve.hpp"
 
 namespace msfab {
 
@@ -297,6 +302,122 @@ PosteriorEstimate fine_newton_estimate(const VoxelMesh& fine, const ElasticAssem
           fmt::format("two fine Newton steps, {:.3g} then {:.3g}; {}{}", size, second_size, indefinite,
                       second.indefinite ? ", also after the first step" : ""),
           true, both};
+}
+
+AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
+                             const CoarseModel& coarse, const CoarseDatabase& level1_db,
+                             const AdaptiveRunOptions& options) {
+  AdaptiveRun run;
+  // Each finer solve starts from the coarser solution, at full load: a few
+  // Newton steps instead of the scene's load stepping from rest.
+  NewtonOptions warm = scene.newton;
+  warm.load_steps = 1;
+  const NewtonResult solve2 =
+      solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
+  const CoarseModel level1 = level1_model_of(scene, fine, coarse, level1_db);
+  const NewtonResult solve1 = solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, warm,
+                                             "level-1 load", start_from(coarse, solve2.x, level1.mesh.mesh.nodes));
+  run.uniform_seconds = solve2.timings.total + solve1.timings.total;
+  AdaptiveModel adapted =
+      build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, level1_db, options.target);
+  // The mixed solve and, with --posterior-check, its a-posteriori check.
+  // Its linear solver follows the size rule of every static solve: the
+  // lattice multigrid takes elements of mixed sizes, whose nodes sit on
+  // the fine lattice (docs/solvers.md). A miss refines the cells where
+  // the estimate puts the error, or tightens the target of the choice by
+  // the ratio it missed by, and solves again.
+  // The solves are ranked by their estimates (kept_solve): an
+  // extrapolated estimate is raised to the fine Newton estimate of a
+  // solve that refines it, since the extrapolation cannot see the error
+  // both uniform levels share. A refinement whose extrapolated estimate
+  // does not come down means the extrapolation, not the model,
+  // dominates it (where the error falls much faster than the rate
+  // assumed, the extrapolated solution is itself off): the loop stops.
+  // A measured estimate that does not come down is a model that needs
+  // more refinement, which the next round gives from those levels.
+  // After a refinement the estimate is also bounded by how far the solve
+  // moved from the previous one (posterior_estimate).
+  std::optional<ElasticAssembler> fine_assembler;
+  if (options.newton_estimate) fine_assembler.emplace(fine.mesh);
+  struct Round {
+    AdaptiveModel model;
+    NewtonResult result;
+    std::string source;
+  };
+  std::vector<Round> rounds;
+  std::vector<CheckedSolve> checked;
+  VecX previous_on_fine;
+  double previous_predicted = 0;
+  for (;;) {
+    // A choice of level-2 cells only is the uniform level-2 model: its
+    // solution is the start, and Newton has nothing left to do.
+    const ElasticAssembler mixed_assembler(adapted.mixed.mesh, adapted.mixed.constraints);
+    const bool all_level2 = adapted.mixed.elements_per_level[0] == 0 && adapted.mixed.elements_per_level[1] == 0;
+    const NodeArray& unknown_rest = adapted.mixed.constraints->unknown_rest;
+    const NewtonResult solved = solve_or_throw(
+        mixed_assembler, adapted.conditions, warm, "adaptive load",
+        all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
+    ++run.solves;
+    const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);
+    // The fine model's own estimate where its tangent allows one, else
+    // the extrapolation's.
+    PosteriorEstimate posterior{0.0, "", false};
+    if (options.newton_estimate)
+      posterior = fine_newton_estimate(fine, *fine_assembler, fine_conditions, scene.newton, adapted, on_fine);
+    const bool measured = posterior.measured;
+    if (!measured) {
+      const std::string no_newton = posterior.source;
+      posterior = posterior_estimate(fine, adapted, on_fine, run.solves > 1 ? &previous_on_fine : nullptr,
+                                     previous_predicted, run.solves - 1);
+      if (options.newton_estimate) posterior.source += " (no Newton estimate: " + no_newton + ")";
+    }
+    const double estimate = posterior.value;
+    previous_on_fine = on_fine;
+    previous_predicted = adapted.choice.predicted_error;
+    spdlog::info(
+        "adaptive solve {}: levels chosen for {:.3g} (predicted {:.3g}), a-posteriori estimate {:.3g} "
+        "({}) against the target {:.3g}; elements fine {} / level 1 {} / level 2 {}",
+        run.solves, adapted.choice_target, adapted.choice.predicted_error, estimate, posterior.source, options.target,
+        adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2]);
+    const std::size_t previously_kept = checked.empty() ? 0 : kept_solve(checked);
+    const double previous_ranked = checked.empty() ? 0 : ranked_estimate(checked, previously_kept);
+    checked.push_back({adapted.choice.cell_level, estimate, measured});
+    rounds.push_back({adapted, solved, posterior.source});
+    const std::size_t kept = kept_solve(checked);
+    run.estimate = ranked_estimate(checked, kept);
+    if (run.estimate > checked[kept].estimate)
+      spdlog::info(
+          "adaptive: solve {}'s extrapolated estimate {:.3g} is raised to {:.3g}, the fine Newton estimate of "
+          "a solve that refines it",
+          kept + 1, checked[kept].estimate, run.estimate);
+    if (!options.posterior_check || run.estimate <= options.target) break;
+    const bool improved = checked.size() == 1 || run.estimate < previous_ranked || kept == checked.size() - 1;
+    if ((!improved && !measured) || run.solves == kMaxAdaptiveSolves) {
+      spdlog::warn(
+          "adaptive: the a-posteriori estimate {:.3g} stays above the target {:.3g} after {} mixed solves; "
+          "keeping the solve with the smallest estimate",
+          run.estimate, options.target, run.solves);
+      break;
+    }
+    // Where the estimate is a field (fine Newton steps), it calibrates
+    // the level-1 and level-2 errors and the levels are refined for the
+    // target with them, to fine cells where level 1 falls short; else
+    // the a-priori choice is made for a target tightened by the ratio
+    // of the miss.
+    if (!rechoose_where_measured(adapted, scene, fine, fine_conditions, coarse, on_fine, posterior, options.target))
+      rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
+                               adapted.choice_target * options.target / estimate);
+  }
+  const std::size_t kept = kept_solve(checked);
+  for (std::size_t r = 0; r < rounds.size(); ++r)
+    if (r != kept) run.rejected_seconds += rounds[r].result.timings.total;
+  run.result = std::move(rounds[kept].result);
+  run.estimate_source = rounds[kept].source;
+  if (run.estimate > checked[kept].estimate)
+    run.estimate_source +=
+        fmt::format(", raised from {:.3g} to the fine Newton estimate of a refinement", checked[kept].estimate);
+  run.model = std::move(rounds[kept].model);
+  return run;
 }
 
 }  // namespace msfab

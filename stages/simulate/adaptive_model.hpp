@@ -148,4 +148,29 @@ struct AdaptiveResultOnMesh {
 AdaptiveResultOnMesh adaptive_result_on_mesh(const AdaptiveModel& model, const ElasticAssembler& assembler,
                                              const NewtonResult& result);
 
+// An adaptive run (msfab-simulate --target-error): the uniform level-2 and
+// level-1 solves, the level choice, the mixed solve and, with
+// `posterior_check`, its a-posteriori check and re-choices (at most
+// kMaxAdaptiveSolves mixed solves). The solves are ranked by their
+// estimates (kept_solve): an extrapolated estimate is raised to the fine
+// Newton estimate of a solve that refines it. docs/ddfem.md, "Adaptive
+// coarsening".
+struct AdaptiveRunOptions {
+  double target = 0;             // the mean-vertex error to meet
+  bool posterior_check = false;  // solve again, finer, while the estimate misses the target
+  bool newton_estimate = false;  // estimate by fine Newton steps where the fine tangent allows
+};
+struct AdaptiveRun {
+  AdaptiveModel model;          // the kept mixed model
+  NewtonResult result;          // its solve
+  double uniform_seconds = 0;   // the uniform level-2 and level-1 solves the estimate comes from
+  double rejected_seconds = 0;  // mixed solves not kept
+  int solves = 0;               // mixed solves
+  double estimate = 0;          // the kept solve's a-posteriori estimate, as ranked
+  std::string estimate_source;  // what that estimate is
+};
+AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const StaticConditions& fine_conditions,
+                             const CoarseModel& coarse, const CoarseDatabase& level1_db,
+                             const AdaptiveRunOptions& options);
+
 }  // namespace msfab

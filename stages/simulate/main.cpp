@@ -35,45 +35,11 @@
 #include "default_scene.hpp"
 #include "result_artifact.hpp"
 #include "scene/scene.hpp"
+#include "static_solve.hpp"
 
 using namespace msfab;
 
 namespace {
-
-NewtonResult solve_or_throw(const ElasticAssembler& assembler, const StaticConditions& conditions,
-                            const NewtonOptions& options, const char* label, const VecX& x0 = VecX()) {
-  NewtonOptions newton = options;
-  Progress progress(label, 100);
-  // Percent of the load, moving within an increment too: the share of the
-  // residual's way (in decades) from its largest value in the increment to
-  // the tolerance, so that a long increment does not sit at one number for
-  // minutes. (With prescribed displacements the first residual of an
-  // increment is small: the gap, not the residual, is what is open.)
-  double converged_load = 0, largest_residual = 0;
-  std::uint64_t shown = 0;
-  const auto show = [&](double load) {
-    shown = std::max(shown, static_cast<std::uint64_t>(100 * std::min(load, 1.0) + 0.5));
-    progress.set(shown);
-  };
-  newton.on_load_step = [&](double load) {
-    converged_load = load;
-    show(load);
-  };
-  newton.on_iteration = [&](const NewtonIteration& it) {
-    largest_residual = it.iteration == 0 ? it.residual : std::max(largest_residual, it.residual);
-    const double tolerance = options.relative_tolerance;
-    double done = 0;
-    if (largest_residual > tolerance && it.residual > 0)
-      done = std::log(largest_residual / std::max(it.residual, tolerance)) / std::log(largest_residual / tolerance);
-    show(converged_load + (it.load_factor - converged_load) * std::clamp(done, 0.0, 0.95));
-  };
-  NewtonResult result = solve_static(assembler, conditions.dirichlet, conditions.force, newton, x0);
-  progress.done();
-  if (!result.converged)
-    throw NumericalError(std::string(label) + ": " + result.failure + "\nresidual history:\n" +
-                         format_history(result.history));
-  return result;
-}
 
 // Elements of the scene's mesh at coarsening level L: the 2^L blocks that
 // hold a solid voxel.
@@ -198,10 +164,6 @@ int main(int argc, char** argv) {
     std::string checked_source;   // adaptive: what that estimate is
     double adaptive_seconds = 0;  // adaptive: everything after the level-2 model, database reading aside
     std::optional<NewtonResult> adaptive_result;
-    // Each finer adaptive solve starts from the coarser solution, at full
-    // load: a few Newton steps instead of the scene's load stepping from rest.
-    NewtonOptions warm_newton = scene.newton;
-    warm_newton.load_steps = 1;
     // Adaptive: the level-1 materials, the level-2 database's own base unless
     // a level-1 database stands in for it. Where the base is compressed, the
     // uniform level-1 and level-2 models share its lookup error, which their
@@ -215,112 +177,15 @@ int main(int argc, char** argv) {
         level1_db = db;
       }
       const auto t_adaptive = std::chrono::steady_clock::now();
-      const NewtonResult solve2 =
-          solve_or_throw(ElasticAssembler(coarse.mesh.mesh), coarse.conditions, scene.newton, "level-2 load");
-      const CoarseModel level1 = level1_model_of(scene, fine, coarse, *level1_db);
-      const NewtonResult solve1 = solve_or_throw(ElasticAssembler(level1.mesh.mesh), level1.conditions, warm_newton,
-                                                 "level-1 load", start_from(coarse, solve2.x, level1.mesh.mesh.nodes));
-      uniform_seconds = solve2.timings.total + solve1.timings.total;
-      adapted = build_adaptive_model(scene, fine, fine_conditions, coarse, solve2.x, level1, solve1.x, *level1_db,
-                                     target_error);
-      // The mixed solve and, with --posterior-check, its a-posteriori check.
-      // Its linear solver follows the size rule of every static solve: the
-      // lattice multigrid takes elements of mixed sizes, whose nodes sit on
-      // the fine lattice (docs/solvers.md). A miss refines the cells where
-      // the estimate puts the error, or tightens the target of the choice by
-      // the ratio it missed by, and solves again.
-      // The solves are ranked by their estimates (kept_solve): an
-      // extrapolated estimate is raised to the fine Newton estimate of a
-      // solve that refines it, since the extrapolation cannot see the error
-      // both uniform levels share. A refinement whose extrapolated estimate
-      // does not come down means the extrapolation, not the model,
-      // dominates it (where the error falls much faster than the rate
-      // assumed, the extrapolated solution is itself off): the loop stops.
-      // A measured estimate that does not come down is a model that needs
-      // more refinement, which the next round gives from those levels.
-      // After a refinement the estimate is also bounded by how far the solve
-      // moved from the previous one (posterior_estimate).
-      std::optional<ElasticAssembler> fine_assembler;
-      if (newton_estimate) fine_assembler.emplace(fine.mesh);
-      struct Round {
-        AdaptiveModel model;
-        NewtonResult result;
-        std::string source;
-      };
-      std::vector<Round> rounds;
-      std::vector<CheckedSolve> checked;
-      VecX previous_on_fine;
-      double previous_predicted = 0;
-      for (;;) {
-        // A choice of level-2 cells only is the uniform level-2 model: its
-        // solution is the start, and Newton has nothing left to do.
-        const ElasticAssembler mixed_assembler(adapted.mixed.mesh, adapted.mixed.constraints);
-        const bool all_level2 = adapted.mixed.elements_per_level[0] == 0 && adapted.mixed.elements_per_level[1] == 0;
-        const NodeArray& unknown_rest = adapted.mixed.constraints->unknown_rest;
-        const NewtonResult solved = solve_or_throw(
-            mixed_assembler, adapted.conditions, warm_newton, "adaptive load",
-            all_level2 ? start_from(coarse, solve2.x, unknown_rest) : start_from(level1, solve1.x, unknown_rest));
-        ++adaptive_solves;
-        const VecX on_fine = adaptive_displacement_on_fine(scene, fine, adapted, mixed_assembler, solved.x);
-        // The fine model's own estimate where its tangent allows one, else
-        // the extrapolation's.
-        PosteriorEstimate posterior{0.0, "", false};
-        if (newton_estimate)
-          posterior = fine_newton_estimate(fine, *fine_assembler, fine_conditions, scene.newton, adapted, on_fine);
-        const bool measured = posterior.measured;
-        if (!measured) {
-          const std::string no_newton = posterior.source;
-          posterior = posterior_estimate(fine, adapted, on_fine, adaptive_solves > 1 ? &previous_on_fine : nullptr,
-                                         previous_predicted, adaptive_solves - 1);
-          if (newton_estimate) posterior.source += " (no Newton estimate: " + no_newton + ")";
-        }
-        const double estimate = posterior.value;
-        previous_on_fine = on_fine;
-        previous_predicted = adapted.choice.predicted_error;
-        spdlog::info(
-            "adaptive solve {}: levels chosen for {:.3g} (predicted {:.3g}), a-posteriori estimate {:.3g} "
-            "({}) against the target {:.3g}; elements fine {} / level 1 {} / level 2 {}",
-            adaptive_solves, adapted.choice_target, adapted.choice.predicted_error, estimate, posterior.source,
-            target_error, adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
-            adapted.mixed.elements_per_level[2]);
-        const std::size_t previously_kept = checked.empty() ? 0 : kept_solve(checked);
-        const double previous_ranked = checked.empty() ? 0 : ranked_estimate(checked, previously_kept);
-        checked.push_back({adapted.choice.cell_level, estimate, measured});
-        rounds.push_back({adapted, solved, posterior.source});
-        const std::size_t kept = kept_solve(checked);
-        checked_error = ranked_estimate(checked, kept);
-        if (checked_error > checked[kept].estimate)
-          spdlog::info(
-              "adaptive: solve {}'s extrapolated estimate {:.3g} is raised to {:.3g}, the fine Newton estimate of "
-              "a solve that refines it",
-              kept + 1, checked[kept].estimate, checked_error);
-        if (!posterior_check || checked_error <= target_error) break;
-        const bool improved = checked.size() == 1 || checked_error < previous_ranked || kept == checked.size() - 1;
-        if ((!improved && !measured) || adaptive_solves == kMaxAdaptiveSolves) {
-          spdlog::warn(
-              "adaptive: the a-posteriori estimate {:.3g} stays above the target {:.3g} after {} mixed solves; "
-              "keeping the solve with the smallest estimate",
-              checked_error, target_error, adaptive_solves);
-          break;
-        }
-        // Where the estimate is a field (fine Newton steps), it calibrates
-        // the level-1 and level-2 errors and the levels are refined for the
-        // target with them, to fine cells where level 1 falls short; else
-        // the a-priori choice is made for a target tightened by the ratio
-        // of the miss.
-        if (!rechoose_where_measured(adapted, scene, fine, fine_conditions, coarse, on_fine, posterior, target_error))
-          rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
-                                   adapted.choice_target * target_error / estimate);
-      }
-      const std::size_t kept = kept_solve(checked);
-      for (std::size_t r = 0; r < rounds.size(); ++r)
-        if (r != kept) rejected_seconds += rounds[r].result.timings.total;
-      adaptive_result = rounds[kept].result;
-      checked_source = rounds[kept].source;
-      if (checked_error > checked[kept].estimate)
-        checked_source +=
-            fmt::format(", raised from {:.3g} to the fine Newton estimate of a refinement", checked[kept].estimate);
-      adapted = std::move(rounds[kept].model);
+      AdaptiveRun run = solve_adaptively(scene, fine, fine_conditions, coarse, *level1_db,
+                                         {target_error, posterior_check, newton_estimate});
+      adapted = std::move(run.model);
+      adaptive_result = std::move(run.result);
+      uniform_seconds = run.uniform_seconds;
+      rejected_seconds = run.rejected_seconds;
+      adaptive_solves = run.solves;
+      checked_error = run.estimate;
+      checked_source = std::move(run.estimate_source);
       adaptive_seconds = seconds_since(t_adaptive);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
