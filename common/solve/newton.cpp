@@ -28,6 +28,9 @@ using Clock = std::chrono::steady_clock;
 // are noise and the line search measures the decrease by the directional
 // derivative instead.
 constexpr double kEnergyRoundOff = 1e-10;
+// A prescribed DOF within this fraction of the body's size of its target
+// is there (prescribed_gap).
+constexpr double kClosedGap = 1e-12;
 
 double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
   double sum = 0;
@@ -114,6 +117,25 @@ RegularizedStep constrained_newton_step(LinearSolver& solver, const SpMat& K, do
         return gap_norm > 0 || slope < 0;
       },
       rhs, dx, context);
+}
+
+// The prescribed DOFs' remaining move, target - x on the fixed DOFs. A gap
+// below 1e-12 of the body's size is the round-off of x + dx after a full
+// step (dx_c = gap_c by construction) and is closed: set to zero, so that
+// it neither switches off the descent test and the line search (both only
+// apply once every prescribed DOF is where it must be) nor enters the
+// right-hand side. Before, a gap of 1e-19 let a step that raised the
+// twisting bar's energy from 2.3e-3 to 7.0e2 through, and Newton took 92
+// iterations instead of 35.
+double prescribed_gap(const std::vector<char>& fixed, const VecX& target, const VecX& x, double length_scale,
+                      VecX& gap) {
+  gap.setZero(x.size());
+  for (Eigen::Index i = 0; i < x.size(); ++i)
+    if (fixed[std::size_t(i)]) gap[i] = target[i] - x[i];
+  const double norm = gap.norm();
+  if (norm > kClosedGap * length_scale) return norm;
+  gap.setZero();
+  return 0;
 }
 
 // The first shift of the preconditioners of indefinite_direct_solve and
@@ -229,10 +251,9 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   if (!std::isfinite(assembler.evaluate(x, &g, &K))) return {VecX(), "an element is inverted (det F <= 0)"};
   g -= force;
   const VecX target = assembler.rest_positions() + dirichlet.displacement;
-  VecX gap = VecX::Zero(n);
-  for (int i = 0; i < n; ++i)
-    if (dirichlet.fixed[i]) gap[i] = target[i] - x[i];
-  const double gap_norm = gap.norm();
+  VecX gap;
+  const double gap_norm = prescribed_gap(dirichlet.fixed, target, x,
+                                         (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm(), gap);
   const VecX Kgap = K * gap;
   const double diag = mean_free_diagonal(K, dirichlet.fixed);
   constrain_matrix(K, dirichlet.fixed, diag);
@@ -420,10 +441,7 @@ bool StaticNewton::at(double s, int step, std::string& why) {
     }
     g_ -= fs;
     const double potential = E - fs.dot(result_.x - X_);
-    gap_.setZero();
-    for (int i = 0; i < n_; ++i)
-      if (fixed_[i]) gap_[i] = target[i] - result_.x[i];
-    const double gap_norm = gap_.norm();
+    const double gap_norm = prescribed_gap(fixed_, target, result_.x, length_scale_, gap_);
     if (gap_norm > 0) Kgap_ = K_ * gap_;
     const double diag = mean_free_diagonal(K_, fixed_);
     if (stiffness_scale == 0) stiffness_scale = diag;
@@ -438,7 +456,7 @@ bool StaticNewton::at(double s, int step, std::string& why) {
     rec.iteration = it;
     rec.residual = residual;
     rec.energy = potential;
-    const bool gap_closed = gap_norm <= 1e-12 * length_scale_;
+    const bool gap_closed = gap_norm == 0;
     stagnant_steps = (round_off_step && residual > 0.5 * previous_residual) ? stagnant_steps + 1 : 0;
     previous_residual = residual;
     if (gap_closed && residual <= options_.relative_tolerance) {
