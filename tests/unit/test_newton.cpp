@@ -357,8 +357,11 @@ TEST(Newton, PrescribedDofsWithinRoundOffOfTheirTargetsAreWhereTheyMustBe) {
     if (DC.fixed[i]) open[i] = target[i] + 1e-6;
   const NewtonStepFrom from_open = newton_step_from(asmb, DC, f, NewtonOptions{}, open);
   ASSERT_TRUE(from_open.failure.empty());
-  for (int i = 0; i < n; ++i)
-    if (DC.fixed[i]) EXPECT_NEAR(from_open.step[i], -1e-6, 1e-12);
+  for (int i = 0; i < n; ++i) {
+    if (DC.fixed[i]) {
+      EXPECT_NEAR(from_open.step[i], -1e-6, 1e-12);
+    }
+  }
 }
 
 TEST(Newton, IterationHookSeesEveryHistoryRecordAsItIsAdded) {
