@@ -32,6 +32,12 @@ constexpr double kEnergyRoundOff = 1e-10;
 // is there (prescribed_gap).
 constexpr double kClosedGap = 1e-12;
 
+// The diagonal of the body's rest bounding box: the length prescribed gaps
+// and round-off floors are measured against.
+double body_size(const ElasticAssembler& assembler) {
+  return (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm();
+}
+
 double mean_free_diagonal(const SpMat& K, const std::vector<char>& fixed) {
   double sum = 0;
   int count = 0;
@@ -252,8 +258,7 @@ NewtonStepFrom newton_step_from(const ElasticAssembler& assembler, const Dirichl
   g -= force;
   const VecX target = assembler.rest_positions() + dirichlet.displacement;
   VecX gap;
-  const double gap_norm = prescribed_gap(dirichlet.fixed, target, x,
-                                         (assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm(), gap);
+  const double gap_norm = prescribed_gap(dirichlet.fixed, target, x, body_size(assembler), gap);
   const VecX Kgap = K * gap;
   const double diag = mean_free_diagonal(K, dirichlet.fixed);
   constrain_matrix(K, dirichlet.fixed, diag);
@@ -321,7 +326,7 @@ class StaticNewton {
         result_(result),
         n_(assembler.num_dofs()),
         X_(assembler.rest_positions()),
-        length_scale_((assembler.mesh().bbox_max() - assembler.mesh().bbox_min()).norm()),
+        length_scale_(body_size(assembler)),
         K_(assembler.pattern()),
         g_(n_),
         gap_(n_),

@@ -346,6 +346,7 @@ AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const St
   };
   std::vector<Round> rounds;
   std::vector<CheckedSolve> checked;
+  std::size_t kept = 0;  // into rounds and checked
   VecX previous_on_fine;
   double previous_predicted = 0;
   for (;;) {
@@ -379,11 +380,9 @@ AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const St
         "({}) against the target {:.3g}; elements fine {} / level 1 {} / level 2 {}",
         run.solves, adapted.choice_target, adapted.choice.predicted_error, estimate, posterior.source, options.target,
         adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2]);
-    const std::size_t previously_kept = checked.empty() ? 0 : kept_solve(checked);
-    const double previous_ranked = checked.empty() ? 0 : ranked_estimate(checked, previously_kept);
     checked.push_back({adapted.choice.cell_level, estimate, measured});
     rounds.push_back({adapted, solved, posterior.source});
-    const std::size_t kept = kept_solve(checked);
+    kept = kept_solve(checked);
     run.estimate = ranked_estimate(checked, kept);
     if (run.estimate > checked[kept].estimate)
       spdlog::info(
@@ -391,7 +390,9 @@ AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const St
           "a solve that refines it",
           kept + 1, checked[kept].estimate, run.estimate);
     if (!options.posterior_check || run.estimate <= options.target) break;
-    const bool improved = checked.size() == 1 || run.estimate < previous_ranked || kept == checked.size() - 1;
+    // A new solve can only raise the earlier ones' ranks, so it lowered the
+    // smallest estimate exactly when it is the one kept.
+    const bool improved = kept + 1 == checked.size();
     if ((!improved && !measured) || run.solves == kMaxAdaptiveSolves) {
       spdlog::warn(
           "adaptive: the a-posteriori estimate {:.3g} stays above the target {:.3g} after {} mixed solves; "
@@ -408,7 +409,6 @@ AdaptiveRun solve_adaptively(const Scene& scene, const VoxelMesh& fine, const St
       rechoose_adaptive_levels(adapted, scene, fine, fine_conditions, coarse,
                                adapted.choice_target * options.target / estimate);
   }
-  const std::size_t kept = kept_solve(checked);
   for (std::size_t r = 0; r < rounds.size(); ++r)
     if (r != kept) run.rejected_seconds += rounds[r].result.timings.total;
   run.result = std::move(rounds[kept].result);

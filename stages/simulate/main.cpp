@@ -20,7 +20,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -156,14 +155,9 @@ int main(int argc, char** argv) {
     CoarseModel coarse;
     if (coarsening.level > 0) coarse = build_coarse_model(scene, fine, coarsening);
     const bool coarsened = coarsening.level > 0;
-    AdaptiveModel adapted;
-    double uniform_seconds = 0;   // adaptive: the two uniform solves the estimate comes from
-    double rejected_seconds = 0;  // adaptive: mixed solves whose a-posteriori check missed the target
-    int adaptive_solves = 0;
-    double checked_error = 0;     // adaptive: the a-posteriori estimate of the kept solve
-    std::string checked_source;   // adaptive: what that estimate is
+    AdaptiveRun adaptive_run;  // adaptive: the kept mixed model, its solve and its check
+    const AdaptiveModel& adapted = adaptive_run.model;
     double adaptive_seconds = 0;  // adaptive: everything after the level-2 model, database reading aside
-    std::optional<NewtonResult> adaptive_result;
     // Adaptive: the level-1 materials, the level-2 database's own base unless
     // a level-1 database stands in for it. Where the base is compressed, the
     // uniform level-1 and level-2 models share its lookup error, which their
@@ -177,15 +171,8 @@ int main(int argc, char** argv) {
         level1_db = db;
       }
       const auto t_adaptive = std::chrono::steady_clock::now();
-      AdaptiveRun run = solve_adaptively(scene, fine, fine_conditions, coarse, *level1_db,
-                                         {target_error, posterior_check, newton_estimate});
-      adapted = std::move(run.model);
-      adaptive_result = std::move(run.result);
-      uniform_seconds = run.uniform_seconds;
-      rejected_seconds = run.rejected_seconds;
-      adaptive_solves = run.solves;
-      checked_error = run.estimate;
-      checked_source = std::move(run.estimate_source);
+      adaptive_run = solve_adaptively(scene, fine, fine_conditions, coarse, *level1_db,
+                                      {target_error, posterior_check, newton_estimate});
       adaptive_seconds = seconds_since(t_adaptive);
     }
     const VoxelMesh& vm = coarsened ? coarse.mesh : fine;
@@ -206,7 +193,8 @@ int main(int argc, char** argv) {
           "{:.3f} s, level choice and mesh {:.3f} s",
           adapted.level_difference, adapted.level_errors[1], adapted.level_errors[2], target_error,
           adapted.choice.predicted_error, adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1],
-          adapted.mixed.elements_per_level[2], adapted.mixed.hanging_nodes, uniform_seconds, adapted.seconds);
+          adapted.mixed.elements_per_level[2], adapted.mixed.hanging_nodes, adaptive_run.uniform_seconds,
+          adapted.seconds);
     else if (coarsened)
       spdlog::info("coarsened to level {} with {} materials: {} -> {} elements, {} distinct blocks, {:.1f} ms{}",
                    coarsening.level, coarsening.material, fine.mesh.num_elements(), vm.mesh.num_elements(),
@@ -232,11 +220,12 @@ int main(int argc, char** argv) {
 
     // 4. Newton (adaptive: solved above, with its check).
     const NewtonResult result =
-        adaptive ? *adaptive_result
+        adaptive ? adaptive_run.result
                  : solve_or_throw(assembler, conditions, scene.newton, coarsened ? "coarse load" : "load");
     // The coarse model's Newton time; adaptive runs include the uniform solves.
     const double coarse_seconds =
-        result.timings.total + (adaptive ? uniform_seconds + rejected_seconds + adapted.seconds : 0.0);
+        result.timings.total +
+        (adaptive ? adaptive_run.uniform_seconds + adaptive_run.rejected_seconds + adapted.seconds : 0.0);
 
     // 5. Fine reference.
     SimulationRecord record;
@@ -307,18 +296,18 @@ int main(int argc, char** argv) {
       record.adaptive = true;
       record.target_error = target_error;
       record.predicted_error = adapted.choice.predicted_error;
-      record.a_posteriori_error = checked_error;
-      record.a_posteriori_source = checked_source;
-      record.adaptive_solves = adaptive_solves;
-      record.rejected_solve_seconds = rejected_seconds;
-      record.uniform_solve_seconds = uniform_seconds;
+      record.a_posteriori_error = adaptive_run.estimate;
+      record.a_posteriori_source = adaptive_run.estimate_source;
+      record.adaptive_solves = adaptive_run.solves;
+      record.rejected_solve_seconds = adaptive_run.rejected_seconds;
+      record.uniform_solve_seconds = adaptive_run.uniform_seconds;
       record.level_difference = adapted.level_difference;
       record.level1_database = level1_database;
       record.elements_per_level = adapted.mixed.elements_per_level;
       // Besides the Newton solves recorded on their own: the level-1 model,
       // the level choices and mixed meshes, and the a-posteriori estimates.
-      record.coarsening_seconds =
-          coarse.seconds + adaptive_seconds - uniform_seconds - rejected_seconds - adaptive_result->timings.total;
+      record.coarsening_seconds = coarse.seconds + adaptive_seconds - adaptive_run.uniform_seconds -
+                                  adaptive_run.rejected_seconds - adaptive_run.result.timings.total;
     }
     const std::string xmf = write_result_artifact(out, record);
 
@@ -334,9 +323,9 @@ int main(int argc, char** argv) {
       std::printf(
           "  adaptive: target error %.3g, predicted %.3g, a-posteriori %.3g after %d mixed solve(s); elements "
           "fine %d / level 1 %d / level 2 %d (of %d fine); level-1 and level-2 solves %.3f s\n",
-          target_error, adapted.choice.predicted_error, checked_error, adaptive_solves,
+          target_error, adapted.choice.predicted_error, adaptive_run.estimate, adaptive_run.solves,
           adapted.mixed.elements_per_level[0], adapted.mixed.elements_per_level[1], adapted.mixed.elements_per_level[2],
-          fine.mesh.num_elements(), uniform_seconds);
+          fine.mesh.num_elements(), adaptive_run.uniform_seconds);
     else if (coarsened)
       std::printf("  coarsening: level %d, %s materials, %s elements, %d -> %d elements, %.3f ms\n", coarsening.level,
                   coarsening.material.c_str(), coarse.element.c_str(), fine.mesh.num_elements(), vm.mesh.num_elements(),
