@@ -9,15 +9,12 @@ namespace msfab {
 ElasticAssembler::ElasticAssembler(const HexMesh& mesh) : mesh_(mesh) {
   // A state only for the elements with bubble modes (about 2.3 kB each): a
   // mixed mesh's fine elements have none.
+  bubble_slot_.assign(mesh.num_elements(), -1);
   int with_bubbles = 0;
   for (int e = 0; e < mesh.num_elements(); ++e)
-    if (mesh.geometries[mesh.element_geometry[e]].has_enhanced_modes()) ++with_bubbles;
-  if (with_bubbles > 0) {
-    bubble_slot_.assign(mesh.num_elements(), -1);
-    for (int e = 0, slot = 0; e < mesh.num_elements(); ++e)
-      if (mesh.geometries[mesh.element_geometry[e]].has_enhanced_modes()) bubble_slot_[e] = slot++;
-    bubbles_.assign(with_bubbles, BubbleState{});
-  }
+    if (mesh.geometries[mesh.element_geometry[e]].has_enhanced_modes()) bubble_slot_[e] = with_bubbles++;
+  if (with_bubbles == 0) bubble_slot_.clear();
+  bubbles_.assign(with_bubbles, BubbleState{});
   const int n = mesh.num_nodes();
   std::vector<std::vector<int>> adjacent(n);
   for (const auto& el : mesh.elements)
